@@ -1,0 +1,211 @@
+//! The TOML schema of a case file, and its translation into [`ElasticProblem`]s.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::CaseError;
+use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
+use crate::fem::Material;
+use crate::fem::loads::{PressureField, SurfaceLoad};
+use crate::mesh::{BodyMesh, Mesh};
+
+/// A case file. Relative paths are relative to the case file's folder.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// The mesh: a gmsh `.msh` (MSH 4.1), or a `.geo` that is meshed with gmsh first.
+    pub mesh: PathBuf,
+    /// Output folder.
+    pub output: PathBuf,
+    /// gmsh `-setnumber` parameters for a `.geo` mesh (e.g. `{ level = 1 }`).
+    #[serde(default)]
+    pub geo_parameters: BTreeMap<String, f64>,
+    /// Also write the assembled stiffness and surface mass matrices (Matrix Market).
+    #[serde(default)]
+    pub export_matrices: bool,
+    #[serde(default)]
+    pub solver: SolverSettings,
+    #[serde(rename = "body")]
+    pub bodies: Vec<BodySpec>,
+    /// The case file itself, set by [`Case::load`].
+    #[serde(skip)]
+    pub path: PathBuf,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// The body's physical group: a surface in 2D, a volume in 3D.
+    pub name: String,
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    /// Force per unit volume (per unit area in 2D).
+    pub body_force: Option<Vec<f64>>,
+    #[serde(default)]
+    pub dirichlet: Vec<DirichletSpec>,
+    #[serde(default, rename = "load")]
+    pub loads: Vec<LoadSpec>,
+}
+
+/// Prescribed displacement components on a boundary group; omitted components are free.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirichletSpec {
+    pub group: String,
+    pub ux: Option<f64>,
+    pub uy: Option<f64>,
+    pub uz: Option<f64>,
+}
+
+/// A surface load: exactly one of `traction`, `pressure`, `hertz_pressure`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    pub group: String,
+    /// Constant traction vector, `dim` components.
+    pub traction: Option<Vec<f64>>,
+    /// Uniform pressure: traction `-p n` with `n` the outward normal.
+    pub pressure: Option<f64>,
+    /// Hertzian pressure `p0 sqrt(1 - r^2 / a^2)`, `r = |x - center|`.
+    pub hertz_pressure: Option<HertzSpec>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzSpec {
+    pub p0: f64,
+    pub a: f64,
+    /// `dim` coordinates.
+    pub center: Vec<f64>,
+}
+
+impl Case {
+    /// Reads and parses a case file; paths in it become relative to the current directory.
+    pub fn load(path: &Path) -> Result<Self, CaseError> {
+        let text = std::fs::read_to_string(path).map_err(|source| CaseError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        let mut case: Case = toml::from_str(&text).map_err(|e| CaseError::Syntax {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        let folder = path.parent().unwrap_or(Path::new(""));
+        case.mesh = folder.join(&case.mesh);
+        case.output = folder.join(&case.output);
+        case.path = path.to_owned();
+        if case.bodies.is_empty() {
+            return Err(case.invalid("[[body]]", "the case names no body"));
+        }
+        if !(case.solver.residual_tolerance > 0.0) {
+            return Err(case.invalid("[solver]", "residual_tolerance must be positive"));
+        }
+        Ok(case)
+    }
+
+    fn invalid(&self, context: impl Into<String>, message: impl Into<String>) -> CaseError {
+        CaseError::Invalid {
+            path: self.path.clone(),
+            context: context.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The mesh body named by `spec`.
+    pub fn body_mesh<'m>(
+        &self,
+        mesh: &'m Mesh,
+        spec: &BodySpec,
+    ) -> Result<&'m BodyMesh, CaseError> {
+        mesh.body(&spec.name).ok_or_else(|| CaseError::UnknownBody {
+            path: self.path.clone(),
+            body: spec.name.clone(),
+            mesh: mesh.path.clone(),
+            available: mesh.bodies.iter().map(|b| b.name.clone()).collect(),
+        })
+    }
+
+    /// The elastic problem of one body: material, Dirichlet conditions, loads, body force.
+    pub fn elastic_problem<'m>(
+        &self,
+        body: &'m BodyMesh,
+        spec: &BodySpec,
+    ) -> Result<ElasticProblem<'m>, CaseError> {
+        let dim = body.dim;
+        let context = |what: &str| format!("body '{}', {what}", spec.name);
+        let vector = |v: &[f64], what: &str| -> Result<[f64; 3], CaseError> {
+            if v.len() != dim {
+                return Err(self.invalid(
+                    context(what),
+                    format!(
+                        "expected {dim} components (the mesh is {dim}D), got {}",
+                        v.len()
+                    ),
+                ));
+            }
+            let mut out = [0.0; 3];
+            out[..dim].copy_from_slice(v);
+            Ok(out)
+        };
+        let material =
+            Material::new(spec.youngs_modulus, spec.poisson_ratio).map_err(|source| {
+                CaseError::Material {
+                    path: self.path.clone(),
+                    body: spec.name.clone(),
+                    source,
+                }
+            })?;
+        let dirichlet = spec
+            .dirichlet
+            .iter()
+            .map(|d| DirichletCondition {
+                group: d.group.clone(),
+                components: [d.ux, d.uy, d.uz],
+            })
+            .collect();
+        let mut loads = Vec::new();
+        for l in &spec.loads {
+            let what = format!("load on '{}'", l.group);
+            let load = match (&l.traction, l.pressure, &l.hertz_pressure) {
+                (Some(t), None, None) => SurfaceLoad::Traction(vector(t, &what)?),
+                (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(p)),
+                (None, None, Some(h)) => {
+                    if !(h.a > 0.0) {
+                        return Err(self.invalid(
+                            context(&what),
+                            format!("hertz_pressure.a must be positive, got {}", h.a),
+                        ));
+                    }
+                    SurfaceLoad::Pressure(PressureField::Hertz {
+                        p0: h.p0,
+                        a: h.a,
+                        center: vector(&h.center, &format!("{what}, hertz_pressure.center"))?,
+                    })
+                }
+                _ => {
+                    return Err(self.invalid(
+                        context(&what),
+                        "give exactly one of traction, pressure, hertz_pressure",
+                    ));
+                }
+            };
+            loads.push(LoadCondition {
+                group: l.group.clone(),
+                load,
+            });
+        }
+        let body_force = spec
+            .body_force
+            .as_deref()
+            .map(|b| vector(b, "body_force"))
+            .transpose()?;
+        ElasticProblem::new(body, material, dirichlet, loads, body_force).map_err(|source| {
+            CaseError::Problem {
+                path: self.path.clone(),
+                source,
+            }
+        })
+    }
+}

@@ -1,0 +1,9 @@
+//! Linear elasticity on one body: the problem, how it is solved, and the solution.
+
+mod problem;
+mod solution;
+mod solve;
+
+pub use problem::{DirichletCondition, ElasticProblem, LoadCondition, ProblemError};
+pub use solution::{ElasticSolution, SolveStats};
+pub use solve::{SolveError, SolverSettings, solve};

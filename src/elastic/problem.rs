@@ -1,0 +1,145 @@
+//! What to solve on one body: material, Dirichlet conditions, surface loads, body force.
+
+use thiserror::Error;
+
+use crate::fem::Material;
+use crate::fem::loads::SurfaceLoad;
+use crate::mesh::BodyMesh;
+
+/// Prescribed displacement components on a boundary group (`None` = free).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirichletCondition {
+    pub group: String,
+    pub components: [Option<f64>; 3],
+}
+
+/// A surface load on a boundary group.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadCondition {
+    pub group: String,
+    pub load: SurfaceLoad,
+}
+
+/// Linear elasticity on one body. Built with [`ElasticProblem::new`], which checks that every
+/// group exists on the body and that the Dirichlet conditions remove all rigid-body motions.
+#[derive(Debug, Clone)]
+pub struct ElasticProblem<'m> {
+    pub body: &'m BodyMesh,
+    pub material: Material,
+    pub dirichlet: Vec<DirichletCondition>,
+    pub loads: Vec<LoadCondition>,
+    pub body_force: Option<[f64; 3]>,
+}
+
+#[derive(Debug, Error, PartialEq)]
+pub enum ProblemError {
+    #[error("body '{body}' has no boundary group '{group}' (groups with facets on this body: {})", .on_body.join(", "))]
+    UnknownGroup {
+        body: String,
+        group: String,
+        on_body: Vec<String>,
+    },
+    #[error(
+        "Dirichlet condition on group '{group}' of body '{body}' prescribes no component (give ux, uy or uz)"
+    )]
+    NoComponent { body: String, group: String },
+    #[error(
+        "Dirichlet condition on group '{group}' of body '{body}' prescribes uz, but the mesh is 2D"
+    )]
+    ComponentOutOfRange { body: String, group: String },
+    #[error(
+        "body '{body}': node {node_tag} component {component} is prescribed {first} by one Dirichlet group and {second} by '{group}'"
+    )]
+    ConflictingDirichlet {
+        body: String,
+        group: String,
+        node_tag: u64,
+        component: usize,
+        first: f64,
+        second: f64,
+    },
+    #[error(
+        "body '{body}' has no Dirichlet condition: its stiffness is singular (rigid-body motions are free); fix a boundary group"
+    )]
+    NoDirichlet { body: String },
+    #[error(
+        "body '{body}': the Dirichlet conditions leave {count} rigid-body motion(s) free, so its stiffness is singular; constrain more components or groups"
+    )]
+    FreeRigidModes { body: String, count: usize },
+    #[error("body '{body}': {what} is not finite")]
+    NotFinite { body: String, what: String },
+}
+
+impl<'m> ElasticProblem<'m> {
+    pub fn new(
+        body: &'m BodyMesh,
+        material: Material,
+        dirichlet: Vec<DirichletCondition>,
+        loads: Vec<LoadCondition>,
+        body_force: Option<[f64; 3]>,
+    ) -> Result<Self, ProblemError> {
+        let problem = Self {
+            body,
+            material,
+            dirichlet,
+            loads,
+            body_force,
+        };
+        problem.check()?;
+        Ok(problem)
+    }
+
+    fn check(&self) -> Result<(), ProblemError> {
+        let name = || self.body.name.clone();
+        let groups = self
+            .dirichlet
+            .iter()
+            .map(|d| &d.group)
+            .chain(self.loads.iter().map(|l| &l.group));
+        for group in groups {
+            if self.body.boundary_group(group).is_none() {
+                return Err(ProblemError::UnknownGroup {
+                    body: name(),
+                    group: group.clone(),
+                    on_body: self.body.boundary_groups.keys().cloned().collect(),
+                });
+            }
+        }
+        for d in &self.dirichlet {
+            if d.components.iter().all(Option::is_none) {
+                return Err(ProblemError::NoComponent {
+                    body: name(),
+                    group: d.group.clone(),
+                });
+            }
+            if self.body.dim == 2 && d.components[2].is_some() {
+                return Err(ProblemError::ComponentOutOfRange {
+                    body: name(),
+                    group: d.group.clone(),
+                });
+            }
+            if d.components.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(ProblemError::NotFinite {
+                    body: name(),
+                    what: format!("the Dirichlet value on '{}'", d.group),
+                });
+            }
+        }
+        if self.dirichlet.is_empty() {
+            return Err(ProblemError::NoDirichlet { body: name() });
+        }
+        let constraints = super::solve::constraints(self)?;
+        let free = crate::fem::rigid_modes::free_rigid_modes(
+            &self.body.coords,
+            self.body.dim,
+            &constraints,
+        );
+        if free > 0 {
+            return Err(ProblemError::FreeRigidModes {
+                body: name(),
+                count: free,
+            });
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,30 @@
+//! The result of one elastic solve.
+
+use serde::Serialize;
+
+use crate::fem::stress::CellFields;
+
+/// Displacement, cell fields, reactions and solver statistics of one body.
+#[derive(Debug, Clone)]
+pub struct ElasticSolution {
+    /// Nodal displacement, interleaved (`dim` per node).
+    pub displacement: Vec<f64>,
+    pub cell_fields: CellFields,
+    /// Reaction force of each Dirichlet group: `sum (K u - f)` over its prescribed dofs, with
+    /// `K`, `f` unconstrained (a node in two groups counts in both).
+    pub reactions: Vec<(String, Vec<f64>)>,
+    pub stats: SolveStats,
+}
+
+/// Sizes, accuracy and timings of one solve, as written to the JSON summary.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SolveStats {
+    pub num_dofs: usize,
+    pub num_prescribed_dofs: usize,
+    pub stiffness_nnz: usize,
+    pub factor_nnz: usize,
+    /// `||K_c u - f_c|| / ||f_c||` of the constrained system.
+    pub relative_residual: f64,
+    /// Seconds per phase, in order.
+    pub timings: Vec<(String, f64)>,
+}

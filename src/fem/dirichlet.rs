@@ -1,0 +1,83 @@
+//! Dirichlet conditions imposed by symmetric elimination on the assembled pattern.
+//!
+//! With fixed dofs `D` of values `g`, the free equations become `K_FF u_F = f_F - K_FD g`. To
+//! keep the pattern (so the symbolic factorization of `K` serves every constrained variant),
+//! the rows and columns of `D` are zeroed in place and their diagonal keeps `K_dd`, with right
+//! hand side `K_dd g_d`: the constrained matrix stays symmetric positive definite and its
+//! scaling is that of `K`.
+
+use faer::sparse::SparseColMat;
+
+/// Which dofs are prescribed, and to what.
+#[derive(Debug, Clone)]
+pub struct Constraints {
+    prescribed: Vec<Option<f64>>,
+}
+
+impl Constraints {
+    pub fn new(num_dofs: usize) -> Self {
+        Self {
+            prescribed: vec![None; num_dofs],
+        }
+    }
+
+    /// Prescribes `value` on `dof`; returns the value already prescribed there if it differs.
+    pub fn prescribe(&mut self, dof: usize, value: f64) -> Result<(), f64> {
+        match self.prescribed[dof] {
+            Some(old) if old != value => Err(old),
+            _ => {
+                self.prescribed[dof] = Some(value);
+                Ok(())
+            }
+        }
+    }
+
+    pub fn value(&self, dof: usize) -> Option<f64> {
+        self.prescribed[dof]
+    }
+
+    pub fn is_fixed(&self, dof: usize) -> bool {
+        self.prescribed[dof].is_some()
+    }
+
+    pub fn num_fixed(&self) -> usize {
+        self.prescribed.iter().filter(|v| v.is_some()).count()
+    }
+
+    /// The constrained system `(K_c, f_c)` on the pattern of `k`.
+    pub fn apply(
+        &self,
+        k: &SparseColMat<usize, f64>,
+        f: &[f64],
+    ) -> (SparseColMat<usize, f64>, Vec<f64>) {
+        let (symbolic, values) = k.parts();
+        let mut rhs = f.to_vec();
+        let mut constrained = values.to_vec();
+        let col_ptr = symbolic.col_ptr();
+        let row_idx = symbolic.row_idx();
+        for j in 0..symbolic.ncols() {
+            for p in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[p];
+                if let Some(g) = self.prescribed[j] {
+                    if i == j {
+                        rhs[j] = values[p] * g;
+                    } else {
+                        if self.prescribed[i].is_none() {
+                            rhs[i] -= values[p] * g;
+                        }
+                        constrained[p] = 0.0;
+                    }
+                } else if self.prescribed[i].is_some() {
+                    constrained[p] = 0.0;
+                }
+            }
+        }
+        (
+            SparseColMat::new(
+                symbolic.to_owned().expect("pattern fits in memory"),
+                constrained,
+            ),
+            rhs,
+        )
+    }
+}

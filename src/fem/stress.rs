@@ -1,0 +1,69 @@
+//! Cell-wise strain and stress of a P1 displacement field (constant on each cell).
+//!
+//! Tensors are stored as full 3 x 3 row-major arrays so that ParaView reads them as tensors. In
+//! plane strain `eps_zz = 0` and `sigma_zz = lambda (eps_xx + eps_yy)`.
+
+use super::Material;
+use super::assembly::node_coords;
+use super::kernels::{
+    strain_matrix_2d, strain_matrix_3d, tetrahedron_gradients, triangle_gradients,
+};
+use crate::mesh::BodyMesh;
+
+/// Strain, stress and von Mises stress per cell.
+#[derive(Debug, Clone, Default)]
+pub struct CellFields {
+    pub strain: Vec<[f64; 9]>,
+    pub stress: Vec<[f64; 9]>,
+    pub von_mises: Vec<f64>,
+}
+
+/// Voigt (engineering shear) to a full symmetric tensor; `voigt` is `[xx, yy, zz, yz, xz, xy]`.
+fn tensor(voigt: [f64; 6], shear_factor: f64) -> [f64; 9] {
+    let [xx, yy, zz, yz, xz, xy] = voigt;
+    let (yz, xz, xy) = (yz * shear_factor, xz * shear_factor, xy * shear_factor);
+    [xx, xy, xz, xy, yy, yz, xz, yz, zz]
+}
+
+fn von_mises(s: &[f64; 9]) -> f64 {
+    let (xx, yy, zz, xy, yz, xz) = (s[0], s[4], s[8], s[1], s[5], s[2]);
+    (0.5 * ((xx - yy).powi(2) + (yy - zz).powi(2) + (zz - xx).powi(2))
+        + 3.0 * (xy * xy + yz * yz + xz * xz))
+        .sqrt()
+}
+
+/// Strain and stress of the displacement `u` (interleaved, `dim` per node) on every cell.
+pub fn cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellFields {
+    let dim = body.dim;
+    let mut fields = CellFields::default();
+    let (lambda, _) = material.lame();
+    for c in 0..body.num_cells() {
+        let cell = body.cell(c);
+        let ue: Vec<f64> = cell
+            .iter()
+            .flat_map(|&a| u[dim * a..dim * a + dim].iter().copied())
+            .collect();
+        let (strain, stress) = if dim == 2 {
+            let (g, _) = triangle_gradients(&node_coords(&body.coords, cell));
+            let eps = strain_matrix_2d(&g) * nalgebra::SVector::<f64, 6>::from_column_slice(&ue);
+            let sig = material.plane_strain_matrix() * eps;
+            (
+                [eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]],
+                [sig[0], sig[1], lambda * (eps[0] + eps[1]), 0.0, 0.0, sig[2]],
+            )
+        } else {
+            let (g, _) = tetrahedron_gradients(&node_coords(&body.coords, cell));
+            let eps = strain_matrix_3d(&g) * nalgebra::SVector::<f64, 12>::from_column_slice(&ue);
+            let sig = material.elasticity_matrix_3d() * eps;
+            (
+                [eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]],
+                [sig[0], sig[1], sig[2], sig[3], sig[4], sig[5]],
+            )
+        };
+        let stress = tensor(stress, 1.0);
+        fields.strain.push(tensor(strain, 0.5));
+        fields.von_mises.push(von_mises(&stress));
+        fields.stress.push(stress);
+    }
+    fields
+}

@@ -1,0 +1,34 @@
+//! # internodes
+//!
+//! Elastic bodies with non-matching meshes in frictionless contact, solved with the INTERNODES
+//! method (Deparis, Forti, Gervasio, Quarteroni 2016; the seed report in `shared/seed`).
+//!
+//! Each body `k` is a P1 linear-elastic body, `K_k u_k = f_k`. Two bodies in contact are
+//! coupled on their active interface nodes through rescaled Wendland C2 radial-basis
+//! interpolation (`R12`, `R21`) and the interface (surface) mass matrices `M1`, `M2`:
+//!
+//! ```text
+//! [ K1   0    -M1        ] [u1    ]   [f1]
+//! [ 0    K2    M2 R21    ] [u2    ] = [f2]
+//! [ I   -R12   0         ] [lambda]   [d ]
+//! ```
+//!
+//! with `lambda` the traction on body 1 and `d` the nodal gaps, the active set updated until no
+//! node is in tension and none penetrates.
+//!
+//! The crate is organised as the solve proceeds:
+//! - [`mesh`]: gmsh MSH 4.1 input, bodies and boundary groups by physical name;
+//! - [`fem`]: P1 elasticity kernels, sparsity patterns, assembly, loads, Dirichlet conditions;
+//! - [`linalg`]: fill-reducing orderings and the sparse Cholesky factorization;
+//! - [`elastic`]: one body's problem, solve and solution;
+//! - [`case`]: the TOML case file;
+//! - [`output`]: XDMF/HDF5, JSON summary, Matrix Market;
+//! - [`run`]: `internodes solve CASE`, from the case file to the result files.
+
+pub mod case;
+pub mod elastic;
+pub mod fem;
+pub mod linalg;
+pub mod mesh;
+pub mod output;
+pub mod run;

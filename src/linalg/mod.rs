@@ -1,0 +1,49 @@
+//! Sparse linear algebra: fill-reducing orderings and the Cholesky factorization of a body's
+//! stiffness, plus the residual check every solve reports.
+
+mod cholesky;
+mod ordering;
+
+pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
+
+use faer::sparse::SparseColMat;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum LinalgError {
+    #[error("the matrix is not positive definite (pivot {pivot} of the permuted matrix)")]
+    NotPositiveDefinite { pivot: usize },
+    #[error("fill-reducing ordering failed: {0}")]
+    Ordering(String),
+    #[error("sparse factorization failed: {0}")]
+    Faer(String),
+    #[error("out of memory in the sparse factorization")]
+    OutOfMemory,
+}
+
+/// `y = A x` for a compressed-column matrix.
+pub fn mat_vec(a: &SparseColMat<usize, f64>, x: &[f64]) -> Vec<f64> {
+    let (symbolic, values) = a.parts();
+    let mut y = vec![0.0; symbolic.nrows()];
+    let col_ptr = symbolic.col_ptr();
+    let row_idx = symbolic.row_idx();
+    for (j, &xj) in x.iter().enumerate() {
+        for p in col_ptr[j]..col_ptr[j + 1] {
+            y[row_idx[p]] += values[p] * xj;
+        }
+    }
+    y
+}
+
+/// `||A x - b|| / ||b||` (0 when `b = 0` and `x = 0`).
+pub fn relative_residual(a: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> f64 {
+    let ax = mat_vec(a, x);
+    let r: f64 = ax
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let nb: f64 = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if nb > 0.0 { r / nb } else { r }
+}

@@ -1,0 +1,73 @@
+//! The `internodes` command line: `solve CASE` and `info MESH`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use internodes::mesh::{MeshSummary, read_msh};
+use internodes::run::{RunOptions, solve_case};
+
+#[derive(Parser)]
+#[command(version, about = "Elastic bodies in contact, solved with INTERNODES")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve the case described by a TOML case file.
+    Solve {
+        /// The case file.
+        case: PathBuf,
+        /// Output folder (overrides the case file's `output`).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+        /// Also write the assembled stiffness and surface mass matrices (Matrix Market).
+        #[arg(long)]
+        export_matrices: bool,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Print the physical groups, element counts and bounding boxes of a gmsh mesh.
+    Info {
+        /// A gmsh MSH 4.1 file.
+        mesh: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let result: Result<(), Box<dyn std::error::Error>> = match Cli::parse().command {
+        Command::Solve {
+            case,
+            output,
+            export_matrices,
+            quiet,
+        } => solve_case(
+            &case,
+            &RunOptions {
+                output,
+                export_matrices,
+                quiet,
+            },
+        )
+        .map(|_| ())
+        .map_err(Into::into),
+        Command::Info { mesh } => read_msh(&mesh)
+            .map(|m| print!("{}", MeshSummary(&m)))
+            .map_err(Into::into),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            let mut source = e.source();
+            while let Some(cause) = source {
+                eprintln!("  caused by: {cause}");
+                source = cause.source();
+            }
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,73 @@
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// Why a mesh file could not be used. Every variant names the file, and the line, physical
+/// group or gmsh element tag that is at fault.
+#[derive(Debug, Error)]
+pub enum MeshError {
+    #[error("cannot read mesh file {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "{path}: MSH format version {version} is not supported; re-export it as MSH 4.1 \
+         (gmsh -format msh41, or Mesh.MshFileVersion = 4.1)"
+    )]
+    UnsupportedVersion { path: PathBuf, version: String },
+    #[error("{path}:{line}: {message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error(
+        "{path}: element type {element_type} in {location} is not supported: \
+         internodes needs P1 meshes ({expected})"
+    )]
+    UnsupportedElement {
+        path: PathBuf,
+        element_type: String,
+        location: String,
+        expected: &'static str,
+    },
+    #[error(
+        "{path}: element {element_tag} refers to node {node_tag}, which the $Nodes section does not define"
+    )]
+    UndefinedNode {
+        path: PathBuf,
+        element_tag: u64,
+        node_tag: u64,
+    },
+    #[error(
+        "{path}: no body found: a body is a named physical {expected} \
+         (the file has no P1 cells in any physical group)"
+    )]
+    NoBodies {
+        path: PathBuf,
+        expected: &'static str,
+    },
+    #[error(
+        "{path}: body '{body}', element {element_tag} is degenerate \
+         (its {measure_name} is {measure:.3e}, relative size {relative:.1e})"
+    )]
+    DegenerateCell {
+        path: PathBuf,
+        body: String,
+        element_tag: u64,
+        measure_name: &'static str,
+        measure: f64,
+        relative: f64,
+    },
+    #[error(
+        "{path}: body '{body}', element {element_tag} is inverted: its orientation is opposite \
+         to that of the {majority} other cells of the body (the mesh folds over itself)"
+    )]
+    InvertedCell {
+        path: PathBuf,
+        body: String,
+        element_tag: u64,
+        majority: usize,
+    },
+}

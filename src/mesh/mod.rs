@@ -1,0 +1,148 @@
+//! Meshes: bodies and boundary groups read from gmsh physical groups.
+//!
+//! A mesh file holds one or more **bodies** (named physical surfaces in 2D, physical volumes in
+//! 3D) meshed with P1 simplices, and **boundary groups** (named physical curves in 2D, surfaces in
+//! 3D). Each body is numbered locally, `0..num_nodes`, and keeps the map back to gmsh node tags,
+//! so that bodies never share a degree of freedom even when the mesh file shares a node.
+//!
+//! Every boundary facet is stored with the node order that makes its right-hand normal point
+//! out of the body (worked out from the adjacent cell, never from the file's facet order).
+
+mod error;
+mod generate;
+mod gmsh;
+mod quality;
+mod summary;
+
+pub use error::MeshError;
+pub use generate::mesh_geo;
+pub use gmsh::read_msh;
+pub use quality::{check_cells, signed_measure};
+pub use summary::MeshSummary;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Spatial dimension of a mesh: 2 (triangles, plane strain) or 3 (tetrahedra).
+pub type Dim = usize;
+
+/// Everything read from one mesh file.
+#[derive(Debug, Clone)]
+pub struct Mesh {
+    /// The file it was read from, for error messages.
+    pub path: PathBuf,
+    /// 2 or 3.
+    pub dim: Dim,
+    /// One body per named physical group of dimension `dim`, in the file's order of tags.
+    pub bodies: Vec<BodyMesh>,
+    /// Every physical group of the file, including the ones no body uses.
+    pub physical_groups: Vec<PhysicalGroup>,
+}
+
+/// A physical group as declared in the file (`$PhysicalNames`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PhysicalGroup {
+    pub dim: Dim,
+    pub tag: i32,
+    pub name: String,
+}
+
+/// One body: P1 simplices, numbered locally.
+#[derive(Debug, Clone)]
+pub struct BodyMesh {
+    pub name: String,
+    pub physical_tag: i32,
+    pub dim: Dim,
+    /// Node coordinates; `z = 0` in 2D.
+    pub coords: Vec<[f64; 3]>,
+    /// Local node index -> gmsh node tag.
+    pub node_tags: Vec<u64>,
+    /// Cell connectivity, `dim + 1` local node indices per cell, flat.
+    pub cells: Vec<usize>,
+    /// Local cell index -> gmsh element tag.
+    pub cell_tags: Vec<u64>,
+    /// Boundary groups that have at least one facet on this body, by name.
+    pub boundary_groups: BTreeMap<String, FacetGroup>,
+}
+
+/// Facets of one boundary group that lie on one body.
+#[derive(Debug, Clone, Default)]
+pub struct FacetGroup {
+    pub physical_tag: i32,
+    /// `dim` local node indices per facet, flat, ordered so the right-hand normal points outward.
+    pub facets: Vec<usize>,
+    /// The body cell each facet belongs to.
+    pub facet_cells: Vec<usize>,
+}
+
+impl BodyMesh {
+    pub fn num_nodes(&self) -> usize {
+        self.coords.len()
+    }
+
+    pub fn nodes_per_cell(&self) -> usize {
+        self.dim + 1
+    }
+
+    pub fn num_cells(&self) -> usize {
+        self.cells.len() / self.nodes_per_cell()
+    }
+
+    pub fn num_dofs(&self) -> usize {
+        self.dim * self.num_nodes()
+    }
+
+    /// Local node indices of cell `c`.
+    pub fn cell(&self, c: usize) -> &[usize] {
+        let n = self.nodes_per_cell();
+        &self.cells[n * c..n * (c + 1)]
+    }
+
+    /// The boundary group `name`, if it has facets on this body.
+    pub fn boundary_group(&self, name: &str) -> Option<&FacetGroup> {
+        self.boundary_groups.get(name)
+    }
+
+    /// Axis-aligned bounding box `(min, max)` of the nodes.
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for x in &self.coords {
+            for k in 0..3 {
+                lo[k] = lo[k].min(x[k]);
+                hi[k] = hi[k].max(x[k]);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+impl FacetGroup {
+    /// Local node indices of facet `f`, given the mesh dimension (nodes per facet).
+    pub fn facet(&self, f: usize, dim: Dim) -> &[usize] {
+        &self.facets[dim * f..dim * (f + 1)]
+    }
+
+    pub fn num_facets(&self, dim: Dim) -> usize {
+        self.facets.len() / dim
+    }
+
+    /// The distinct local nodes of the group, sorted.
+    pub fn nodes(&self) -> Vec<usize> {
+        let mut nodes = self.facets.clone();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    }
+}
+
+impl Mesh {
+    pub fn body(&self, name: &str) -> Option<&BodyMesh> {
+        self.bodies.iter().find(|b| b.name == name)
+    }
+
+    /// The physical group called `name`, if the file declares one.
+    pub fn physical_group(&self, name: &str) -> Option<&PhysicalGroup> {
+        self.physical_groups.iter().find(|g| g.name == name)
+    }
+}

@@ -1,0 +1,61 @@
+//! What `internodes info MESH` prints: groups, element counts and bounding boxes.
+
+use std::fmt;
+
+use super::Mesh;
+
+/// A printable overview of a mesh file.
+pub struct MeshSummary<'a>(pub &'a Mesh);
+
+impl fmt::Display for MeshSummary<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mesh = self.0;
+        let (cell, facet) = if mesh.dim == 2 {
+            ("triangles", "segments")
+        } else {
+            ("tetrahedra", "triangles")
+        };
+        writeln!(f, "{} ({}D, P1)", mesh.path.display(), mesh.dim)?;
+        writeln!(f, "physical groups:")?;
+        for g in &mesh.physical_groups {
+            writeln!(f, "  dim {}  tag {:>4}  {}", g.dim, g.tag, g.name)?;
+        }
+        for body in &mesh.bodies {
+            let (lo, hi) = body.bounding_box();
+            let d = mesh.dim;
+            writeln!(
+                f,
+                "body '{}': {} nodes, {} {}, {} dofs",
+                body.name,
+                body.num_nodes(),
+                body.num_cells(),
+                cell,
+                body.num_dofs()
+            )?;
+            writeln!(
+                f,
+                "  bounding box [{}] .. [{}]",
+                fmt_point(&lo[..d]),
+                fmt_point(&hi[..d])
+            )?;
+            for (name, group) in &body.boundary_groups {
+                writeln!(
+                    f,
+                    "  boundary '{}': {} {}, {} nodes",
+                    name,
+                    group.num_facets(d),
+                    facet,
+                    group.nodes().len()
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn fmt_point(p: &[f64]) -> String {
+    p.iter()
+        .map(|x| format!("{x:.6}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

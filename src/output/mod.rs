@@ -1,0 +1,29 @@
+//! Result files: XDMF + HDF5 for ParaView and h5py, the JSON summary, Matrix Market matrices.
+
+mod matrix_market;
+mod summary;
+mod xdmf;
+
+pub use matrix_market::write_matrix_market;
+pub use summary::{BodySummary, CaseSummary};
+pub use xdmf::{BodyFields, write_xdmf};
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum OutputError {
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot write HDF5 file {path}: {source}")]
+    Hdf5 { path: PathBuf, source: hdf5::Error },
+    #[error("cannot write {path}: {source}")]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+}
