@@ -79,13 +79,18 @@ impl Cholesky {
         matrix: &SparseColMat<usize, f64>,
     ) -> Result<Self, LinalgError> {
         let par = Par::rayon(0);
-        let mut values = vec![0.0; symbolic.inner.len_val()];
-        let mut mem = MemBuffer::try_new(
-            symbolic
-                .inner
-                .factorize_numeric_llt_scratch::<f64>(par, Default::default()),
-        )
-        .map_err(|_| LinalgError::OutOfMemory)?;
+        let len = symbolic.inner.len_val();
+        let mut values = Vec::new();
+        values
+            .try_reserve_exact(len)
+            .map_err(|_| LinalgError::OutOfMemory { bytes: 8 * len })?;
+        values.resize(len, 0.0);
+        let scratch = symbolic
+            .inner
+            .factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        let mut mem = MemBuffer::try_new(scratch).map_err(|_| LinalgError::OutOfMemory {
+            bytes: scratch.size_bytes(),
+        })?;
         symbolic
             .inner
             .factorize_numeric_llt(

@@ -17,8 +17,10 @@ pub enum LinalgError {
     Ordering(String),
     #[error("sparse factorization failed: {0}")]
     Faer(String),
-    #[error("out of memory in the sparse factorization")]
-    OutOfMemory,
+    #[error(
+        "out of memory: the Cholesky factor needs {bytes} bytes; use a coarser mesh or a larger machine"
+    )]
+    OutOfMemory { bytes: usize },
 }
 
 /// `y = A x` for a compressed-column matrix.

@@ -1,0 +1,118 @@
+// ----------------------------------------------------------------------------
+// half_disc_on_block.geo -- internodes mesh: 2D (plane strain) Hertz contact,
+//                           elastic half disc pressed onto an elastic block
+// ----------------------------------------------------------------------------
+//
+// Models : in the xy plane (y up), the lower half of the disc of radius R
+//          centred at (0,R+gap): its pole (lowest point) is at (0,gap) and its
+//          flat chord at y = R + gap; it sits on the block [-W,W] x [-H,0]
+//          whose top edge y = 0 contains the origin. With gap = 0 the bodies
+//          touch at the origin only; gap < 0 is an initial overlap. The two
+//          meshes are independent (no shared nodes, not even at the origin).
+//          A displacement is imposed on disc_top, block_base is clamped; the
+//          Hertz (cylinder) contact half-width is a ~ 0.1 R.
+//          The pole and the origin are mesh nodes (curves are split there).
+//
+// Parameters (override with  -setnumber name value; lengths in model units):
+//   level  refinement level (integer, may be negative to coarsen);
+//          every mesh size below is multiplied by 2^-level          [0]
+//   R      disc radius                                               [1]
+//   gap    height of the pole above the block top (neg. = overlap)   [0]
+//   W      half-width of the block                                   [2 R]
+//   H      height of the block                                       [2 R]
+//   h_c    mesh size within distance r_c of the origin / the pole
+//          (level 0)                                                 [R/40]
+//   h_far  mesh size far from the contact point (level 0)            [R/2]
+//   r_c    radius of the uniformly refined contact zone              [R/4]
+//   d_far  distance from the contact point where h_far is reached;
+//          linear growth from h_c at r_c                             [2 R]
+//
+// Run :    gmsh -2 half_disc_on_block.geo -format msh41 -o hdob.msh
+//          gmsh -2 half_disc_on_block.geo -setnumber level 2 -setnumber gap -0.005 -o l2.msh
+//
+// Physical groups (P1: 3-node triangles, 2-node lines):
+//
+//                            disc_top (y = R + gap, chord)
+//                  (-R,R+gap) +-------------------+ (R,R+gap)
+//                              \                 /
+//                               `.    disc     .'  <- disc_contact
+//                                 `-._______.-'       (whole lower arc)
+//                                       o pole (0,gap)
+//   (-W,0) +----------------------------o----------------------------+ (W,0)
+//          |                 block_contact (whole top edge)          |
+//   block_ |                                                         | block_
+//   sides  |                       block                             | sides
+//          |                                                         |
+//  (-W,-H) +---------------------------------------------------------+ (W,-H)
+//                                 block_base
+//
+// Boundary lines are oriented counter-clockwise around their body (the body
+// is on the left of each line, outward normal = (dy, -dx)).
+// ----------------------------------------------------------------------------
+
+DefineConstant[
+  level = {0, Name "Parameters/level"},
+  R = {1, Name "Parameters/R"},
+  gap = {0, Name "Parameters/gap"},
+  W = {2 * R, Name "Parameters/W"},
+  H = {2 * R, Name "Parameters/H"},
+  h_c = {R / 40, Name "Parameters/h_c"},
+  h_far = {R / 2, Name "Parameters/h_far"},
+  r_c = {R / 4, Name "Parameters/r_c"},
+  d_far = {2 * R, Name "Parameters/d_far"}
+];
+
+Geometry.AutoCoherence = 0; // never merge coincident points (bodies are disjoint)
+s = 2 ^ (-level);           // size factor of this refinement level
+
+// --- block [-W, W] x [-H, 0], top edge split at the origin --------------------
+p0 = newp; Point(p0) = {0, 0, 0};
+p1 = newp; Point(p1) = {-W, -H, 0};
+p2 = newp; Point(p2) = {W, -H, 0};
+p3 = newp; Point(p3) = {W, 0, 0};
+p4 = newp; Point(p4) = {-W, 0, 0};
+l_base = newl; Line(l_base) = {p1, p2};
+l_right = newl; Line(l_right) = {p2, p3};
+l_top1 = newl; Line(l_top1) = {p3, p0};
+l_top2 = newl; Line(l_top2) = {p0, p4};
+l_left = newl; Line(l_left) = {p4, p1};
+cl = newll; Curve Loop(cl) = {l_base, l_right, l_top1, l_top2, l_left};
+s_block = news; Plane Surface(s_block) = {cl};
+
+// --- half disc: lower half of the disc of radius R centred at (0, R+gap) --------
+yc = R + gap;
+q0 = newp; Point(q0) = {0, yc, 0};     // centre
+q1 = newp; Point(q1) = {0, gap, 0};    // pole
+q2 = newp; Point(q2) = {R, yc, 0};
+q3 = newp; Point(q3) = {-R, yc, 0};
+a1 = newl; Circle(a1) = {q3, q0, q1};
+a2 = newl; Circle(a2) = {q1, q0, q2};
+l_chord = newl; Line(l_chord) = {q2, q3};
+cl = newll; Curve Loop(cl) = {a1, a2, l_chord};
+s_disc = news; Plane Surface(s_disc) = {cl};
+
+// --- mesh size: refinement towards the contact point -----------------------------
+Field[1] = Distance;
+Field[1].PointsList = {p0, q1};
+Field[2] = Threshold;
+Field[2].InField = 1;
+Field[2].SizeMin = h_c * s;
+Field[2].SizeMax = h_far * s;
+Field[2].DistMin = r_c;
+Field[2].DistMax = d_far;
+Background Field = 2;
+
+Mesh.MeshSizeExtendFromBoundary = 0;
+Mesh.MeshSizeFromPoints = 0;
+Mesh.MeshSizeFromCurvature = 0;
+Mesh.Algorithm = 6; // Frontal-Delaunay
+Mesh.ElementOrder = 1;
+
+// --- physical groups ------------------------------------------------------------
+Physical Surface("disc") = {s_disc};
+Physical Surface("block") = {s_block};
+Physical Curve("disc_contact") = {a1, a2};
+Physical Curve("disc_top") = {l_chord};
+Physical Curve("block_contact") = {l_top1, l_top2};
+Physical Curve("block_base") = {l_base};
+Physical Curve("block_sides") = {l_right, l_left};

@@ -1,0 +1,312 @@
+//! The gmsh reader on the committed fixtures: bodies, groups, local numbering, orientation,
+//! and a clear error for every kind of bad file.
+
+mod common;
+
+use common::{edited_fixture, fixture, read_fixture};
+use internodes::fem::kernels::facet_measure_and_normal;
+use internodes::mesh::{MeshError, read_msh};
+
+#[test]
+fn ascii_and_binary_files_give_the_same_mesh() {
+    for (ascii, binary) in [
+        ("block_2d.msh", "block_2d_bin.msh"),
+        ("block_3d.msh", "block_3d_bin.msh"),
+    ] {
+        let a = read_fixture(ascii);
+        let b = read_fixture(binary);
+        assert_eq!(a.dim, b.dim);
+        assert_eq!(a.bodies.len(), b.bodies.len());
+        for (x, y) in a.bodies.iter().zip(&b.bodies) {
+            assert_eq!(x.name, y.name);
+            assert_eq!(x.node_tags, y.node_tags);
+            assert_eq!(x.cells, y.cells);
+            // The ASCII file prints coordinates with 16 significant digits.
+            for (p, q) in x.coords.iter().zip(&y.coords) {
+                for k in 0..3 {
+                    assert!((p[k] - q[k]).abs() <= 1e-14 * (1.0 + q[k].abs()));
+                }
+            }
+            assert_eq!(
+                x.boundary_groups.keys().collect::<Vec<_>>(),
+                y.boundary_groups.keys().collect::<Vec<_>>()
+            );
+        }
+    }
+}
+
+#[test]
+fn bodies_and_groups_come_from_physical_names() {
+    let mesh = read_fixture("two_blocks_3d.msh");
+    assert_eq!(mesh.dim, 3);
+    let names: Vec<&str> = mesh.bodies.iter().map(|b| b.name.as_str()).collect();
+    assert_eq!(names, ["lower", "upper"]);
+    let lower = mesh.body("lower").unwrap();
+    let groups: Vec<&String> = lower.boundary_groups.keys().collect();
+    assert_eq!(groups, ["lower_base", "lower_contact", "lower_sides"]);
+    // Bodies are numbered locally and never share a gmsh node.
+    let upper = mesh.body("upper").unwrap();
+    assert!(lower.node_tags.iter().all(|t| !upper.node_tags.contains(t)));
+    assert!(lower.cells.iter().all(|&n| n < lower.num_nodes()));
+    assert!(mesh.physical_group("upper_top").is_some());
+}
+
+#[test]
+fn facet_normals_point_out_of_the_body() {
+    // The blocks' top faces lie on y = 0 (2D) / z = 0 (3D) with the body below: normal +e_dim.
+    for (file, group) in [
+        ("block_2d.msh", "block_top"),
+        ("block_3d.msh", "block_top"),
+        ("block_3d_bin.msh", "block_base"),
+    ] {
+        let mesh = read_fixture(file);
+        let body = &mesh.bodies[0];
+        let dim = body.dim;
+        let facets = body.boundary_group(group).unwrap();
+        let expected = if group == "block_top" { 1.0 } else { -1.0 };
+        for f in 0..facets.num_facets(dim) {
+            let x: Vec<[f64; 3]> = facets
+                .facet(f, dim)
+                .iter()
+                .map(|&n| body.coords[n])
+                .collect();
+            let (_, normal) = facet_measure_and_normal(&x, dim);
+            assert!(
+                (normal[dim - 1] - expected).abs() < 1e-12,
+                "{file} {group} facet {f}: normal {normal:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn two_dimensional_and_three_dimensional_contact_geometries_read() {
+    let m = read_fixture("half_disc_on_block.msh");
+    assert_eq!(m.dim, 2);
+    assert!(
+        m.body("disc")
+            .unwrap()
+            .boundary_group("disc_contact")
+            .is_some()
+    );
+    let m = read_fixture("hemisphere_on_block.msh");
+    assert_eq!(m.dim, 3);
+    assert!(
+        m.body("block")
+            .unwrap()
+            .boundary_group("block_contact")
+            .is_some()
+    );
+}
+
+fn error_of(path: &std::path::Path) -> (MeshError, String) {
+    let e = read_msh(path).expect_err("the file is bad");
+    let message = e.to_string();
+    (e, message)
+}
+
+#[test]
+fn missing_file_is_an_io_error_naming_the_file() {
+    let (e, message) = error_of(&fixture("no_such_mesh.msh"));
+    assert!(matches!(e, MeshError::Io { .. }));
+    assert!(message.contains("no_such_mesh.msh"), "{message}");
+}
+
+#[test]
+fn truncated_file_names_the_line_where_it_ends() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        let cut: Vec<&str> = text.lines().take(300).collect();
+        cut.join("\n") + "\n"
+    });
+    let (e, message) = error_of(&path);
+    assert!(
+        matches!(e, MeshError::Syntax { line, .. } if line > 1),
+        "{message}"
+    );
+    assert!(message.contains("block_2d.msh:"), "{message}");
+}
+
+#[test]
+fn malformed_node_line_is_a_syntax_error() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        let start = text.find("$Nodes").unwrap();
+        let line_end = |from: usize| from + text[from..].find('\n').unwrap() + 1;
+        // Skip the section header, the summary line and the first block header; break a coordinate.
+        let mut at = line_end(line_end(line_end(start)));
+        at = line_end(at); // first node tag
+        let end = line_end(at);
+        format!("{}0.5 abc 0\n{}", &text[..at], &text[end..])
+    });
+    let (e, message) = error_of(&path);
+    assert!(matches!(e, MeshError::Syntax { .. }), "{message}");
+}
+
+#[test]
+fn msh2_files_are_rejected_with_the_fix() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        text.replacen("4.1 0 8", "2.2 0 8", 1)
+    });
+    let (e, message) = error_of(&path);
+    assert!(
+        matches!(e, MeshError::UnsupportedVersion { .. }),
+        "{message}"
+    );
+    assert!(
+        message.contains("2.2") && message.contains("msh41"),
+        "{message}"
+    );
+}
+
+#[test]
+fn physical_names_section_errors_name_the_line() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        text.replacen("\"block_top\"", "block_top", 1)
+    });
+    let (e, message) = error_of(&path);
+    match e {
+        MeshError::Syntax { line, .. } => assert!((3..=10).contains(&line), "{message}"),
+        other => panic!("unexpected {other}"),
+    }
+}
+
+/// Rewrites the type of the first element block of dimension `dim` from `from` to `to`,
+/// padding each element of that block with `extra_nodes` copies of its last node.
+fn retype_first_block(text: &str, dim: &str, from: &str, to: &str, extra_nodes: usize) -> String {
+    let start = text.find("$Elements").unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let first = text[..start].lines().count() + 2;
+    let mut i = first;
+    while i < lines.len() {
+        let parts: Vec<&str> = lines[i].split_whitespace().collect();
+        let count: usize = parts[3].parse().unwrap();
+        if parts[0] == dim && parts[2] == from {
+            lines[i] = format!("{} {} {} {}", parts[0], parts[1], to, parts[3]);
+            for line in &mut lines[i + 1..=i + count] {
+                let last = line.split_whitespace().last().unwrap().to_string();
+                for _ in 0..extra_nodes {
+                    line.push(' ');
+                    line.push_str(&last);
+                }
+            }
+            break;
+        }
+        i += count + 1;
+    }
+    lines.join("\n") + "\n"
+}
+
+#[test]
+fn second_order_elements_are_unsupported() {
+    // A quadrangle (type 3, 4 nodes) block where the body's triangles were.
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        retype_first_block(&text, "2", "2", "3", 1)
+    });
+    let (e, message) = error_of(&path);
+    assert!(
+        matches!(e, MeshError::UnsupportedElement { .. }),
+        "{message}"
+    );
+    assert!(
+        message.contains("Qua4") && message.contains("triangles"),
+        "{message}"
+    );
+}
+
+/// Moves node `tag` of an ASCII fixture to `x`.
+fn move_node(text: &str, tag: u64, x: [f64; 3]) -> String {
+    let start = text.find("$Nodes").unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut i = text[..start].lines().count() + 2;
+    loop {
+        let parts: Vec<usize> = lines[i]
+            .split_whitespace()
+            .map(|p| p.parse().unwrap())
+            .collect();
+        let count = parts[3];
+        let tags: Vec<u64> = lines[i + 1..=i + count]
+            .iter()
+            .map(|l| l.trim().parse().unwrap())
+            .collect();
+        if let Some(k) = tags.iter().position(|&t| t == tag) {
+            lines[i + 1 + count + k] = format!("{} {} {}", x[0], x[1], x[2]);
+            return lines.join("\n") + "\n";
+        }
+        i += 2 * count + 1;
+    }
+}
+
+#[test]
+fn degenerate_cells_are_reported_with_their_element_tag() {
+    let mesh = read_fixture("block_2d.msh");
+    let body = &mesh.bodies[0];
+    // Put node 2 of the first cell onto the midpoint of its other two nodes.
+    let cell = body.cell(0);
+    let (p, q) = (body.coords[cell[0]], body.coords[cell[1]]);
+    let mid = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0, 0.0];
+    let tag = body.node_tags[cell[2]];
+    // Only meaningful if the node belongs to no other cell that would fold first; the error
+    // must name some element either way.
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| move_node(&text, tag, mid));
+    let (e, message) = error_of(&path);
+    assert!(
+        matches!(e, MeshError::DegenerateCell { element_tag, .. } if element_tag == body.cell_tags[0]),
+        "{message}"
+    );
+    assert!(message.contains("body 'block'"), "{message}");
+}
+
+#[test]
+fn inverted_cells_are_reported_with_their_element_tag() {
+    let mesh = read_fixture("block_2d.msh");
+    let body = &mesh.bodies[0];
+    let cell = body.cell(0).to_vec();
+    let (a, b, c) = (
+        body.coords[cell[0]],
+        body.coords[cell[1]],
+        body.coords[cell[2]],
+    );
+    // Reflect node c through the line (a, b): the cell flips orientation.
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let t = ((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / (dx * dx + dy * dy);
+    let foot = [a[0] + t * dx, a[1] + t * dy];
+    let reflected = [2.0 * foot[0] - c[0], 2.0 * foot[1] - c[1], 0.0];
+    let tag = body.node_tags[cell[2]];
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| move_node(&text, tag, reflected));
+    let (e, message) = error_of(&path);
+    assert!(
+        matches!(
+            e,
+            MeshError::InvertedCell { .. } | MeshError::DegenerateCell { .. }
+        ),
+        "{message}"
+    );
+    if let MeshError::InvertedCell { element_tag, .. } = e {
+        assert!(body.cell_tags.contains(&element_tag));
+    }
+}
+
+#[test]
+fn a_file_without_bodies_is_rejected() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        // Drop the body's physical tag from every surface entity: no cell is in a group then.
+        let start = text.find("$Entities").unwrap();
+        let end = text.find("$EndEntities").unwrap();
+        let mut lines: Vec<String> = text[start..end].lines().map(str::to_string).collect();
+        let counts: Vec<usize> = lines[1]
+            .split_whitespace()
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let first_surface = 2 + counts[0] + counts[1];
+        for line in &mut lines[first_surface..first_surface + counts[2]] {
+            let mut parts: Vec<&str> = line.split_whitespace().collect();
+            // tag, 6 bounding box values, number of physical tags, the tags, ...
+            let n: usize = parts[7].parse().unwrap();
+            parts.drain(8..8 + n);
+            parts[7] = "0";
+            *line = parts.join(" ");
+        }
+        format!("{}{}\n{}", &text[..start], lines.join("\n"), &text[end..])
+    });
+    let (e, message) = error_of(&path);
+    assert!(matches!(e, MeshError::NoBodies { .. }), "{message}");
+}

@@ -1,0 +1,186 @@
+#!/usr/bin/python3
+"""Validation of internodes against FEniCSx (dolfinx 0.5.2): ``make validate``.
+
+For every case file ``validation/cases/<case>.toml`` and every mesh level:
+
+  1. mesh ``geo/<script>.geo`` with gmsh at that level (the case's ``mesh``
+     entry names ``<script>_l<level>.msh``) into ``validation/build/meshes``;
+  2. write the case file of that level (``mesh`` replaced) and run
+     ``internodes solve CASE --output DIR --export-matrices``;
+  3. build the dolfinx reference from the same mesh and case and compare
+     (``compare.py``: matrices, displacements, reactions, strains, stresses).
+
+Then print one table (check, case, figure, tolerance, PASS/FAIL), write it to
+``validation/build/results.json`` and exit with status 1 if anything failed
+or is missing.
+
+Usage:  /usr/bin/python3 validation/run.py [--binary PATH] [--quick] [--levels L ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import shutil
+import subprocess
+import sys
+import time
+import tomllib
+from dataclasses import asdict
+from pathlib import Path
+
+VALIDATION = Path(__file__).resolve().parent
+REPO = VALIDATION.parent
+sys.path.insert(0, str(VALIDATION))
+
+from compare import Check, compare_case, failure  # noqa: E402
+from dolfinx_reference import ReferenceFailure, read_case  # noqa: E402
+
+BUILD = VALIDATION / "build"
+DEFAULT_LEVELS = (0, 1)
+MESH_NAME = re.compile(r"(?P<script>.+)_l(?P<level>-?\d+)\.msh")
+
+
+class StepFailed(RuntimeError):
+    """A step (meshing, solving) failed; the message says which and why."""
+
+
+def parse_args() -> argparse.Namespace:
+    """Command line: binary, levels."""
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes",
+                        help="internodes executable (default: target/release/internodes)")
+    parser.add_argument("--quick", action="store_true", help="coarsest level only (level 0)")
+    parser.add_argument("--levels", type=int, nargs="+", default=DEFAULT_LEVELS,
+                        help=f"mesh refinement levels (default: {' '.join(map(str, DEFAULT_LEVELS))})")
+    parser.add_argument("--cases", nargs="+", help="case names (default: all of validation/cases)")
+    args = parser.parse_args()
+    if args.quick:
+        args.levels = [min(args.levels)]
+    return args
+
+
+def run(command: list, what: str) -> None:
+    """Run a command; on failure raise StepFailed with the end of its output."""
+    result = subprocess.run([str(c) for c in command], capture_output=True, text=True)
+    if result.returncode != 0:
+        tail = "\n".join((result.stdout + result.stderr).strip().splitlines()[-5:])
+        raise StepFailed(f"{what} failed (exit {result.returncode}): {tail}")
+
+
+def geo_script(case_file: Path) -> str:
+    """The geo script a case is meshed from: its ``mesh`` is ``.../<script>_l<level>.msh``."""
+    with open(case_file, "rb") as f:
+        mesh = Path(tomllib.load(f).get("mesh", ""))
+    match = MESH_NAME.fullmatch(mesh.name)
+    if match is None or not (REPO / "geo" / f"{match['script']}.geo").is_file():
+        raise StepFailed(f"{case_file}: mesh '{mesh}' is not <script>_l<level>.msh with geo/<script>.geo existing")
+    return match["script"]
+
+
+def generate_mesh(script: str, level: int) -> Path:
+    """gmsh -3 geo/<script>.geo -setnumber level L -> build/meshes/<script>_l<L>.msh (MSH 4.1)."""
+    mesh = BUILD / "meshes" / f"{script}_l{level}.msh"
+    mesh.parent.mkdir(parents=True, exist_ok=True)
+    run(["gmsh", "-3", REPO / "geo" / f"{script}.geo", "-setnumber", "level", level,
+         "-format", "msh41", "-o", mesh, "-v", "1"], f"gmsh {script}.geo level {level}")
+    return mesh
+
+
+def write_level_case(case_file: Path, mesh: Path, folder: Path) -> Path:
+    """Copy of the case file in ``folder`` with ``mesh`` replaced (everything else verbatim)."""
+    text, count = re.subn(r'(?m)^mesh\s*=.*$', f"mesh = {json.dumps(str(mesh))}", case_file.read_text())
+    if count != 1:
+        raise StepFailed(f"{case_file}: expected exactly one top-level 'mesh = ...' line, found {count}")
+    folder.mkdir(parents=True, exist_ok=True)
+    level_case = folder / case_file.name
+    level_case.write_text(text)
+    return level_case
+
+
+def validate_level(binary: Path, case_file: Path, script: str, level: int, timings: dict) -> list[Check]:
+    """Steps 1-3 for one case at one level; returns its checks."""
+    label = f"{case_file.stem}_l{level}"
+    folder = BUILD / label
+
+    # 1. Mesh the geo script at this level.
+    start = time.perf_counter()
+    mesh = generate_mesh(script, level)
+    timings["mesh"] = time.perf_counter() - start
+
+    # 2. Solve with internodes, exporting the matrices.
+    start = time.perf_counter()
+    level_case = write_level_case(case_file, mesh, folder)
+    output = folder / "internodes"
+    shutil.rmtree(output, ignore_errors=True)  # never compare stale output
+    run([binary, "solve", level_case, "--output", output, "--export-matrices"], f"internodes solve {level_case}")
+    timings["internodes"] = time.perf_counter() - start
+
+    # 3. dolfinx reference from the same mesh and case file, and comparison.
+    start = time.perf_counter()
+    checks = compare_case(read_case(level_case), output, label)
+    timings["dolfinx + compare"] = time.perf_counter() - start
+    return checks
+
+
+def print_table(checks: list[Check]) -> None:
+    """One row per check: check, case, figure, tolerance, PASS/FAIL, note."""
+    header = f"{'#':>3}  {'check':<17} {'case':<38} {'figure':>10} {'tolerance':>9}  result  note"
+    print(header)
+    print("-" * len(header))
+    for i, c in enumerate(checks, 1):
+        print(f"{i:>3}  {c.check:<17} {c.case:<38} {c.figure:>10.2e} {c.tolerance:>9.0e}  "
+              f"{'PASS' if c.passed else 'FAIL':<6}  {c.note}")
+
+
+def main() -> int:
+    """Run every case at every level, print and save the table; 0 if all checks pass."""
+    args = parse_args()
+    cases = sorted((VALIDATION / "cases").glob("*.toml"))
+    if args.cases:
+        cases = [VALIDATION / "cases" / f"{name}.toml" for name in args.cases]
+    checks: list[Check] = []
+    timings: dict[str, dict[str, float]] = {}
+
+    # 0. The binary must exist and answer `solve --help`.
+    try:
+        run([args.binary, "solve", "--help"], f"{args.binary} solve --help")
+    except (StepFailed, OSError) as error:
+        checks.append(failure("binary", str(args.binary), str(error)))
+        cases = []
+
+    for case_file in cases:
+        try:
+            script = geo_script(case_file)
+        except (StepFailed, OSError) as error:
+            checks.append(failure("case file", case_file.stem, str(error)))
+            continue
+        for level in args.levels:
+            label = f"{case_file.stem}_l{level}"
+            timings[label] = {}
+            print(f"== {label}", flush=True)
+            try:
+                checks += validate_level(args.binary, case_file, script, level, timings[label])
+            except (StepFailed, ReferenceFailure, OSError, ValueError) as error:
+                checks.append(failure("run", label, f"{type(error).__name__}: {error}"))
+            print("   " + ", ".join(f"{phase} {seconds:.2f} s" for phase, seconds in timings[label].items()),
+                  flush=True)
+
+    # 4. One table, also as JSON; the exit status says whether everything passed.
+    print()
+    print_table(checks)
+    passed = bool(checks) and all(c.passed for c in checks)
+    print(f"\n{sum(c.passed for c in checks)}/{len(checks)} checks passed: {'PASS' if passed else 'FAIL'}")
+    BUILD.mkdir(parents=True, exist_ok=True)
+    results = {"binary": str(args.binary), "levels": list(args.levels), "passed": passed, "timings": timings,
+               "checks": [asdict(c) | {"figure": None if math.isnan(c.figure) else c.figure, "passed": c.passed}
+                          for c in checks]}
+    (BUILD / "results.json").write_text(json.dumps(results, indent=2))
+    print(f"results written to {BUILD / 'results.json'}")
+    return 0 if passed else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
