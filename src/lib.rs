@@ -14,7 +14,9 @@
 //! ```
 //!
 //! with `lambda` the traction on body 1 and `d` the nodal gaps, the active set updated until no
-//! node is in tension and none penetrates.
+//! node is in tension and none penetrates. The modules below provide what that system is built
+//! from: each body's stiffness `K_k`, load `f_k` and interface mass matrices `M_k`, and the
+//! sparse Cholesky factorization of `K_k`.
 //!
 //! The crate is organised as the solve proceeds:
 //! - [`mesh`]: gmsh MSH 4.1 input, bodies and boundary groups by physical name;

@@ -172,7 +172,8 @@ def main() -> int:
     print()
     print_table(checks)
     passed = bool(checks) and all(c.passed for c in checks)
-    print(f"\n{sum(c.passed for c in checks)}/{len(checks)} checks passed: {'PASS' if passed else 'FAIL'}")
+    num_passed = sum(c.passed for c in checks)
+    print(f"\nvalidation: {num_passed} passed, {len(checks) - num_passed} failed")
     BUILD.mkdir(parents=True, exist_ok=True)
     results = {"binary": str(args.binary), "levels": list(args.levels), "passed": passed, "timings": timings,
                "checks": [asdict(c) | {"figure": None if math.isnan(c.figure) else c.figure, "passed": c.passed}

@@ -99,7 +99,7 @@ impl Case {
         if case.bodies.is_empty() {
             return Err(case.invalid("[[body]]", "the case names no body"));
         }
-        if !(case.solver.residual_tolerance > 0.0) {
+        if case.solver.residual_tolerance.is_nan() || case.solver.residual_tolerance <= 0.0 {
             return Err(case.invalid("[solver]", "residual_tolerance must be positive"));
         }
         Ok(case)
@@ -172,7 +172,7 @@ impl Case {
                 (Some(t), None, None) => SurfaceLoad::Traction(vector(t, &what)?),
                 (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(p)),
                 (None, None, Some(h)) => {
-                    if !(h.a > 0.0) {
+                    if h.a.is_nan() || h.a <= 0.0 {
                         return Err(self.invalid(
                             context(&what),
                             format!("hertz_pressure.a must be positive, got {}", h.a),

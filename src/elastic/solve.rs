@@ -158,7 +158,7 @@ pub fn solve(
         factor.solve_in_place(&mut u, 1)
     });
     stats.relative_residual = relative_residual(&k_c, &u, &f_c);
-    if !(stats.relative_residual <= settings.residual_tolerance) {
+    if stats.relative_residual.is_nan() || stats.relative_residual > settings.residual_tolerance {
         return Err(SolveError::Inaccurate {
             body: body.name.clone(),
             residual: stats.relative_residual,

@@ -47,7 +47,7 @@ pub fn check_cells(path: &Path, body: &BodyMesh) -> Result<(), MeshError> {
         .collect();
     for (c, &m) in measures.iter().enumerate() {
         let relative = m.abs() / longest_edge(&body.coords, body.cell(c)).powi(dim as i32);
-        if !(relative >= DEGENERATE_RELATIVE_MEASURE) {
+        if relative.is_nan() || relative < DEGENERATE_RELATIVE_MEASURE {
             return Err(MeshError::DegenerateCell {
                 path: path.to_owned(),
                 body: body.name.clone(),

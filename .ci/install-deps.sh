@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Installs the Debian packages that building, testing, meshing and validating need, when they
+# are missing. Idempotent; needs root (or sudo) only when something is missing.
+#   libhdf5-dev pkg-config : the hdf5 crate links Debian's serial HDF5
+#   gmsh python3-gmsh      : mesh generation (geo/), and dolfinx's gmsh reader
+#   python3-dolfinx ...    : validation/ (FEniCSx reference), never used by the solver
+set -euo pipefail
+packages=(pkg-config libhdf5-dev gmsh python3-gmsh python3-dolfinx python3-h5py python3-scipy python3-matplotlib)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+    exit 0
+fi
+echo "installing: ${missing[*]}"
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+while pgrep -x apt-get >/dev/null || pgrep -x dpkg >/dev/null; do sleep 5; done
+$sudo apt-get update
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,39 @@
+# internodes: `make demo` runs the main job, `make test` runs every check.
+# Each target installs the Debian packages it needs first (.ci/install-deps.sh).
+
+PYTHON  := /usr/bin/python3
+BINARY  := target/release/internodes
+LEVELS  ?= 0 1 2
+
+.PHONY: deps build demo test validate meshes bench clean
+
+deps:
+	bash .ci/install-deps.sh
+
+build: deps
+	cargo build --release
+
+# Mesh geo/block_3d.geo with gmsh and solve it: a block under a Hertzian pressure.
+# Open out/demo/solution.xdmf in ParaView (XDMF3 reader).
+demo: build
+	$(BINARY) solve geo/block_3d.toml --output out/demo
+
+# Unit and integration tests (no gmsh or Python needed), then the FEniCSx cross-checks.
+test: build
+	cargo test --release
+	$(MAKE) --no-print-directory validate
+
+validate: build
+	$(PYTHON) validation/run.py
+
+# Every geo/ script at the refinement levels $(LEVELS), into meshes/.
+meshes: deps
+	bash geo/mesh_all.sh meshes $(LEVELS)
+
+# Assembly and solve timings against dolfinx (several minutes; report in validation/BENCHMARK.md).
+bench: build
+	$(PYTHON) validation/benchmark.py
+
+clean:
+	cargo clean
+	rm -rf out meshes validation/build

@@ -1,0 +1,314 @@
+//! The command line and the case file, end to end: a solve writes readable results, and every
+//! kind of bad case gets an error that names the file and the key, group or body at fault.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::fixture;
+use internodes::case::CaseError;
+use internodes::elastic::{ProblemError, SolveError};
+use internodes::fem::MaterialError;
+use internodes::run::{RunError, RunOptions, solve_case};
+
+const BINARY: &str = env!("CARGO_BIN_EXE_internodes");
+
+/// A valid 3D case on the `block_3d` fixture; tests edit its text.
+fn block_case() -> String {
+    format!(
+        r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+uz = 0.0
+
+[[body.load]]
+group = "block_top"
+hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
+"#,
+        fixture("block_3d.msh").display()
+    )
+}
+
+fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    (dir, path)
+}
+
+fn run_quiet(case: &Path) -> Result<internodes::run::RunReport, RunError> {
+    solve_case(
+        case,
+        &RunOptions {
+            quiet: true,
+            ..Default::default()
+        },
+    )
+}
+
+/// Runs a case that must fail and returns the error and its message.
+fn failure(text: &str) -> (RunError, String) {
+    let (_dir, path) = write_case(text);
+    let e = match run_quiet(&path) {
+        Ok(_) => panic!("the case should fail:\n{text}"),
+        Err(e) => e,
+    };
+    let message = e.to_string();
+    assert!(
+        message.contains("case.toml"),
+        "the error names the case file: {message}"
+    );
+    (e, message)
+}
+
+#[test]
+fn solve_writes_xdmf_hdf5_and_summary() {
+    let (dir, path) = write_case(&block_case());
+    let output = Command::new(BINARY)
+        .args(["solve", path.to_str().unwrap(), "--export-matrices"])
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("numeric factorization"),
+        "phases are reported: {stderr}"
+    );
+
+    let out = dir.path().join("out");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let body = &summary["bodies"][0];
+    assert_eq!(body["name"], "block");
+    let num_nodes = body["num_nodes"].as_u64().unwrap() as usize;
+    let reaction_z = body["reactions"]["block_base"][2].as_f64().unwrap();
+    assert!(
+        reaction_z > 0.0,
+        "the base pushes up against a downward load"
+    );
+
+    let file = hdf5::File::open(out.join("solution.h5")).unwrap();
+    let u = file.dataset("fields/displacement").unwrap();
+    assert_eq!(u.shape(), vec![num_nodes, 3]);
+    assert_eq!(file.dataset("mesh/topology").unwrap().shape()[1], 4);
+    assert_eq!(file.dataset("fields/stress").unwrap().shape()[1], 9);
+    let tags: Vec<i64> = file.dataset("mesh/node_tag").unwrap().read_raw().unwrap();
+    assert_eq!(tags.len(), num_nodes);
+
+    let xdmf = std::fs::read_to_string(out.join("solution.xdmf")).unwrap();
+    assert!(
+        xdmf.contains("TopologyType=\"Tetrahedron\"")
+            && xdmf.contains("solution.h5:/fields/displacement")
+    );
+    for matrix in [
+        "block_stiffness.mtx",
+        "block__block_base_mass.mtx",
+        "block__block_top_mass.mtx",
+    ] {
+        let text = std::fs::read_to_string(out.join("matrices").join(matrix)).unwrap();
+        assert!(text.starts_with("%%MatrixMarket matrix coordinate real general"));
+    }
+}
+
+#[test]
+fn info_prints_groups_and_counts() {
+    let output = Command::new(BINARY)
+        .args(["info", fixture("two_blocks_2d.msh").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        text.contains("body 'lower': 58 nodes, 90 triangles"),
+        "{text}"
+    );
+    assert!(
+        text.contains("boundary 'upper_contact'") && text.contains("bounding box"),
+        "{text}"
+    );
+}
+
+#[test]
+fn cli_reports_errors_with_a_failure_status() {
+    let (_dir, path) = write_case(&block_case().replace("youngs_modulus", "youngs_modulu"));
+    let output = Command::new(BINARY)
+        .args(["solve", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.starts_with("error: case file") && stderr.contains("youngs_modulu"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"));
+}
+
+#[test]
+fn misspelled_key_names_the_key_and_line() {
+    let (e, message) = failure(&block_case().replace("poisson_ratio", "poison_ratio"));
+    assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
+    assert!(
+        message.contains("poison_ratio") && message.contains("line 7"),
+        "{message}"
+    );
+}
+
+#[test]
+fn missing_key_is_named() {
+    let (e, message) = failure(&block_case().replace("poisson_ratio = 0.3\n", ""));
+    assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
+    assert!(message.contains("poisson_ratio"), "{message}");
+}
+
+#[test]
+fn non_physical_materials_are_rejected() {
+    let (e, message) =
+        failure(&block_case().replace("youngs_modulus = 1000.0", "youngs_modulus = 0.0"));
+    assert!(
+        matches!(
+            e,
+            RunError::Case(CaseError::Material {
+                source: MaterialError::YoungsModulus(_),
+                ..
+            })
+        ),
+        "{message}"
+    );
+    assert!(message.contains("body 'block'"));
+    let (e, message) = failure(&block_case().replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
+    assert!(
+        matches!(
+            e,
+            RunError::Case(CaseError::Material {
+                source: MaterialError::PoissonRatio(_),
+                ..
+            })
+        ),
+        "{message}"
+    );
+    let (e, _) = failure(&block_case().replace("poisson_ratio = 0.3", "poisson_ratio = -1.2"));
+    assert!(matches!(e, RunError::Case(CaseError::Material { .. })));
+}
+
+#[test]
+fn unknown_group_lists_the_groups_of_the_body() {
+    let (e, message) =
+        failure(&block_case().replace("group = \"block_top\"", "group = \"block_tpo\""));
+    assert!(matches!(
+        e,
+        RunError::Case(CaseError::Problem {
+            source: ProblemError::UnknownGroup { .. },
+            ..
+        })
+    ));
+    assert!(
+        message.contains("block_tpo") && message.contains("block_base, block_sides, block_top"),
+        "{message}"
+    );
+}
+
+#[test]
+fn unknown_body_lists_the_bodies_of_the_mesh() {
+    let (e, message) = failure(&block_case().replace("name = \"block\"", "name = \"sphere\""));
+    assert!(matches!(e, RunError::Case(CaseError::UnknownBody { .. })));
+    assert!(
+        message.contains("'sphere'") && message.contains("its bodies: block"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_body_without_dirichlet_condition_is_singular() {
+    let text = block_case();
+    let start = text.find("[[body.dirichlet]]").unwrap();
+    let end = text.find("[[body.load]]").unwrap();
+    let (e, message) = failure(&format!("{}{}", &text[..start], &text[end..]));
+    assert!(
+        matches!(
+            e,
+            RunError::Case(CaseError::Problem {
+                source: ProblemError::NoDirichlet { .. },
+                ..
+            })
+        ),
+        "{message}"
+    );
+    assert!(message.contains("singular"));
+}
+
+#[test]
+fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
+    // Only uz = 0 on the flat base: translations in x, y and the rotation about z are free.
+    let (e, message) = failure(&block_case().replace("ux = 0.0\nuy = 0.0\n", ""));
+    assert!(
+        matches!(
+            e,
+            RunError::Case(CaseError::Problem {
+                source: ProblemError::FreeRigidModes { count: 3, .. },
+                ..
+            })
+        ),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_load_must_have_exactly_one_kind() {
+    let (e, message) =
+        failure(&block_case().replace("hertz_pressure =", "pressure = 1.0\nhertz_pressure ="));
+    assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
+    assert!(
+        message.contains("exactly one of") && message.contains("load on 'block_top'"),
+        "{message}"
+    );
+}
+
+#[test]
+fn vectors_must_match_the_mesh_dimension() {
+    let (e, message) =
+        failure(&block_case().replace("center = [0.0, 0.0, 0.0]", "center = [0.0, 0.0]"));
+    assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
+    assert!(message.contains("expected 3 components"), "{message}");
+}
+
+#[test]
+fn a_bad_mesh_is_reported_through_the_case() {
+    let (e, message) = failure(&block_case().replace("block_3d.msh", "no_such.msh"));
+    assert!(matches!(e, RunError::Case(CaseError::Mesh { .. })));
+    assert!(message.contains("no_such.msh"), "{message}");
+}
+
+#[test]
+fn inaccurate_solves_are_errors_not_results() {
+    // A residual tolerance below round-off cannot be met: the solve must say so.
+    let text = block_case().replace(
+        "[[body]]",
+        "[solver]\nresidual_tolerance = 1e-30\n\n[[body]]",
+    );
+    let (e, message) = failure(&text);
+    assert!(
+        matches!(
+            e,
+            RunError::Solve {
+                source: SolveError::Inaccurate { .. },
+                ..
+            }
+        ),
+        "{message}"
+    );
+}
