@@ -28,6 +28,7 @@
 //! - [`run`]: `internodes solve CASE`, from the case file to the result files.
 
 pub mod case;
+pub mod contact;
 pub mod elastic;
 pub mod fem;
 pub mod linalg;

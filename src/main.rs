@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use internodes::contact::ContactStatus;
 use internodes::mesh::{MeshSummary, read_msh};
 use internodes::run::{RunOptions, solve_case};
 
@@ -52,8 +53,15 @@ fn main() -> ExitCode {
                 quiet,
             },
         )
-        .map(|_| ())
-        .map_err(Into::into),
+        .map_err(Into::into)
+        .and_then(|report| match report.summary.contact.as_ref().map(|c| c.status) {
+            Some(ContactStatus::IterationLimit | ContactStatus::Cycling) => Err(format!(
+                "the contact solve did not converge (see {}/summary.json); the last iterate was written for inspection",
+                report.output_dir.display()
+            )
+            .into()),
+            _ => Ok(()),
+        }),
         Command::Info { mesh } => read_msh(&mesh)
             .map(|m| print!("{}", MeshSummary(&m)))
             .map_err(Into::into),

@@ -6,11 +6,16 @@ use std::time::Instant;
 use thiserror::Error;
 
 use crate::case::{Case, CaseError};
+use crate::contact::{
+    ContactError, ContactProblem, ContactSolution, ContactStatus, SurfaceFields, solve_contact,
+};
 use crate::elastic::{ElasticSolution, SolveError, solve};
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
+use crate::mesh::BodyMesh;
 use crate::mesh::{Mesh, mesh_geo, read_msh};
 use crate::output::{
-    BodyFields, BodySummary, CaseSummary, OutputError, write_matrix_market, write_xdmf,
+    BodyFields, BodySummary, CaseSummary, ContactSummary, OutputError, write_matrix_market,
+    write_xdmf,
 };
 
 /// Command-line overrides of the case file.
@@ -27,6 +32,8 @@ pub enum RunError {
     Case(#[from] CaseError),
     #[error("case file {path}: {source}")]
     Solve { path: PathBuf, source: SolveError },
+    #[error("case file {path}: contact: {source}")]
+    Contact { path: PathBuf, source: ContactError },
     #[error(transparent)]
     Output(#[from] OutputError),
 }
@@ -85,8 +92,44 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
     ));
 
     // 3. One elastic solve per body.
-    let mut solved = Vec::new();
+    let mut solved: Vec<SolvedBody> = Vec::new();
+    let contact = case.contact_problem(&mesh)?;
+    let mut contact_summary = None;
+    if let Some(problem) = &contact {
+        say(format!(
+            "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
+            problem.primary.body.name,
+            problem.primary_surface.group,
+            problem.primary_surface.len(),
+            problem.secondary.body.name,
+            problem.secondary_surface.group,
+            problem.secondary_surface.len(),
+            serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
+        ));
+        let phase = Instant::now();
+        let solution =
+            solve_contact(problem, &case.solver).map_err(|source| RunError::Contact {
+                path: case.path.clone(),
+                source,
+            })?;
+        timings.push(("contact solve".to_string(), phase.elapsed().as_secs_f64()));
+        say(format!("contact status: {}", describe(&solution)));
+        contact_summary = Some(summarize_contact(problem, &solution));
+        solved.push(SolvedBody {
+            name: problem.primary.body.name.clone(),
+            solution: solution.primary,
+            surface: Some(solution.primary_fields),
+        });
+        solved.push(SolvedBody {
+            name: problem.secondary.body.name.clone(),
+            solution: solution.secondary,
+            surface: Some(solution.secondary_fields),
+        });
+    }
     for spec in &case.bodies {
+        if solved.iter().any(|s| s.name == spec.name) {
+            continue;
+        }
         let body = case.body_mesh(&mesh, spec)?;
         let problem = case.elastic_problem(body, spec)?;
         say(format!(
@@ -105,17 +148,29 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
             format!("solve {}", body.name),
             phase.elapsed().as_secs_f64(),
         ));
-        solved.push((spec, body, solution));
+        solved.push(SolvedBody {
+            name: spec.name.clone(),
+            solution,
+            surface: None,
+        });
     }
+    // In the case file's order of bodies.
+    solved.sort_by_key(|s| case.bodies.iter().position(|b| b.name == s.name));
 
     // 4. Result files.
     let phase = Instant::now();
+    let meshes: Vec<&BodyMesh> = solved
+        .iter()
+        .map(|s| mesh.body(&s.name).expect("solved bodies are mesh bodies"))
+        .collect();
     let fields: Vec<BodyFields> = solved
         .iter()
-        .map(|(_, body, s)| BodyFields {
+        .zip(&meshes)
+        .map(|(s, body)| BodyFields {
             mesh: body,
-            displacement: &s.displacement,
-            cell_fields: &s.cell_fields,
+            displacement: &s.solution.displacement,
+            cell_fields: &s.solution.cell_fields,
+            surface: s.surface.as_ref(),
         })
         .collect();
     write_xdmf(&output_dir, "solution", &fields)?;
@@ -125,7 +180,7 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
     timings.push(("write output".to_string(), phase.elapsed().as_secs_f64()));
     timings.push(("total".to_string(), start.elapsed().as_secs_f64()));
 
-    let summary = summarize(&case, &mesh, &solved, timings);
+    let summary = summarize(&case, &mesh, &solved, contact_summary, timings);
     summary.write(&output_dir.join("summary.json"))?;
     say(format!(
         "wrote {} (solution.xdmf, solution.h5, summary.json) in {:.3} s total",
@@ -187,17 +242,23 @@ fn export_matrices(case: &Case, mesh: &Mesh, output_dir: &Path) -> Result<(), Ru
 fn summarize(
     case: &Case,
     mesh: &Mesh,
-    solved: &[(
-        &crate::case::BodySpec,
-        &crate::mesh::BodyMesh,
-        ElasticSolution,
-    )],
+    solved: &[SolvedBody],
+    contact: Option<ContactSummary>,
     timings: Vec<(String, f64)>,
 ) -> CaseSummary {
     let (mut node_offset, mut cell_offset) = (0, 0);
     let bodies = solved
         .iter()
-        .map(|(spec, body, s)| {
+        .map(|solved| {
+            let spec = case
+                .bodies
+                .iter()
+                .find(|b| b.name == solved.name)
+                .expect("solved bodies come from the case");
+            let body = mesh
+                .body(&solved.name)
+                .expect("solved bodies are mesh bodies");
+            let s = &solved.solution;
             let summary = BodySummary {
                 name: body.name.clone(),
                 youngs_modulus: spec.youngs_modulus,
@@ -220,6 +281,67 @@ fn summarize(
         mesh: mesh.path.display().to_string(),
         dimension: mesh.dim,
         bodies,
+        contact,
         timings,
+    }
+}
+
+/// One body's solution and, in contact runs, its interface fields.
+struct SolvedBody {
+    name: String,
+    solution: ElasticSolution,
+    surface: Option<SurfaceFields>,
+}
+
+/// One line on how the contact solve ended.
+fn describe(solution: &ContactSolution) -> String {
+    let iterations = solution.history.len();
+    match solution.status {
+        ContactStatus::Converged => format!(
+            "converged in {iterations} iterations; contact force {:.6e}, imbalance {:.1e}{}",
+            norm(&solution.force_primary),
+            solution.force_imbalance,
+            solution.hertz_primary.map_or(String::new(), |h| format!(", Hertz fit a = {:.6e}, p0 = {:.6e}", h.a, h.p0))
+        ),
+        ContactStatus::NoContact => "no contact: the candidate surfaces never come within interpolation range; each body was solved alone".to_string(),
+        ContactStatus::IterationLimit => format!("NOT converged: the iteration cap ({iterations}) was reached"),
+        ContactStatus::Cycling => format!("NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"),
+    }
+}
+
+fn norm(f: &[f64; 3]) -> f64 {
+    (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()
+}
+
+fn summarize_contact(problem: &ContactProblem, solution: &ContactSolution) -> ContactSummary {
+    let dim = problem.primary_surface.dim;
+    ContactSummary {
+        status: solution.status,
+        primary: problem.primary.body.name.clone(),
+        secondary: problem.secondary.body.name.clone(),
+        settings: problem.settings,
+        force_primary: solution.force_primary[..dim].to_vec(),
+        force_secondary: solution.force_secondary[..dim].to_vec(),
+        force_imbalance: solution.force_imbalance,
+        active_primary: solution
+            .primary_fields
+            .active
+            .iter()
+            .filter(|&&a| a)
+            .count(),
+        active_secondary: solution
+            .secondary_fields
+            .active
+            .iter()
+            .filter(|&&a| a)
+            .count(),
+        max_pressure: solution
+            .primary_fields
+            .pressure
+            .iter()
+            .cloned()
+            .fold(0.0, f64::max),
+        hertz_fit: solution.hertz_primary,
+        iterations: solution.history.clone(),
     }
 }

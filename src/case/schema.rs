@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::CaseError;
+use crate::contact::{ContactProblem, ContactSettings, ContactSurface, Formulation};
 use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
@@ -29,9 +30,31 @@ pub struct Case {
     pub solver: SolverSettings,
     #[serde(rename = "body")]
     pub bodies: Vec<BodySpec>,
+    /// Two of the bodies in contact (optional: without it every body is solved alone).
+    pub contact: Option<ContactSpec>,
     /// The case file itself, set by [`Case::load`].
     #[serde(skip)]
     pub path: PathBuf,
+}
+
+/// The `[contact]` table: which bodies and surfaces meet, and how.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// The body that carries the multiplier (often the finer interface mesh).
+    pub primary: String,
+    /// Its candidate contact surface (a boundary group).
+    pub primary_surface: String,
+    pub secondary: String,
+    pub secondary_surface: String,
+    /// "frictionless" (default) or "tied".
+    pub formulation: Option<Formulation>,
+    /// Default 50.
+    pub max_iterations: Option<usize>,
+    /// Fraction of the local nodal spacing, default 1e-3.
+    pub penetration_tolerance: Option<f64>,
+    /// Fraction of the largest contact pressure, default 1e-8.
+    pub tension_tolerance: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -207,5 +230,69 @@ impl Case {
                 source,
             }
         })
+    }
+
+    /// The contact problem of the `[contact]` table, if any.
+    pub fn contact_problem<'m>(
+        &self,
+        mesh: &'m Mesh,
+    ) -> Result<Option<ContactProblem<'m>>, CaseError> {
+        let Some(spec) = &self.contact else {
+            return Ok(None);
+        };
+        if spec.primary == spec.secondary {
+            return Err(self.invalid(
+                "[contact]",
+                "primary and secondary must be different bodies",
+            ));
+        }
+        let defaults = ContactSettings::default();
+        let settings = ContactSettings {
+            formulation: spec.formulation.unwrap_or(defaults.formulation),
+            max_iterations: spec.max_iterations.unwrap_or(defaults.max_iterations),
+            penetration_tolerance: spec
+                .penetration_tolerance
+                .unwrap_or(defaults.penetration_tolerance),
+            tension_tolerance: spec.tension_tolerance.unwrap_or(defaults.tension_tolerance),
+        };
+        for (name, value) in [
+            ("penetration_tolerance", settings.penetration_tolerance),
+            ("tension_tolerance", settings.tension_tolerance),
+        ] {
+            if value.is_nan() || value < 0.0 {
+                return Err(self.invalid(
+                    "[contact]",
+                    format!("{name} must be non-negative, got {value}"),
+                ));
+            }
+        }
+        if settings.max_iterations == 0 {
+            return Err(self.invalid("[contact]", "max_iterations must be at least 1"));
+        }
+        let side = |body: &str,
+                    surface: &str|
+         -> Result<(ElasticProblem<'m>, ContactSurface), CaseError> {
+            let body_spec = self.bodies.iter().find(|b| b.name == body).ok_or_else(|| {
+                self.invalid(
+                    "[contact]",
+                    format!(
+                        "body '{body}' has no [[body]] table (materials and supports are needed)"
+                    ),
+                )
+            })?;
+            let body_mesh = self.body_mesh(mesh, body_spec)?;
+            let surface = ContactSurface::new(body_mesh, surface)
+                .map_err(|e| self.invalid("[contact]", e.to_string()))?;
+            Ok((self.elastic_problem(body_mesh, body_spec)?, surface))
+        };
+        let (primary, primary_surface) = side(&spec.primary, &spec.primary_surface)?;
+        let (secondary, secondary_surface) = side(&spec.secondary, &spec.secondary_surface)?;
+        Ok(Some(ContactProblem {
+            primary,
+            secondary,
+            primary_surface,
+            secondary_surface,
+            settings,
+        }))
     }
 }

@@ -6,4 +6,4 @@ mod solve;
 
 pub use problem::{DirichletCondition, ElasticProblem, LoadCondition, ProblemError};
 pub use solution::{ElasticSolution, SolveStats};
-pub use solve::{SolveError, SolverSettings, solve};
+pub use solve::{AssembledBody, SolveError, SolverSettings, assemble, reactions, solve};

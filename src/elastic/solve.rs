@@ -6,11 +6,12 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::{ElasticProblem, ElasticSolution, ProblemError, SolveStats};
-use crate::fem::Constraints;
 use crate::fem::assembly::{assemble_stiffness, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::stress::cell_fields;
+use crate::fem::{Constraints, SparsityPattern};
 use crate::linalg::{Cholesky, CholeskySymbolic, LinalgError, Ordering, relative_residual};
+use faer::sparse::SparseColMat;
 
 /// How to solve; every field has a documented default.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -82,7 +83,12 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
 }
 
 /// Runs `f`, records its duration under `name`, and reports it when verbose.
-fn timed<T>(stats: &mut SolveStats, verbose: bool, name: &str, f: impl FnOnce() -> T) -> T {
+pub(crate) fn timed<T>(
+    stats: &mut SolveStats,
+    verbose: bool,
+    name: &str,
+    f: impl FnOnce() -> T,
+) -> T {
     let start = Instant::now();
     let value = f();
     let seconds = start.elapsed().as_secs_f64();
@@ -93,34 +99,37 @@ fn timed<T>(stats: &mut SolveStats, verbose: bool, name: &str, f: impl FnOnce() 
     value
 }
 
-/// Solves the elastic problem of one body.
-pub fn solve(
+/// A body's assembled system: `K` and `f` as assembled, and the Dirichlet-constrained
+/// `K_c`, `f_c` on the same pattern.
+pub struct AssembledBody {
+    pub pattern: SparsityPattern,
+    pub k: SparseColMat<usize, f64>,
+    pub f: Vec<f64>,
+    pub constraints: Constraints,
+    pub k_c: SparseColMat<usize, f64>,
+    pub f_c: Vec<f64>,
+}
+
+/// Assembles `K`, `f` and applies the Dirichlet conditions, timing each phase into `stats`.
+pub fn assemble(
     problem: &ElasticProblem,
-    settings: &SolverSettings,
-) -> Result<ElasticSolution, SolveError> {
+    stats: &mut SolveStats,
+    verbose: bool,
+) -> Result<AssembledBody, ProblemError> {
     let body = problem.body;
-    let dim = body.dim;
-    let verbose = settings.verbose;
-    let linalg = |source| SolveError::Linalg {
-        body: body.name.clone(),
-        source,
-    };
-    let mut stats = SolveStats {
-        num_dofs: body.num_dofs(),
-        ..Default::default()
-    };
+    stats.num_dofs = body.num_dofs();
 
     // 1. Sparsity pattern and stiffness K (unconstrained).
-    let pattern = timed(&mut stats, verbose, "sparsity pattern", || {
+    let pattern = timed(stats, verbose, "sparsity pattern", || {
         stiffness_pattern(body)
     });
-    let k = timed(&mut stats, verbose, "assemble stiffness", || {
+    let k = timed(stats, verbose, "assemble stiffness", || {
         assemble_stiffness(body, &problem.material, &pattern)
     });
     stats.stiffness_nnz = pattern.nnz();
 
     // 2. Load vector f: surface loads and body force.
-    let f = timed(&mut stats, verbose, "assemble loads", || {
+    let f = timed(stats, verbose, "assemble loads", || {
         let mut f = vec![0.0; body.num_dofs()];
         for load in &problem.loads {
             let group = body
@@ -137,38 +146,31 @@ pub fn solve(
     // 3. Dirichlet conditions, eliminated symmetrically on the same pattern.
     let constraints = constraints(problem)?;
     stats.num_prescribed_dofs = constraints.num_fixed();
-    let (k_c, f_c) = timed(&mut stats, verbose, "apply Dirichlet conditions", || {
+    let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
         constraints.apply(&k, &f)
     });
-
-    // 4. Cholesky: symbolic (ordering) then numeric.
-    let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
-        CholeskySymbolic::new(&pattern, settings.ordering)
+    Ok(AssembledBody {
+        pattern,
+        k,
+        f,
+        constraints,
+        k_c,
+        f_c,
     })
-    .map_err(linalg)?;
-    stats.factor_nnz = symbolic.factor_nnz();
-    let factor = timed(&mut stats, verbose, "numeric factorization", || {
-        Cholesky::factorize(symbolic, &k_c)
-    })
-    .map_err(linalg)?;
+}
 
-    // 5. Solve and check the residual of the constrained system.
-    let mut u = f_c.clone();
-    timed(&mut stats, verbose, "triangular solves", || {
-        factor.solve_in_place(&mut u, 1)
-    });
-    stats.relative_residual = relative_residual(&k_c, &u, &f_c);
-    if stats.relative_residual.is_nan() || stats.relative_residual > settings.residual_tolerance {
-        return Err(SolveError::Inaccurate {
-            body: body.name.clone(),
-            residual: stats.relative_residual,
-            tolerance: settings.residual_tolerance,
-        });
-    }
-
-    // 6. Reactions r = K u - f on the prescribed dofs of each Dirichlet group.
-    let r = crate::linalg::mat_vec(&k, &u);
-    let reactions = problem
+/// Reaction of each Dirichlet group: `sum (K u - f - f_other)` over its prescribed dofs, where
+/// `f_other` are forces not in `f` (contact forces; empty for a single body).
+pub fn reactions(
+    problem: &ElasticProblem,
+    system: &AssembledBody,
+    u: &[f64],
+    f_other: &[f64],
+) -> Vec<(String, Vec<f64>)> {
+    let body = problem.body;
+    let dim = body.dim;
+    let r = crate::linalg::mat_vec(&system.k, u);
+    problem
         .dirichlet
         .iter()
         .map(|condition| {
@@ -178,18 +180,60 @@ pub fn solve(
             let mut total = vec![0.0; dim];
             for node in group.nodes() {
                 for c in (0..dim).filter(|&c| condition.components[c].is_some()) {
-                    total[c] += r[dim * node + c] - f[dim * node + c];
+                    let d = dim * node + c;
+                    total[c] += r[d] - system.f[d] - f_other.get(d).copied().unwrap_or(0.0);
                 }
             }
             (condition.group.clone(), total)
         })
-        .collect();
+        .collect()
+}
 
-    // 7. Strain and stress per cell.
+/// Solves the elastic problem of one body.
+pub fn solve(
+    problem: &ElasticProblem,
+    settings: &SolverSettings,
+) -> Result<ElasticSolution, SolveError> {
+    let body = problem.body;
+    let verbose = settings.verbose;
+    let linalg = |source| SolveError::Linalg {
+        body: body.name.clone(),
+        source,
+    };
+    let mut stats = SolveStats::default();
+    let system = assemble(problem, &mut stats, verbose)?;
+    let (pattern, k_c, f_c) = (&system.pattern, &system.k_c, &system.f_c);
+
+    // 4. Cholesky: symbolic (ordering) then numeric.
+    let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
+        CholeskySymbolic::new(pattern, settings.ordering)
+    })
+    .map_err(linalg)?;
+    stats.factor_nnz = symbolic.factor_nnz();
+    let factor = timed(&mut stats, verbose, "numeric factorization", || {
+        Cholesky::factorize(symbolic, k_c)
+    })
+    .map_err(linalg)?;
+
+    // 5. Solve and check the residual of the constrained system.
+    let mut u = f_c.clone();
+    timed(&mut stats, verbose, "triangular solves", || {
+        factor.solve_in_place(&mut u, 1)
+    });
+    stats.relative_residual = relative_residual(k_c, &u, f_c);
+    if stats.relative_residual.is_nan() || stats.relative_residual > settings.residual_tolerance {
+        return Err(SolveError::Inaccurate {
+            body: body.name.clone(),
+            residual: stats.relative_residual,
+            tolerance: settings.residual_tolerance,
+        });
+    }
+
+    // 6. Reactions and cell fields.
+    let reactions = reactions(problem, &system, &u, &[]);
     let cell_fields = timed(&mut stats, verbose, "strain and stress", || {
         cell_fields(body, &problem.material, &u)
     });
-
     Ok(ElasticSolution {
         displacement: u,
         cell_fields,

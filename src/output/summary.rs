@@ -6,6 +6,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::OutputError;
+use crate::contact::{ContactSettings, ContactStatus, HertzFit, IterationRecord};
 use crate::elastic::SolveStats;
 
 #[derive(Debug, Serialize)]
@@ -14,6 +15,9 @@ pub struct CaseSummary {
     pub mesh: String,
     pub dimension: usize,
     pub bodies: Vec<BodySummary>,
+    /// Present in contact runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSummary>,
     /// Seconds per phase of the whole run, in order.
     pub timings: Vec<(String, f64)>,
 }
@@ -33,6 +37,26 @@ pub struct BodySummary {
     /// Reaction force of each Dirichlet group.
     pub reactions: BTreeMap<String, Vec<f64>>,
     pub solve: SolveStats,
+}
+
+/// How the contact solve ended, its forces and the iteration history.
+#[derive(Debug, Serialize)]
+pub struct ContactSummary {
+    pub status: ContactStatus,
+    pub primary: String,
+    pub secondary: String,
+    pub settings: ContactSettings,
+    /// Total contact force on each body, and `|F1 + F2| / |F1|`.
+    pub force_primary: Vec<f64>,
+    pub force_secondary: Vec<f64>,
+    pub force_imbalance: f64,
+    /// Active nodes at the end, on each surface.
+    pub active_primary: usize,
+    pub active_secondary: usize,
+    pub max_pressure: f64,
+    /// Hertz ellipse fitted to the primary pressure (contact radius / half-width and peak).
+    pub hertz_fit: Option<HertzFit>,
+    pub iterations: Vec<IterationRecord>,
 }
 
 impl CaseSummary {

@@ -4,13 +4,16 @@
 //! `/mesh/geometry` (N, 3), `/mesh/topology` (C, dim + 1), `/mesh/node_tag` (N) gmsh node tags,
 //! `/mesh/node_body` (N), `/mesh/cell_body` (C), `/mesh/cell_tag` (C) gmsh element tags,
 //! `/fields/displacement` (N, 3), `/fields/strain` and `/fields/stress` (C, 9) row-major 3 x 3,
-//! `/fields/von_mises` (C).
+//! `/fields/von_mises` (C); in contact runs also `/fields/contact_traction` (N, 3),
+//! `/fields/contact_pressure` (N), `/fields/normal_gap` (N) and `/fields/contact_active` (N),
+//! zero at nodes off the candidate surfaces (gap NaN where the other surface is out of range).
 
 use std::path::Path;
 
 use ndarray::{Array1, Array2};
 
 use super::OutputError;
+use crate::contact::SurfaceFields;
 use crate::fem::stress::CellFields;
 use crate::mesh::BodyMesh;
 
@@ -20,6 +23,8 @@ pub struct BodyFields<'a> {
     /// Interleaved, `dim` per node.
     pub displacement: &'a [f64],
     pub cell_fields: &'a CellFields,
+    /// Interface fields on the body's contact candidate surface, in contact runs.
+    pub surface: Option<&'a SurfaceFields>,
 }
 
 /// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`.
@@ -36,8 +41,22 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
     let mut topology = Vec::with_capacity((dim + 1) * num_cells);
     let (mut cell_tag, mut cell_body) = (Vec::new(), Vec::new());
     let (mut strain, mut stress, mut von_mises) = (Vec::new(), Vec::new(), Vec::new());
+    let contact = bodies.iter().any(|b| b.surface.is_some());
+    let mut traction = vec![0.0; 3 * num_nodes];
+    let mut pressure = vec![0.0; num_nodes];
+    let mut gap = vec![0.0; num_nodes];
+    let mut active = vec![0i32; num_nodes];
     let mut offset = 0;
     for (id, body) in bodies.iter().enumerate() {
+        if let Some(surface) = body.surface {
+            for (s, &node) in surface.nodes.iter().enumerate() {
+                let row = offset + node;
+                traction[3 * row..3 * row + 3].copy_from_slice(&surface.traction[s]);
+                pressure[row] = surface.pressure[s];
+                gap[row] = surface.normal_gap[s];
+                active[row] = i32::from(surface.active[s]);
+            }
+        }
         let m = body.mesh;
         for (a, x) in m.coords.iter().enumerate() {
             geometry.extend_from_slice(x);
@@ -103,20 +122,40 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
             .new_dataset_builder()
             .with_data(&Array1::from(von_mises))
             .create("von_mises")?;
+        if contact {
+            fields
+                .new_dataset_builder()
+                .with_data(&table(traction, 3))
+                .create("contact_traction")?;
+            fields
+                .new_dataset_builder()
+                .with_data(&Array1::from(pressure))
+                .create("contact_pressure")?;
+            fields
+                .new_dataset_builder()
+                .with_data(&Array1::from(gap))
+                .create("normal_gap")?;
+            fields
+                .new_dataset_builder()
+                .with_data(&Array1::from(active))
+                .create("contact_active")?;
+        }
         file.close()
     };
     write().map_err(hdf5_error)?;
 
     let xdmf_path = dir.join(format!("{stem}.xdmf"));
-    std::fs::write(&xdmf_path, xdmf_text(stem, dim, num_nodes, num_cells)).map_err(|source| {
-        OutputError::Io {
-            path: xdmf_path,
-            source,
-        }
+    std::fs::write(
+        &xdmf_path,
+        xdmf_text(stem, dim, num_nodes, num_cells, contact),
+    )
+    .map_err(|source| OutputError::Io {
+        path: xdmf_path,
+        source,
     })
 }
 
-fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize) -> String {
+fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize, contact: bool) -> String {
     let h5 = format!("{stem}.h5");
     let item = |dims: String, number: &str, precision: u8, path: &str| {
         format!(
@@ -206,6 +245,44 @@ fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize) -> Stri
         8,
         "/fields/von_mises",
     );
+    if contact {
+        s += &attribute(
+            "contact_traction",
+            "Vector",
+            "Node",
+            format!("{n} 3"),
+            "Float",
+            8,
+            "/fields/contact_traction",
+        );
+        s += &attribute(
+            "contact_pressure",
+            "Scalar",
+            "Node",
+            n.to_string(),
+            "Float",
+            8,
+            "/fields/contact_pressure",
+        );
+        s += &attribute(
+            "normal_gap",
+            "Scalar",
+            "Node",
+            n.to_string(),
+            "Float",
+            8,
+            "/fields/normal_gap",
+        );
+        s += &attribute(
+            "contact_active",
+            "Scalar",
+            "Node",
+            n.to_string(),
+            "Int",
+            4,
+            "/fields/contact_active",
+        );
+    }
     s += "    </Grid>\n  </Domain>\n</Xdmf>\n";
     s
 }

@@ -1,0 +1,53 @@
+//! What to solve: two elastic bodies, their candidate surfaces, and how to treat the contact.
+
+use serde::{Deserialize, Serialize};
+
+use super::ContactSurface;
+use crate::elastic::ElasticProblem;
+
+/// Which constraint couples the active surfaces (README, "Contact formulations").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Formulation {
+    /// Normal constraint only, one scalar multiplier per primary node: surfaces may slide.
+    #[default]
+    Frictionless,
+    /// Vector constraint (the seed's system): active surfaces are glued together.
+    Tied,
+}
+
+/// Settings of the active-set loop; every field has a documented default.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactSettings {
+    /// Default: frictionless.
+    pub formulation: Formulation,
+    /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
+    pub max_iterations: usize,
+    /// A candidate node penetrates when its gap along its normal is below `-tol * h`, `h` its
+    /// distance to the nearest node of its own surface (default 1e-3).
+    pub penetration_tolerance: f64,
+    /// An active node is in tension when `lambda . n > tol * p_max`, `p_max` the largest
+    /// contact pressure of the iteration (default 1e-8).
+    pub tension_tolerance: f64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            formulation: Formulation::default(),
+            max_iterations: 50,
+            penetration_tolerance: 1e-3,
+            tension_tolerance: 1e-8,
+        }
+    }
+}
+
+/// Two bodies in contact: body 1 (primary) carries the multiplier.
+pub struct ContactProblem<'m> {
+    pub primary: ElasticProblem<'m>,
+    pub secondary: ElasticProblem<'m>,
+    pub primary_surface: ContactSurface,
+    pub secondary_surface: ContactSurface,
+    pub settings: ContactSettings,
+}

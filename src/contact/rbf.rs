@@ -1,0 +1,797 @@
+//! Rescaled, compactly supported radial-basis interpolation between contact interfaces.
+//!
+//! The INTERNODES method transfers fields between the two non-matching interfaces of a contact
+//! problem with the rescaled localized radial-basis interpolation of the seed report (section 2):
+//!
+//! * Wendland C2 basis (eq. 2.2): `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`, with
+//!   `delta = |x - xi_j| / r_j` and a support radius `r_j` per interpolation node.
+//! * Source nodes `xi_1..xi_M` with radii `r_j`, target points `zeta_1..zeta_N`:
+//!   `(Phi_MM)_ij = phi(|xi_i - xi_j| / r_j)` (eq. 2.4), `(Phi_NM)_ij = phi(|zeta_i - xi_j| / r_j)`
+//!   (eq. 2.5), and the interpolation matrix is `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` (eq. 2.6) with
+//!   `D_NN = diag(Phi_NM Phi_MM^-1 1)` (eq. 2.7). Every row of `R_NM` therefore sums to one:
+//!   constants are reproduced exactly.
+//! * Because column `j` uses its own radius `r_j`, `Phi_MM` is not symmetric; it is factored with a
+//!   sparse LU. Both RBF matrices are sparse (compact support) and are assembled with a k-d tree
+//!   radius search, never by visiting all pairs.
+//! * Radii come from seed Algorithm 1 ([`support_radii`]); the interface nodes of two facing
+//!   surfaces, which satisfy Condition 3 of the seed, come from seed Algorithm 2
+//!   ([`interface_nodes`]).
+//!
+//! Points are `[f64; 3]`; 2D problems pass `z = 0` (points on a curve), 3D problems points on a
+//! surface. Nothing here depends on the dimension.
+//!
+//! Accuracy: with radii tied to the nodal spacing the rescaled interpolation is first order,
+//! `O(h)` (see `tests/interpolation.rs` for the measured rates).
+
+use std::num::NonZeroUsize;
+
+use faer::MatMut;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMat, Triplet};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+
+/// Starting value of the constant `c` of seed Algorithm 1 (`r_i = d_i / c`).
+pub const C_START: f64 = 0.5;
+
+/// Upper bound `C` of seed Conditions 1-3: Algorithm 1 fails when `c` would exceed it, and
+/// Algorithm 2 keeps a node only if it lies within `C r_j` of a node `j` of the other side.
+pub const C_MAX: f64 = 0.95;
+
+/// Relative threshold for the rescaling factors `D_ii` (eq. 2.7).
+///
+/// Target `i` is *uncovered* when `D_ii = sum_j (Phi_NM)_ij y_j <= UNCOVERED_TOL * sum_j
+/// (Phi_NM)_ij |y_j|`, with `y = Phi_MM^-1 1`. The right-hand side is the size of the terms that are
+/// summed, so the test is independent of how deep the target lies in the supports (the rescaled
+/// row of `R` does not depend on the scale of the row of `Phi_NM`). A target outside every support
+/// has an empty row (`0 <= 0`) and is uncovered; so is a target whose `D_ii` is negative or lost
+/// to cancellation.
+pub const UNCOVERED_TOL: f64 = 1e-10;
+
+/// Errors of the radial-basis interpolation.
+#[derive(Debug, thiserror::Error)]
+pub enum RbfError {
+    /// A point has a NaN or infinite coordinate.
+    #[error("point {index} has a non-finite coordinate")]
+    NonFinite {
+        /// Index of the point in the given slice.
+        index: usize,
+    },
+    /// Two nodes of the same set coincide: the nearest-neighbour distance is zero, so Condition 2
+    /// cannot hold for any radius.
+    #[error("nodes {first} and {second} coincide")]
+    CoincidentNodes {
+        /// Index of the first node.
+        first: usize,
+        /// Index of the second node.
+        second: usize,
+    },
+    /// A single node has no neighbour, so Algorithm 1 cannot size its support.
+    #[error("a single node has no neighbour to derive its support radius from")]
+    SingleNode,
+    /// Algorithm 1 raised `c` up to [`C_MAX`] and Condition 1 still fails.
+    #[error(
+        "no radius parameters satisfy Condition 1: {points} nodes still have too many neighbours at c = {c}"
+    )]
+    NoRadius {
+        /// Number of nodes that violate Condition 1 at the last `c` tried.
+        points: usize,
+        /// The last `c` tried.
+        c: f64,
+    },
+    /// Algorithm 2 removed every node of one side: the surfaces do not face each other.
+    #[error("the {side} interface is empty: the surfaces do not face each other")]
+    EmptyInterface {
+        /// The side that became empty.
+        side: Side,
+    },
+    /// An interpolation was requested without source nodes.
+    #[error("no source nodes to interpolate from")]
+    NoSources,
+    /// The number of radii differs from the number of source nodes.
+    #[error("{radii} radii given for {sources} source nodes")]
+    LengthMismatch {
+        /// Number of source nodes.
+        sources: usize,
+        /// Number of radii.
+        radii: usize,
+    },
+    /// A support radius is not positive and finite.
+    #[error("support radius {radius} of source node {index} is not positive and finite")]
+    InvalidRadius {
+        /// Index of the source node.
+        index: usize,
+        /// The offending radius.
+        radius: f64,
+    },
+    /// `Phi_MM` could not be factored or its factorization gives non-finite values.
+    #[error("the RBF matrix Phi_MM is singular: {detail}")]
+    SingularPhi {
+        /// What failed.
+        detail: String,
+    },
+    /// The k-d tree could not be built (more than `u32::MAX` points).
+    #[error("k-d tree construction failed: {0}")]
+    KdTree(#[from] kiddo::kd_tree::ConstructionError),
+    /// The sparse matrix could not be assembled.
+    #[error("sparse RBF matrix assembly failed: {0}")]
+    Assembly(String),
+}
+
+/// One of the two contact interfaces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The primary interface (nodes `xi` in the seed).
+    Primary,
+    /// The secondary interface (nodes `zeta` in the seed).
+    Secondary,
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Side::Primary => "primary",
+            Side::Secondary => "secondary",
+        })
+    }
+}
+
+/// Wendland C2 radial basis function (seed eq. 2.2): `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`
+/// for `delta >= 0`. It is `1` at `0`, vanishes with its first and second derivatives at `1` and is
+/// zero beyond.
+pub fn wendland_c2(delta: f64) -> f64 {
+    if delta >= 1.0 {
+        0.0
+    } else {
+        let t = 1.0 - delta;
+        let t2 = t * t;
+        t2 * t2 * (1.0 + 4.0 * delta)
+    }
+}
+
+/// Support radii of a node set by seed Algorithm 1.
+///
+/// With `d_i` the distance from node `i` to its nearest other node, the radii are `r_i = d_i / c`
+/// for the smallest `c` of the sequence `0.5, 0.75, 0.875, 0.9375` (`c <- (1 + c) / 2`, bounded by
+/// [`C_MAX`]) such that every node satisfies Condition 1:
+/// `n_i = #{j != i : |xi_i - xi_j| < r_i} < 1 / phi(c)`. Condition 2 (`|xi_i - xi_j| >= c r_j`)
+/// holds by construction. Together they make `Phi_MM` strictly column diagonally dominant (column
+/// `j` has fewer than `1 / phi(c)` off-diagonal entries, each at most `phi(c)`), hence invertible.
+///
+/// An empty set gives no radii. A single node has no neighbour and gives
+/// [`RbfError::SingleNode`] ([`interface_nodes`] has its own rule for that case). Coincident nodes
+/// give [`RbfError::CoincidentNodes`]; if `c` would exceed `C_MAX` the result is
+/// [`RbfError::NoRadius`].
+pub fn support_radii(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
+    check_finite(points)?;
+    match points.len() {
+        0 => return Ok(Vec::new()),
+        1 => return Err(RbfError::SingleNode),
+        _ => {}
+    }
+    let tree = ImmutableKdTree::<f64, 3>::new_from_slice(points)?;
+    let nearest = nearest_other_distances(&tree, points)?;
+    let mut c = C_START;
+    loop {
+        let bound = 1.0 / wendland_c2(c);
+        let radii: Vec<f64> = nearest.iter().map(|d| d / c).collect();
+        let violating = points
+            .iter()
+            .zip(&radii)
+            .enumerate()
+            .filter(|&(i, (p, &r))| {
+                let n_i = tree
+                    .query(p)
+                    .within::<SquaredEuclidean<f64>>(r * r)
+                    .unsorted()
+                    .execute()
+                    .into_iter()
+                    .filter(|hit| {
+                        hit.item as usize != i && distance(p, &points[hit.item as usize]) < r
+                    })
+                    .count();
+                n_i as f64 >= bound
+            })
+            .count();
+        if violating == 0 {
+            return Ok(radii);
+        }
+        let next = 0.5 * (1.0 + c);
+        if next > C_MAX {
+            return Err(RbfError::NoRadius {
+                points: violating,
+                c,
+            });
+        }
+        c = next;
+    }
+}
+
+/// The interface nodes found by seed Algorithm 2, with their support radii.
+///
+/// Indices refer to the slices given to [`interface_nodes`], in increasing order; the radii are
+/// those of Algorithm 1 on the returned sets (`primary_radii[k]` belongs to `primary[k]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterfaceNodes {
+    /// Kept primary nodes.
+    pub primary: Vec<usize>,
+    /// Support radii of the kept primary nodes.
+    pub primary_radii: Vec<f64>,
+    /// Kept secondary nodes.
+    pub secondary: Vec<usize>,
+    /// Support radii of the kept secondary nodes.
+    pub secondary_radii: Vec<f64>,
+}
+
+/// Interface nodes of two facing surfaces by seed Algorithm 2.
+///
+/// Starting from all nodes, `I` (primary) and `J` (secondary), each pass
+/// 1. computes the radii `r^xi` of `I` and `r^zeta` of `J` by Algorithm 1 on the current sets;
+/// 2. keeps `i in I` only if some `j in J` has `D^{xi,zeta}(i, j) = |xi_i - zeta_j| < C r^zeta_j`
+///    (distance matrix of eq. 2.8, evaluated through a k-d tree rather than stored), and keeps
+///    `j in J` only if some `i in I` has `|xi_i - zeta_j| < C r^xi_i` (Condition 3,
+///    `C =` [`C_MAX`]).
+///
+/// Both removals of a pass use the sets and radii at the start of the pass, so the result does
+/// not depend on which side is called primary. The loop stops only when a pass changes neither
+/// side (the AND of the two stopping conditions): removing nodes of one side changes what the
+/// other side covers, so a pass in which only one side changed is not final. Every pass that
+/// does not stop removes at least one node, hence at most `primary.len() + secondary.len()`
+/// passes.
+///
+/// A side reduced to a single node has no neighbour for Algorithm 1; its radius is then the
+/// largest radius of the other side (that side's spacing). If both sides are single nodes, each
+/// gets `|xi - zeta| / C_START`, so each covers the other; if they coincide the result is
+/// [`RbfError::SingleNode`].
+///
+/// If a side becomes empty the surfaces do not face each other: [`RbfError::EmptyInterface`].
+pub fn interface_nodes(
+    primary: &[[f64; 3]],
+    secondary: &[[f64; 3]],
+) -> Result<InterfaceNodes, RbfError> {
+    check_finite(primary)?;
+    check_finite(secondary)?;
+    let mut active_p: Vec<usize> = (0..primary.len()).collect();
+    let mut active_s: Vec<usize> = (0..secondary.len()).collect();
+    loop {
+        if active_p.is_empty() {
+            return Err(RbfError::EmptyInterface {
+                side: Side::Primary,
+            });
+        }
+        if active_s.is_empty() {
+            return Err(RbfError::EmptyInterface {
+                side: Side::Secondary,
+            });
+        }
+        let xp: Vec<[f64; 3]> = active_p.iter().map(|&i| primary[i]).collect();
+        let xs: Vec<[f64; 3]> = active_s.iter().map(|&j| secondary[j]).collect();
+        let (rp, rs) = pair_radii(&xp, &xs)?;
+        let keep_p = covered_by(&xp, &xs, &rs)?;
+        let keep_s = covered_by(&xs, &xp, &rp)?;
+        let unchanged_p = keep_p.iter().all(|&k| k);
+        let unchanged_s = keep_s.iter().all(|&k| k);
+        if unchanged_p && unchanged_s {
+            return Ok(InterfaceNodes {
+                primary: active_p,
+                primary_radii: rp,
+                secondary: active_s,
+                secondary_radii: rs,
+            });
+        }
+        active_p = retain(&active_p, &keep_p);
+        active_s = retain(&active_s, &keep_s);
+    }
+}
+
+/// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` (seed eq. 2.6) from
+/// source nodes with support radii to target points.
+///
+/// Holds `Phi_NM` (sparse rows), the sparse LU factors of `Phi_MM` and `D_NN^-1`; `R_NM` itself
+/// (dense in general) is never formed, except on request by [`Interpolation::matrix`].
+#[derive(Debug)]
+pub struct Interpolation {
+    num_sources: usize,
+    /// Row offsets of `Phi_NM` into `phi_cols` / `phi_vals` (length `N + 1`).
+    phi_rows: Vec<usize>,
+    /// Source (column) index of each stored entry of `Phi_NM`.
+    phi_cols: Vec<usize>,
+    /// Value of each stored entry of `Phi_NM`.
+    phi_vals: Vec<f64>,
+    /// Sparse LU factors of `Phi_MM`.
+    lu: Lu<usize, f64>,
+    /// `1 / D_ii` for covered targets, `0` for uncovered ones.
+    inv_d: Vec<f64>,
+    /// Targets with `D_ii` not clearly positive (see [`UNCOVERED_TOL`]).
+    uncovered: Vec<usize>,
+}
+
+impl Interpolation {
+    /// Assembles `Phi_MM` (eq. 2.4) and `Phi_NM` (eq. 2.5) with a k-d tree radius search, factors
+    /// `Phi_MM` by sparse LU and computes `D_NN = diag(Phi_NM Phi_MM^-1 1)` (eq. 2.7).
+    ///
+    /// Targets whose `D_ii` is not clearly positive (outside every source support; threshold
+    /// [`UNCOVERED_TOL`]) do not make `new` fail: their row of `R` is zero and they are listed by
+    /// [`Interpolation::uncovered_targets`].
+    ///
+    /// Cost: one radius search per source and per target (radius `max_j r_j`), one sparse LU of
+    /// `Phi_MM` and one solve.
+    pub fn new(
+        sources: &[[f64; 3]],
+        radii: &[f64],
+        targets: &[[f64; 3]],
+    ) -> Result<Self, RbfError> {
+        if sources.is_empty() {
+            return Err(RbfError::NoSources);
+        }
+        if radii.len() != sources.len() {
+            return Err(RbfError::LengthMismatch {
+                sources: sources.len(),
+                radii: radii.len(),
+            });
+        }
+        if let Some((index, &radius)) = radii
+            .iter()
+            .enumerate()
+            .find(|&(_, r)| !(r.is_finite() && *r > 0.0))
+        {
+            return Err(RbfError::InvalidRadius { index, radius });
+        }
+        check_finite(sources)?;
+        check_finite(targets)?;
+        let m = sources.len();
+        let tree = ImmutableKdTree::<f64, 3>::new_from_slice(sources)?;
+        let r_max = radii.iter().copied().fold(0.0, f64::max);
+
+        let (mm_rows, mm_cols, mm_vals) = rbf_rows(&tree, sources, radii, r_max, sources);
+        let triplets: Vec<Triplet<usize, usize, f64>> = (0..m)
+            .flat_map(|i| (mm_rows[i]..mm_rows[i + 1]).map(move |k| (i, k)))
+            .map(|(i, k)| Triplet::new(i, mm_cols[k], mm_vals[k]))
+            .collect();
+        let phi_mm = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets)
+            .map_err(|e| RbfError::Assembly(format!("{e:?}")))?;
+        let symbolic =
+            SymbolicLu::try_new(phi_mm.symbolic()).map_err(|e| RbfError::SingularPhi {
+                detail: format!("{e:?}"),
+            })?;
+        let lu = Lu::try_new_with_symbolic(symbolic, phi_mm.as_ref()).map_err(|e| {
+            RbfError::SingularPhi {
+                detail: format!("{e:?}"),
+            }
+        })?;
+
+        // y = Phi_MM^-1 1
+        let mut y = vec![1.0; m];
+        lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut y, m, 1));
+        if let Some(j) = y.iter().position(|v| !v.is_finite()) {
+            return Err(RbfError::SingularPhi {
+                detail: format!("entry {j} of Phi_MM^-1 1 is not finite"),
+            });
+        }
+
+        let (phi_rows, phi_cols, phi_vals) = rbf_rows(&tree, sources, radii, r_max, targets);
+        let mut inv_d = Vec::with_capacity(targets.len());
+        let mut uncovered = Vec::new();
+        for t in 0..targets.len() {
+            let range = phi_rows[t]..phi_rows[t + 1];
+            let (sum, magnitude) = phi_cols[range.clone()]
+                .iter()
+                .zip(&phi_vals[range])
+                .fold((0.0, 0.0), |(s, a), (&j, &v)| {
+                    (s + v * y[j], a + v * y[j].abs())
+                });
+            if sum > UNCOVERED_TOL * magnitude {
+                inv_d.push(1.0 / sum);
+            } else {
+                inv_d.push(0.0);
+                uncovered.push(t);
+            }
+        }
+        Ok(Self {
+            num_sources: m,
+            phi_rows,
+            phi_cols,
+            phi_vals,
+            lu,
+            inv_d,
+            uncovered,
+        })
+    }
+
+    /// Number of source nodes `M`.
+    pub fn num_sources(&self) -> usize {
+        self.num_sources
+    }
+
+    /// Number of target points `N`.
+    pub fn num_targets(&self) -> usize {
+        self.inv_d.len()
+    }
+
+    /// Interpolates a field with `components` values per source node, interleaved
+    /// (`values[j * components + k]`), to the targets: returns `R_NM g` in the same interleaved
+    /// layout (`N * components` values). Rows of uncovered targets are zero.
+    ///
+    /// Cost: one sparse LU solve with `components` right-hand sides and one product with
+    /// `Phi_NM`.
+    ///
+    /// # Panics
+    /// If `values.len() != num_sources() * components`.
+    pub fn apply(&self, values: &[f64], components: usize) -> Vec<f64> {
+        let m = self.num_sources;
+        assert_eq!(
+            values.len(),
+            m * components,
+            "expected {components} values for each of the {m} source nodes"
+        );
+        let n = self.num_targets();
+        if components == 0 {
+            return Vec::new();
+        }
+        // Column-major M x components copy, solved in place: x = Phi_MM^-1 g.
+        let mut x = vec![0.0; m * components];
+        for (j, node) in values.chunks_exact(components).enumerate() {
+            for (k, &v) in node.iter().enumerate() {
+                x[k * m + j] = v;
+            }
+        }
+        self.lu
+            .solve_in_place(MatMut::from_column_major_slice_mut(&mut x, m, components));
+        let mut out = vec![0.0; n * components];
+        for (t, row) in out.chunks_exact_mut(components).enumerate() {
+            let scale = self.inv_d[t];
+            if scale == 0.0 {
+                continue;
+            }
+            for p in self.phi_rows[t]..self.phi_rows[t + 1] {
+                let (j, v) = (self.phi_cols[p], self.phi_vals[p]);
+                for (k, o) in row.iter_mut().enumerate() {
+                    *o += v * x[k * m + j];
+                }
+            }
+            row.iter_mut().for_each(|o| *o *= scale);
+        }
+        out
+    }
+
+    /// The dense `N x M` interpolation matrix `R_NM` (eq. 2.6). Costs `M` solves and `N * M`
+    /// memory: meant for small interfaces and tests.
+    pub fn matrix(&self) -> nalgebra::DMatrix<f64> {
+        let m = self.num_sources;
+        let mut identity = vec![0.0; m * m];
+        identity.iter_mut().step_by(m + 1).for_each(|v| *v = 1.0);
+        // With the identity as an M-component field, output row t holds row t of R.
+        nalgebra::DMatrix::from_row_slice(self.num_targets(), m, &self.apply(&identity, m))
+    }
+
+    /// Targets outside every source support: `D_ii` not clearly positive (see
+    /// [`UNCOVERED_TOL`]). Their rows of `R` are zero. Sorted increasingly.
+    pub fn uncovered_targets(&self) -> &[usize] {
+        &self.uncovered
+    }
+}
+
+/// Euclidean distance.
+fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}
+
+fn check_finite(points: &[[f64; 3]]) -> Result<(), RbfError> {
+    match points.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
+        Some(index) => Err(RbfError::NonFinite { index }),
+        None => Ok(()),
+    }
+}
+
+/// Distance from every point to its nearest other point (at least two points in the tree).
+fn nearest_other_distances(
+    tree: &ImmutableKdTree<f64, 3>,
+    points: &[[f64; 3]],
+) -> Result<Vec<f64>, RbfError> {
+    let two = NonZeroUsize::MIN.saturating_add(1);
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let hits = tree
+                .query(p)
+                .nearest_n::<SquaredEuclidean<f64>>(two)
+                .execute();
+            // With coincident points the query point itself need not come first.
+            let j = hits
+                .iter()
+                .map(|hit| hit.item as usize)
+                .find(|&j| j != i)
+                .ok_or(RbfError::SingleNode)?;
+            let d = distance(p, &points[j]);
+            if d > 0.0 {
+                Ok(d)
+            } else {
+                Err(RbfError::CoincidentNodes {
+                    first: i.min(j),
+                    second: i.max(j),
+                })
+            }
+        })
+        .collect()
+}
+
+/// Radii of both sides for one pass of Algorithm 2, with the single-node rule of
+/// [`interface_nodes`]. Both sets are non-empty.
+fn pair_radii(xp: &[[f64; 3]], xs: &[[f64; 3]]) -> Result<(Vec<f64>, Vec<f64>), RbfError> {
+    match (xp.len(), xs.len()) {
+        (1, 1) => {
+            let d = distance(&xp[0], &xs[0]);
+            if d > 0.0 {
+                Ok((vec![d / C_START], vec![d / C_START]))
+            } else {
+                Err(RbfError::SingleNode)
+            }
+        }
+        (1, _) => {
+            let rs = support_radii(xs)?;
+            let r = rs.iter().copied().fold(0.0, f64::max);
+            Ok((vec![r], rs))
+        }
+        (_, 1) => {
+            let rp = support_radii(xp)?;
+            let r = rp.iter().copied().fold(0.0, f64::max);
+            Ok((rp, vec![r]))
+        }
+        _ => Ok((support_radii(xp)?, support_radii(xs)?)),
+    }
+}
+
+/// For each point, whether some node `j` has it strictly within `C_MAX * radii[j]`
+/// (Condition 3).
+fn covered_by(
+    points: &[[f64; 3]],
+    nodes: &[[f64; 3]],
+    radii: &[f64],
+) -> Result<Vec<bool>, RbfError> {
+    let tree = ImmutableKdTree::<f64, 3>::new_from_slice(nodes)?;
+    let reach = C_MAX * radii.iter().copied().fold(0.0, f64::max);
+    Ok(points
+        .iter()
+        .map(|p| {
+            tree.query(p)
+                .within::<SquaredEuclidean<f64>>(search_radius_squared(reach))
+                .unsorted()
+                .execute()
+                .into_iter()
+                .any(|hit| {
+                    let j = hit.item as usize;
+                    distance(p, &nodes[j]) < C_MAX * radii[j]
+                })
+        })
+        .collect())
+}
+
+fn retain(indices: &[usize], keep: &[bool]) -> Vec<usize> {
+    indices
+        .iter()
+        .zip(keep)
+        .filter_map(|(&i, &k)| k.then_some(i))
+        .collect()
+}
+
+/// Squared search radius for the k-d tree, slightly enlarged so that rounding in the tree's
+/// distance never drops a node that the exact filter `distance < radius` keeps.
+fn search_radius_squared(radius: f64) -> f64 {
+    radius * radius * (1.0 + 1e-12)
+}
+
+/// Rows of the RBF matrix `(Phi)_tj = phi(|x_t - xi_j| / r_j)` for the given points against the
+/// sources in `tree` (eqs. 2.4 and 2.5), in compressed-row form `(offsets, columns, values)`
+/// with the columns of each row sorted.
+fn rbf_rows(
+    tree: &ImmutableKdTree<f64, 3>,
+    sources: &[[f64; 3]],
+    radii: &[f64],
+    r_max: f64,
+    points: &[[f64; 3]],
+) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+    let mut offsets = Vec::with_capacity(points.len() + 1);
+    offsets.push(0);
+    let mut cols = Vec::new();
+    let mut vals = Vec::new();
+    let mut row: Vec<(usize, f64)> = Vec::new();
+    for p in points {
+        row.clear();
+        row.extend(
+            tree.query(p)
+                .within::<SquaredEuclidean<f64>>(search_radius_squared(r_max))
+                .unsorted()
+                .execute()
+                .into_iter()
+                .filter_map(|hit| {
+                    let j = hit.item as usize;
+                    let delta = distance(p, &sources[j]) / radii[j];
+                    (delta < 1.0).then(|| (j, wendland_c2(delta)))
+                }),
+        );
+        row.sort_unstable_by_key(|&(j, _)| j);
+        cols.extend(row.iter().map(|&(j, _)| j));
+        vals.extend(row.iter().map(|&(_, v)| v));
+        offsets.push(cols.len());
+    }
+    (offsets, cols, vals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: usize, h: f64) -> Vec<[f64; 3]> {
+        (0..n)
+            .flat_map(|i| (0..n).map(move |j| [i as f64 * h, j as f64 * h, 0.0]))
+            .collect()
+    }
+
+    #[test]
+    fn wendland_values() {
+        assert_eq!(wendland_c2(0.0), 1.0);
+        assert_eq!(wendland_c2(1.0), 0.0);
+        assert_eq!(wendland_c2(1.5), 0.0);
+        assert_eq!(wendland_c2(1e3), 0.0);
+        // (1 - 0.5)^4 (1 + 2) = 3 / 16
+        assert!((wendland_c2(0.5) - 3.0 / 16.0).abs() < 1e-15);
+        // Monotone decreasing on [0, 1].
+        let samples: Vec<f64> = (0..=100).map(|k| wendland_c2(k as f64 / 100.0)).collect();
+        assert!(samples.windows(2).all(|w| w[1] <= w[0]));
+    }
+
+    #[test]
+    fn wendland_is_c2_at_one() {
+        // phi, phi' and phi'' vanish as delta -> 1-: phi = O(e^4), phi' = O(e^3), phi'' = O(e^2).
+        let h = 1e-3;
+        for e in [1e-2, 1e-3] {
+            let d = 1.0 - e;
+            let f = |x: f64| wendland_c2(x);
+            let d1 = (f(d + h * e) - f(d - h * e)) / (2.0 * h * e);
+            let d2 = (f(d + h * e) - 2.0 * f(d) + f(d - h * e)) / (h * e * h * e);
+            assert!(f(d) < 6.0 * e.powi(4));
+            assert!(d1.abs() < 25.0 * e.powi(3), "phi'({d}) = {d1}");
+            assert!(d2.abs() < 80.0 * e.powi(2), "phi''({d}) = {d2}");
+        }
+        // Exact derivatives phi' = -20 delta (1 - delta)^3, phi'' = 20 (1 - delta)^2 (4 delta - 1)
+        // checked against differences in the interior.
+        let d = 0.3;
+        let fd1 = (wendland_c2(d + 1e-6) - wendland_c2(d - 1e-6)) / 2e-6;
+        assert!((fd1 + 20.0 * d * (1.0f64 - d).powi(3)).abs() < 1e-8);
+    }
+
+    #[test]
+    fn radii_on_uniform_grid_are_equal_and_satisfy_condition_1() {
+        let h = 0.125; // exact in binary: all distances between grid points are exact multiples
+        let points = grid(9, h);
+        let radii = support_radii(&points).expect("radii on a grid");
+        assert_eq!(radii.len(), points.len());
+        assert!(radii.iter().all(|&r| r == radii[0]), "{radii:?}");
+        // r = d / c with d = h.
+        let c = h / radii[0];
+        assert!((C_START..=C_MAX).contains(&c));
+        let bound = 1.0 / wendland_c2(c);
+        for (i, p) in points.iter().enumerate() {
+            let n_i = points
+                .iter()
+                .enumerate()
+                .filter(|&(j, q)| j != i && distance(p, q) < radii[i])
+                .count();
+            assert!(
+                (n_i as f64) < bound,
+                "node {i}: {n_i} neighbours, bound {bound}"
+            );
+            // Condition 2.
+            for (j, q) in points.iter().enumerate() {
+                if j != i {
+                    assert!(distance(p, q) >= c * radii[j]);
+                }
+            }
+        }
+        // On a 2D grid c = 0.5 gives r = 2h with 8 neighbours inside (>= 1/phi(0.5) = 5.33),
+        // so Algorithm 1 must have moved on to c = 0.75 (4 neighbours < 64).
+        assert_eq!(c, 0.75);
+    }
+
+    #[test]
+    fn radii_errors() {
+        assert!(support_radii(&[]).expect("empty").is_empty());
+        assert!(matches!(
+            support_radii(&[[0.0; 3]]),
+            Err(RbfError::SingleNode)
+        ));
+        assert!(matches!(
+            support_radii(&[[0.0; 3], [1.0, 0.0, 0.0], [0.0; 3]]),
+            Err(RbfError::CoincidentNodes {
+                first: 0,
+                second: 2
+            })
+        ));
+        assert!(matches!(
+            support_radii(&[[0.0; 3], [f64::NAN, 0.0, 0.0]]),
+            Err(RbfError::NonFinite { index: 1 })
+        ));
+    }
+
+    #[test]
+    fn sparse_phi_mm_matches_dense() {
+        // Irregular 3D points on a sphere cap with their Algorithm 1 radii.
+        let points: Vec<[f64; 3]> = (0..40)
+            .map(|k| {
+                let t = 0.15 * k as f64;
+                let (theta, psi) = (0.6 * (k as f64 * 0.37).sin().abs(), t);
+                [
+                    theta.sin() * psi.cos(),
+                    theta.sin() * psi.sin(),
+                    theta.cos(),
+                ]
+            })
+            .collect();
+        let radii = support_radii(&points).expect("radii");
+        let tree = ImmutableKdTree::<f64, 3>::new_from_slice(&points).expect("tree");
+        let r_max = radii.iter().copied().fold(0.0, f64::max);
+        let (rows, cols, vals) = rbf_rows(&tree, &points, &radii, r_max, &points);
+        let m = points.len();
+        let mut sparse = vec![0.0; m * m];
+        for i in 0..m {
+            for k in rows[i]..rows[i + 1] {
+                sparse[i * m + cols[k]] = vals[k];
+            }
+        }
+        let mut off_diagonal = 0;
+        for i in 0..m {
+            for j in 0..m {
+                let dense = wendland_c2(distance(&points[i], &points[j]) / radii[j]);
+                assert_eq!(sparse[i * m + j], dense, "entry ({i}, {j})");
+                if i != j && dense > 0.0 {
+                    off_diagonal += 1;
+                }
+            }
+        }
+        assert!(off_diagonal > 0, "the test set must couple some nodes");
+        // Column diagonal dominance from Conditions 1 and 2.
+        for j in 0..m {
+            let col: f64 = (0..m).filter(|&i| i != j).map(|i| sparse[i * m + j]).sum();
+            assert!(col < 1.0, "column {j}: off-diagonal sum {col}");
+        }
+    }
+
+    #[test]
+    fn uncovered_target_gets_zero_row() {
+        let sources: Vec<[f64; 3]> = (0..5).map(|k| [k as f64 * 0.25, 0.0, 0.0]).collect();
+        let radii = support_radii(&sources).expect("radii");
+        let targets = [[0.3, 0.0, 0.0], [10.0, 0.0, 0.0], [0.9, 0.01, 0.0]];
+        let interp = Interpolation::new(&sources, &radii, &targets).expect("interpolation");
+        assert_eq!(interp.uncovered_targets(), &[1]);
+        let r = interp.matrix();
+        assert!(r.row(1).iter().all(|&v| v == 0.0));
+        for t in [0, 2] {
+            assert!((r.row(t).sum() - 1.0).abs() < 1e-14);
+        }
+        let out = interp.apply(&[2.0; 5], 1);
+        assert_eq!(out[1], 0.0);
+        assert!((out[0] - 2.0).abs() < 1e-14 && (out[2] - 2.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn interpolation_input_errors() {
+        let s = [[0.0; 3], [1.0, 0.0, 0.0]];
+        assert!(matches!(
+            Interpolation::new(&[], &[], &s),
+            Err(RbfError::NoSources)
+        ));
+        assert!(matches!(
+            Interpolation::new(&s, &[1.0], &s),
+            Err(RbfError::LengthMismatch {
+                sources: 2,
+                radii: 1
+            })
+        ));
+        assert!(matches!(
+            Interpolation::new(&s, &[1.0, 0.0], &s),
+            Err(RbfError::InvalidRadius { index: 1, .. })
+        ));
+    }
+}

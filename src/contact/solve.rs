@@ -1,0 +1,496 @@
+//! The INTERNODES active-set loop (seed Algorithm 3, with removal and addition in one pass).
+//!
+//! ```text
+//! I^C, J^C <- all candidate nodes
+//! repeat
+//!   1. I, J, radii <- interface nodes among I^C, J^C          (seed Algorithm 2)
+//!   2. R12, R21, M1, M2, d on the reference geometry           (method.md section 2)
+//!   3. solve the coupled system for u1, u2, lambda
+//!   4. tension:     active nodes with lambda . n > tol_t p_max
+//!      penetration: candidate nodes with gap . n < -tol_p h    (deformed configuration)
+//!   5. I^C <- I - tension + penetrating, same for J^C
+//! until nothing is in tension or penetrating (converged), an active set repeats (cycling),
+//! or the iteration cap is reached
+//! ```
+
+use std::collections::{BTreeSet, HashSet};
+use std::time::Instant;
+
+use super::rbf::{Interpolation, interface_nodes, support_radii};
+use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
+use super::system::{CoupledSolution, Coupling, solve_coupled};
+use super::{ContactError, ContactProblem, ContactSurface, hertz};
+use crate::elastic::{
+    AssembledBody, ElasticProblem, ElasticSolution, SolveStats, SolverSettings, assemble,
+    reactions, solve,
+};
+use crate::fem::stress::cell_fields;
+
+/// Solves a two-body contact problem.
+pub fn solve_contact(
+    problem: &ContactProblem,
+    solver: &SolverSettings,
+) -> Result<ContactSolution, ContactError> {
+    let verbose = solver.verbose;
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let settings = &problem.settings;
+    let dim = s1.dim;
+
+    // Each body's constrained system, assembled once for all iterations.
+    let (mut stats1, mut stats2) = (SolveStats::default(), SolveStats::default());
+    let body1 = assemble(&problem.primary, &mut stats1, false)?;
+    let body2 = assemble(&problem.secondary, &mut stats2, false)?;
+
+    // Interpolation between all candidates, for the contact checks of step 4.
+    let to_primary = Interpolation::new(&s2.coords, &support_radii(&s2.coords)?, &s1.coords)?;
+    let to_secondary = Interpolation::new(&s1.coords, &support_radii(&s1.coords)?, &s2.coords)?;
+
+    let mut candidates1: BTreeSet<usize> = (0..s1.len()).collect();
+    let mut candidates2: BTreeSet<usize> = (0..s2.len()).collect();
+    let mut seen: HashSet<(Vec<usize>, Vec<usize>)> = HashSet::new();
+    let mut history = Vec::new();
+    let mut last: Option<(Coupling, CoupledSolution)> = None;
+    let mut status = ContactStatus::IterationLimit;
+
+    for iteration in 1..=settings.max_iterations {
+        let start = Instant::now();
+        // 1. Interface nodes among the candidates (Algorithm 2).
+        let c1: Vec<usize> = candidates1.iter().copied().collect();
+        let c2: Vec<usize> = candidates2.iter().copied().collect();
+        let Some(interface) = find_interface(s1, s2, &c1, &c2)? else {
+            status = ContactStatus::NoContact;
+            break;
+        };
+
+        // 2. Interface operators on the reference geometry.
+        let coupling = coupling(problem, &interface)?;
+
+        // 3. The coupled solve.
+        let solution = solve_coupled(&body1, &body2, &coupling, dim)?;
+        if solution.relative_residual.is_nan()
+            || solution.relative_residual > solver.residual_tolerance
+        {
+            return Err(ContactError::Inaccurate {
+                residual: solution.relative_residual,
+                tolerance: solver.residual_tolerance,
+            });
+        }
+
+        // 4. Contact checks on the deformed configuration.
+        let gaps1 = normal_gaps(s1, s2, &to_primary, &solution.u1, &solution.u2);
+        let gaps2 = normal_gaps(s2, s1, &to_secondary, &solution.u2, &solution.u1);
+        let tractions2 = secondary_tractions(&coupling, &solution, dim);
+        let pressure_max = solution
+            .traction
+            .iter()
+            .zip(&coupling.normals)
+            .map(|(l, n)| -dot(l, n))
+            .fold(0.0, f64::max);
+        let tension_limit = settings.tension_tolerance * pressure_max;
+        let tension1: Vec<usize> = interface
+            .primary
+            .iter()
+            .zip(&solution.traction)
+            .filter(|&(&s, l)| dot(l, &s1.normals[s]) > tension_limit)
+            .map(|(&s, _)| s)
+            .collect();
+        let tension2: Vec<usize> = interface
+            .secondary
+            .iter()
+            .zip(&tractions2)
+            .filter(|&(&s, l)| dot(l, &s2.normals[s]) > tension_limit)
+            .map(|(&s, _)| s)
+            .collect();
+        let max_tension = solution
+            .traction
+            .iter()
+            .zip(&interface.primary)
+            .map(|(l, &s)| dot(l, &s1.normals[s]))
+            .chain(
+                tractions2
+                    .iter()
+                    .zip(&interface.secondary)
+                    .map(|(l, &s)| dot(l, &s2.normals[s])),
+            )
+            .fold(0.0, f64::max);
+        let penetrating1 = penetrating(s1, &gaps1, settings.penetration_tolerance);
+        let penetrating2 = penetrating(s2, &gaps2, settings.penetration_tolerance);
+        let (max_penetration, max_penetration_over_h) =
+            deepest(s1, &gaps1).max_by(deepest(s2, &gaps2));
+
+        // 5. New candidate sets: drop tension, add penetration, both at once.
+        let active1: BTreeSet<usize> = interface.primary.iter().copied().collect();
+        let active2: BTreeSet<usize> = interface.secondary.iter().copied().collect();
+        let next1 = update(&active1, &tension1, &penetrating1);
+        let next2 = update(&active2, &tension2, &penetrating2);
+        let added = next1.difference(&active1).count() + next2.difference(&active2).count();
+        let removed = tension1.len() + tension2.len();
+        let record = IterationRecord {
+            iteration,
+            active_primary: active1.len(),
+            active_secondary: active2.len(),
+            added,
+            removed,
+            max_penetration,
+            max_penetration_over_h,
+            max_tension,
+            relative_residual: solution.relative_residual,
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        if verbose {
+            eprintln!(
+                "  iteration {:>3}: active {:>5} + {:>5}, added {:>4}, removed {:>4}, penetration {:.2e} ({:.1e} h), tension {:.2e}, {:.3} s",
+                record.iteration,
+                record.active_primary,
+                record.active_secondary,
+                record.added,
+                record.removed,
+                record.max_penetration,
+                record.max_penetration_over_h,
+                record.max_tension,
+                record.seconds
+            );
+        }
+        history.push(record);
+        last = Some((coupling, solution));
+
+        let converged = tension1.is_empty()
+            && tension2.is_empty()
+            && penetrating1.iter().all(|s| active1.contains(s))
+            && penetrating2.iter().all(|s| active2.contains(s));
+        if converged {
+            status = ContactStatus::Converged;
+            break;
+        }
+        seen.insert((
+            active1.iter().copied().collect(),
+            active2.iter().copied().collect(),
+        ));
+        if seen.contains(&(
+            next1.iter().copied().collect(),
+            next2.iter().copied().collect(),
+        )) {
+            status = ContactStatus::Cycling;
+            break;
+        }
+        candidates1 = next1;
+        candidates2 = next2;
+    }
+
+    match last {
+        Some((coupling, solution)) if status != ContactStatus::NoContact => finish(
+            problem,
+            &body1,
+            &body2,
+            stats1,
+            stats2,
+            status,
+            history,
+            &coupling,
+            solution,
+            &to_primary,
+            &to_secondary,
+        ),
+        _ => no_contact(problem, solver, history),
+    }
+}
+
+/// Interface nodes (surface indices) with their radii, or `None` when the candidate sets do not
+/// face each other within interpolation range.
+struct Interface {
+    primary: Vec<usize>,
+    primary_radii: Vec<f64>,
+    secondary: Vec<usize>,
+    secondary_radii: Vec<f64>,
+}
+
+fn find_interface(
+    s1: &ContactSurface,
+    s2: &ContactSurface,
+    c1: &[usize],
+    c2: &[usize],
+) -> Result<Option<Interface>, ContactError> {
+    if c1.len() < 2 || c2.len() < 2 {
+        return Ok(None);
+    }
+    let x1: Vec<[f64; 3]> = c1.iter().map(|&s| s1.coords[s]).collect();
+    let x2: Vec<[f64; 3]> = c2.iter().map(|&s| s2.coords[s]).collect();
+    match interface_nodes(&x1, &x2) {
+        Ok(found) if found.primary.len() >= 2 && found.secondary.len() >= 2 => {
+            Ok(Some(Interface {
+                primary: found.primary.iter().map(|&k| c1[k]).collect(),
+                primary_radii: found.primary_radii,
+                secondary: found.secondary.iter().map(|&k| c2[k]).collect(),
+                secondary_radii: found.secondary_radii,
+            }))
+        }
+        Ok(_) | Err(super::rbf::RbfError::EmptyInterface { .. }) => Ok(None),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// `R12`, `R21`, `M1`, `M2` and the gaps `d = R12 x2 - x1` of an interface.
+fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling, ContactError> {
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let x1: Vec<[f64; 3]> = interface.primary.iter().map(|&s| s1.coords[s]).collect();
+    let x2: Vec<[f64; 3]> = interface.secondary.iter().map(|&s| s2.coords[s]).collect();
+    let r12 = Interpolation::new(&x2, &interface.secondary_radii, &x1)?;
+    let r21 = Interpolation::new(&x1, &interface.primary_radii, &x2)?;
+    let x2_flat: Vec<f64> = x2.iter().flat_map(|x| x.iter().copied()).collect();
+    let x2_at_1 = r12.apply(&x2_flat, 3);
+    // Only the normal part of R12 x2 - x1 is a gap: R reproduces constants but not the linear
+    // coordinate field, so its tangential part is interpolation error, which the tied
+    // constraint would otherwise impose as a spurious O(h) tangential jump.
+    let gaps = x1
+        .iter()
+        .zip(&interface.primary)
+        .enumerate()
+        .map(|(a, (x, &s))| {
+            let n = s1.normals[s];
+            let normal_gap: f64 = (0..3).map(|k| n[k] * (x2_at_1[3 * a + k] - x[k])).sum();
+            std::array::from_fn(|k| normal_gap * n[k])
+        })
+        .collect();
+    Ok(Coupling {
+        formulation: problem.settings.formulation,
+        primary_nodes: interface.primary.iter().map(|&s| s1.nodes[s]).collect(),
+        secondary_nodes: interface.secondary.iter().map(|&s| s2.nodes[s]).collect(),
+        normals: interface.primary.iter().map(|&s| s1.normals[s]).collect(),
+        r12: r12.matrix(),
+        r21: r21.matrix(),
+        m1: s1.mass_matrix(&interface.primary),
+        m2: s2.mass_matrix(&interface.secondary),
+        gaps,
+    })
+}
+
+/// Gap of each node of `own` to the deformed `other` surface along its outward normal:
+/// `n . (R x_other(u) - x_own(u))`; NaN where `other` is out of interpolation range.
+fn normal_gaps(
+    own: &ContactSurface,
+    other: &ContactSurface,
+    to_own: &Interpolation,
+    u_own: &[f64],
+    u_other: &[f64],
+) -> Vec<f64> {
+    let dim = own.dim;
+    let deformed = |s: &ContactSurface, u: &[f64], i: usize| -> [f64; 3] {
+        let node = s.nodes[i];
+        std::array::from_fn(|k| s.coords[i][k] + if k < dim { u[dim * node + k] } else { 0.0 })
+    };
+    let other_flat: Vec<f64> = (0..other.len())
+        .flat_map(|j| deformed(other, u_other, j))
+        .collect();
+    let other_at_own = to_own.apply(&other_flat, 3);
+    let uncovered: HashSet<usize> = to_own.uncovered_targets().iter().copied().collect();
+    (0..own.len())
+        .map(|i| {
+            if uncovered.contains(&i) {
+                return f64::NAN;
+            }
+            let x = deformed(own, u_own, i);
+            (0..3)
+                .map(|k| own.normals[i][k] * (other_at_own[3 * i + k] - x[k]))
+                .sum()
+        })
+        .collect()
+}
+
+fn penetrating(surface: &ContactSurface, gaps: &[f64], tolerance: f64) -> Vec<usize> {
+    (0..surface.len())
+        .filter(|&i| gaps[i] < -tolerance * surface.spacing[i])
+        .collect()
+}
+
+/// Largest penetration `(absolute, relative to h)` over a surface (0 when none).
+struct Deepest(f64, f64);
+
+impl Deepest {
+    fn max_by(self, other: Deepest) -> (f64, f64) {
+        if other.1 > self.1 {
+            (other.0, other.1)
+        } else {
+            (self.0, self.1)
+        }
+    }
+}
+
+fn deepest(surface: &ContactSurface, gaps: &[f64]) -> Deepest {
+    let mut worst = Deepest(0.0, 0.0);
+    for (i, &g) in gaps.iter().enumerate() {
+        if -g / surface.spacing[i] > worst.1 {
+            worst = Deepest(-g, -g / surface.spacing[i]);
+        }
+    }
+    worst
+}
+
+fn update(active: &BTreeSet<usize>, tension: &[usize], penetrating: &[usize]) -> BTreeSet<usize> {
+    let mut next = active.clone();
+    for s in tension {
+        next.remove(s);
+    }
+    next.extend(penetrating.iter().copied());
+    next
+}
+
+/// `lambda_2 = -R21 lambda` at the active secondary nodes.
+fn secondary_tractions(
+    coupling: &Coupling,
+    solution: &CoupledSolution,
+    dim: usize,
+) -> Vec<[f64; 3]> {
+    (0..coupling.secondary_nodes.len())
+        .map(|j| {
+            std::array::from_fn(|c| {
+                if c >= dim {
+                    return 0.0;
+                }
+                -(0..coupling.primary_nodes.len())
+                    .map(|b| coupling.r21[(j, b)] * solution.traction[b][c])
+                    .sum::<f64>()
+            })
+        })
+        .collect()
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    problem: &ContactProblem,
+    body1: &AssembledBody,
+    body2: &AssembledBody,
+    mut stats1: SolveStats,
+    mut stats2: SolveStats,
+    status: ContactStatus,
+    history: Vec<IterationRecord>,
+    coupling: &Coupling,
+    solution: CoupledSolution,
+    to_primary: &Interpolation,
+    to_secondary: &Interpolation,
+) -> Result<ContactSolution, ContactError> {
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let dim = s1.dim;
+    stats1.relative_residual = solution.relative_residual;
+    stats2.relative_residual = solution.relative_residual;
+    let tractions2 = secondary_tractions(coupling, &solution, dim);
+    let gaps1 = normal_gaps(s1, s2, to_primary, &solution.u1, &solution.u2);
+    let gaps2 = normal_gaps(s2, s1, to_secondary, &solution.u2, &solution.u1);
+    let primary_fields = surface_fields(s1, &coupling.primary_nodes, &solution.traction, gaps1);
+    let secondary_fields = surface_fields(s2, &coupling.secondary_nodes, &tractions2, gaps2);
+    let total = |force: &[f64]| -> [f64; 3] {
+        std::array::from_fn(|c| {
+            if c < dim {
+                force.iter().skip(c).step_by(dim).sum()
+            } else {
+                0.0
+            }
+        })
+    };
+    let force_primary = total(&solution.contact_force1);
+    let force_secondary = total(&solution.contact_force2);
+    let norm = |f: &[f64; 3]| dot(f, f).sqrt();
+    let sum: [f64; 3] = std::array::from_fn(|c| force_primary[c] + force_secondary[c]);
+    let force_imbalance = if norm(&force_primary) > 0.0 {
+        norm(&sum) / norm(&force_primary)
+    } else {
+        0.0
+    };
+    let hertz_primary = hertz::fit(s1, &primary_fields);
+
+    let body_solution = |p: &ElasticProblem,
+                         body: &AssembledBody,
+                         u: Vec<f64>,
+                         force: &[f64],
+                         stats: SolveStats| ElasticSolution {
+        reactions: reactions(p, body, &u, force),
+        cell_fields: cell_fields(p.body, &p.material, &u),
+        displacement: u,
+        stats,
+    };
+    Ok(ContactSolution {
+        status,
+        history,
+        primary: body_solution(
+            &problem.primary,
+            body1,
+            solution.u1,
+            &solution.contact_force1,
+            stats1,
+        ),
+        secondary: body_solution(
+            &problem.secondary,
+            body2,
+            solution.u2,
+            &solution.contact_force2,
+            stats2,
+        ),
+        primary_fields,
+        secondary_fields,
+        force_primary,
+        force_secondary,
+        force_imbalance,
+        hertz_primary,
+    })
+}
+
+fn surface_fields(
+    surface: &ContactSurface,
+    active_nodes: &[usize],
+    tractions: &[[f64; 3]],
+    gaps: Vec<f64>,
+) -> SurfaceFields {
+    let mut fields = SurfaceFields {
+        nodes: surface.nodes.clone(),
+        traction: vec![[0.0; 3]; surface.len()],
+        pressure: vec![0.0; surface.len()],
+        normal_gap: gaps,
+        active: vec![false; surface.len()],
+    };
+    for (node, traction) in active_nodes.iter().zip(tractions) {
+        let s = surface
+            .nodes
+            .binary_search(node)
+            .expect("active nodes are surface nodes");
+        fields.traction[s] = *traction;
+        fields.pressure[s] = -dot(traction, &surface.normals[s]);
+        fields.active[s] = true;
+    }
+    fields
+}
+
+/// The bodies never come within interpolation range: each is solved alone.
+fn no_contact(
+    problem: &ContactProblem,
+    solver: &SolverSettings,
+    history: Vec<IterationRecord>,
+) -> Result<ContactSolution, ContactError> {
+    let quiet = SolverSettings {
+        verbose: false,
+        ..*solver
+    };
+    let primary = solve(&problem.primary, &quiet)?;
+    let secondary = solve(&problem.secondary, &quiet)?;
+    let empty = |s: &ContactSurface| SurfaceFields {
+        nodes: s.nodes.clone(),
+        traction: vec![[0.0; 3]; s.len()],
+        pressure: vec![0.0; s.len()],
+        normal_gap: vec![f64::NAN; s.len()],
+        active: vec![false; s.len()],
+    };
+    Ok(ContactSolution {
+        status: ContactStatus::NoContact,
+        history,
+        primary,
+        secondary,
+        primary_fields: empty(&problem.primary_surface),
+        secondary_fields: empty(&problem.secondary_surface),
+        force_primary: [0.0; 3],
+        force_secondary: [0.0; 3],
+        force_imbalance: 0.0,
+        hertz_primary: None,
+    })
+}

@@ -1,0 +1,155 @@
+//! A body's contact candidate surface: its nodes, their outward normals and spacing, and the
+//! interface mass matrix of any active subset.
+//!
+//! Nodal normals are area-weighted averages of the normals of ALL candidate facets touching a
+//! node (not only active ones, so rim nodes have well-defined normals), each facet oriented out
+//! of its adjacent cell by the mesh reader (method.md section 3).
+
+use std::collections::HashMap;
+
+use nalgebra::DMatrix;
+use thiserror::Error;
+
+use crate::fem::kernels::{facet_mass, facet_measure_and_normal};
+use crate::mesh::BodyMesh;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum SurfaceError {
+    #[error("body '{body}' has no boundary group '{group}' (groups with facets on this body: {})", .on_body.join(", "))]
+    MissingGroup {
+        body: String,
+        group: String,
+        on_body: Vec<String>,
+    },
+    #[error("contact surface '{group}' of body '{body}' has fewer than two nodes")]
+    TooSmall { body: String, group: String },
+}
+
+/// The candidate surface of one body. Surface node `s` is body node `nodes[s]`.
+#[derive(Debug, Clone)]
+pub struct ContactSurface {
+    pub body: String,
+    pub group: String,
+    pub dim: usize,
+    /// Body-local node indices, sorted.
+    pub nodes: Vec<usize>,
+    /// Reference coordinates of the surface nodes.
+    pub coords: Vec<[f64; 3]>,
+    /// Outward unit normals.
+    pub normals: Vec<[f64; 3]>,
+    /// Distance to the nearest other surface node (the local spacing h).
+    pub spacing: Vec<f64>,
+    /// Facets as surface node indices, `dim` per facet.
+    facets: Vec<usize>,
+    facet_measures: Vec<f64>,
+}
+
+impl ContactSurface {
+    pub fn new(body: &BodyMesh, group_name: &str) -> Result<Self, SurfaceError> {
+        let dim = body.dim;
+        let group = body
+            .boundary_group(group_name)
+            .ok_or_else(|| SurfaceError::MissingGroup {
+                body: body.name.clone(),
+                group: group_name.to_string(),
+                on_body: body.boundary_groups.keys().cloned().collect(),
+            })?;
+        let nodes = group.nodes();
+        if nodes.len() < 2 {
+            return Err(SurfaceError::TooSmall {
+                body: body.name.clone(),
+                group: group_name.to_string(),
+            });
+        }
+        let index: HashMap<usize, usize> = nodes.iter().enumerate().map(|(s, &n)| (n, s)).collect();
+        let coords: Vec<[f64; 3]> = nodes.iter().map(|&n| body.coords[n]).collect();
+        let mut normals = vec![[0.0; 3]; nodes.len()];
+        let mut facets = Vec::with_capacity(group.facets.len());
+        let mut facet_measures = Vec::new();
+        for f in 0..group.num_facets(dim) {
+            let facet = group.facet(f, dim);
+            let x: Vec<[f64; 3]> = facet.iter().map(|&n| body.coords[n]).collect();
+            let (measure, normal) = facet_measure_and_normal(&x, dim);
+            for &n in facet {
+                let s = index[&n];
+                facets.push(s);
+                for k in 0..3 {
+                    normals[s][k] += measure * normal[k];
+                }
+            }
+            facet_measures.push(measure);
+        }
+        for n in &mut normals {
+            let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            n.iter_mut().for_each(|v| *v /= norm);
+        }
+        let spacing = nearest_neighbour_distances(&coords);
+        Ok(Self {
+            body: body.name.clone(),
+            group: group_name.to_string(),
+            dim,
+            nodes,
+            coords,
+            normals,
+            spacing,
+            facets,
+            facet_measures,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The interface mass matrix `M[a, b] = int phi_a phi_b ds` on the active nodes `active`
+    /// (surface indices), integrated over every candidate facet that has an active node.
+    ///
+    /// Entries couple active nodes only: the multiplier is a P1 field that vanishes at
+    /// inactive nodes, so a rim facet with some inactive nodes still carries the traction of
+    /// its active ones. Returned dense, `|active| x |active|`, in the order of `active`.
+    pub fn mass_matrix(&self, active: &[usize]) -> DMatrix<f64> {
+        let dim = self.dim;
+        let mut position = vec![usize::MAX; self.len()];
+        for (k, &s) in active.iter().enumerate() {
+            position[s] = k;
+        }
+        let mut m = DMatrix::zeros(active.len(), active.len());
+        for (f, &measure) in self.facet_measures.iter().enumerate() {
+            let facet = &self.facets[dim * f..dim * (f + 1)];
+            let local = facet_mass(measure, dim);
+            for (a, &sa) in facet.iter().enumerate() {
+                for (b, &sb) in facet.iter().enumerate() {
+                    let (pa, pb) = (position[sa], position[sb]);
+                    if pa != usize::MAX && pb != usize::MAX {
+                        m[(pa, pb)] += local[a][b];
+                    }
+                }
+            }
+        }
+        m
+    }
+}
+
+/// Distance from each point to its nearest other point (k-d tree; points are distinct mesh
+/// nodes, so a surface with two or more nodes gives positive distances).
+fn nearest_neighbour_distances(points: &[[f64; 3]]) -> Vec<f64> {
+    use kiddo::{ImmutableKdTree, SquaredEuclidean};
+    let tree = ImmutableKdTree::new_from_slice(points).expect("a surface has at least two nodes");
+    let two = std::num::NonZero::new(2usize).expect("2 > 0");
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            tree.query(p)
+                .nearest_n::<SquaredEuclidean<f64>>(two)
+                .execute()
+                .iter()
+                .find(|n| n.item as usize != i)
+                .map_or(0.0, |n| n.distance.sqrt())
+        })
+        .collect()
+}
