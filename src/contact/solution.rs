@@ -28,7 +28,8 @@ pub struct IterationRecord {
     pub active_secondary: usize,
     pub added: usize,
     pub removed: usize,
-    /// Largest penetration of a candidate node, absolute and relative to its spacing h.
+    /// Largest penetration of an inactive candidate node, absolute and relative to its
+    /// spacing h.
     pub max_penetration: f64,
     pub max_penetration_over_h: f64,
     /// Largest tension `lambda . n` of an active node (0 when none is in tension).

@@ -1,7 +1,7 @@
 //! The INTERNODES active-set loop (seed Algorithm 3, with removal and addition in one pass).
 //!
 //! ```text
-//! I^C, J^C <- all candidate nodes
+//! I^C, J^C <- candidate nodes that touch or penetrate in the reference configuration
 //! repeat
 //!   1. I, J, radii <- interface nodes among I^C, J^C          (seed Algorithm 2)
 //!   2. R12, R21, M1, M2, d on the reference geometry           (method.md section 2)
@@ -12,6 +12,10 @@
 //! until nothing is in tension or penetrating (converged), an active set repeats (cycling),
 //! or the iteration cap is reached
 //! ```
+//!
+//! An empty interface is a valid iterate: the bodies are then solved apart, and penetration
+//! adds the nodes that the loads push into the other body. Converging with an empty interface
+//! means the bodies do not touch ([`ContactStatus::NoContact`]).
 
 use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
@@ -21,10 +25,10 @@ use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFi
 use super::system::{CoupledSolution, Coupling, solve_coupled};
 use super::{ContactError, ContactProblem, ContactSurface, hertz};
 use crate::elastic::{
-    AssembledBody, ElasticProblem, ElasticSolution, SolveStats, SolverSettings, assemble,
-    reactions, solve,
+    AssembledBody, ElasticProblem, ElasticSolution, SolveStats, SolverSettings, assemble, reactions,
 };
 use crate::fem::stress::cell_fields;
+use nalgebra::DMatrix;
 
 /// Solves a two-body contact problem.
 pub fn solve_contact(
@@ -45,8 +49,16 @@ pub fn solve_contact(
     let to_primary = Interpolation::new(&s2.coords, &support_radii(&s2.coords)?, &s1.coords)?;
     let to_secondary = Interpolation::new(&s1.coords, &support_radii(&s1.coords)?, &s2.coords)?;
 
-    let mut candidates1: BTreeSet<usize> = (0..s1.len()).collect();
-    let mut candidates2: BTreeSet<usize> = (0..s2.len()).collect();
+    let (zero1, zero2) = (vec![0.0; body1.f.len()], vec![0.0; body2.f.len()]);
+    let tol = settings.penetration_tolerance;
+    let mut candidates1: BTreeSet<usize> =
+        penetrating(s1, &normal_gaps(s1, s2, &to_primary, &zero1, &zero2), tol)
+            .into_iter()
+            .collect();
+    let mut candidates2: BTreeSet<usize> =
+        penetrating(s2, &normal_gaps(s2, s1, &to_secondary, &zero2, &zero1), tol)
+            .into_iter()
+            .collect();
     let mut seen: HashSet<(Vec<usize>, Vec<usize>)> = HashSet::new();
     let mut history = Vec::new();
     let mut last: Option<(Coupling, CoupledSolution)> = None;
@@ -57,10 +69,7 @@ pub fn solve_contact(
         // 1. Interface nodes among the candidates (Algorithm 2).
         let c1: Vec<usize> = candidates1.iter().copied().collect();
         let c2: Vec<usize> = candidates2.iter().copied().collect();
-        let Some(interface) = find_interface(s1, s2, &c1, &c2)? else {
-            status = ContactStatus::NoContact;
-            break;
-        };
+        let interface = find_interface(s1, s2, &c1, &c2)?.unwrap_or_default();
 
         // 2. Interface operators on the reference geometry.
         let coupling = coupling(problem, &interface)?;
@@ -115,8 +124,8 @@ pub fn solve_contact(
             .fold(0.0, f64::max);
         let penetrating1 = penetrating(s1, &gaps1, settings.penetration_tolerance);
         let penetrating2 = penetrating(s2, &gaps2, settings.penetration_tolerance);
-        let (max_penetration, max_penetration_over_h) =
-            deepest(s1, &gaps1).max_by(deepest(s2, &gaps2));
+        let (max_penetration, max_penetration_over_h) = deepest(s1, &gaps1, &interface.primary)
+            .max_by(deepest(s2, &gaps2, &interface.secondary));
 
         // 5. New candidate sets: drop tension, add penetration, both at once.
         let active1: BTreeSet<usize> = interface.primary.iter().copied().collect();
@@ -159,44 +168,55 @@ pub fn solve_contact(
             && penetrating1.iter().all(|s| active1.contains(s))
             && penetrating2.iter().all(|s| active2.contains(s));
         if converged {
-            status = ContactStatus::Converged;
+            status = if active1.is_empty() {
+                ContactStatus::NoContact
+            } else {
+                ContactStatus::Converged
+            };
             break;
         }
-        seen.insert((
-            active1.iter().copied().collect(),
-            active2.iter().copied().collect(),
-        ));
-        if seen.contains(&(
-            next1.iter().copied().collect(),
-            next2.iter().copied().collect(),
-        )) {
-            status = ContactStatus::Cycling;
-            break;
+        // A repeated set means the simultaneous update oscillates (typically at the rim, where
+        // an outer node in tension holds the surfaces together and its inner neighbours
+        // penetrate). Fall back to a one-sided step: remove the tension nodes only, or if none,
+        // add the penetrating ones only; if that repeats a set too, the loop cycles.
+        seen.insert(key(&active1, &active2));
+        let (mut next1, mut next2) = (next1, next2);
+        if seen.contains(&key(&next1, &next2)) {
+            let one_sided = if removed > 0 {
+                (&[][..], &[][..])
+            } else {
+                (&penetrating1[..], &penetrating2[..])
+            };
+            next1 = update(&active1, &tension1, one_sided.0);
+            next2 = update(&active2, &tension2, one_sided.1);
+            if seen.contains(&key(&next1, &next2)) {
+                status = ContactStatus::Cycling;
+                break;
+            }
         }
         candidates1 = next1;
         candidates2 = next2;
     }
 
-    match last {
-        Some((coupling, solution)) if status != ContactStatus::NoContact => finish(
-            problem,
-            &body1,
-            &body2,
-            stats1,
-            stats2,
-            status,
-            history,
-            &coupling,
-            solution,
-            &to_primary,
-            &to_secondary,
-        ),
-        _ => no_contact(problem, solver, history),
-    }
+    let (coupling, solution) = last.expect("the loop runs at least once (max_iterations >= 1)");
+    finish(
+        problem,
+        &body1,
+        &body2,
+        stats1,
+        stats2,
+        status,
+        history,
+        &coupling,
+        solution,
+        &to_primary,
+        &to_secondary,
+    )
 }
 
-/// Interface nodes (surface indices) with their radii, or `None` when the candidate sets do not
+/// Interface nodes (surface indices) with their radii; empty when the candidate sets do not
 /// face each other within interpolation range.
+#[derive(Default)]
 struct Interface {
     primary: Vec<usize>,
     primary_radii: Vec<f64>,
@@ -234,6 +254,24 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let x1: Vec<[f64; 3]> = interface.primary.iter().map(|&s| s1.coords[s]).collect();
     let x2: Vec<[f64; 3]> = interface.secondary.iter().map(|&s| s2.coords[s]).collect();
+    let (m1_rows, m1) = s1.mass_matrix(&interface.primary);
+    let (m2_rows, m2) = s2.mass_matrix(&interface.secondary);
+    let mut coupling = Coupling {
+        formulation: problem.settings.formulation,
+        primary_nodes: interface.primary.iter().map(|&s| s1.nodes[s]).collect(),
+        secondary_nodes: interface.secondary.iter().map(|&s| s2.nodes[s]).collect(),
+        normals: interface.primary.iter().map(|&s| s1.normals[s]).collect(),
+        r12: DMatrix::zeros(x1.len(), x2.len()),
+        r21: DMatrix::zeros(x2.len(), x1.len()),
+        m1_rows: m1_rows.iter().map(|&s| s1.nodes[s]).collect(),
+        m1,
+        m2_rows: m2_rows.iter().map(|&s| s2.nodes[s]).collect(),
+        m2,
+        gaps: Vec::new(),
+    };
+    if x1.is_empty() {
+        return Ok(coupling);
+    }
     let r12 = Interpolation::new(&x2, &interface.secondary_radii, &x1)?;
     let r21 = Interpolation::new(&x1, &interface.primary_radii, &x2)?;
     let x2_flat: Vec<f64> = x2.iter().flat_map(|x| x.iter().copied()).collect();
@@ -241,7 +279,7 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     // Only the normal part of R12 x2 - x1 is a gap: R reproduces constants but not the linear
     // coordinate field, so its tangential part is interpolation error, which the tied
     // constraint would otherwise impose as a spurious O(h) tangential jump.
-    let gaps = x1
+    let gaps: Vec<[f64; 3]> = x1
         .iter()
         .zip(&interface.primary)
         .enumerate()
@@ -251,17 +289,10 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
             std::array::from_fn(|k| normal_gap * n[k])
         })
         .collect();
-    Ok(Coupling {
-        formulation: problem.settings.formulation,
-        primary_nodes: interface.primary.iter().map(|&s| s1.nodes[s]).collect(),
-        secondary_nodes: interface.secondary.iter().map(|&s| s2.nodes[s]).collect(),
-        normals: interface.primary.iter().map(|&s| s1.normals[s]).collect(),
-        r12: r12.matrix(),
-        r21: r21.matrix(),
-        m1: s1.mass_matrix(&interface.primary),
-        m2: s2.mass_matrix(&interface.secondary),
-        gaps,
-    })
+    coupling.gaps = gaps;
+    coupling.r12 = r12.matrix();
+    coupling.r21 = r21.matrix();
+    Ok(coupling)
 }
 
 /// Gap of each node of `own` to the deformed `other` surface along its outward normal:
@@ -302,7 +333,7 @@ fn penetrating(surface: &ContactSurface, gaps: &[f64], tolerance: f64) -> Vec<us
         .collect()
 }
 
-/// Largest penetration `(absolute, relative to h)` over a surface (0 when none).
+/// Largest penetration `(absolute, relative to h)` (0 when none).
 struct Deepest(f64, f64);
 
 impl Deepest {
@@ -315,14 +346,20 @@ impl Deepest {
     }
 }
 
-fn deepest(surface: &ContactSurface, gaps: &[f64]) -> Deepest {
+/// The deepest penetration among the inactive candidates (the nodes the penetration criterion
+/// applies to; active nodes are held by the interface constraint).
+fn deepest(surface: &ContactSurface, gaps: &[f64], active: &[usize]) -> Deepest {
     let mut worst = Deepest(0.0, 0.0);
     for (i, &g) in gaps.iter().enumerate() {
-        if -g / surface.spacing[i] > worst.1 {
+        if -g / surface.spacing[i] > worst.1 && !active.contains(&i) {
             worst = Deepest(-g, -g / surface.spacing[i]);
         }
     }
     worst
+}
+
+fn key(a: &BTreeSet<usize>, b: &BTreeSet<usize>) -> (Vec<usize>, Vec<usize>) {
+    (a.iter().copied().collect(), b.iter().copied().collect())
 }
 
 fn update(active: &BTreeSet<usize>, tension: &[usize], penetrating: &[usize]) -> BTreeSet<usize> {
@@ -460,37 +497,4 @@ fn surface_fields(
         fields.active[s] = true;
     }
     fields
-}
-
-/// The bodies never come within interpolation range: each is solved alone.
-fn no_contact(
-    problem: &ContactProblem,
-    solver: &SolverSettings,
-    history: Vec<IterationRecord>,
-) -> Result<ContactSolution, ContactError> {
-    let quiet = SolverSettings {
-        verbose: false,
-        ..*solver
-    };
-    let primary = solve(&problem.primary, &quiet)?;
-    let secondary = solve(&problem.secondary, &quiet)?;
-    let empty = |s: &ContactSurface| SurfaceFields {
-        nodes: s.nodes.clone(),
-        traction: vec![[0.0; 3]; s.len()],
-        pressure: vec![0.0; s.len()],
-        normal_gap: vec![f64::NAN; s.len()],
-        active: vec![false; s.len()],
-    };
-    Ok(ContactSolution {
-        status: ContactStatus::NoContact,
-        history,
-        primary,
-        secondary,
-        primary_fields: empty(&problem.primary_surface),
-        secondary_fields: empty(&problem.secondary_surface),
-        force_primary: [0.0; 3],
-        force_secondary: [0.0; 3],
-        force_imbalance: 0.0,
-        hertz_primary: None,
-    })
 }

@@ -105,32 +105,50 @@ impl ContactSurface {
         self.nodes.is_empty()
     }
 
-    /// The interface mass matrix `M[a, b] = int phi_a phi_b ds` on the active nodes `active`
-    /// (surface indices), integrated over every candidate facet that has an active node.
+    /// The interface mass matrix of the active nodes `active` (surface indices):
+    /// `M[a, b] = int phi_a phi_b ds` for every node `a` of a facet that has an active node,
+    /// and active `b`.
     ///
-    /// Entries couple active nodes only: the multiplier is a P1 field that vanishes at
-    /// inactive nodes, so a rim facet with some inactive nodes still carries the traction of
-    /// its active ones. Returned dense, `|active| x |active|`, in the order of `active`.
-    pub fn mass_matrix(&self, active: &[usize]) -> DMatrix<f64> {
+    /// The multiplier is a P1 field that vanishes at inactive nodes, so the force it exerts,
+    /// `M lambda`, also reaches the inactive neighbours on the rim; dropping those rows would
+    /// lose part of the contact force. Returns the rows (surface indices) and the dense
+    /// `|rows| x |active|` matrix, columns in the order of `active`.
+    pub fn mass_matrix(&self, active: &[usize]) -> (Vec<usize>, DMatrix<f64>) {
         let dim = self.dim;
-        let mut position = vec![usize::MAX; self.len()];
+        let mut column = vec![usize::MAX; self.len()];
         for (k, &s) in active.iter().enumerate() {
-            position[s] = k;
+            column[s] = k;
         }
-        let mut m = DMatrix::zeros(active.len(), active.len());
-        for (f, &measure) in self.facet_measures.iter().enumerate() {
+        let touched: Vec<usize> = (0..self.facet_measures.len())
+            .filter(|&f| {
+                self.facets[dim * f..dim * (f + 1)]
+                    .iter()
+                    .any(|&s| column[s] != usize::MAX)
+            })
+            .collect();
+        let mut rows: Vec<usize> = touched
+            .iter()
+            .flat_map(|&f| self.facets[dim * f..dim * (f + 1)].to_vec())
+            .collect();
+        rows.sort_unstable();
+        rows.dedup();
+        let mut row = vec![usize::MAX; self.len()];
+        for (k, &s) in rows.iter().enumerate() {
+            row[s] = k;
+        }
+        let mut m = DMatrix::zeros(rows.len(), active.len());
+        for &f in &touched {
             let facet = &self.facets[dim * f..dim * (f + 1)];
-            let local = facet_mass(measure, dim);
+            let local = facet_mass(self.facet_measures[f], dim);
             for (a, &sa) in facet.iter().enumerate() {
                 for (b, &sb) in facet.iter().enumerate() {
-                    let (pa, pb) = (position[sa], position[sb]);
-                    if pa != usize::MAX && pb != usize::MAX {
-                        m[(pa, pb)] += local[a][b];
+                    if column[sb] != usize::MAX {
+                        m[(row[sa], column[sb])] += local[a][b];
                     }
                 }
             }
         }
-        m
+        (rows, m)
     }
 }
 

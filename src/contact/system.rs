@@ -42,8 +42,11 @@ pub struct Coupling {
     pub r12: DMatrix<f64>,
     /// `R21` (|J| x |I|), interpolating from I to J.
     pub r21: DMatrix<f64>,
-    /// Interface mass matrices of the active facets, `M1` (|I| x |I|) and `M2` (|J| x |J|).
+    /// Interface mass matrices of the facets with an active node: rows are the body nodes of
+    /// those facets (`m1_rows`, `m2_rows`), columns the active nodes I (resp. J).
+    pub m1_rows: Vec<usize>,
     pub m1: DMatrix<f64>,
+    pub m2_rows: Vec<usize>,
     pub m2: DMatrix<f64>,
     /// Nodal gaps in the reference configuration: the normal part of `R12 x2(J) - x1(I)`.
     pub gaps: Vec<[f64; 3]>,
@@ -105,13 +108,11 @@ pub fn solve_coupled(
     let m = coupling.num_multipliers(dim);
     let n = n1 + n2 + m;
     let k_scale = diagonal_max(&body1.k_c).max(diagonal_max(&body2.k_c));
-    let m_scale = (0..coupling.m1.nrows())
-        .map(|a| coupling.m1[(a, a)])
-        .fold(0.0, f64::max);
-    if m_scale <= 0.0 {
+    let m_scale = coupling.m1.iter().cloned().fold(0.0, f64::max);
+    if m > 0 && m_scale <= 0.0 {
         return Err(ContactError::EmptyInterfaceMass);
     }
-    let s = k_scale / m_scale;
+    let s = if m > 0 { k_scale / m_scale } else { 1.0 };
     let t = k_scale;
 
     let dropped: Vec<bool> = (0..m)
@@ -132,8 +133,8 @@ pub fn solve_coupled(
     // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2.
     let m2_r21 = &coupling.m2 * &coupling.r21;
     for (nodes, matrix, sign, offset, body) in [
-        (&coupling.primary_nodes, &coupling.m1, -1.0, 0, body1),
-        (&coupling.secondary_nodes, &m2_r21, 1.0, n1, body2),
+        (&coupling.m1_rows, &coupling.m1, -1.0, 0, body1),
+        (&coupling.m2_rows, &m2_r21, 1.0, n1, body2),
     ] {
         for (a, &node) in nodes.iter().enumerate() {
             for c in 0..dim {

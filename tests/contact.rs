@@ -1,0 +1,315 @@
+//! The INTERNODES contact solver on committed meshes: exact patch tests, 2D Hertz contact, the
+//! statuses of the active-set loop, and bad contact input.
+
+mod common;
+
+use common::fixture;
+use internodes::case::{Case, CaseError};
+use internodes::contact::{ContactSolution, ContactStatus, solve_contact};
+use internodes::elastic::SolverSettings;
+use internodes::mesh::read_msh;
+
+/// Solves the `[contact]` of a case given as TOML text.
+fn solve(text: &str) -> Result<ContactSolution, String> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    let case = Case::load(&path).map_err(|e| e.to_string())?;
+    let mesh = read_msh(&case.mesh).map_err(|e| e.to_string())?;
+    let problem = case
+        .contact_problem(&mesh)
+        .map_err(|e| e.to_string())?
+        .expect("the case has a [contact] table");
+    let settings = SolverSettings {
+        verbose: false,
+        ..case.solver
+    };
+    solve_contact(&problem, &settings).map_err(|e| e.to_string())
+}
+
+/// Two stacked unit blocks with non-matching meshes, compressed by `delta` through the top of
+/// the upper one, the lower one on its base; `sides` are extra Dirichlet lines for both
+/// bodies' side groups (e.g. rollers).
+fn two_blocks(dim: usize, formulation: &str, lower_sides: &str, upper_sides: &str) -> String {
+    let vertical = if dim == 2 { "uy" } else { "uz" };
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "upper"
+primary_surface = "upper_contact"
+secondary = "lower"
+secondary_surface = "lower_contact"
+formulation = "{formulation}"
+
+[[body]]
+name = "lower"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "lower_base"
+{vertical} = 0.0
+{lower_sides}
+
+[[body]]
+name = "upper"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "upper_top"
+{vertical} = -0.01
+{upper_sides}
+"#,
+        mesh = fixture(&format!("two_blocks_{dim}d.msh")).display()
+    )
+}
+
+fn rollers(body: &str, dim: usize) -> String {
+    let lateral = if dim == 2 {
+        "ux = 0.0"
+    } else {
+        "ux = 0.0\nuy = 0.0"
+    };
+    format!("[[body.dirichlet]]\ngroup = \"{body}_sides\"\n{lateral}")
+}
+
+#[test]
+fn contact_patch_test_gives_the_uniform_applied_pressure() {
+    // Uniaxial strain: both unit-height blocks carry sigma = (lambda + 2 mu) delta / 2, so the
+    // contact pressure is that constant on every interface node, whatever the meshes.
+    let (lambda, mu) = (1000.0 * 0.3 / (1.3 * 0.4), 1000.0 / 2.6);
+    let expected = (lambda + 2.0 * mu) * 0.01 / 2.0;
+    for dim in [2, 3] {
+        for formulation in ["frictionless", "tied"] {
+            let text = two_blocks(
+                dim,
+                formulation,
+                &rollers("lower", dim),
+                &rollers("upper", dim),
+            );
+            let solution = solve(&text).unwrap();
+            let label = format!("{dim}D {formulation}");
+            assert_eq!(solution.status, ContactStatus::Converged, "{label}");
+            for fields in [&solution.primary_fields, &solution.secondary_fields] {
+                assert!(
+                    fields.active.iter().all(|&a| a),
+                    "{label}: every interface node is active"
+                );
+                for (p, traction) in fields.pressure.iter().zip(&fields.traction) {
+                    assert!(
+                        (p - expected).abs() <= 1e-6 * expected,
+                        "{label}: pressure {p}, expected {expected}"
+                    );
+                    let tangential =
+                        (traction[0].powi(2) + traction[1].powi(2) + traction[2].powi(2) - p * p)
+                            .max(0.0)
+                            .sqrt();
+                    assert!(
+                        tangential <= 1e-6 * expected,
+                        "{label}: tangential traction {tangential}"
+                    );
+                }
+            }
+            // The interface force balances, and equals the reaction of the lower base.
+            assert!(
+                solution.force_imbalance <= 1e-12,
+                "{label}: imbalance {}",
+                solution.force_imbalance
+            );
+            let force = solution.force_primary[dim - 1].abs();
+            assert!(
+                (force - expected).abs() <= 1e-6 * expected,
+                "{label}: force {force}"
+            );
+            let (_, base) = &solution.secondary.reactions[0];
+            assert!(
+                (base[dim - 1] - expected).abs() <= 1e-6 * expected,
+                "{label}: base reaction {base:?}"
+            );
+        }
+    }
+}
+
+/// The half-disc (R = 1) pressed by 0.02 onto the block, both E = 1000, nu = 0.3, on the mesh
+/// refined to R/80 in the contact zone.
+fn half_disc_on_block(extra: &str) -> String {
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "disc"
+primary_surface = "disc_contact"
+secondary = "block"
+secondary_surface = "block_contact"
+{extra}
+
+[[body]]
+name = "disc"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "disc_top"
+ux = 0.0
+uy = -0.02
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+"#,
+        mesh = fixture("half_disc_on_block_hertz.msh").display()
+    )
+}
+
+#[test]
+fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
+    let solution = solve(&half_disc_on_block("")).unwrap();
+    assert_eq!(solution.status, ContactStatus::Converged);
+    let fields = &solution.primary_fields;
+
+    // No active node in tension, no inactive candidate penetrating beyond the tolerance.
+    assert!(
+        fields
+            .active
+            .iter()
+            .zip(&fields.pressure)
+            .all(|(&a, &p)| !a || p >= 0.0)
+    );
+    let last = solution.history.last().unwrap();
+    assert!(
+        last.max_penetration_over_h <= 1e-3,
+        "penetration {} h",
+        last.max_penetration_over_h
+    );
+    assert!(
+        solution.force_imbalance < 0.01,
+        "imbalance {}",
+        solution.force_imbalance
+    );
+
+    // Hertz for the measured force per unit length (method.md section 4):
+    // a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), 1/E* = 2 (1 - nu^2) / E.
+    let e_star = 1000.0 / (2.0 * (1.0 - 0.09));
+    let force = solution.force_primary[1].abs();
+    let a = (4.0 * force / (std::f64::consts::PI * e_star)).sqrt();
+    let p0 = 2.0 * force / (std::f64::consts::PI * a);
+    assert!((0.08..0.14).contains(&a), "a/R about 0.1 (a = {a})");
+    let fit = solution
+        .hertz_primary
+        .expect("enough loaded nodes for the fit");
+    assert!(
+        (fit.a - a).abs() <= 0.05 * a,
+        "half-width {} vs Hertz {a}",
+        fit.a
+    );
+    assert!(
+        (fit.p0 - p0).abs() <= 0.05 * p0,
+        "peak pressure {} vs Hertz {p0}",
+        fit.p0
+    );
+
+    // No hole: every candidate node well inside the contact zone is active.
+    let mesh = read_msh(&fixture("half_disc_on_block_hertz.msh")).unwrap();
+    let disc = mesh.body("disc").unwrap();
+    for (s, &node) in fields.nodes.iter().enumerate() {
+        let x = disc.coords[node];
+        if (x[0] - fit.center[0]).abs() < 0.9 * fit.a && x[1] < 0.05 {
+            assert!(
+                fields.active[s],
+                "hole: node at x = {} inside a = {} is inactive",
+                x[0], fit.a
+            );
+        }
+    }
+}
+
+#[test]
+fn bodies_pulled_apart_end_with_no_contact() {
+    let text = two_blocks(2, "frictionless", "", "")
+        .replace("uy = -0.01", "uy = 0.01\nux = 0.0")
+        .replace(
+            "group = \"lower_base\"\nuy = 0.0",
+            "group = \"lower_base\"\nuy = 0.0\nux = 0.0",
+        );
+    let solution = solve(&text).unwrap();
+    assert_eq!(solution.status, ContactStatus::NoContact);
+    assert!(solution.primary_fields.active.iter().all(|&a| !a));
+    assert_eq!(solution.force_primary, [0.0; 3]);
+}
+
+#[test]
+fn surfaces_that_do_not_face_each_other_end_with_no_contact() {
+    // The base of the lower block and the top of the upper one are two units apart.
+    let text = two_blocks(
+        2,
+        "frictionless",
+        &rollers("lower", 2),
+        &rollers("upper", 2),
+    )
+    .replace(
+        "primary_surface = \"upper_contact\"",
+        "primary_surface = \"upper_top\"",
+    )
+    .replace(
+        "secondary_surface = \"lower_contact\"",
+        "secondary_surface = \"lower_base\"",
+    );
+    let solution = solve(&text).unwrap();
+    assert_eq!(solution.status, ContactStatus::NoContact);
+}
+
+#[test]
+fn the_iteration_cap_is_a_status() {
+    let solution = solve(&half_disc_on_block("max_iterations = 2")).unwrap();
+    assert_eq!(solution.status, ContactStatus::IterationLimit);
+    assert_eq!(solution.history.len(), 2);
+}
+
+#[test]
+fn a_missing_candidate_group_is_named() {
+    let text = two_blocks(2, "frictionless", "", "").replace(
+        "primary_surface = \"upper_contact\"",
+        "primary_surface = \"upper_contct\"",
+    );
+    let message = solve(&text).err().expect("the case is invalid");
+    assert!(
+        message.contains("upper_contct") && message.contains("upper_contact"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_contact_body_needs_a_body_table() {
+    let text = two_blocks(
+        2,
+        "frictionless",
+        &rollers("lower", 2),
+        &rollers("upper", 2),
+    )
+    .replace("secondary = \"lower\"", "secondary = \"base\"");
+    let message = solve(&text).err().expect("the case is invalid");
+    assert!(
+        message.contains("'base'") && message.contains("[[body]]"),
+        "{message}"
+    );
+}
+
+#[test]
+fn misspelled_contact_keys_are_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.toml");
+    std::fs::write(
+        &path,
+        two_blocks(2, "frictionless", "", "").replace("formulation", "formulatoin"),
+    )
+    .unwrap();
+    let error = Case::load(&path).unwrap_err();
+    assert!(matches!(error, CaseError::Syntax { .. }));
+    assert!(error.to_string().contains("formulatoin"));
+}
