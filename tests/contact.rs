@@ -7,6 +7,8 @@ use common::fixture;
 use internodes::case::{Case, CaseError};
 use internodes::contact::{ContactSolution, ContactStatus, solve_contact};
 use internodes::elastic::SolverSettings;
+use internodes::fem::assembly::assemble_surface_mass;
+use internodes::linalg::mat_vec;
 use internodes::mesh::read_msh;
 
 /// Solves the `[contact]` of a case given as TOML text.
@@ -214,9 +216,30 @@ fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
         fit.p0
     );
 
-    // No hole: every candidate node well inside the contact zone is active.
+    // The reported force is the integral of the P1 traction field (vanishing at inactive
+    // nodes), and the block's base reaction balances the force the block receives.
     let mesh = read_msh(&fixture("half_disc_on_block_hertz.msh")).unwrap();
     let disc = mesh.body("disc").unwrap();
+    let m = assemble_surface_mass(disc, disc.boundary_group("disc_contact").unwrap());
+    for c in 0..2 {
+        let mut t = vec![0.0; disc.num_nodes()];
+        for (s, &node) in fields.nodes.iter().enumerate() {
+            t[node] = fields.traction[s][c];
+        }
+        let integral: f64 = mat_vec(&m, &t).iter().sum();
+        assert!(
+            (integral - solution.force_primary[c]).abs() <= 1e-10 * force,
+            "component {c}: {integral} vs {}",
+            solution.force_primary[c]
+        );
+    }
+    let (_, base) = &solution.secondary.reactions[0];
+    assert!(
+        (base[1] + solution.force_secondary[1]).abs() <= 1e-8 * force,
+        "base reaction {base:?}"
+    );
+
+    // No hole: every candidate node well inside the contact zone is active.
     for (s, &node) in fields.nodes.iter().enumerate() {
         let x = disc.coords[node];
         if (x[0] - fit.center[0]).abs() < 0.9 * fit.a && x[1] < 0.05 {

@@ -3,8 +3,11 @@
 //! ```text
 //! I^C, J^C <- candidate nodes that touch or penetrate in the reference configuration
 //! repeat
-//!   1. I, J, radii <- interface nodes among I^C, J^C          (seed Algorithm 2)
-//!   2. R12, R21, M1, M2, d on the reference geometry           (method.md section 2)
+//!   1. I, J <- interface nodes among I^C, J^C                 (seed Algorithm 2)
+//!   2. R12, R21, M1, M2, d on the reference geometry           (method.md section 2);
+//!      R12 takes its sources from J and the ring of secondary nodes around it, R21 from I and
+//!      the ring of inactive primary nodes around it (where lambda = 0): no extrapolation at
+//!      the rim of the contact zone
 //!   3. solve the coupled system for u1, u2, lambda
 //!   4. tension:     active nodes with lambda . n > tol_t p_max
 //!      penetration: candidate nodes with gap . n < -tol_p h    (deformed configuration)
@@ -214,14 +217,12 @@ pub fn solve_contact(
     )
 }
 
-/// Interface nodes (surface indices) with their radii; empty when the candidate sets do not
+/// Interface nodes (surface indices); empty when the candidate sets do not
 /// face each other within interpolation range.
 #[derive(Default)]
 struct Interface {
     primary: Vec<usize>,
-    primary_radii: Vec<f64>,
     secondary: Vec<usize>,
-    secondary_radii: Vec<f64>,
 }
 
 fn find_interface(
@@ -239,9 +240,7 @@ fn find_interface(
         Ok(found) if found.primary.len() >= 2 && found.secondary.len() >= 2 => {
             Ok(Some(Interface {
                 primary: found.primary.iter().map(|&k| c1[k]).collect(),
-                primary_radii: found.primary_radii,
                 secondary: found.secondary.iter().map(|&k| c2[k]).collect(),
-                secondary_radii: found.secondary_radii,
             }))
         }
         Ok(_) | Err(super::rbf::RbfError::EmptyInterface { .. }) => Ok(None),
@@ -261,7 +260,8 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
         primary_nodes: interface.primary.iter().map(|&s| s1.nodes[s]).collect(),
         secondary_nodes: interface.secondary.iter().map(|&s| s2.nodes[s]).collect(),
         normals: interface.primary.iter().map(|&s| s1.normals[s]).collect(),
-        r12: DMatrix::zeros(x1.len(), x2.len()),
+        r12: DMatrix::zeros(x1.len(), 0),
+        r12_nodes: Vec::new(),
         r21: DMatrix::zeros(x2.len(), x1.len()),
         m1_rows: m1_rows.iter().map(|&s| s1.nodes[s]).collect(),
         m1,
@@ -272,9 +272,23 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     if x1.is_empty() {
         return Ok(coupling);
     }
-    let r12 = Interpolation::new(&x2, &interface.secondary_radii, &x1)?;
-    let r21 = Interpolation::new(&x1, &interface.primary_radii, &x2)?;
-    let x2_flat: Vec<f64> = x2.iter().flat_map(|x| x.iter().copied()).collect();
+    // Likewise R12 interpolates the secondary displacement, which exists on the whole surface:
+    // taking its sources from J and the ring around it avoids extrapolating at the rim of I.
+    let ring2: Vec<[f64; 3]> = m2_rows.iter().map(|&s| s2.coords[s]).collect();
+    let r12 = Interpolation::new(&ring2, &support_radii(&ring2)?, &x1)?;
+    // R21 interpolates the multiplier field, a P1 field on the primary surface that vanishes at
+    // inactive nodes: its sources are all nodes of the facets touching I (the zeros of the
+    // inactive ring included), so that the traction passed to body 2 decays outside the contact
+    // zone instead of carrying the rim value onto J nodes beyond it.
+    let ring: Vec<[f64; 3]> = m1_rows.iter().map(|&s| s1.coords[s]).collect();
+    let r21_ring = Interpolation::new(&ring, &support_radii(&ring)?, &x2)?.matrix();
+    let r21 = DMatrix::from_fn(x2.len(), x1.len(), |j, a| {
+        let column = m1_rows
+            .binary_search(&interface.primary[a])
+            .expect("active nodes are rows of M1");
+        r21_ring[(j, column)]
+    });
+    let x2_flat: Vec<f64> = ring2.iter().flat_map(|x| x.iter().copied()).collect();
     let x2_at_1 = r12.apply(&x2_flat, 3);
     // Only the normal part of R12 x2 - x1 is a gap: R reproduces constants but not the linear
     // coordinate field, so its tangential part is interpolation error, which the tied
@@ -291,7 +305,8 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
         .collect();
     coupling.gaps = gaps;
     coupling.r12 = r12.matrix();
-    coupling.r21 = r21.matrix();
+    coupling.r12_nodes = m2_rows.iter().map(|&s| s2.nodes[s]).collect();
+    coupling.r21 = r21;
     Ok(coupling)
 }
 

@@ -38,8 +38,10 @@ pub struct Coupling {
     pub secondary_nodes: Vec<usize>,
     /// Outward normals of body 1 at I.
     pub normals: Vec<[f64; 3]>,
-    /// `R12` (|I| x |J|), interpolating from J to I.
+    /// `R12` (|I| x |r12_nodes|), interpolating the secondary displacement to I from the
+    /// secondary nodes `r12_nodes` (J and the ring of nodes around it).
     pub r12: DMatrix<f64>,
+    pub r12_nodes: Vec<usize>,
     /// `R21` (|J| x |I|), interpolating from I to J.
     pub r21: DMatrix<f64>,
     /// Interface mass matrices of the facets with an active node: rows are the body nodes of
@@ -171,7 +173,7 @@ pub fn solve_coupled(
             }
             let row = n1 + n2 + row;
             triplets.push(Triplet::new(row, dim * node + c, t * weight));
-            for (j, &node2) in coupling.secondary_nodes.iter().enumerate() {
+            for (j, &node2) in coupling.r12_nodes.iter().enumerate() {
                 let value = -t * coupling.r12[(a, j)] * weight;
                 if value != 0.0 {
                     triplets.push(Triplet::new(row, n1 + dim * node2 + c, value));
@@ -207,18 +209,8 @@ pub fn solve_coupled(
     let mut contact_force1 = vec![0.0; n1];
     let mut contact_force2 = vec![0.0; n2];
     for (nodes, matrix, sign, force) in [
-        (
-            &coupling.primary_nodes,
-            &coupling.m1,
-            1.0,
-            &mut contact_force1,
-        ),
-        (
-            &coupling.secondary_nodes,
-            &m2_r21,
-            -1.0,
-            &mut contact_force2,
-        ),
+        (&coupling.m1_rows, &coupling.m1, 1.0, &mut contact_force1),
+        (&coupling.m2_rows, &m2_r21, -1.0, &mut contact_force2),
     ] {
         for (a, &node) in nodes.iter().enumerate() {
             for (b, lambda) in traction.iter().enumerate() {
