@@ -178,11 +178,13 @@ pub fn solve_contact(
             };
             break;
         }
-        // A repeated set means the simultaneous update oscillates (typically at the rim, where
-        // an outer node in tension holds the surfaces together and its inner neighbours
-        // penetrate). Fall back to a one-sided step: remove the tension nodes only, or if none,
-        // add the penetrating ones only; if that repeats a set too, the loop cycles.
-        seen.insert(key(&active1, &active2));
+        // A repeated candidate set means the simultaneous update oscillates (typically at the
+        // rim, where an outer node in tension holds the surfaces together and its inner
+        // neighbours penetrate). Fall back to a one-sided step: remove the tension nodes only,
+        // or if none, add the penetrating ones only; if that repeats a set too, the loop cycles.
+        // Candidate sets (the input of an iteration) are compared, not the interfaces that
+        // Algorithm 2 prunes from them.
+        seen.insert(key(&candidates1, &candidates2));
         let (mut next1, mut next2) = (next1, next2);
         if seen.contains(&key(&next1, &next2)) {
             let one_sided = if removed > 0 {
