@@ -26,6 +26,7 @@ Results: a table on stdout, the report ``validation/BENCHMARK.md`` and the
 raw numbers ``validation/build/bench/results.json``.
 
 Usage:  /usr/bin/python3 validation/benchmark.py [--sizes small|all] [--binary PATH]
+        /usr/bin/python3 validation/benchmark.py --report-only   (rewrite the report from results.json)
 
 Run it with nothing else running on the machine: timings are wall times.
 """
@@ -38,6 +39,7 @@ import json
 import os
 import platform
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -114,11 +116,13 @@ def _rss_gb(pid: int) -> float:
 
 
 def measure(command: list, log: Path, env: dict | None = None) -> dict:
-    """Run ``command`` (output to ``log``); its wall time, CPU time and peak RSS.
+    """Run ``command`` (output to ``log``); its wall time, CPU time, peak RSS, and
+    the 1-minute load average of the machine just before it.
 
     The child is killed if it exceeds MAX_RSS_GB or MAX_SECONDS (RunFailed).
     Peak RSS is the child's own ``ru_maxrss`` from ``os.wait4``.
     """
+    load = os.getloadavg()[0]  # other processes on the machine (shared): reported with the run
     with open(log, "w") as out:
         start = time.perf_counter()
         child = subprocess.Popen([str(c) for c in command], stdout=out, stderr=subprocess.STDOUT,
@@ -140,7 +144,8 @@ def measure(command: list, log: Path, env: dict | None = None) -> dict:
     if child.returncode != 0:
         tail = " | ".join(log.read_text().strip().splitlines()[-3:])
         raise RunFailed(f"exit status {child.returncode}: {tail}")
-    return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_mb": usage.ru_maxrss / 1024}
+    return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_mb": usage.ru_maxrss / 1024,
+            "load_before": load}
 
 
 # ---------------------------------------------------------------------------
@@ -196,6 +201,7 @@ def run_ours(binary: Path, case: Path, output: Path) -> dict:
     """One internodes solve; phases from summary.json, displacement from solution.h5."""
     import h5py
 
+    shutil.rmtree(output, ignore_errors=True)  # never read a stale summary
     usage = measure([binary, "solve", case, "--quiet", "--output", output], output.with_suffix(".log"))
     summary = json.loads((output / "summary.json").read_text())
     (body,) = [b for b in summary["bodies"] if b["name"] == BODY]
@@ -209,6 +215,7 @@ def run_ours(binary: Path, case: Path, output: Path) -> dict:
         "relative_residual": body["solve"]["relative_residual"],
         "phases": phases,
         "internal_timings": dict(summary["timings"]),
+        "read_mesh": sum(t for phase, t in summary["timings"] if "mesh" in phase),
         "assemble": phases["sparsity pattern"] + phases["assemble stiffness"],
         "ordering": phases["ordering + symbolic"],
         "factor": phases["numeric factorization"],
@@ -242,7 +249,7 @@ def benchmark_size(size: Size, binary: Path) -> dict:
             if kind == "ours":
                 runs[run] = run_ours(binary, cases[run], output)
             else:
-                if "ours_nd" not in runs:
+                if status(runs["ours_nd"]) != "ok":
                     raise RunFailed("needs the node coordinates of the nested-dissection run")
                 runs[run] = run_dolfinx(option, cases, size.folder / "ours_nd" / "solution.h5", output)
             print(f"{runs[run]['wall']:.1f} s, {runs[run]['peak_mb']:.0f} MB", flush=True)
@@ -381,7 +388,8 @@ def environment(binary: Path) -> dict:
 
     def output(command: list) -> str:
         try:
-            return subprocess.run(command, capture_output=True, text=True, cwd=REPO).stdout.strip()
+            result = subprocess.run(command, capture_output=True, text=True, cwd=REPO)
+            return (result.stdout or result.stderr).strip()
         except OSError:
             return "unavailable"
 
@@ -463,13 +471,13 @@ def summary_table(sizes: list[dict]) -> list[list[str]]:
             r = runs[run]
             row += ([status(r)] + ["-"] * 4 if "error" in r else
                     [fmt(r["assemble"]), fmt(r["ordering"] + r["factor"]), fmt(r["solve"]), fmt(r["wall"]),
-                     fmt(r["peak_mb"], 4)])
+                     f"{r['peak_mb']:.0f}"])
         cg, mumps = runs["dolfinx_cg"], runs["dolfinx_mumps"]
         assembly = [r["assemble"] for r in (cg, mumps) if "error" not in r]
         row += [fmt(min(assembly)) if assembly else "-",
                 f"{fmt(cg['solver_total'])} ({cg['iterations']})" if "error" not in cg else status(cg),
                 fmt(mumps["solver_total"]) if "error" not in mumps else status(mumps),
-                "/".join(fmt(r["peak_mb"], 4) for r in (cg, mumps) if "error" not in r) or "-"]
+                " / ".join(f"{r['peak_mb']:.0f}" for r in (cg, mumps) if "error" not in r) or "-"]
         assembly_ratio, solve_ratio = ratios(runs)
         row += [fmt(assembly_ratio, 2), fmt(solve_ratio, 2)]
         row += [f"{r['l2_vs']['value']:.1e}" if "l2_vs" in r else "-" for r in (mumps, cg)]
@@ -479,27 +487,24 @@ def summary_table(sizes: list[dict]) -> list[list[str]]:
 
 def detail_table(sizes: list[dict]) -> list[list[str]]:
     """Every run: all its phases, wall / CPU time, peak memory, factor size, residual, Δu."""
-    rows = [["DOFs", "run", "mesh / compile", "assemble", "ordering+symbolic / setup", "factor / solve",
+    rows = [["DOFs", "run", "read mesh", "compile", "assemble", "ordering + symbolic", "factor / setup",
              "solve", "wall", "CPU / wall", "peak MB", "nnz(L)", "residual", "Δu (vs)"]]
     for size in sizes:
-        for run, (label, kind, _) in RUNS.items():
+        for run, (label, kind, option) in RUNS.items():
             r = size["runs"][run]
             if "error" in r:
-                rows.append([f"{3 * size['nodes']:,}", label] + [r["error"]] + [""] * 10)
+                rows.append([f"{3 * size['nodes']:,}", label, r["error"]] + [""] * 11)
                 continue
             if kind == "ours":
-                phases = [fmt(r["internal_timings"]["mesh"]), fmt(r["assemble"]), fmt(r["ordering"]),
-                          fmt(r["factor"]), fmt(r["solve"])]
+                phases = [r["read_mesh"], None, r["assemble"], r["ordering"], r["factor"], r["solve"]]
             else:
                 t = r["timings"]
-                phases = [f"{fmt(t['mesh'])} / {fmt(t['form compilation'])}", fmt(r["assemble"]),
-                          fmt(t["setup"]), "-", f"{fmt(t['solve'])}"]
-                label += f" ({r['iterations']} its)" if "iterations" in r and RUNS[run][2] == "cg" else ""
-                label += f" ({r['mumps_ordering']})" if "mumps_ordering" in r else ""
+                phases = [t["mesh"], t["form compilation"], r["assemble"], None, t["setup"], t["solve"]]
+                label += f" ({r['iterations']} its)" if option == "cg" else f" ({r['mumps_ordering']})"
             l2 = r.get("l2_vs")
-            rows.append([f"{3 * size['nodes']:,}", label, *phases, fmt(r["wall"]), f"{r['cpu'] / r['wall']:.2f}",
-                         fmt(r["peak_mb"], 4), f"{r['factor_nnz']:,}" if "factor_nnz" in r else "-",
-                         f"{r['relative_residual']:.1e}",
+            rows.append([f"{3 * size['nodes']:,}", label, *map(fmt, phases), fmt(r["wall"]),
+                         f"{r['cpu'] / r['wall']:.2f}", f"{r['peak_mb']:.0f}",
+                         f"{r['factor_nnz']:,}" if "factor_nnz" in r else "-", f"{r['relative_residual']:.1e}",
                          f"{l2['value']:.1e} ({RUNS[l2['reference']][0]})" if l2 else "-"])
     return rows
 
@@ -512,69 +517,132 @@ def markdown(rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
+def _done(size: dict, *runs: str) -> bool:
+    """Whether all these runs of a size completed."""
+    return all(status(size["runs"][r]) == "ok" for r in runs)
+
+
+def _series(values: list[float], unit: str = "x") -> str:
+    """"1.2x, 1.5x" (one figure per size)."""
+    return ", ".join(f"{v:.2f}{unit}" for v in values)
+
+
+def _trend(values: list[float]) -> str:
+    """" (growing with the size)" / " (shrinking ...)" when monotonic over several sizes."""
+    if len(values) < 2:
+        return ""
+    pairs = list(zip(values, values[1:]))
+    if all(b > a for a, b in pairs):
+        return " (growing with the size)"
+    if all(b < a for a, b in pairs):
+        return " (shrinking with the size)"
+    return ""
+
+
 def reading(sizes: list[dict]) -> list[str]:
     """A short reading of the figures, derived from them (one paragraph per point)."""
     text = []
-    both = [s for s in sizes if all("error" not in s["runs"][r] for r in ("ours_nd", "ours_amd"))]
+    # Ordering: AMD against nested dissection.
+    both = [s for s in sizes if _done(s, "ours_nd", "ours_amd")]
     if both:
-        factor = [(s["runs"]["ours_amd"]["ordering"] + s["runs"]["ours_amd"]["factor"])
-                  / (s["runs"]["ours_nd"]["ordering"] + s["runs"]["ours_nd"]["factor"]) for s in both]
-        fill = [s["runs"]["ours_amd"]["factor_nnz"] / s["runs"]["ours_nd"]["factor_nnz"] for s in both]
-        peak = [s["runs"]["ours_amd"]["peak_mb"] / s["runs"]["ours_nd"]["peak_mb"] for s in both]
-        winner = "Nested dissection" if min(factor) > 1 else ("AMD" if max(factor) < 1 else "Neither ordering")
+        nd, amd = [s["runs"]["ours_nd"] for s in both], [s["runs"]["ours_amd"] for s in both]
+        work = [(a["ordering"] + a["factor"]) / (n["ordering"] + n["factor"]) for n, a in zip(nd, amd)]
+        winner = "Nested dissection" if min(work) > 1 else ("AMD" if max(work) < 1 else "Neither ordering")
         text.append(
-            f"**Ordering.** {winner} wins: AMD's ordering + factorization takes "
-            f"{', '.join(f'{x:.1f}x' for x in factor)} the time of nested dissection's, with "
-            f"{', '.join(f'{x:.1f}x' for x in fill)} the factor entries and {', '.join(f'{x:.1f}x' for x in peak)} "
-            f"the peak memory (at {', '.join(s['name'] for s in both)} DOFs); the gap widens with the size, "
-            f"as expected in 3D where nested dissection's fill grows like n^(4/3) and its work like n^2.")
-    skipped = [s["name"] for s in sizes if "error" in s["runs"]["ours_amd"]]
-    if skipped:
-        text.append(f"AMD was stopped at {', '.join(skipped)} DOFs: "
-                    f"{'; '.join(s['runs']['ours_amd']['error'] for s in sizes if s['name'] in skipped)}.")
-    assembly = [(s["name"], ratios(s["runs"])[0]) for s in sizes if ratios(s["runs"])[0] is not None]
-    if assembly:
-        met = [n for n, r in assembly if r <= 1.0]
+            f"**Ordering.** {winner} wins. At {', '.join(s['name'] for s in both)} DOFs, AMD's ordering + "
+            f"factorization takes {_series(work)} the time of nested dissection's{_trend(work)}, with "
+            f"{_series([a['factor_nnz'] / n['factor_nnz'] for n, a in zip(nd, amd)])} its factor entries and "
+            f"{_series([a['peak_mb'] / n['peak_mb'] for n, a in zip(nd, amd)])} its peak memory. "
+            "Nested dissection is the right default for 3D meshes.")
+    for s in sizes:
+        if status(s["runs"]["ours_amd"]) != "ok":
+            text.append(f"AMD at {s['name']} DOFs: {s['runs']['ours_amd']['error']}.")
+    # Assembly.
+    measured = [(s["name"], ratios(s["runs"])[0]) for s in sizes if ratios(s["runs"])[0] is not None]
+    if measured:
+        missed = [name for name, r in measured if r > 1.0]
         text.append(
-            f"**Assembly.** Our assembly (sparsity pattern + stiffness) takes "
-            f"{', '.join(f'{r:.2f}x' for _, r in assembly)} dolfinx's `assemble_matrix` + `A.assemble()` "
-            f"(which includes its sparsity pattern and the Dirichlet rows) on the same mesh: the aim "
-            f"\"at least as fast as dolfinx\" is "
-            + ("met at every size." if len(met) == len(assembly) else
-               f"met at {', '.join(met) or 'no size'} and missed at "
-               f"{', '.join(n for n, r in assembly if r > 1.0)}.")
-            + " Our figure excludes applying the Dirichlet conditions (a separate phase, in the details).")
-    solves = [(s, ratios(s["runs"])[1]) for s in sizes if ratios(s["runs"])[1] is not None]
-    if solves:
+            f"**Assembly.** Our assembly (sparsity pattern + stiffness) takes {_series([r for _, r in measured])} "
+            f"the time of dolfinx's `assemble_matrix` + `A.assemble()` (its sparsity pattern, assembly and "
+            f"Dirichlet rows) on the same mesh at {', '.join(n for n, _ in measured)} DOFs: the aim \"at least as "
+            "fast as dolfinx's\" is " + (f"missed at {', '.join(missed)} DOFs." if missed else "met at every size.")
+            + (" A miss by less than 15% is within the run-to-run variation of this shared machine (a repeat "
+               "can flip it): read it as parity." if missed and max(r for _, r in measured) < 1.15 else "")
+            + " Applying our Dirichlet conditions is a separate phase, not counted (see *Every run*: "
+            "`summary.json`, \"apply Dirichlet conditions\").")
+    # Solve: against the best dolfinx solver, and what bounds our time.
+    compared = [s for s in sizes if None not in ratios(s["runs"])]
+    if compared:
         parts = []
-        for s, r in solves:
-            runs, ours = s["runs"], s["runs"][best_ours(s["runs"])]
-            share = ours["factor"] / our_solve_total(ours)
-            parts.append(f"{s['name']}: {r:.2f}x against {RUNS[best_dolfinx(runs)][0]} "
-                         f"(numeric factorization = {share:.0%} of our time)")
+        for s in compared:
+            ours = s["runs"][best_ours(s["runs"])]
+            parts.append(f"{ratios(s['runs'])[1]:.2f}x at {s['name']} against {RUNS[best_dolfinx(s['runs'])][0]}, "
+                         f"numeric factorization {ours['factor'] / our_solve_total(ours):.0%} of our time")
+        text.append("**Solve.** Our assembly + ordering + factorization + solve against dolfinx's assembly + "
+                    "best solver: " + "; ".join(parts) + ".")
+    with_cg = [s for s in compared if _done(s, "dolfinx_cg")]
+    if with_cg:
+        against_cg = [our_solve_total(s["runs"][best_ours(s["runs"])])
+                      / (s["runs"]["dolfinx_cg"]["assemble"] + s["runs"]["dolfinx_cg"]["solver_total"])
+                      for s in with_cg]
+        iterations = [s["runs"]["dolfinx_cg"]["iterations"] for s in with_cg]
+        memory = [s["runs"][best_ours(s["runs"])]["peak_mb"] / s["runs"]["dolfinx_cg"]["peak_mb"] for s in with_cg]
         text.append(
-            "**Solve.** Our assembly + ordering + factorization + solve, against dolfinx's assembly + best "
-            "solver: " + "; ".join(parts) + ". A sparse Cholesky of a 3D problem does O(n^2) work against "
-            "roughly O(n) per CG + GAMG iteration with a near-constant iteration count, so the ratio to CG + GAMG "
-            "worsens with the size: there, our time is bounded by the numeric factorization, not by assembly.")
-    mumps = [s for s in sizes if all("error" not in s["runs"][r] for r in ("ours_nd", "dolfinx_mumps"))]
-    if mumps:
+            f"Against CG + GAMG alone the time ratio is {_series(against_cg)}{_trend(against_cg)}, with "
+            f"{', '.join(map(str, iterations))} CG iterations, and the peak-memory ratio {_series(memory)}. This is the expected limit of a sparse direct "
+            "solver in 3D: with nested dissection the factor grows like n^(4/3) and the factorization work like "
+            "n^2, while CG + GAMG costs about O(n) per iteration with a nearly constant iteration count. Where we "
+            "are slower, the bound is the numeric factorization (its flop count, fixed by the ordering, and the "
+            "kernel's flop rate), not assembly.")
+    # Against MUMPS, the other direct solver.
+    direct = [s for s in sizes if _done(s, "ours_nd", "dolfinx_mumps")]
+    if direct:
+        nd, mumps = [s["runs"]["ours_nd"] for s in direct], [s["runs"]["dolfinx_mumps"] for s in direct]
+        fill = [n["factor_nnz"] / m["factor_nnz"] for n, m in zip(nd, mumps)]
         text.append(
-            "**Against MUMPS** (a direct solver like ours): our nested-dissection factor has "
-            + ", ".join(f"{s['runs']['ours_nd']['factor_nnz'] / s['runs']['dolfinx_mumps']['factor_nnz']:.2f}x"
-                        for s in mumps)
-            + " MUMPS's entries and our ordering + factorization + solve takes "
-            + ", ".join(f"{(lambda o: (o['ordering'] + o['factor'] + o['solve']))(s['runs']['ours_nd']) / s['runs']['dolfinx_mumps']['solver_total']:.2f}x"
-                        for s in mumps)
-            + " MUMPS's analysis + factorization + solve (ours uses "
-            + ", ".join(f"{s['runs']['ours_nd']['cpu'] / s['runs']['ours_nd']['wall']:.1f}" for s in mumps)
-            + " cores on average over the whole run, MUMPS one).")
-    diffs = [s["runs"][r]["l2_vs"]["value"] for s in sizes for r in ("dolfinx_mumps", "dolfinx_cg")
-             if "l2_vs" in s["runs"][r]]
-    if diffs:
-        text.append(f"**Sanity.** Every solution agrees with ours: relative L2 difference at most "
-                    f"{max(diffs):.1e} (MUMPS: round-off; CG: its rtol {CG_RTOL:.0e}).")
+            f"**Against MUMPS** (Cholesky, ordering {mumps[0]['mumps_ordering']}): our nested-dissection factor "
+            f"has {_series(fill)} MUMPS's entries, and "
+            f"our ordering + factorization + solve takes "
+            f"{_series([(n['ordering'] + n['factor'] + n['solve']) / m['solver_total'] for n, m in zip(nd, mumps)])}"
+            f" the time of MUMPS's analysis + factorization + solve, with "
+            f"{_series([n['peak_mb'] / m['peak_mb'] for n, m in zip(nd, mumps)])} its peak memory. "
+            + ("With about the same fill, the time gap is the speed of the factorization kernels (MUMPS with "
+               "one BLAS thread, BLAS library in the table above)."
+               if all(0.8 < f < 1.25 for f in fill) else "The fills differ: the orderings matter as much as "
+               "the kernels."))
+    cores = [s["runs"]["ours_nd"]["cpu"] / s["runs"]["ours_nd"]["wall"] for s in sizes if _done(s, "ours_nd")]
+    if cores:
+        text.append(
+            f"**Threads.** Our process used {_series(cores, '')} CPU seconds per wall second (nested dissection)"
+            + (": in effect one core, although the binary may use rayon / faer threads; the comparison with the serial dolfinx runs is then serial against serial. "
+               "Either the factorization does not run in parallel or the second core was taken by other "
+               "processes (see the load averages below)." if max(cores) < 1.2 else
+               ": it runs on several threads, whereas the dolfinx runs are serial (one MPI process, one BLAS "
+               "thread); the time ratios above favour us by up to that factor."))
+    # Sanity.
+    diffs = {r: [s["runs"][r]["l2_vs"]["value"] for s in sizes if "l2_vs" in s["runs"][r]]
+             for r in ("dolfinx_mumps", "dolfinx_cg")}
+    if any(diffs.values()):
+        text.append("**Sanity.** Relative L2 difference between our displacement and dolfinx's: at most "
+                    + " and ".join(f"{max(v):.1e} against {RUNS[r][0]}" for r, v in diffs.items() if v)
+                    + f" (MUMPS: round-off; CG: its rtol {CG_RTOL:.0e}).")
     return text
+
+
+def _load_range(sizes: list[dict]) -> str:
+    """"min to max" of the load averages measured before the runs."""
+    loads = [r["load_before"] for s in sizes for r in s["runs"].values() if "load_before" in r]
+    return f"{min(loads):.1f} to {max(loads):.1f}" if loads else "not measured"
+
+
+def _disturbed(sizes: list[dict]) -> str:
+    """The runs that got clearly less than one core (CPU / wall < 0.85): their times are overestimated."""
+    runs = [f"{RUNS[name][0]} at {s['name']} ({r['cpu'] / r['wall']:.2f})" for s in sizes
+            for name, r in s["runs"].items() if "cpu" in r and r["cpu"] / r["wall"] < 0.85]
+    if not runs:
+        return "Every run had at least 0.85 CPU seconds per wall second."
+    return "Runs that had less than 0.85 CPU seconds per wall second, so their times are overestimated: " + \
+        ", ".join(runs) + "."
 
 
 def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
@@ -624,9 +692,13 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "",
         markdown(detail_table(sizes)),
         "",
-        "For ours: *mesh* = reading the .msh file; *ordering+symbolic*, *factor*, *solve* as above. For dolfinx: "
-        "*mesh* = gmsh model -> dolfinx mesh, *compile* = FFCx form compilation (JIT-cached after the first "
-        "run: varies), *setup* = GAMG hierarchy or MUMPS analysis + factorization. *CPU / wall* = (user + "
+        "For ours: *read mesh* = reading the .msh file; *ordering + symbolic*, *factor* (numeric), *solve* "
+        "(triangular solves) as reported in `summary.json`. For dolfinx: *read mesh* = gmsh file -> dolfinx "
+        "mesh (`model_to_mesh`), *compile* = FFCx form compilation (JIT-cached after the first run: varies), "
+        "*setup* = `ksp.setUp()`: GAMG hierarchy, or MUMPS analysis (ordering) + factorization; the MUMPS "
+        "ordering is MUMPS's automatic choice (this Debian build has no METIS / SCOTCH: asking for them "
+        "falls back to PORD). The KSP is configured in code, then `setFromOptions()` (PETSc's GAMG defaults "
+        "are only complete after it: without it GAMG's setup was 5x slower). *CPU / wall* = (user + "
         "system CPU time) / wall time of the process: above 1 means several threads (ours uses rayon / faer "
         "threads, dolfinx runs are serial). *nnz(L)*: factor entries (MUMPS: INFOG(29)). *residual*: "
         "||K u - f|| / ||f|| of the constrained system.",
@@ -636,6 +708,9 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         f"* {env['nproc']} cores on a shared machine: wall times vary by up to 2x between runs. The runs are "
         "sequential (one process at a time) with nothing else of the benchmark running; compare figures of "
         "one run of the benchmark rather than across reports.",
+        "* Load average (1 min) of the machine just before each run: "
+        + _load_range(sizes) + "; on 2 cores, a load above ~1 before a serial run means it shared the CPU "
+        "with other processes (its *CPU / wall* below 1 shows the same). " + _disturbed(sizes),
         "* Each figure is one measurement (no repetition); the smallest size is the least reliable.",
         f"* A run is stopped beyond {MAX_SECONDS:.0f} s or {MAX_RSS_GB:.0f} GB resident and reported as skipped.",
         "* Raw numbers: `validation/build/bench/results.json` (git-ignored), with the logs of every run.",
@@ -656,6 +731,8 @@ def parse_args() -> argparse.Namespace:
                         help="small: the 30k-DOF mesh only (a quick check); all: 30k, 100k, 300k (default)")
     parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes",
                         help="internodes executable (default: target/release/internodes)")
+    parser.add_argument("--report-only", action="store_true",
+                        help="rewrite the report from validation/build/bench/results.json without running")
     parser.add_argument("--worker", choices=("cg", "mumps"), help=argparse.SUPPRESS)
     parser.add_argument("--case", type=Path, help=argparse.SUPPRESS)
     parser.add_argument("--coordinates", type=Path, help=argparse.SUPPRESS)
@@ -668,6 +745,12 @@ def main() -> int:
     args = parse_args()
     if args.worker:
         dolfinx_worker(args.worker, args.case, args.coordinates, args.output)
+        return 0
+
+    if args.report_only:
+        results = json.loads((BENCH / "results.json").read_text())
+        write_report(results["environment"], results["sizes"], results["argv"])
+        print(f"report: {REPORT.relative_to(REPO)}")
         return 0
 
     # 0. Environment: the binary must run; BLAS is reported (OpenBLAS or not).
@@ -698,8 +781,9 @@ def main() -> int:
     for paragraph in reading(sizes):
         print(paragraph, end="\n\n")
     BENCH.mkdir(parents=True, exist_ok=True)
-    (BENCH / "results.json").write_text(json.dumps({"environment": env, "sizes": sizes}, indent=2))
-    write_report(env, sizes, [Path(sys.argv[0]).name, *sys.argv[1:]])
+    argv = [Path(sys.argv[0]).name, *sys.argv[1:]]
+    (BENCH / "results.json").write_text(json.dumps({"environment": env, "argv": argv, "sizes": sizes}, indent=2))
+    write_report(env, sizes, argv)
     print(f"report: {REPORT.relative_to(REPO)}, raw numbers: {(BENCH / 'results.json').relative_to(REPO)}")
     failed = len(sizes) < (1 if args.sizes == "small" else len(SIZES)) or any(
         status(r) == "failed" for s in sizes for r in s["runs"].values())
