@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::CaseError;
-use crate::contact::{ContactProblem, ContactSettings, ContactSurface, Formulation};
+use crate::contact::{ContactProblem, ContactSettings, ContactSurface, CoupledSolver, Formulation};
 use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
@@ -49,6 +49,8 @@ pub struct ContactSpec {
     pub secondary_surface: String,
     /// "frictionless" (default) or "tied".
     pub formulation: Option<Formulation>,
+    /// "schur" (default) or "monolithic-lu".
+    pub solver: Option<CoupledSolver>,
     /// Default 50.
     pub max_iterations: Option<usize>,
     /// Fraction of the local nodal spacing, default 1e-3.
@@ -249,6 +251,7 @@ impl Case {
         let defaults = ContactSettings::default();
         let settings = ContactSettings {
             formulation: spec.formulation.unwrap_or(defaults.formulation),
+            solver: spec.solver.unwrap_or(defaults.solver),
             max_iterations: spec.max_iterations.unwrap_or(defaults.max_iterations),
             penetration_tolerance: spec
                 .penetration_tolerance

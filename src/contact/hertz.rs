@@ -10,7 +10,8 @@ use super::ContactSurface;
 use super::solution::{HertzFit, SurfaceFields};
 
 /// The fit over the nodes of `surface` with positive pressure; `None` with fewer than three
-/// such nodes or a profile that does not decrease outward.
+/// such nodes, a profile that does not decrease outward, or a fitted radius more than twice the
+/// extent of the loaded nodes.
 pub fn fit(surface: &ContactSurface, fields: &SurfaceFields) -> Option<HertzFit> {
     let loaded: Vec<usize> = (0..surface.len())
         .filter(|&i| fields.active[i] && fields.pressure[i] > 0.0)
@@ -53,8 +54,15 @@ pub fn fit(surface: &ContactSurface, fields: &SurfaceFields) -> Option<HertzFit>
     if slope >= 0.0 || intercept <= 0.0 {
         return None;
     }
+    // A fitted radius far beyond the loaded nodes means the profile is not an ellipse (a flat
+    // punch or a uniform pressure): no Hertz estimate then.
+    let a = (-intercept / slope).sqrt();
+    let extent = points.iter().map(|p| p.0).fold(0.0, f64::max).sqrt();
+    if a > 2.0 * extent {
+        return None;
+    }
     Some(HertzFit {
-        a: (-intercept / slope).sqrt(),
+        a,
         p0: intercept.sqrt(),
         center,
     })

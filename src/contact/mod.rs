@@ -7,6 +7,7 @@
 //! updated by the seed's Algorithm 3 ([`solve_contact`]). Method, signs and known traps:
 //! `shared/notes/method.md`.
 
+mod coupled_solver;
 mod hertz;
 mod problem;
 pub mod rbf;
@@ -15,6 +16,7 @@ mod solve;
 mod surface;
 pub mod system;
 
+pub use coupled_solver::CoupledSolver;
 pub use problem::{ContactProblem, ContactSettings, Formulation};
 pub use solution::{ContactSolution, ContactStatus, HertzFit, IterationRecord, SurfaceFields};
 pub use solve::solve_contact;

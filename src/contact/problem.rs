@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::ContactSurface;
+use super::coupled_solver::CoupledSolver;
 use crate::elastic::ElasticProblem;
 
 /// Which constraint couples the active surfaces (README, "Contact formulations").
@@ -22,6 +23,9 @@ pub enum Formulation {
 pub struct ContactSettings {
     /// Default: frictionless.
     pub formulation: Formulation,
+    /// How each iteration's linear system is solved (default: Schur complement on Cholesky
+    /// factors computed once).
+    pub solver: CoupledSolver,
     /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
     pub max_iterations: usize,
     /// A candidate node penetrates when its gap along its normal is below `-tol * h`, `h` its
@@ -36,6 +40,7 @@ impl Default for ContactSettings {
     fn default() -> Self {
         Self {
             formulation: Formulation::default(),
+            solver: CoupledSolver::default(),
             max_iterations: 50,
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,

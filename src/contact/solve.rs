@@ -23,14 +23,16 @@
 use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
 
+use super::coupled_solver::{self, BodyFactors, CoupledSolver};
 use super::rbf::{Interpolation, interface_nodes, support_radii};
 use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
-use super::system::{CoupledSolution, Coupling, solve_coupled};
+use super::system::{CoupledSolution, CoupledSystem, Coupling};
 use super::{ContactError, ContactProblem, ContactSurface, hertz};
 use crate::elastic::{
     AssembledBody, ElasticProblem, ElasticSolution, SolveStats, SolverSettings, assemble, reactions,
 };
 use crate::fem::stress::cell_fields;
+use crate::linalg::relative_residual;
 use nalgebra::DMatrix;
 
 /// Solves a two-body contact problem.
@@ -47,6 +49,22 @@ pub fn solve_contact(
     let (mut stats1, mut stats2) = (SolveStats::default(), SolveStats::default());
     let body1 = assemble(&problem.primary, &mut stats1, false)?;
     let body2 = assemble(&problem.secondary, &mut stats2, false)?;
+
+    // With the Schur path, each body's stiffness is factored once for all iterations.
+    let factors = match settings.solver {
+        CoupledSolver::Schur => {
+            let start = Instant::now();
+            let factors = BodyFactors::new(&body1, &body2, solver.ordering)?;
+            if verbose {
+                eprintln!(
+                    "  Cholesky of both bodies: {:.3} s",
+                    start.elapsed().as_secs_f64()
+                );
+            }
+            Some(factors)
+        }
+        CoupledSolver::MonolithicLu => None,
+    };
 
     // Interpolation between all candidates, for the contact checks of step 4.
     let to_primary = Interpolation::new(&s2.coords, &support_radii(&s2.coords)?, &s1.coords)?;
@@ -78,7 +96,10 @@ pub fn solve_contact(
         let coupling = coupling(problem, &interface)?;
 
         // 3. The coupled solve.
-        let solution = solve_coupled(&body1, &body2, &coupling, dim)?;
+        let system = CoupledSystem::assemble(&body1, &body2, &coupling, dim)?;
+        let x = coupled_solver::solve(&system, &body1, &body2, factors.as_ref())?;
+        let residual = relative_residual(&system.matrix(&body1, &body2)?, &x, &system.rhs());
+        let solution = system.solution(&x, &coupling, dim, residual);
         if solution.relative_residual.is_nan()
             || solution.relative_residual > solver.residual_tolerance
         {

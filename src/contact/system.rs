@@ -21,14 +21,11 @@
 //! with `k` the largest diagonal entry of `K1` and `m` that of `M1`, so that every block has
 //! the magnitude of `K`; the solution is unscaled on return.
 
-use faer::prelude::*;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::DMatrix;
 
 use super::{ContactError, Formulation};
 use crate::elastic::AssembledBody;
-use crate::linalg::relative_residual;
 
 /// The interface operators of one iteration, on the active nodes (surface indices).
 pub struct Coupling {
@@ -98,136 +95,194 @@ impl Coupling {
     }
 }
 
-/// Assembles and solves the coupled system with a sparse LU of the whole matrix.
-pub fn solve_coupled(
-    body1: &AssembledBody,
-    body2: &AssembledBody,
-    coupling: &Coupling,
-    dim: usize,
-) -> Result<CoupledSolution, ContactError> {
-    let n1 = body1.f_c.len();
-    let n2 = body2.f_c.len();
-    let m = coupling.num_multipliers(dim);
-    let n = n1 + n2 + m;
-    let k_scale = diagonal_max(&body1.k_c).max(diagonal_max(&body2.k_c));
-    let m_scale = coupling.m1.iter().cloned().fold(0.0, f64::max);
-    if m > 0 && m_scale <= 0.0 {
-        return Err(ContactError::EmptyInterfaceMass);
-    }
-    let s = if m > 0 { k_scale / m_scale } else { 1.0 };
-    let t = k_scale;
+/// The coupled system of one iteration, kept in blocks so that it can be solved either as one
+/// sparse matrix or through the bodies' own factorizations:
+///
+/// ```text
+/// [ K  B ] [u     ]   [f]      K = diag(K1, K2) (constrained), B the scaled coupling columns,
+/// [ C  D ] [lambda] = [g]      C the scaled constraint rows, D = t on dropped multipliers
+/// ```
+pub struct CoupledSystem {
+    pub n1: usize,
+    pub n2: usize,
+    /// Number of multipliers.
+    pub m: usize,
+    /// Multiplier scaling: the unknown is `lambda / s`.
+    pub s: f64,
+    /// Entries `(row < n1 + n2, multiplier, value)` of B.
+    pub b: Vec<(usize, usize, f64)>,
+    /// Entries `(multiplier, column < n1 + n2, value)` of C.
+    pub c: Vec<(usize, usize, f64)>,
+    /// Diagonal of D.
+    pub d: Vec<f64>,
+    /// `[f1; f2]` (constrained) and `g`.
+    pub f: Vec<f64>,
+    pub g: Vec<f64>,
+}
 
-    let dropped: Vec<bool> = (0..m)
-        .map(|col| coupling.is_dropped(col, body1, dim))
-        .collect();
-    let mut triplets = Vec::new();
-    for (body, offset) in [(body1, 0), (body2, n1)] {
-        let (symbolic, values) = body.k_c.parts();
-        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-        for j in 0..symbolic.ncols() {
-            for p in col_ptr[j]..col_ptr[j + 1] {
-                if values[p] != 0.0 {
-                    triplets.push(Triplet::new(offset + row_idx[p], offset + j, values[p]));
-                }
-            }
+impl CoupledSystem {
+    /// Assembles the blocks of the coupled system (method.md section 2).
+    pub fn assemble(
+        body1: &AssembledBody,
+        body2: &AssembledBody,
+        coupling: &Coupling,
+        dim: usize,
+    ) -> Result<Self, ContactError> {
+        let n1 = body1.f_c.len();
+        let n2 = body2.f_c.len();
+        let m = coupling.num_multipliers(dim);
+        let k_scale = diagonal_max(&body1.k_c).max(diagonal_max(&body2.k_c));
+        let m_scale = coupling.m1.iter().cloned().fold(0.0, f64::max);
+        if m > 0 && m_scale <= 0.0 {
+            return Err(ContactError::EmptyInterfaceMass);
         }
-    }
-    // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2.
-    let m2_r21 = &coupling.m2 * &coupling.r21;
-    for (nodes, matrix, sign, offset, body) in [
-        (&coupling.m1_rows, &coupling.m1, -1.0, 0, body1),
-        (&coupling.m2_rows, &m2_r21, 1.0, n1, body2),
-    ] {
-        for (a, &node) in nodes.iter().enumerate() {
-            for c in 0..dim {
-                let dof = dim * node + c;
-                if body.constraints.is_fixed(dof) {
-                    continue;
-                }
-                for b in 0..coupling.primary_nodes.len() {
-                    let (col, weight) = coupling.multiplier_terms(b, c, dim);
-                    if dropped[col] {
+        let s = if m > 0 { k_scale / m_scale } else { 1.0 };
+        let t = k_scale;
+        let dropped: Vec<bool> = (0..m)
+            .map(|col| coupling.is_dropped(col, body1, dim))
+            .collect();
+
+        // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2.
+        let mut b = Vec::new();
+        let m2_r21 = &coupling.m2 * &coupling.r21;
+        for (nodes, matrix, sign, offset, body) in [
+            (&coupling.m1_rows, &coupling.m1, -1.0, 0, body1),
+            (&coupling.m2_rows, &m2_r21, 1.0, n1, body2),
+        ] {
+            for (a, &node) in nodes.iter().enumerate() {
+                for c in 0..dim {
+                    let dof = dim * node + c;
+                    if body.constraints.is_fixed(dof) {
                         continue;
                     }
-                    let value = sign * s * matrix[(a, b)] * weight;
-                    if value != 0.0 {
-                        triplets.push(Triplet::new(offset + dof, n1 + n2 + col, value));
+                    for k in 0..coupling.primary_nodes.len() {
+                        let (col, weight) = coupling.multiplier_terms(k, c, dim);
+                        let value = sign * s * matrix[(a, k)] * weight;
+                        if !dropped[col] && value != 0.0 {
+                            b.push((offset + dof, col, value));
+                        }
                     }
                 }
             }
         }
-    }
-    // Constraint rows: u1 - R12 u2 = d (tied), or its normal component (frictionless).
-    let mut rhs = Vec::with_capacity(n);
-    rhs.extend_from_slice(&body1.f_c);
-    rhs.extend_from_slice(&body2.f_c);
-    rhs.resize(n, 0.0);
-    for col in (0..m).filter(|&col| dropped[col]) {
-        triplets.push(Triplet::new(n1 + n2 + col, n1 + n2 + col, t));
-    }
-    for (a, &node) in coupling.primary_nodes.iter().enumerate() {
-        for c in 0..dim {
-            let (row, weight) = coupling.multiplier_terms(a, c, dim);
-            if dropped[row] {
-                continue;
-            }
-            let row = n1 + n2 + row;
-            triplets.push(Triplet::new(row, dim * node + c, t * weight));
-            for (j, &node2) in coupling.r12_nodes.iter().enumerate() {
-                let value = -t * coupling.r12[(a, j)] * weight;
-                if value != 0.0 {
-                    triplets.push(Triplet::new(row, n1 + dim * node2 + c, value));
+        // Constraint rows: u1 - R12 u2 = d (tied), or its normal component (frictionless).
+        let mut c_entries = Vec::new();
+        let mut g = vec![0.0; m];
+        let d: Vec<f64> = dropped.iter().map(|&x| if x { t } else { 0.0 }).collect();
+        for (a, &node) in coupling.primary_nodes.iter().enumerate() {
+            for c in 0..dim {
+                let (row, weight) = coupling.multiplier_terms(a, c, dim);
+                if dropped[row] {
+                    continue;
                 }
+                c_entries.push((row, dim * node + c, t * weight));
+                for (j, &node2) in coupling.r12_nodes.iter().enumerate() {
+                    let value = -t * coupling.r12[(a, j)] * weight;
+                    if value != 0.0 {
+                        c_entries.push((row, n1 + dim * node2 + c, value));
+                    }
+                }
+                g[row] += t * weight * coupling.gaps[a][c];
             }
-            rhs[row] += t * weight * coupling.gaps[a][c];
         }
-    }
-
-    let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
-        .map_err(|e| ContactError::Linalg(format!("assembling the coupled system: {e:?}")))?;
-    let lu_error =
-        |e: String| ContactError::Linalg(format!("sparse LU of the coupled system: {e}"));
-    let symbolic =
-        SymbolicLu::try_new(matrix.symbolic()).map_err(|e| lu_error(format!("{e:?}")))?;
-    let lu = Lu::try_new_with_symbolic(symbolic, matrix.as_ref())
-        .map_err(|e| lu_error(format!("{e:?}")))?;
-    let mut x = rhs.clone();
-    lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut x, n, 1));
-    let relative_residual = relative_residual(&matrix, &x, &rhs);
-
-    // Unscale the multipliers and form the tractions and interface forces.
-    let traction: Vec<[f64; 3]> = (0..coupling.primary_nodes.len())
-        .map(|b| {
-            let mut lambda = [0.0; 3];
-            for (c, value) in lambda.iter_mut().enumerate().take(dim) {
-                let (col, weight) = coupling.multiplier_terms(b, c, dim);
-                *value = s * x[n1 + n2 + col] * weight;
-            }
-            lambda
+        let mut f = body1.f_c.clone();
+        f.extend_from_slice(&body2.f_c);
+        Ok(Self {
+            n1,
+            n2,
+            m,
+            s,
+            b,
+            c: c_entries,
+            d,
+            f,
+            g,
         })
-        .collect();
-    let mut contact_force1 = vec![0.0; n1];
-    let mut contact_force2 = vec![0.0; n2];
-    for (nodes, matrix, sign, force) in [
-        (&coupling.m1_rows, &coupling.m1, 1.0, &mut contact_force1),
-        (&coupling.m2_rows, &m2_r21, -1.0, &mut contact_force2),
-    ] {
-        for (a, &node) in nodes.iter().enumerate() {
-            for (b, lambda) in traction.iter().enumerate() {
-                for c in 0..dim {
-                    force[dim * node + c] += sign * matrix[(a, b)] * lambda[c];
+    }
+
+    /// The whole matrix, for the monolithic solve and the residual check of every solve.
+    pub fn matrix(
+        &self,
+        body1: &AssembledBody,
+        body2: &AssembledBody,
+    ) -> Result<SparseColMat<usize, f64>, ContactError> {
+        let (n1, n) = (self.n1, self.n1 + self.n2);
+        let mut triplets = Vec::new();
+        for (body, offset) in [(body1, 0), (body2, n1)] {
+            let (symbolic, values) = body.k_c.parts();
+            let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+            for j in 0..symbolic.ncols() {
+                for p in col_ptr[j]..col_ptr[j + 1] {
+                    if values[p] != 0.0 {
+                        triplets.push(Triplet::new(offset + row_idx[p], offset + j, values[p]));
+                    }
                 }
             }
         }
+        triplets.extend(self.b.iter().map(|&(i, k, v)| Triplet::new(i, n + k, v)));
+        triplets.extend(self.c.iter().map(|&(k, j, v)| Triplet::new(n + k, j, v)));
+        triplets.extend(
+            self.d
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| **v != 0.0)
+                .map(|(k, &v)| Triplet::new(n + k, n + k, v)),
+        );
+        SparseColMat::<usize, f64>::try_new_from_triplets(n + self.m, n + self.m, &triplets)
+            .map_err(|e| ContactError::Linalg(format!("assembling the coupled system: {e:?}")))
     }
-    Ok(CoupledSolution {
-        u1: x[..n1].to_vec(),
-        u2: x[n1..n1 + n2].to_vec(),
-        traction,
-        contact_force1,
-        contact_force2,
-        relative_residual,
-    })
+
+    /// `[f; g]`.
+    pub fn rhs(&self) -> Vec<f64> {
+        let mut rhs = self.f.clone();
+        rhs.extend_from_slice(&self.g);
+        rhs
+    }
+
+    /// Unscales the solution `x = [u1; u2; lambda / s]` and forms the tractions and the
+    /// interface forces.
+    pub fn solution(
+        &self,
+        x: &[f64],
+        coupling: &Coupling,
+        dim: usize,
+        relative_residual: f64,
+    ) -> CoupledSolution {
+        let (n1, n2) = (self.n1, self.n2);
+        let traction: Vec<[f64; 3]> = (0..coupling.primary_nodes.len())
+            .map(|k| {
+                let mut lambda = [0.0; 3];
+                for (c, value) in lambda.iter_mut().enumerate().take(dim) {
+                    let (col, weight) = coupling.multiplier_terms(k, c, dim);
+                    *value = self.s * x[n1 + n2 + col] * weight;
+                }
+                lambda
+            })
+            .collect();
+        let m2_r21 = &coupling.m2 * &coupling.r21;
+        let mut contact_force1 = vec![0.0; n1];
+        let mut contact_force2 = vec![0.0; n2];
+        for (nodes, matrix, sign, force) in [
+            (&coupling.m1_rows, &coupling.m1, 1.0, &mut contact_force1),
+            (&coupling.m2_rows, &m2_r21, -1.0, &mut contact_force2),
+        ] {
+            for (a, &node) in nodes.iter().enumerate() {
+                for (k, lambda) in traction.iter().enumerate() {
+                    for c in 0..dim {
+                        force[dim * node + c] += sign * matrix[(a, k)] * lambda[c];
+                    }
+                }
+            }
+        }
+        CoupledSolution {
+            u1: x[..n1].to_vec(),
+            u2: x[n1..n1 + n2].to_vec(),
+            traction,
+            contact_force1,
+            contact_force2,
+            relative_residual,
+        }
+    }
 }
 
 fn diagonal_max(k: &SparseColMat<usize, f64>) -> f64 {
