@@ -24,7 +24,7 @@ pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;
 
-use crate::elastic::{ProblemError, SolveError};
+use crate::elastic::ProblemError;
 
 /// Why a contact solve could not be carried out (how the active-set loop ended is a
 /// [`ContactStatus`], not an error).
@@ -32,10 +32,6 @@ use crate::elastic::{ProblemError, SolveError};
 pub enum ContactError {
     #[error(transparent)]
     Problem(#[from] ProblemError),
-    #[error(transparent)]
-    Solve(#[from] SolveError),
-    #[error(transparent)]
-    Surface(#[from] SurfaceError),
     #[error("interpolation between the contact surfaces: {0}")]
     Interpolation(#[from] rbf::RbfError),
     #[error("the active primary facets have no area: the interface mass matrix is zero")]

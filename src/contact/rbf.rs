@@ -484,6 +484,18 @@ fn check_finite(points: &[[f64; 3]]) -> Result<(), RbfError> {
     }
 }
 
+/// Distance from every point to its nearest other point: the nodal spacing `d_i` of seed
+/// Algorithm 1, also the local spacing `h` of the contact tolerances. Needs two or more
+/// distinct, finite points.
+pub fn nearest_distances(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
+    check_finite(points)?;
+    if points.len() < 2 {
+        return Err(RbfError::SingleNode);
+    }
+    let tree = ImmutableKdTree::<f64, 3>::new_from_slice(points)?;
+    nearest_other_distances(&tree, points)
+}
+
 /// Distance from every point to its nearest other point (at least two points in the tree).
 fn nearest_other_distances(
     tree: &ImmutableKdTree<f64, 3>,

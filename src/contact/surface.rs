@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use nalgebra::DMatrix;
 use thiserror::Error;
 
+use super::rbf::nearest_distances;
 use crate::fem::kernels::{facet_mass, facet_measure_and_normal};
 use crate::mesh::BodyMesh;
 
@@ -23,6 +24,12 @@ pub enum SurfaceError {
     },
     #[error("contact surface '{group}' of body '{body}' has fewer than two nodes")]
     TooSmall { body: String, group: String },
+    #[error("contact surface '{group}' of body '{body}': {message}")]
+    Spacing {
+        body: String,
+        group: String,
+        message: String,
+    },
 }
 
 /// The candidate surface of one body. Surface node `s` is body node `nodes[s]`.
@@ -83,7 +90,11 @@ impl ContactSurface {
             let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             n.iter_mut().for_each(|v| *v /= norm);
         }
-        let spacing = nearest_neighbour_distances(&coords);
+        let spacing = nearest_distances(&coords).map_err(|e| SurfaceError::Spacing {
+            body: body.name.clone(),
+            group: group_name.to_string(),
+            message: e.to_string(),
+        })?;
         Ok(Self {
             body: body.name.clone(),
             group: group_name.to_string(),
@@ -150,24 +161,4 @@ impl ContactSurface {
         }
         (rows, m)
     }
-}
-
-/// Distance from each point to its nearest other point (k-d tree; points are distinct mesh
-/// nodes, so a surface with two or more nodes gives positive distances).
-fn nearest_neighbour_distances(points: &[[f64; 3]]) -> Vec<f64> {
-    use kiddo::{ImmutableKdTree, SquaredEuclidean};
-    let tree = ImmutableKdTree::new_from_slice(points).expect("a surface has at least two nodes");
-    let two = std::num::NonZero::new(2usize).expect("2 > 0");
-    points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            tree.query(p)
-                .nearest_n::<SquaredEuclidean<f64>>(two)
-                .execute()
-                .iter()
-                .find(|n| n.item as usize != i)
-                .map_or(0.0, |n| n.distance.sqrt())
-        })
-        .collect()
 }
