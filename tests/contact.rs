@@ -5,7 +5,7 @@ mod common;
 
 use common::fixture;
 use internodes::case::{Case, CaseError};
-use internodes::contact::{ContactSolution, ContactStatus, solve_contact};
+use internodes::contact::{ContactSolution, ContactStatus, ContactSurface, solve_contact};
 use internodes::elastic::SolverSettings;
 use internodes::fem::assembly::assemble_surface_mass;
 use internodes::linalg::mat_vec;
@@ -383,4 +383,89 @@ fn schur_and_monolithic_solves_agree() {
         );
         assert!(schur.history.iter().all(|h| h.relative_residual < 1e-10));
     }
+}
+
+#[test]
+fn equal_half_discs_with_different_meshes_meet_on_a_flat_symmetric_surface() {
+    // Two identical half-discs (R = 1), the upper one meshed 1.5 times coarser, pressed together
+    // by 0.02: by symmetry the contact surface is the plane y = -0.01 and the pressure is
+    // symmetric about x = 0.
+    let text = format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "upper"
+primary_surface = "upper_contact"
+secondary = "lower"
+secondary_surface = "lower_contact"
+
+[[body]]
+name = "lower"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "lower_support"
+ux = 0.0
+uy = 0.0
+
+[[body]]
+name = "upper"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "upper_support"
+ux = 0.0
+uy = -0.02
+"#,
+        mesh = fixture("two_half_discs.msh").display()
+    );
+    let solution = solve(&text).unwrap();
+    assert_eq!(solution.status, ContactStatus::Converged);
+    let mesh = read_msh(&fixture("two_half_discs.msh")).unwrap();
+    // The interface spacing: the smallest nodal spacing of the two contact surfaces.
+    let finest_spacing = ["upper", "lower"]
+        .iter()
+        .map(|name| {
+            let surface =
+                ContactSurface::new(mesh.body(name).unwrap(), &format!("{name}_contact")).unwrap();
+            surface
+                .spacing
+                .iter()
+                .cloned()
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(f64::INFINITY, f64::min);
+    for (fields, body_solution, name) in [
+        (&solution.primary_fields, &solution.primary, "upper"),
+        (&solution.secondary_fields, &solution.secondary, "lower"),
+    ] {
+        let body = mesh.body(name).unwrap();
+        let active: Vec<usize> = (0..fields.nodes.len())
+            .filter(|&s| fields.active[s])
+            .collect();
+        assert!(active.len() >= 5, "{name}: {} active nodes", active.len());
+        for &s in &active {
+            let node = fields.nodes[s];
+            let y = body.coords[node][1] + body_solution.displacement[2 * node + 1];
+            assert!(
+                (y + 0.01).abs() <= 0.01 * finest_spacing,
+                "{name}: node at y = {y}, {:.2e} off the plane",
+                (y + 0.01).abs()
+            );
+        }
+    }
+    // Symmetric pressure: no tangential resultant, pressure centred on x = 0.
+    let force = solution.force_primary;
+    assert!(
+        force[0].abs() <= 1e-3 * force[1].abs(),
+        "tangential resultant {force:?}"
+    );
+    let fit = solution.hertz_primary.expect("a Hertzian profile");
+    assert!(
+        fit.center[0].abs() <= 0.01 * fit.a,
+        "pressure centre x = {}",
+        fit.center[0]
+    );
+    assert!(solution.force_imbalance < 0.01);
 }
