@@ -469,3 +469,94 @@ uy = -0.02
     );
     assert!(solution.force_imbalance < 0.01);
 }
+
+#[test]
+fn tied_conforming_blocks_give_the_solution_of_their_union() {
+    // `lower` and `upper` share a conforming interface but are separate bodies (duplicated
+    // nodes); `union` is the single body made of both, on the same nodes. Pushed down and
+    // sheared through the top with the base clamped, the tied pair must be the union.
+    for dim in [2, 3] {
+        let mesh_path = fixture(&format!("glued_blocks_{dim}d.msh"));
+        let top = if dim == 2 {
+            "ux = 0.002\nuy = -0.02"
+        } else {
+            "ux = 0.002\nuy = 0.001\nuz = -0.02"
+        };
+        let base = if dim == 2 {
+            "ux = 0.0\nuy = 0.0"
+        } else {
+            "ux = 0.0\nuy = 0.0\nuz = 0.0"
+        };
+        let body = |name: &str, groups: &[(&str, &str)]| {
+            let mut text = format!(
+                "[[body]]\nname = \"{name}\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n"
+            );
+            for (group, values) in groups {
+                text += &format!("[[body.dirichlet]]\ngroup = \"{group}\"\n{values}\n");
+            }
+            text
+        };
+        let header = format!("mesh = \"{}\"\noutput = \"out\"\n", mesh_path.display());
+        let tied = format!(
+            "{header}[contact]\nprimary = \"upper\"\nprimary_surface = \"interface\"\nsecondary = \"lower\"\nsecondary_surface = \"interface\"\nformulation = \"tied\"\n{}{}",
+            body("lower", &[("lower_base", base)]),
+            body("upper", &[("upper_top", top)])
+        );
+        let solution = solve(&tied).unwrap();
+        assert_eq!(solution.status, ContactStatus::Converged, "{dim}D");
+        assert!(
+            solution.primary_fields.active.iter().all(|&a| a),
+            "{dim}D: the whole interface is glued"
+        );
+
+        // The union, solved as one body.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("union.toml");
+        std::fs::write(
+            &path,
+            format!(
+                "{header}{}",
+                body("union", &[("lower_base", base), ("upper_top", top)])
+            ),
+        )
+        .unwrap();
+        let case = Case::load(&path).unwrap();
+        let mesh = read_msh(&mesh_path).unwrap();
+        let union_mesh = mesh.body("union").unwrap();
+        let problem = case.elastic_problem(union_mesh, &case.bodies[0]).unwrap();
+        let settings = SolverSettings {
+            verbose: false,
+            ..SolverSettings::default()
+        };
+        let union = internodes::elastic::solve(&problem, &settings).unwrap();
+        let union_u = |tag: u64, c: usize| {
+            let node = union_mesh
+                .node_tags
+                .binary_search(&tag)
+                .expect("union holds every node");
+            union.displacement[dim * node + c]
+        };
+        let scale = union
+            .displacement
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        let mut worst: f64 = 0.0;
+        for (name, body_solution) in [("lower", &solution.secondary), ("upper", &solution.primary)]
+        {
+            let body_mesh = mesh.body(name).unwrap();
+            for (node, &tag) in body_mesh.node_tags.iter().enumerate() {
+                for c in 0..dim {
+                    let difference =
+                        (body_solution.displacement[dim * node + c] - union_u(tag, c)).abs();
+                    assert!(
+                        difference <= 1e-8 * scale,
+                        "{dim}D {name} node {tag}: differs by {:.2e} of max|u|",
+                        difference / scale
+                    );
+                    worst = worst.max(difference / scale);
+                }
+            }
+        }
+        eprintln!("{dim}D: tied pair against the union: largest difference {worst:.1e} of max|u|");
+    }
+}
