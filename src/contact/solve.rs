@@ -110,52 +110,22 @@ pub fn solve_contact(
         }
 
         // 4. Contact checks on the deformed configuration.
-        let gaps1 = normal_gaps(s1, s2, &to_primary, &solution.u1, &solution.u2);
-        let gaps2 = normal_gaps(s2, s1, &to_secondary, &solution.u2, &solution.u1);
-        let tractions2 = secondary_tractions(&coupling, &solution, dim);
-        let pressure_max = solution
-            .traction
-            .iter()
-            .zip(&coupling.normals)
-            .map(|(l, n)| -dot(l, n))
-            .fold(0.0, f64::max);
-        let tension_limit = settings.tension_tolerance * pressure_max;
-        let tension1: Vec<usize> = interface
-            .primary
-            .iter()
-            .zip(&solution.traction)
-            .filter(|&(&s, l)| dot(l, &s1.normals[s]) > tension_limit)
-            .map(|(&s, _)| s)
-            .collect();
-        let tension2: Vec<usize> = interface
-            .secondary
-            .iter()
-            .zip(&tractions2)
-            .filter(|&(&s, l)| dot(l, &s2.normals[s]) > tension_limit)
-            .map(|(&s, _)| s)
-            .collect();
-        let max_tension = solution
-            .traction
-            .iter()
-            .zip(&interface.primary)
-            .map(|(l, &s)| dot(l, &s1.normals[s]))
-            .chain(
-                tractions2
-                    .iter()
-                    .zip(&interface.secondary)
-                    .map(|(l, &s)| dot(l, &s2.normals[s])),
-            )
-            .fold(0.0, f64::max);
-        let penetrating1 = penetrating(s1, &gaps1, settings.penetration_tolerance);
-        let penetrating2 = penetrating(s2, &gaps2, settings.penetration_tolerance);
-        let (max_penetration, max_penetration_over_h) = deepest(s1, &gaps1, &interface.primary)
-            .max_by(deepest(s2, &gaps2, &interface.secondary));
+        let checks = contact_checks(
+            problem,
+            &interface,
+            &coupling,
+            &solution,
+            &to_primary,
+            &to_secondary,
+        );
+        let (tension1, tension2) = (&checks.tension1, &checks.tension2);
+        let (penetrating1, penetrating2) = (&checks.penetrating1, &checks.penetrating2);
 
         // 5. New candidate sets: drop tension, add penetration, both at once.
         let active1: BTreeSet<usize> = interface.primary.iter().copied().collect();
         let active2: BTreeSet<usize> = interface.secondary.iter().copied().collect();
-        let next1 = update(&active1, &tension1, &penetrating1);
-        let next2 = update(&active2, &tension2, &penetrating2);
+        let next1 = update(&active1, tension1, penetrating1);
+        let next2 = update(&active2, tension2, penetrating2);
         let added = next1.difference(&active1).count() + next2.difference(&active2).count();
         let removed = tension1.len() + tension2.len();
         let record = IterationRecord {
@@ -164,9 +134,9 @@ pub fn solve_contact(
             active_secondary: active2.len(),
             added,
             removed,
-            max_penetration,
-            max_penetration_over_h,
-            max_tension,
+            max_penetration: checks.max_penetration,
+            max_penetration_over_h: checks.max_penetration_over_h,
+            max_tension: checks.max_tension,
             relative_residual: solution.relative_residual,
             seconds: start.elapsed().as_secs_f64(),
         };
@@ -213,8 +183,8 @@ pub fn solve_contact(
             } else {
                 (&penetrating1[..], &penetrating2[..])
             };
-            next1 = update(&active1, &tension1, one_sided.0);
-            next2 = update(&active2, &tension2, one_sided.1);
+            next1 = update(&active1, tension1, one_sided.0);
+            next2 = update(&active2, tension2, one_sided.1);
             if seen.contains(&key(&next1, &next2)) {
                 status = ContactStatus::Cycling;
                 break;
@@ -238,6 +208,73 @@ pub fn solve_contact(
         &to_primary,
         &to_secondary,
     )
+}
+
+/// What the contact checks of one iteration found (surface indices).
+struct Checks {
+    /// Active nodes in tension: `lambda . n > tol_t p_max` (body 2: `-R21 lambda`).
+    tension1: Vec<usize>,
+    tension2: Vec<usize>,
+    /// Candidate nodes whose deformed gap is below `-tol_p h`.
+    penetrating1: Vec<usize>,
+    penetrating2: Vec<usize>,
+    max_tension: f64,
+    /// Deepest penetration of an inactive candidate, absolute and relative to its h.
+    max_penetration: f64,
+    max_penetration_over_h: f64,
+}
+
+/// Tension of the active nodes and penetration of the candidates, deformed configuration.
+fn contact_checks(
+    problem: &ContactProblem,
+    interface: &Interface,
+    coupling: &Coupling,
+    solution: &CoupledSolution,
+    to_primary: &Interpolation,
+    to_secondary: &Interpolation,
+) -> Checks {
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let settings = &problem.settings;
+    let gaps1 = normal_gaps(s1, s2, to_primary, &solution.u1, &solution.u2);
+    let gaps2 = normal_gaps(s2, s1, to_secondary, &solution.u2, &solution.u1);
+    let tractions2 = secondary_tractions(coupling, solution, s1.dim);
+    // lambda . n on each active node of both surfaces (positive = tension).
+    let normal1: Vec<(usize, f64)> = interface
+        .primary
+        .iter()
+        .zip(&solution.traction)
+        .map(|(&s, l)| (s, dot(l, &s1.normals[s])))
+        .collect();
+    let normal2: Vec<(usize, f64)> = interface
+        .secondary
+        .iter()
+        .zip(&tractions2)
+        .map(|(&s, l)| (s, dot(l, &s2.normals[s])))
+        .collect();
+    let pressure_max = normal1.iter().map(|&(_, t)| -t).fold(0.0, f64::max);
+    let limit = settings.tension_tolerance * pressure_max;
+    let in_tension = |normal: &[(usize, f64)]| {
+        normal
+            .iter()
+            .filter(|&&(_, t)| t > limit)
+            .map(|&(s, _)| s)
+            .collect()
+    };
+    let (max_penetration, max_penetration_over_h) =
+        deepest(s1, &gaps1, &interface.primary).max_by(deepest(s2, &gaps2, &interface.secondary));
+    Checks {
+        tension1: in_tension(&normal1),
+        tension2: in_tension(&normal2),
+        penetrating1: penetrating(s1, &gaps1, settings.penetration_tolerance),
+        penetrating2: penetrating(s2, &gaps2, settings.penetration_tolerance),
+        max_tension: normal1
+            .iter()
+            .chain(&normal2)
+            .map(|&(_, t)| t)
+            .fold(0.0, f64::max),
+        max_penetration,
+        max_penetration_over_h,
+    }
 }
 
 /// Interface nodes (surface indices); empty when the candidate sets do not
