@@ -95,3 +95,7 @@ Physical Curve("lower_base") = {lo_base};
 Physical Curve("upper_top") = {up_top};
 Physical Curve("lower_sides") = {lo_right, lo_left};
 Physical Curve("upper_sides") = {up_right, up_left};
+// Corner points, to pin the blocks against rigid-body motions without lateral rollers:
+// the left end of the lower base and of the upper top.
+Physical Point("lower_corner") = {p1};
+Physical Point("upper_corner") = {q4};

@@ -99,11 +99,13 @@ Return
 bx_x0 = 0; bx_x1 = L; bx_y0 = 0; bx_y1 = L; bx_z0 = -H_l; bx_z1 = 0; bx_h = h_l * s;
 Call MakeBlock;
 lo_vol = bx_vol; lo_base = bx_bottom; lo_contact = bx_top; lo_sides[] = bx_sides[];
+lo_corner_a = bx_b1; lo_corner_b = bx_b2;
 
 // --- upper block [0,L]^2 x [0,H_u] --------------------------------------------------
 bx_x0 = 0; bx_x1 = L; bx_y0 = 0; bx_y1 = L; bx_z0 = 0; bx_z1 = H_u; bx_h = h_u * s;
 Call MakeBlock;
 up_vol = bx_vol; up_contact = bx_bottom; up_top = bx_top; up_sides[] = bx_sides[];
+up_corner_a = bx_t1; up_corner_b = bx_t2;
 
 // --- mesh size: uniform per body (from the point sizes) -------------------------
 Mesh.MeshSizeFromPoints = 1;
@@ -121,3 +123,9 @@ Physical Surface("lower_base") = {lo_base};
 Physical Surface("upper_top") = {up_top};
 Physical Surface("lower_sides") = {lo_sides[]};
 Physical Surface("upper_sides") = {up_sides[]};
+// Corner points, to pin the blocks against rigid-body motions without lateral rollers:
+// corner_a = (0, 0) and corner_b = (L, 0) of the lower base and of the upper top.
+Physical Point("lower_corner_a") = {lo_corner_a};
+Physical Point("lower_corner_b") = {lo_corner_b};
+Physical Point("upper_corner_a") = {up_corner_a};
+Physical Point("upper_corner_b") = {up_corner_b};

@@ -560,3 +560,48 @@ fn tied_conforming_blocks_give_the_solution_of_their_union() {
         eprintln!("{dim}D: tied pair against the union: largest difference {worst:.1e} of max|u|");
     }
 }
+
+#[test]
+fn frictionless_patch_test_without_rollers_gives_the_uniaxial_stress() {
+    // Each block is only pinned at corners (points) against rigid-body motions, so both expand
+    // laterally under uniaxial stress: sigma = E' delta / 2 with E' = E in 3D and E / (1 - nu^2)
+    // in plane strain. The displacement is linear and the normal displacement constant on the
+    // interface, which the rescaled interpolation reproduces exactly, so the frictionless
+    // pressure is exact; the tied constraint would also impose the tangential field, which the
+    // interpolation does not reproduce.
+    for dim in [2, 3] {
+        let (lower_pins, upper_pins) = if dim == 2 {
+            (
+                "[[body.dirichlet]]\ngroup = \"lower_corner\"\nux = 0.0".to_string(),
+                "[[body.dirichlet]]\ngroup = \"upper_corner\"\nux = 0.0".to_string(),
+            )
+        } else {
+            let pins = |body: &str| {
+                format!(
+                    "[[body.dirichlet]]\ngroup = \"{body}_corner_a\"\nux = 0.0\nuy = 0.0\n[[body.dirichlet]]\ngroup = \"{body}_corner_b\"\nuy = 0.0"
+                )
+            };
+            (pins("lower"), pins("upper"))
+        };
+        let solution = solve(&two_blocks(dim, "frictionless", &lower_pins, &upper_pins)).unwrap();
+        assert_eq!(solution.status, ContactStatus::Converged, "{dim}D");
+        let e_prime = if dim == 2 {
+            1000.0 / (1.0 - 0.09)
+        } else {
+            1000.0
+        };
+        let expected = e_prime * 0.01 / 2.0;
+        for fields in [&solution.primary_fields, &solution.secondary_fields] {
+            assert!(
+                fields.active.iter().all(|&a| a),
+                "{dim}D: every interface node is active"
+            );
+            for p in &fields.pressure {
+                assert!(
+                    (p - expected).abs() <= 1e-6 * expected,
+                    "{dim}D: pressure {p}, expected {expected}"
+                );
+            }
+        }
+    }
+}

@@ -33,7 +33,7 @@ pub struct ElasticProblem<'m> {
 
 #[derive(Debug, Error, PartialEq)]
 pub enum ProblemError {
-    #[error("body '{body}' has no boundary group '{group}' (groups with facets on this body: {})", .on_body.join(", "))]
+    #[error("body '{body}' has no group '{group}' (groups on this body: {})", .on_body.join(", "))]
     UnknownGroup {
         body: String,
         group: String,
@@ -91,18 +91,20 @@ impl<'m> ElasticProblem<'m> {
 
     fn check(&self) -> Result<(), ProblemError> {
         let name = || self.body.name.clone();
-        let groups = self
-            .dirichlet
-            .iter()
-            .map(|d| &d.group)
-            .chain(self.loads.iter().map(|l| &l.group));
-        for group in groups {
-            if self.body.boundary_group(group).is_none() {
-                return Err(ProblemError::UnknownGroup {
-                    body: name(),
-                    group: group.clone(),
-                    on_body: self.body.boundary_groups.keys().cloned().collect(),
-                });
+        // Dirichlet conditions may sit on boundary or point groups, loads need facets.
+        let unknown = |group: &String| ProblemError::UnknownGroup {
+            body: name(),
+            group: group.clone(),
+            on_body: self.body.group_names(),
+        };
+        for d in &self.dirichlet {
+            if self.body.group_nodes(&d.group).is_none() {
+                return Err(unknown(&d.group));
+            }
+        }
+        for l in &self.loads {
+            if self.body.boundary_group(&l.group).is_none() {
+                return Err(unknown(&l.group));
             }
         }
         for d in &self.dirichlet {

@@ -59,10 +59,10 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
     let dim = body.dim;
     let mut constraints = Constraints::new(body.num_dofs());
     for condition in &problem.dirichlet {
-        let group = body
-            .boundary_group(&condition.group)
+        let nodes = body
+            .group_nodes(&condition.group)
             .expect("groups are checked first");
-        for node in group.nodes() {
+        for node in nodes {
             for (component, value) in condition.components.iter().enumerate().take(dim) {
                 if let Some(value) = *value {
                     constraints
@@ -174,11 +174,11 @@ pub fn reactions(
         .dirichlet
         .iter()
         .map(|condition| {
-            let group = body
-                .boundary_group(&condition.group)
+            let nodes = body
+                .group_nodes(&condition.group)
                 .expect("groups are checked first");
             let mut total = vec![0.0; dim];
-            for node in group.nodes() {
+            for node in nodes {
                 for c in (0..dim).filter(|&c| condition.components[c].is_some()) {
                     let d = dim * node + c;
                     total[c] += r[d] - system.f[d] - f_other.get(d).copied().unwrap_or(0.0);

@@ -64,6 +64,11 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
                 if !group.facets.is_empty() {
                     body.boundary_groups.insert(name_of(fd, ftag), group);
                 }
+            } else if fd == 0 {
+                let nodes = file.point_group(&body, facets);
+                if !nodes.is_empty() {
+                    body.point_groups.insert(name_of(fd, ftag), nodes);
+                }
             }
         }
         check_cells(path, &body)?;
@@ -153,11 +158,15 @@ impl FileContents {
             let Some(tags) = physical_tags.get(&(d, block.entity_tag)) else {
                 continue;
             };
-            if tags.is_empty() || d + 1 < dim {
+            // Cells, facets and points (node groups for Dirichlet conditions); edges of a 3D
+            // mesh are not used.
+            if tags.is_empty() || (d + 1 < dim && d != 0) {
                 continue;
             }
             let expected_type = if d == dim {
                 cell_type(dim)
+            } else if d == 0 {
+                ElementType::Pnt
             } else {
                 facet_type(dim)
             };
@@ -218,7 +227,20 @@ impl FileContents {
             cell_tags: cells.element_tags.clone(),
             node_tags,
             boundary_groups: BTreeMap::new(),
+            point_groups: BTreeMap::new(),
         })
+    }
+
+    /// The local nodes of `body` in a group of points, sorted.
+    fn point_group(&self, body: &BodyMesh, points: &GroupElements) -> Vec<usize> {
+        let mut nodes: Vec<usize> = points
+            .node_tags
+            .iter()
+            .filter_map(|tag| body.node_tags.binary_search(tag).ok())
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
     }
 
     /// The facets of a boundary group that are faces of `body`'s cells, oriented outward.

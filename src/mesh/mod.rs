@@ -1,4 +1,4 @@
-//! Meshes: bodies and boundary groups read from gmsh physical groups.
+//! Meshes: bodies, boundary groups and point groups read from gmsh physical groups.
 //!
 //! A mesh file holds one or more **bodies** (named physical surfaces in 2D, physical volumes in
 //! 3D) meshed with P1 simplices, and **boundary groups** (named physical curves in 2D, surfaces in
@@ -63,6 +63,9 @@ pub struct BodyMesh {
     pub cell_tags: Vec<u64>,
     /// Boundary groups that have at least one facet on this body, by name.
     pub boundary_groups: BTreeMap<String, FacetGroup>,
+    /// Groups of points (gmsh physical points) on this body: sorted local nodes, by name. They
+    /// can carry Dirichlet conditions, e.g. to pin a corner against rigid-body motions.
+    pub point_groups: BTreeMap<String, Vec<usize>>,
 }
 
 /// Facets of one boundary group that lie on one body.
@@ -101,6 +104,23 @@ impl BodyMesh {
     /// The boundary group `name`, if it has facets on this body.
     pub fn boundary_group(&self, name: &str) -> Option<&FacetGroup> {
         self.boundary_groups.get(name)
+    }
+
+    /// The nodes of a boundary group or a point group, sorted.
+    pub fn group_nodes(&self, name: &str) -> Option<Vec<usize>> {
+        self.boundary_groups
+            .get(name)
+            .map(FacetGroup::nodes)
+            .or_else(|| self.point_groups.get(name).cloned())
+    }
+
+    /// Names of the boundary and point groups on this body.
+    pub fn group_names(&self) -> Vec<String> {
+        self.boundary_groups
+            .keys()
+            .chain(self.point_groups.keys())
+            .cloned()
+            .collect()
     }
 
     /// Axis-aligned bounding box `(min, max)` of the nodes.

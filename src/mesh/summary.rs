@@ -38,6 +38,9 @@ impl fmt::Display for MeshSummary<'_> {
                 fmt_point(&lo[..d]),
                 fmt_point(&hi[..d])
             )?;
+            for (name, nodes) in &body.point_groups {
+                writeln!(f, "  points '{}': {} nodes", name, nodes.len())?;
+            }
             for (name, group) in &body.boundary_groups {
                 writeln!(
                     f,
