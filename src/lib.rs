@@ -14,15 +14,15 @@
 //! ```
 //!
 //! with `lambda` the traction on body 1 and `d` the nodal gaps, the active set updated until no
-//! node is in tension and none penetrates. The modules below provide what that system is built
-//! from: each body's stiffness `K_k`, load `f_k` and interface mass matrices `M_k`, and the
-//! sparse Cholesky factorization of `K_k`.
+//! node is in tension and none penetrates (the seed's Algorithm 3).
 //!
 //! The crate is organised as the solve proceeds:
 //! - [`mesh`]: gmsh MSH 4.1 input, bodies and boundary groups by physical name;
 //! - [`fem`]: P1 elasticity kernels, sparsity patterns, assembly, loads, Dirichlet conditions;
 //! - [`linalg`]: fill-reducing orderings and the sparse Cholesky factorization;
 //! - [`elastic`]: one body's problem, solve and solution;
+//! - [`contact`]: two bodies coupled by INTERNODES: interpolation, interface operators, the
+//!   coupled system and its solvers, the active-set loop;
 //! - [`case`]: the TOML case file;
 //! - [`output`]: XDMF/HDF5, JSON summary, Matrix Market;
 //! - [`run`]: `internodes solve CASE`, from the case file to the result files.
