@@ -605,3 +605,31 @@ fn frictionless_patch_test_without_rollers_gives_the_uniaxial_stress() {
         }
     }
 }
+
+#[test]
+fn a_cycling_active_set_ends_with_the_cycling_status() {
+    // Pressed by 0.08 (a / R about 0.25) the half-disc's active set returns to an earlier one at
+    // the rim (measured: at iteration 8); the loop must stop there with its status.
+    let text = half_disc_on_block("").replace("uy = -0.02", "uy = -0.08");
+    let solution = solve(&text).unwrap();
+    assert_eq!(solution.status, ContactStatus::Cycling);
+    assert!(
+        solution.history.len() >= 2 && solution.history.len() < 50,
+        "{} iterations",
+        solution.history.len()
+    );
+
+    // The command line writes the last iterate and exits with a failure status.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.toml");
+    std::fs::write(&path, &text).unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_internodes"))
+        .args(["solve", path.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("did not converge"), "{stderr}");
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
+    assert!(summary.contains("\"status\": \"cycling\""), "{summary}");
+}
