@@ -19,7 +19,7 @@ pub mod system;
 pub use coupled_solver::CoupledSolver;
 pub use problem::{ContactProblem, ContactSettings, Formulation};
 pub use solution::{ContactSolution, ContactStatus, HertzFit, IterationRecord, SurfaceFields};
-pub use solve::solve_contact;
+pub use solve::{Candidates, ContactSolver, solve_contact};
 pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;

@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use super::solve::Candidates;
 use crate::elastic::ElasticSolution;
 
 /// How the active-set loop ended. Only `Converged` is a contact solution; the others carry the
@@ -76,4 +77,8 @@ pub struct ContactSolution {
     pub force_secondary: [f64; 3],
     pub force_imbalance: f64,
     pub hertz_primary: Option<HertzFit>,
+    /// The factor the loads and prescribed displacements were scaled by.
+    pub load_factor: f64,
+    /// The candidate sets at the end, from which a next load step starts.
+    pub candidates: Candidates,
 }

@@ -35,179 +35,251 @@ use crate::fem::stress::cell_fields;
 use crate::linalg::relative_residual;
 use nalgebra::DMatrix;
 
-/// Solves a two-body contact problem.
+/// Solves a two-body contact problem at its full load.
 pub fn solve_contact(
     problem: &ContactProblem,
     solver: &SolverSettings,
 ) -> Result<ContactSolution, ContactError> {
-    let verbose = solver.verbose;
-    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-    let settings = &problem.settings;
-    let dim = s1.dim;
+    ContactSolver::new(problem, solver)?.solve(1.0, None)
+}
 
-    // Each body's constrained system, assembled once for all iterations.
-    let (mut stats1, mut stats2) = (SolveStats::default(), SolveStats::default());
-    let body1 = assemble(&problem.primary, &mut stats1, false)?;
-    let body2 = assemble(&problem.secondary, &mut stats2, false)?;
+/// The candidate sets an active-set loop starts from (surface indices).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Candidates {
+    pub primary: BTreeSet<usize>,
+    pub secondary: BTreeSet<usize>,
+}
 
-    // With the Schur path, each body's stiffness is factored once for all iterations.
-    let factors = match settings.solver {
-        CoupledSolver::Schur => {
-            let start = Instant::now();
-            let factors = BodyFactors::new(&body1, &body2, solver.ordering)?;
-            if verbose {
-                eprintln!(
-                    "  Cholesky of both bodies: {:.3} s",
-                    start.elapsed().as_secs_f64()
-                );
+/// A contact problem set up once: both bodies assembled (and, on the Schur path, factored) and
+/// the candidate-to-candidate interpolations built. Every load step reuses all of it: loads and
+/// prescribed displacements enter the system linearly, `f_c(s) = s f_c(1)`, while `K`, its
+/// factors and the interface geometry do not change.
+pub struct ContactSolver<'a> {
+    problem: &'a ContactProblem<'a>,
+    solver: SolverSettings,
+    body1: AssembledBody,
+    body2: AssembledBody,
+    stats1: SolveStats,
+    stats2: SolveStats,
+    factors: Option<BodyFactors>,
+    to_primary: Interpolation,
+    to_secondary: Interpolation,
+}
+
+impl<'a> ContactSolver<'a> {
+    pub fn new(
+        problem: &'a ContactProblem<'a>,
+        solver: &SolverSettings,
+    ) -> Result<Self, ContactError> {
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        // Each body's constrained system, assembled once.
+        let (mut stats1, mut stats2) = (SolveStats::default(), SolveStats::default());
+        let body1 = assemble(&problem.primary, &mut stats1, false)?;
+        let body2 = assemble(&problem.secondary, &mut stats2, false)?;
+        // With the Schur path, each body's stiffness is factored once.
+        let factors = match problem.settings.solver {
+            CoupledSolver::Schur => {
+                let start = Instant::now();
+                let factors = BodyFactors::new(&body1, &body2, solver.ordering)?;
+                if solver.verbose {
+                    eprintln!(
+                        "  Cholesky of both bodies: {:.3} s",
+                        start.elapsed().as_secs_f64()
+                    );
+                }
+                Some(factors)
             }
-            Some(factors)
-        }
-        CoupledSolver::MonolithicLu => None,
-    };
-
-    // Interpolation between all candidates, for the contact checks of step 4.
-    let to_primary = Interpolation::new(&s2.coords, &support_radii(&s2.coords)?, &s1.coords)?;
-    let to_secondary = Interpolation::new(&s1.coords, &support_radii(&s1.coords)?, &s2.coords)?;
-
-    let (zero1, zero2) = (vec![0.0; body1.f.len()], vec![0.0; body2.f.len()]);
-    let tol = settings.penetration_tolerance;
-    let mut candidates1: BTreeSet<usize> =
-        penetrating(s1, &normal_gaps(s1, s2, &to_primary, &zero1, &zero2), tol)
-            .into_iter()
-            .collect();
-    let mut candidates2: BTreeSet<usize> =
-        penetrating(s2, &normal_gaps(s2, s1, &to_secondary, &zero2, &zero1), tol)
-            .into_iter()
-            .collect();
-    let mut seen: HashSet<(Vec<usize>, Vec<usize>)> = HashSet::new();
-    let mut history = Vec::new();
-    let mut last: Option<(Coupling, CoupledSolution)> = None;
-    let mut status = ContactStatus::IterationLimit;
-
-    for iteration in 1..=settings.max_iterations {
-        let start = Instant::now();
-        // 1. Interface nodes among the candidates (Algorithm 2).
-        let c1: Vec<usize> = candidates1.iter().copied().collect();
-        let c2: Vec<usize> = candidates2.iter().copied().collect();
-        let interface = find_interface(s1, s2, &c1, &c2)?.unwrap_or_default();
-
-        // 2. Interface operators on the reference geometry.
-        let coupling = coupling(problem, &interface)?;
-
-        // 3. The coupled solve.
-        let system = CoupledSystem::assemble(&body1, &body2, &coupling, dim)?;
-        let x = coupled_solver::solve(&system, &body1, &body2, factors.as_ref())?;
-        let residual = relative_residual(&system.matrix(&body1, &body2)?, &x, &system.rhs());
-        let solution = system.solution(&x, &coupling, dim, residual);
-        if solution.relative_residual.is_nan()
-            || solution.relative_residual > solver.residual_tolerance
-        {
-            return Err(ContactError::Inaccurate {
-                residual: solution.relative_residual,
-                tolerance: solver.residual_tolerance,
-            });
-        }
-
-        // 4. Contact checks on the deformed configuration.
-        let checks = contact_checks(
-            problem,
-            &interface,
-            &coupling,
-            &solution,
-            &to_primary,
-            &to_secondary,
-        );
-        let (tension1, tension2) = (&checks.tension1, &checks.tension2);
-        let (penetrating1, penetrating2) = (&checks.penetrating1, &checks.penetrating2);
-
-        // 5. New candidate sets: drop tension, add penetration, both at once.
-        let active1: BTreeSet<usize> = interface.primary.iter().copied().collect();
-        let active2: BTreeSet<usize> = interface.secondary.iter().copied().collect();
-        let next1 = update(&active1, tension1, penetrating1);
-        let next2 = update(&active2, tension2, penetrating2);
-        let added = next1.difference(&active1).count() + next2.difference(&active2).count();
-        let removed = tension1.len() + tension2.len();
-        let record = IterationRecord {
-            iteration,
-            active_primary: active1.len(),
-            active_secondary: active2.len(),
-            added,
-            removed,
-            max_penetration: checks.max_penetration,
-            max_penetration_over_h: checks.max_penetration_over_h,
-            max_tension: checks.max_tension,
-            relative_residual: solution.relative_residual,
-            seconds: start.elapsed().as_secs_f64(),
+            CoupledSolver::MonolithicLu => None,
         };
-        if verbose {
-            eprintln!(
-                "  iteration {:>3}: active {:>5} + {:>5}, added {:>4}, removed {:>4}, penetration {:.2e} ({:.1e} h), tension {:.2e}, {:.3} s",
-                record.iteration,
-                record.active_primary,
-                record.active_secondary,
-                record.added,
-                record.removed,
-                record.max_penetration,
-                record.max_penetration_over_h,
-                record.max_tension,
-                record.seconds
-            );
-        }
-        history.push(record);
-        last = Some((coupling, solution));
-
-        let converged = tension1.is_empty()
-            && tension2.is_empty()
-            && penetrating1.iter().all(|s| active1.contains(s))
-            && penetrating2.iter().all(|s| active2.contains(s));
-        if converged {
-            status = if active1.is_empty() {
-                ContactStatus::NoContact
-            } else {
-                ContactStatus::Converged
-            };
-            break;
-        }
-        // A repeated candidate set means the simultaneous update oscillates (typically at the
-        // rim, where an outer node in tension holds the surfaces together and its inner
-        // neighbours penetrate). Fall back to a one-sided step: remove the tension nodes only,
-        // or if none, add the penetrating ones only; if that repeats a set too, the loop cycles.
-        // Candidate sets (the input of an iteration) are compared, not the interfaces that
-        // Algorithm 2 prunes from them.
-        seen.insert(key(&candidates1, &candidates2));
-        let (mut next1, mut next2) = (next1, next2);
-        if seen.contains(&key(&next1, &next2)) {
-            let one_sided = if removed > 0 {
-                (&[][..], &[][..])
-            } else {
-                (&penetrating1[..], &penetrating2[..])
-            };
-            next1 = update(&active1, tension1, one_sided.0);
-            next2 = update(&active2, tension2, one_sided.1);
-            if seen.contains(&key(&next1, &next2)) {
-                status = ContactStatus::Cycling;
-                break;
-            }
-        }
-        candidates1 = next1;
-        candidates2 = next2;
+        // Interpolation between all candidates, for the contact checks of step 4.
+        let to_primary = Interpolation::new(&s2.coords, &support_radii(&s2.coords)?, &s1.coords)?;
+        let to_secondary = Interpolation::new(&s1.coords, &support_radii(&s1.coords)?, &s2.coords)?;
+        Ok(Self {
+            problem,
+            solver: *solver,
+            body1,
+            body2,
+            stats1,
+            stats2,
+            factors,
+            to_primary,
+            to_secondary,
+        })
     }
 
-    let (coupling, solution) = last.expect("the loop runs at least once (max_iterations >= 1)");
-    finish(
-        problem,
-        &body1,
-        &body2,
-        stats1,
-        stats2,
-        status,
-        history,
-        &coupling,
-        solution,
-        &to_primary,
-        &to_secondary,
-    )
+    /// The candidates that penetrate or touch in the reference configuration.
+    pub fn initial_candidates(&self) -> Candidates {
+        let (s1, s2) = (
+            &self.problem.primary_surface,
+            &self.problem.secondary_surface,
+        );
+        let (zero1, zero2) = (vec![0.0; self.body1.f.len()], vec![0.0; self.body2.f.len()]);
+        let tol = self.problem.settings.penetration_tolerance;
+        Candidates {
+            primary: penetrating(
+                s1,
+                &normal_gaps(s1, s2, &self.to_primary, &zero1, &zero2),
+                tol,
+            )
+            .into_iter()
+            .collect(),
+            secondary: penetrating(
+                s2,
+                &normal_gaps(s2, s1, &self.to_secondary, &zero2, &zero1),
+                tol,
+            )
+            .into_iter()
+            .collect(),
+        }
+    }
+
+    /// Runs the active-set loop with the loads and prescribed displacements scaled by
+    /// `load_factor`, from `start` (default: [`Self::initial_candidates`]).
+    pub fn solve(
+        &self,
+        load_factor: f64,
+        start: Option<&Candidates>,
+    ) -> Result<ContactSolution, ContactError> {
+        let problem = self.problem;
+        let solver = &self.solver;
+        let verbose = solver.verbose;
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let settings = &problem.settings;
+        let dim = s1.dim;
+        let (body1, body2) = (&self.body1, &self.body2);
+        let (to_primary, to_secondary) = (&self.to_primary, &self.to_secondary);
+        let factors = self.factors.as_ref();
+        let start_candidates = start.cloned().unwrap_or_else(|| self.initial_candidates());
+        let mut candidates1 = start_candidates.primary;
+        let mut candidates2 = start_candidates.secondary;
+        let mut seen: HashSet<(Vec<usize>, Vec<usize>)> = HashSet::new();
+        let mut history = Vec::new();
+        let mut last: Option<(Coupling, CoupledSolution)> = None;
+        let mut status = ContactStatus::IterationLimit;
+
+        for iteration in 1..=settings.max_iterations {
+            let start = Instant::now();
+            // 1. Interface nodes among the candidates (Algorithm 2).
+            let c1: Vec<usize> = candidates1.iter().copied().collect();
+            let c2: Vec<usize> = candidates2.iter().copied().collect();
+            let interface = find_interface(s1, s2, &c1, &c2)?.unwrap_or_default();
+
+            // 2. Interface operators on the reference geometry.
+            let coupling = coupling(problem, &interface)?;
+
+            // 3. The coupled solve.
+            let system = CoupledSystem::assemble(body1, body2, &coupling, dim, load_factor)?;
+            let x = coupled_solver::solve(&system, body1, body2, factors)?;
+            let residual = relative_residual(&system.matrix(body1, body2)?, &x, &system.rhs());
+            let solution = system.solution(&x, &coupling, dim, residual);
+            if solution.relative_residual.is_nan()
+                || solution.relative_residual > solver.residual_tolerance
+            {
+                return Err(ContactError::Inaccurate {
+                    residual: solution.relative_residual,
+                    tolerance: solver.residual_tolerance,
+                });
+            }
+
+            // 4. Contact checks on the deformed configuration.
+            let checks = contact_checks(
+                problem,
+                &interface,
+                &coupling,
+                &solution,
+                &to_primary,
+                &to_secondary,
+            );
+            let (tension1, tension2) = (&checks.tension1, &checks.tension2);
+            let (penetrating1, penetrating2) = (&checks.penetrating1, &checks.penetrating2);
+
+            // 5. New candidate sets: drop tension, add penetration, both at once.
+            let active1: BTreeSet<usize> = interface.primary.iter().copied().collect();
+            let active2: BTreeSet<usize> = interface.secondary.iter().copied().collect();
+            let next1 = update(&active1, tension1, penetrating1);
+            let next2 = update(&active2, tension2, penetrating2);
+            let added = next1.difference(&active1).count() + next2.difference(&active2).count();
+            let removed = tension1.len() + tension2.len();
+            let record = IterationRecord {
+                iteration,
+                active_primary: active1.len(),
+                active_secondary: active2.len(),
+                added,
+                removed,
+                max_penetration: checks.max_penetration,
+                max_penetration_over_h: checks.max_penetration_over_h,
+                max_tension: checks.max_tension,
+                relative_residual: solution.relative_residual,
+                seconds: start.elapsed().as_secs_f64(),
+            };
+            if verbose {
+                eprintln!(
+                    "  iteration {:>3}: active {:>5} + {:>5}, added {:>4}, removed {:>4}, penetration {:.2e} ({:.1e} h), tension {:.2e}, {:.3} s",
+                    record.iteration,
+                    record.active_primary,
+                    record.active_secondary,
+                    record.added,
+                    record.removed,
+                    record.max_penetration,
+                    record.max_penetration_over_h,
+                    record.max_tension,
+                    record.seconds
+                );
+            }
+            history.push(record);
+            last = Some((coupling, solution));
+
+            let converged = tension1.is_empty()
+                && tension2.is_empty()
+                && penetrating1.iter().all(|s| active1.contains(s))
+                && penetrating2.iter().all(|s| active2.contains(s));
+            if converged {
+                status = if active1.is_empty() {
+                    ContactStatus::NoContact
+                } else {
+                    ContactStatus::Converged
+                };
+                break;
+            }
+            // A repeated candidate set means the simultaneous update oscillates (typically at the
+            // rim, where an outer node in tension holds the surfaces together and its inner
+            // neighbours penetrate). Fall back to a one-sided step: remove the tension nodes only,
+            // or if none, add the penetrating ones only; if that repeats a set too, the loop cycles.
+            // Candidate sets (the input of an iteration) are compared, not the interfaces that
+            // Algorithm 2 prunes from them.
+            seen.insert(key(&candidates1, &candidates2));
+            let (mut next1, mut next2) = (next1, next2);
+            if seen.contains(&key(&next1, &next2)) {
+                let one_sided = if removed > 0 {
+                    (&[][..], &[][..])
+                } else {
+                    (&penetrating1[..], &penetrating2[..])
+                };
+                next1 = update(&active1, tension1, one_sided.0);
+                next2 = update(&active2, tension2, one_sided.1);
+                if seen.contains(&key(&next1, &next2)) {
+                    status = ContactStatus::Cycling;
+                    break;
+                }
+            }
+            candidates1 = next1;
+            candidates2 = next2;
+        }
+
+        let (coupling, solution) = last.expect("the loop runs at least once (max_iterations >= 1)");
+        let candidates = Candidates {
+            primary: candidates1,
+            secondary: candidates2,
+        };
+        self.finish(
+            load_factor,
+            status,
+            history,
+            &coupling,
+            solution,
+            candidates,
+        )
+    }
 }
 
 /// What the contact checks of one iteration found (surface indices).
@@ -471,82 +543,87 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn finish(
-    problem: &ContactProblem,
-    body1: &AssembledBody,
-    body2: &AssembledBody,
-    mut stats1: SolveStats,
-    mut stats2: SolveStats,
-    status: ContactStatus,
-    history: Vec<IterationRecord>,
-    coupling: &Coupling,
-    solution: CoupledSolution,
-    to_primary: &Interpolation,
-    to_secondary: &Interpolation,
-) -> Result<ContactSolution, ContactError> {
-    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-    let dim = s1.dim;
-    stats1.relative_residual = solution.relative_residual;
-    stats2.relative_residual = solution.relative_residual;
-    let tractions2 = secondary_tractions(coupling, &solution, dim);
-    let gaps1 = normal_gaps(s1, s2, to_primary, &solution.u1, &solution.u2);
-    let gaps2 = normal_gaps(s2, s1, to_secondary, &solution.u2, &solution.u1);
-    let primary_fields = surface_fields(s1, &coupling.primary_nodes, &solution.traction, gaps1);
-    let secondary_fields = surface_fields(s2, &coupling.secondary_nodes, &tractions2, gaps2);
-    let total = |force: &[f64]| -> [f64; 3] {
-        std::array::from_fn(|c| {
-            if c < dim {
-                force.iter().skip(c).step_by(dim).sum()
-            } else {
-                0.0
-            }
-        })
-    };
-    let force_primary = total(&solution.contact_force1);
-    let force_secondary = total(&solution.contact_force2);
-    let norm = |f: &[f64; 3]| dot(f, f).sqrt();
-    let sum: [f64; 3] = std::array::from_fn(|c| force_primary[c] + force_secondary[c]);
-    let force_imbalance = if norm(&force_primary) > 0.0 {
-        norm(&sum) / norm(&force_primary)
-    } else {
-        0.0
-    };
-    let hertz_primary = hertz::fit(s1, &primary_fields);
+impl ContactSolver<'_> {
+    /// The solution of the last iterate, with surface fields, forces and the Hertz fit.
+    fn finish(
+        &self,
+        load_factor: f64,
+        status: ContactStatus,
+        history: Vec<IterationRecord>,
+        coupling: &Coupling,
+        solution: CoupledSolution,
+        candidates: Candidates,
+    ) -> Result<ContactSolution, ContactError> {
+        let problem = self.problem;
+        let (body1, body2) = (&self.body1, &self.body2);
+        let (to_primary, to_secondary) = (&self.to_primary, &self.to_secondary);
+        let (mut stats1, mut stats2) = (self.stats1.clone(), self.stats2.clone());
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let dim = s1.dim;
+        stats1.relative_residual = solution.relative_residual;
+        stats2.relative_residual = solution.relative_residual;
+        let tractions2 = secondary_tractions(coupling, &solution, dim);
+        let gaps1 = normal_gaps(s1, s2, to_primary, &solution.u1, &solution.u2);
+        let gaps2 = normal_gaps(s2, s1, to_secondary, &solution.u2, &solution.u1);
+        let primary_fields = surface_fields(s1, &coupling.primary_nodes, &solution.traction, gaps1);
+        let secondary_fields = surface_fields(s2, &coupling.secondary_nodes, &tractions2, gaps2);
+        let total = |force: &[f64]| -> [f64; 3] {
+            std::array::from_fn(|c| {
+                if c < dim {
+                    force.iter().skip(c).step_by(dim).sum()
+                } else {
+                    0.0
+                }
+            })
+        };
+        let force_primary = total(&solution.contact_force1);
+        let force_secondary = total(&solution.contact_force2);
+        let norm = |f: &[f64; 3]| dot(f, f).sqrt();
+        let sum: [f64; 3] = std::array::from_fn(|c| force_primary[c] + force_secondary[c]);
+        let force_imbalance = if norm(&force_primary) > 0.0 {
+            norm(&sum) / norm(&force_primary)
+        } else {
+            0.0
+        };
+        let hertz_primary = hertz::fit(s1, &primary_fields);
 
-    let body_solution = |p: &ElasticProblem,
-                         body: &AssembledBody,
-                         u: Vec<f64>,
-                         force: &[f64],
-                         stats: SolveStats| ElasticSolution {
-        reactions: reactions(p, body, &u, force),
-        cell_fields: cell_fields(p.body, &p.material, &u),
-        displacement: u,
-        stats,
-    };
-    Ok(ContactSolution {
-        status,
-        history,
-        primary: body_solution(
-            &problem.primary,
-            body1,
-            solution.u1,
-            &solution.contact_force1,
-            stats1,
-        ),
-        secondary: body_solution(
-            &problem.secondary,
-            body2,
-            solution.u2,
-            &solution.contact_force2,
-            stats2,
-        ),
-        primary_fields,
-        secondary_fields,
-        force_primary,
-        force_secondary,
-        force_imbalance,
-        hertz_primary,
-    })
+        let body_solution = |p: &ElasticProblem,
+                             body: &AssembledBody,
+                             u: Vec<f64>,
+                             force: &[f64],
+                             stats: SolveStats| ElasticSolution {
+            reactions: reactions(p, body, &u, load_factor, force),
+            cell_fields: cell_fields(p.body, &p.material, &u),
+            displacement: u,
+            stats,
+        };
+        Ok(ContactSolution {
+            status,
+            history,
+            primary: body_solution(
+                &problem.primary,
+                body1,
+                solution.u1,
+                &solution.contact_force1,
+                stats1,
+            ),
+            secondary: body_solution(
+                &problem.secondary,
+                body2,
+                solution.u2,
+                &solution.contact_force2,
+                stats2,
+            ),
+            primary_fields,
+            secondary_fields,
+            force_primary,
+            force_secondary,
+            force_imbalance,
+            hertz_primary,
+            load_factor,
+            candidates,
+        })
+    }
 }
 
 fn surface_fields(

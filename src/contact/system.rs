@@ -121,12 +121,14 @@ pub struct CoupledSystem {
 }
 
 impl CoupledSystem {
-    /// Assembles the blocks of the coupled system (method.md section 2).
+    /// Assembles the blocks of the coupled system (method.md section 2), with the loads and
+    /// prescribed displacements scaled by `load_factor`.
     pub fn assemble(
         body1: &AssembledBody,
         body2: &AssembledBody,
         coupling: &Coupling,
         dim: usize,
+        load_factor: f64,
     ) -> Result<Self, ContactError> {
         let n1 = body1.f_c.len();
         let n2 = body2.f_c.len();
@@ -185,8 +187,13 @@ impl CoupledSystem {
                 g[row] += t * weight * coupling.gaps[a][c];
             }
         }
-        let mut f = body1.f_c.clone();
-        f.extend_from_slice(&body2.f_c);
+        // Loads and prescribed displacements scale the constrained right-hand side linearly.
+        let f: Vec<f64> = body1
+            .f_c
+            .iter()
+            .chain(&body2.f_c)
+            .map(|v| load_factor * v)
+            .collect();
         Ok(Self {
             n1,
             n2,

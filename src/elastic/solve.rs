@@ -159,12 +159,13 @@ pub fn assemble(
     })
 }
 
-/// Reaction of each Dirichlet group: `sum (K u - f - f_other)` over its prescribed dofs, where
-/// `f_other` are forces not in `f` (contact forces; empty for a single body).
+/// Reaction of each Dirichlet group: `sum (K u - s f - f_other)` over its prescribed dofs, with
+/// `s` the load factor and `f_other` forces not in `f` (contact forces; empty for a single body).
 pub fn reactions(
     problem: &ElasticProblem,
     system: &AssembledBody,
     u: &[f64],
+    load_factor: f64,
     f_other: &[f64],
 ) -> Vec<(String, Vec<f64>)> {
     let body = problem.body;
@@ -181,7 +182,8 @@ pub fn reactions(
             for node in nodes {
                 for c in (0..dim).filter(|&c| condition.components[c].is_some()) {
                     let d = dim * node + c;
-                    total[c] += r[d] - system.f[d] - f_other.get(d).copied().unwrap_or(0.0);
+                    total[c] +=
+                        r[d] - load_factor * system.f[d] - f_other.get(d).copied().unwrap_or(0.0);
                 }
             }
             (condition.group.clone(), total)
@@ -230,7 +232,7 @@ pub fn solve(
     }
 
     // 6. Reactions and cell fields.
-    let reactions = reactions(problem, &system, &u, &[]);
+    let reactions = reactions(problem, &system, &u, 1.0, &[]);
     let cell_fields = timed(&mut stats, verbose, "strain and stress", || {
         cell_fields(body, &problem.material, &u)
     });
