@@ -7,15 +7,15 @@ use thiserror::Error;
 
 use crate::case::{Case, CaseError};
 use crate::contact::{
-    ContactError, ContactProblem, ContactSolution, ContactStatus, SurfaceFields, solve_contact,
+    ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus, SurfaceFields,
 };
 use crate::elastic::{ElasticSolution, SolveError, solve};
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
 use crate::mesh::BodyMesh;
 use crate::mesh::{Mesh, mesh_geo, read_msh};
 use crate::output::{
-    BodyFields, BodySummary, CaseSummary, ContactSummary, OutputError, write_matrix_market,
-    write_xdmf,
+    BodyFields, BodySummary, CaseSummary, ContactSummary, OutputError, StepRecord,
+    write_matrix_market, write_xdmf,
 };
 
 /// Command-line overrides of the case file.
@@ -106,15 +106,58 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
             problem.secondary_surface.len(),
             serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
         ));
+        // The set-up (assembly, factorizations, interpolation) once, then one active-set loop
+        // per load step, each starting from the previous active set.
+        let contact_error = |source| RunError::Contact {
+            path: case.path.clone(),
+            source,
+        };
         let phase = Instant::now();
-        let solution =
-            solve_contact(problem, &case.solver).map_err(|source| RunError::Contact {
-                path: case.path.clone(),
-                source,
-            })?;
-        timings.push(("contact solve".to_string(), phase.elapsed().as_secs_f64()));
-        say(format!("contact status: {}", describe(&solution)));
-        contact_summary = Some(summarize_contact(problem, &solution));
+        let contact_solver = ContactSolver::new(problem, &case.solver).map_err(contact_error)?;
+        timings.push(("contact set-up".to_string(), phase.elapsed().as_secs_f64()));
+        let load_steps = case.load_steps();
+        let mut steps = Vec::new();
+        let mut last: Option<ContactSolution> = None;
+        for (k, &factor) in load_steps.iter().enumerate() {
+            if load_steps.len() > 1 {
+                say(format!(
+                    "load step {}/{}: factor {factor}",
+                    k + 1,
+                    load_steps.len()
+                ));
+            }
+            let phase = Instant::now();
+            let start = last.as_ref().map(|s| &s.candidates);
+            let solution = contact_solver.solve(factor, start).map_err(contact_error)?;
+            let seconds = phase.elapsed().as_secs_f64();
+            timings.push((format!("contact step {}", k + 1), seconds));
+            say(format!("contact status: {}", describe(&solution)));
+            steps.push(StepRecord {
+                step: k + 1,
+                load_factor: factor,
+                status: solution.status,
+                iterations: solution.history.len(),
+                force_primary: solution.force_primary[..mesh.dim].to_vec(),
+                force_imbalance: solution.force_imbalance,
+                hertz_a: solution.hertz_primary.map(|h| h.a),
+                hertz_p0: solution.hertz_primary.map(|h| h.p0),
+                seconds,
+            });
+            let stop = matches!(
+                solution.status,
+                ContactStatus::IterationLimit | ContactStatus::Cycling
+            );
+            last = Some(solution);
+            if stop {
+                say("stopping the load steps: this step did not converge".to_string());
+                break;
+            }
+        }
+        let solution = last.expect("at least one load step");
+        let csv = output_dir.join("force_displacement.csv");
+        std::fs::write(&csv, StepRecord::csv(&steps))
+            .map_err(|source| OutputError::Io { path: csv, source })?;
+        contact_summary = Some(summarize_contact(problem, &solution, steps));
         solved.push(SolvedBody {
             name: problem.primary.body.name.clone(),
             solution: solution.primary,
@@ -313,7 +356,11 @@ fn norm(f: &[f64; 3]) -> f64 {
     (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()
 }
 
-fn summarize_contact(problem: &ContactProblem, solution: &ContactSolution) -> ContactSummary {
+fn summarize_contact(
+    problem: &ContactProblem,
+    solution: &ContactSolution,
+    steps: Vec<StepRecord>,
+) -> ContactSummary {
     let dim = problem.primary_surface.dim;
     ContactSummary {
         status: solution.status,
@@ -343,5 +390,6 @@ fn summarize_contact(problem: &ContactProblem, solution: &ContactSolution) -> Co
             .fold(0.0, f64::max),
         hertz_fit: solution.hertz_primary,
         iterations: solution.history.clone(),
+        steps,
     }
 }

@@ -633,3 +633,65 @@ fn a_cycling_active_set_ends_with_the_cycling_status() {
     let summary = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
     assert!(summary.contains("\"status\": \"cycling\""), "{summary}");
 }
+
+#[test]
+fn load_steps_reuse_the_set_up_and_match_independent_solves() {
+    // Stepping 0.5 -> 1 from the previous active set (one set-up, one factorization) must give,
+    // at each step, what an independent solve at that load factor gives.
+    let text = half_disc_on_block("");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("case.toml");
+    std::fs::write(&path, &text).unwrap();
+    let case = Case::load(&path).unwrap();
+    let mesh = read_msh(&case.mesh).unwrap();
+    let problem = case.contact_problem(&mesh).unwrap().unwrap();
+    let settings = SolverSettings {
+        verbose: false,
+        ..case.solver
+    };
+    let solver = internodes::contact::ContactSolver::new(&problem, &settings).unwrap();
+    let half = solver.solve(0.5, None).unwrap();
+    let full = solver.solve(1.0, Some(&half.candidates)).unwrap();
+    let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for (factor, stepped) in [(0.5, &half), (1.0, &full)] {
+        let alone = solver.solve(factor, None).unwrap();
+        assert_eq!(stepped.status, ContactStatus::Converged);
+        assert_eq!(
+            stepped.primary_fields.active, alone.primary_fields.active,
+            "factor {factor}: same active set"
+        );
+        let diff: Vec<f64> = stepped
+            .primary
+            .displacement
+            .iter()
+            .zip(&alone.primary.displacement)
+            .map(|(a, b)| a - b)
+            .collect();
+        assert!(
+            max(&diff) <= 1e-8 * max(&alone.primary.displacement),
+            "factor {factor}: differs by {:.2e}",
+            max(&diff)
+        );
+    }
+    assert!(full.force_primary[1].abs() > half.force_primary[1].abs());
+
+    // From the command line: one CSV row per step.
+    let stepped_text = text.replace("[contact]", "[contact]\nload_steps = [0.5, 1.0]");
+    std::fs::write(&path, &stepped_text).unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_internodes"))
+        .args(["solve", path.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("out/force_displacement.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert!(
+        rows[0].starts_with("step,load_factor,status,iterations,contact_force_x,contact_force_y")
+    );
+    assert!(rows[2].starts_with("2,1,converged,"), "{csv}");
+}

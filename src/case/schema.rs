@@ -57,6 +57,10 @@ pub struct ContactSpec {
     pub penetration_tolerance: Option<f64>,
     /// Fraction of the largest contact pressure, default 1e-8.
     pub tension_tolerance: Option<f64>,
+    /// Load factors, applied in turn to every load and prescribed displacement of the two
+    /// bodies; each step starts from the previous active set and reuses every factorization.
+    /// Default: one step at factor 1.
+    pub load_steps: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -234,6 +238,14 @@ impl Case {
         })
     }
 
+    /// The load factors of the contact solve (default: one step at 1).
+    pub fn load_steps(&self) -> Vec<f64> {
+        self.contact
+            .as_ref()
+            .and_then(|c| c.load_steps.clone())
+            .unwrap_or_else(|| vec![1.0])
+    }
+
     /// The contact problem of the `[contact]` table, if any.
     pub fn contact_problem<'m>(
         &self,
@@ -268,6 +280,14 @@ impl Case {
                     format!("{name} must be non-negative, got {value}"),
                 ));
             }
+        }
+        if let Some(steps) = &spec.load_steps
+            && (steps.is_empty() || steps.iter().any(|f| !f.is_finite()))
+        {
+            return Err(self.invalid(
+                "[contact]",
+                "load_steps must be a non-empty list of finite factors",
+            ));
         }
         if settings.max_iterations == 0 {
             return Err(self.invalid("[contact]", "max_iterations must be at least 1"));

@@ -187,8 +187,8 @@ impl<'a> ContactSolver<'a> {
                 &interface,
                 &coupling,
                 &solution,
-                &to_primary,
-                &to_secondary,
+                to_primary,
+                to_secondary,
             );
             let (tension1, tension2) = (&checks.tension1, &checks.tension2);
             let (penetrating1, penetrating2) = (&checks.penetrating1, &checks.penetrating2);

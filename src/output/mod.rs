@@ -5,7 +5,7 @@ mod summary;
 mod xdmf;
 
 pub use matrix_market::write_matrix_market;
-pub use summary::{BodySummary, CaseSummary, ContactSummary};
+pub use summary::{BodySummary, CaseSummary, ContactSummary, StepRecord};
 pub use xdmf::{BodyFields, write_xdmf};
 
 use std::path::PathBuf;

@@ -56,7 +56,59 @@ pub struct ContactSummary {
     pub max_pressure: f64,
     /// Hertz ellipse fitted to the primary pressure (contact radius / half-width and peak).
     pub hertz_fit: Option<HertzFit>,
+    /// Iteration history of the last load step.
     pub iterations: Vec<IterationRecord>,
+    /// One record per load step (also written as `force_displacement.csv`).
+    pub steps: Vec<StepRecord>,
+}
+
+/// How one load step ended.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepRecord {
+    pub step: usize,
+    pub load_factor: f64,
+    pub status: ContactStatus,
+    pub iterations: usize,
+    pub force_primary: Vec<f64>,
+    pub force_imbalance: f64,
+    pub hertz_a: Option<f64>,
+    pub hertz_p0: Option<f64>,
+    pub seconds: f64,
+}
+
+impl StepRecord {
+    /// The steps as CSV: one header line, one row per step.
+    pub fn csv(steps: &[StepRecord]) -> String {
+        let dim = steps.first().map_or(0, |s| s.force_primary.len());
+        let axes = ["x", "y", "z"];
+        let mut text = String::from("step,load_factor,status,iterations");
+        for axis in &axes[..dim] {
+            text += &format!(",contact_force_{axis}");
+        }
+        text += ",force_imbalance,hertz_a,hertz_p0,seconds\n";
+        let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
+        for s in steps {
+            let status = serde_json::to_value(s.status).expect("a unit enum serializes");
+            text += &format!(
+                "{},{},{},{}",
+                s.step,
+                s.load_factor,
+                status.as_str().unwrap_or(""),
+                s.iterations
+            );
+            for f in &s.force_primary {
+                text += &format!(",{f:.10e}");
+            }
+            text += &format!(
+                ",{:.3e},{},{},{:.3}\n",
+                s.force_imbalance,
+                optional(s.hertz_a),
+                optional(s.hertz_p0),
+                s.seconds
+            );
+        }
+        text
+    }
 }
 
 impl CaseSummary {
