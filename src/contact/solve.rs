@@ -398,7 +398,7 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
         m1_rows: m1_rows.iter().map(|&s| s1.nodes[s]).collect(),
         m1,
         m2_rows: m2_rows.iter().map(|&s| s2.nodes[s]).collect(),
-        m2,
+        m2_r21: DMatrix::zeros(m2.nrows(), x1.len()),
         gaps: Vec::new(),
     };
     if x1.is_empty() {
@@ -436,6 +436,7 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
         })
         .collect();
     coupling.gaps = gaps;
+    coupling.m2_r21 = &m2 * &r21;
     coupling.r12 = r12.matrix();
     coupling.r12_nodes = m2_rows.iter().map(|&s| s2.nodes[s]).collect();
     coupling.r21 = r21;

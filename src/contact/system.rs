@@ -42,11 +42,12 @@ pub struct Coupling {
     /// `R21` (|J| x |I|), interpolating from I to J.
     pub r21: DMatrix<f64>,
     /// Interface mass matrices of the facets with an active node: rows are the body nodes of
-    /// those facets (`m1_rows`, `m2_rows`), columns the active nodes I (resp. J).
+    /// those facets (`m1_rows`, `m2_rows`), columns the active nodes I (resp. J). Body 2's is
+    /// kept multiplied by `R21` (|m2_rows| x |I|), the only form the system uses.
     pub m1_rows: Vec<usize>,
     pub m1: DMatrix<f64>,
     pub m2_rows: Vec<usize>,
-    pub m2: DMatrix<f64>,
+    pub m2_r21: DMatrix<f64>,
     /// Nodal gaps in the reference configuration: the normal part of `R12 x2(J) - x1(I)`.
     pub gaps: Vec<[f64; 3]>,
 }
@@ -146,10 +147,9 @@ impl CoupledSystem {
 
         // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2.
         let mut b = Vec::new();
-        let m2_r21 = &coupling.m2 * &coupling.r21;
         for (nodes, matrix, sign, offset, body) in [
             (&coupling.m1_rows, &coupling.m1, -1.0, 0, body1),
-            (&coupling.m2_rows, &m2_r21, 1.0, n1, body2),
+            (&coupling.m2_rows, &coupling.m2_r21, 1.0, n1, body2),
         ] {
             for (a, &node) in nodes.iter().enumerate() {
                 for c in 0..dim {
@@ -266,12 +266,16 @@ impl CoupledSystem {
                 lambda
             })
             .collect();
-        let m2_r21 = &coupling.m2 * &coupling.r21;
         let mut contact_force1 = vec![0.0; n1];
         let mut contact_force2 = vec![0.0; n2];
         for (nodes, matrix, sign, force) in [
             (&coupling.m1_rows, &coupling.m1, 1.0, &mut contact_force1),
-            (&coupling.m2_rows, &m2_r21, -1.0, &mut contact_force2),
+            (
+                &coupling.m2_rows,
+                &coupling.m2_r21,
+                -1.0,
+                &mut contact_force2,
+            ),
         ] {
             for (a, &node) in nodes.iter().enumerate() {
                 for (k, lambda) in traction.iter().enumerate() {
