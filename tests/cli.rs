@@ -3,10 +3,10 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-use common::fixture;
+use common::{fixture, write_case};
 use internodes::case::CaseError;
 use internodes::elastic::{ProblemError, SolveError};
 use internodes::fem::MaterialError;
@@ -37,13 +37,6 @@ hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
 "#,
         fixture("block_3d.msh").display()
     )
-}
-
-fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("case.toml");
-    std::fs::write(&path, text).unwrap();
-    (dir, path)
 }
 
 fn run_quiet(case: &Path) -> Result<internodes::run::RunReport, RunError> {

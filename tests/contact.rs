@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::fixture;
+use common::{fixture, run_solve, write_case};
 use internodes::case::{Case, CaseError};
 use internodes::contact::{ContactSolution, ContactStatus, ContactSurface, solve_contact};
 use internodes::elastic::SolverSettings;
@@ -13,9 +13,7 @@ use internodes::mesh::read_msh;
 
 /// Solves the `[contact]` of a case given as TOML text.
 fn solve(text: &str) -> Result<ContactSolution, String> {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("case.toml");
-    std::fs::write(&path, text).unwrap();
+    let (_dir, path) = write_case(text);
     let case = Case::load(&path).map_err(|e| e.to_string())?;
     let mesh = read_msh(&case.mesh).map_err(|e| e.to_string())?;
     let problem = case
@@ -325,13 +323,8 @@ fn a_contact_body_needs_a_body_table() {
 
 #[test]
 fn misspelled_contact_keys_are_rejected() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("case.toml");
-    std::fs::write(
-        &path,
-        two_blocks(2, "frictionless", "", "").replace("formulation", "formulatoin"),
-    )
-    .unwrap();
+    let (_dir, path) =
+        write_case(&two_blocks(2, "frictionless", "", "").replace("formulation", "formulatoin"));
     let error = Case::load(&path).unwrap_err();
     assert!(matches!(error, CaseError::Syntax { .. }));
     assert!(error.to_string().contains("formulatoin"));
@@ -510,16 +503,10 @@ fn tied_conforming_blocks_give_the_solution_of_their_union() {
         );
 
         // The union, solved as one body.
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("union.toml");
-        std::fs::write(
-            &path,
-            format!(
-                "{header}{}",
-                body("union", &[("lower_base", base), ("upper_top", top)])
-            ),
-        )
-        .unwrap();
+        let (_dir, path) = write_case(&format!(
+            "{header}{}",
+            body("union", &[("lower_base", base), ("upper_top", top)])
+        ));
         let case = Case::load(&path).unwrap();
         let mesh = read_msh(&mesh_path).unwrap();
         let union_mesh = mesh.body("union").unwrap();
@@ -620,13 +607,8 @@ fn a_cycling_active_set_ends_with_the_cycling_status() {
     );
 
     // The command line writes the last iterate and exits with a failure status.
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("case.toml");
-    std::fs::write(&path, &text).unwrap();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_internodes"))
-        .args(["solve", path.to_str().unwrap(), "--quiet"])
-        .output()
-        .unwrap();
+    let (dir, path) = write_case(&text);
+    let output = run_solve(&path);
     assert_eq!(output.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("did not converge"), "{stderr}");
@@ -639,9 +621,7 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     // Stepping 0.5 -> 1 from the previous active set (one set-up, one factorization) must give,
     // at each step, what an independent solve at that load factor gives.
     let text = half_disc_on_block("");
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("case.toml");
-    std::fs::write(&path, &text).unwrap();
+    let (dir, path) = write_case(&text);
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
     let problem = case.contact_problem(&mesh).unwrap().unwrap();
@@ -678,10 +658,7 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     // From the command line: one CSV row per step.
     let stepped_text = text.replace("[contact]", "[contact]\nload_steps = [0.5, 1.0]");
     std::fs::write(&path, &stepped_text).unwrap();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_internodes"))
-        .args(["solve", path.to_str().unwrap(), "--quiet"])
-        .output()
-        .unwrap();
+    let output = run_solve(&path);
     assert!(
         output.status.success(),
         "{}",

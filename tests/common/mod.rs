@@ -1,7 +1,8 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 use internodes::mesh::{Mesh, read_msh};
 
@@ -26,4 +27,21 @@ pub fn edited_fixture(
     let path = dir.path().join(name);
     std::fs::write(&path, edit(text)).expect("write edited fixture");
     (dir, path)
+}
+
+/// A case file with `text`, written to a fresh temporary folder (kept alive by the returned
+/// guard; relative output paths land inside it).
+pub fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let path = dir.path().join("case.toml");
+    std::fs::write(&path, text).expect("write the case file");
+    (dir, path)
+}
+
+/// Runs `internodes solve CASE --quiet`.
+pub fn run_solve(case: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_internodes"))
+        .args(["solve", case.to_str().expect("UTF-8 path"), "--quiet"])
+        .output()
+        .expect("run the internodes binary")
 }
