@@ -13,10 +13,12 @@ deps:
 build: deps
 	cargo build --release
 
-# Mesh geo/block_3d.geo with gmsh and solve it: a block under a Hertzian pressure.
-# Open out/demo/solution.xdmf in ParaView (XDMF3 reader).
+# Mesh geo/hemisphere_on_block.geo with gmsh and solve the 3D Hertz contact of an elastic
+# hemisphere pressed onto an elastic block (INTERNODES, frictionless).
+# Open out/demo/solution.xdmf in ParaView (XDMF3 reader); out/demo/summary.json has the contact
+# force, the Hertz fit and the iteration history.
 demo: build
-	$(BINARY) solve geo/block_3d.toml --output out/demo
+	$(BINARY) solve geo/hemisphere_on_block.toml --output out/demo
 
 # Unit and integration tests (no gmsh or Python needed), then the FEniCSx cross-checks.
 test: build

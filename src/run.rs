@@ -7,7 +7,8 @@ use thiserror::Error;
 
 use crate::case::{Case, CaseError};
 use crate::contact::{
-    ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus, SurfaceFields,
+    ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus, Formulation,
+    SurfaceFields,
 };
 use crate::elastic::{ElasticSolution, SolveError, solve};
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
@@ -131,7 +132,10 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
             let solution = contact_solver.solve(factor, start).map_err(contact_error)?;
             let seconds = phase.elapsed().as_secs_f64();
             timings.push((format!("contact step {}", k + 1), seconds));
-            say(format!("contact status: {}", describe(&solution)));
+            say(format!(
+                "contact status: {}",
+                describe(&solution, problem.settings.formulation)
+            ));
             steps.push(StepRecord {
                 step: k + 1,
                 load_factor: factor,
@@ -337,14 +341,19 @@ struct SolvedBody {
 }
 
 /// One line on how the contact solve ended.
-fn describe(solution: &ContactSolution) -> String {
+fn describe(solution: &ContactSolution, formulation: Formulation) -> String {
     let iterations = solution.history.len();
     match solution.status {
         ContactStatus::Converged => format!(
-            "converged in {iterations} iterations; contact force {:.6e}, imbalance {:.1e}{}",
+            "converged in {iterations} iterations; contact force {:.6e}, imbalance {:.1e}{}{}",
             norm(&solution.force_primary),
             solution.force_imbalance,
-            solution.hertz_primary.map_or(String::new(), |h| format!(", Hertz fit a = {:.6e}, p0 = {:.6e}", h.a, h.p0))
+            solution.hertz_primary.map_or(String::new(), |h| format!(", Hertz fit a = {:.6e}, p0 = {:.6e}", h.a, h.p0)),
+            if formulation == Formulation::Tied {
+                format!(", largest tangential traction {:.3e}", solution.max_tangential_traction)
+            } else {
+                String::new()
+            }
         ),
         ContactStatus::NoContact => "no contact: the candidate surfaces never come within interpolation range; each body was solved alone".to_string(),
         ContactStatus::IterationLimit => format!("NOT converged: the iteration cap ({iterations}) was reached"),
@@ -388,6 +397,7 @@ fn summarize_contact(
             .iter()
             .cloned()
             .fold(0.0, f64::max),
+        max_tangential_traction: solution.max_tangential_traction,
         hertz_fit: solution.hertz_primary,
         iterations: solution.history.clone(),
         steps,

@@ -173,14 +173,18 @@ fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
     assert_eq!(solution.status, ContactStatus::Converged);
     let fields = &solution.primary_fields;
 
-    // No active node in tension, no inactive candidate penetrating beyond the tolerance.
-    assert!(
-        fields
-            .active
-            .iter()
-            .zip(&fields.pressure)
-            .all(|(&a, &p)| !a || p >= 0.0)
-    );
+    // No active node in tension (its contact force, i.e. its mean pressure, is compressive),
+    // no inactive candidate penetrating beyond the tolerance.
+    for (fields, body) in [(fields, "disc"), (&solution.secondary_fields, "block")] {
+        for (s, _) in fields.active.iter().enumerate().filter(|&(_, &a)| a) {
+            assert!(
+                fields.mean_pressure[s] >= 0.0,
+                "{body}: active node {} has mean pressure {}",
+                fields.nodes[s],
+                fields.mean_pressure[s]
+            );
+        }
+    }
     let last = solution.history.last().unwrap();
     assert!(
         last.max_penetration_over_h <= 1e-3,
@@ -593,11 +597,174 @@ fn frictionless_patch_test_without_rollers_gives_the_uniaxial_stress() {
     }
 }
 
+/// The hemisphere (R = 1) pressed by `delta` onto the block, frictionless unless `extra` says
+/// otherwise; `e_sphere` and `e_block` are the Young's moduli, nu = 0.3 for both.
+fn hemisphere_on_block(mesh: &str, delta: f64, e_sphere: f64, e_block: f64, extra: &str) -> String {
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "sphere"
+primary_surface = "sphere_contact"
+secondary = "block"
+secondary_surface = "block_contact"
+{extra}
+
+[[body]]
+name = "sphere"
+youngs_modulus = {e_sphere:?}
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "sphere_top"
+ux = 0.0
+uy = 0.0
+uz = {uz:?}
+
+[[body]]
+name = "block"
+youngs_modulus = {e_block:?}
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+uz = 0.0
+"#,
+        mesh = fixture(mesh).display(),
+        uz = -delta
+    )
+}
+
+/// What a converged 3D Hertz solve must show (issue: "hemisphere on a large block at a/R about
+/// 0.1"): no active node in tension on either surface, no candidate penetrating beyond the
+/// tolerance, no hole (every primary candidate closer to the axis than `a - h` is active, `a`
+/// Hertz's radius for the measured force and `h` the node's spacing: the discrete rim is one
+/// spacing wide), a small force imbalance, and the fitted contact radius and peak pressure
+/// within 5% of Hertz with the combined modulus `e_star` for the measured force. Returns the
+/// relative errors of a and p0.
+fn assert_hertz_3d(solution: &ContactSolution, e_star: f64, label: &str) -> (f64, f64) {
+    assert_eq!(solution.status, ContactStatus::Converged, "{label}");
+    for fields in [&solution.primary_fields, &solution.secondary_fields] {
+        for (s, _) in fields.active.iter().enumerate().filter(|&(_, &a)| a) {
+            assert!(
+                fields.mean_pressure[s] >= 0.0,
+                "{label}: active node {} has mean pressure {}",
+                fields.nodes[s],
+                fields.mean_pressure[s]
+            );
+        }
+    }
+    let last = solution.history.last().unwrap();
+    assert!(
+        last.max_penetration_over_h <= 1e-3,
+        "{label}: penetration {} h",
+        last.max_penetration_over_h
+    );
+    // Measured 1.6% (identical materials) and 2.2% (E ratio 10): INTERNODES transfers forces
+    // through R21, which is not the transpose of R12, so the balance is only approximate.
+    assert!(
+        solution.force_imbalance < 0.03,
+        "{label}: imbalance {}",
+        solution.force_imbalance
+    );
+
+    // Hertz (method.md section 4): a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2), R = 1.
+    let force = solution.force_primary[2].abs();
+    let a = (3.0 * force / (4.0 * e_star)).cbrt();
+    let p0 = 3.0 * force / (2.0 * std::f64::consts::PI * a * a);
+    assert!(
+        (0.08..0.14).contains(&a),
+        "{label}: a/R about 0.1 (a = {a})"
+    );
+
+    let mesh = read_msh(&fixture("hemisphere_on_block_hertz.msh")).unwrap();
+    let sphere = ContactSurface::new(mesh.body("sphere").unwrap(), "sphere_contact").unwrap();
+    let fields = &solution.primary_fields;
+    for s in 0..sphere.len() {
+        let r = sphere.coords[s][0].hypot(sphere.coords[s][1]);
+        assert!(
+            fields.active[s] || r >= a - sphere.spacing[s],
+            "{label}: hole at r = {r} (a = {a})"
+        );
+    }
+
+    let fit = solution
+        .hertz_primary
+        .expect("enough loaded nodes for the fit");
+    let (error_a, error_p0) = ((fit.a - a) / a, (fit.p0 - p0) / p0);
+    assert!(
+        error_a.abs() <= 0.05,
+        "{label}: contact radius {} vs Hertz {a}",
+        fit.a
+    );
+    assert!(
+        error_p0.abs() <= 0.05,
+        "{label}: peak pressure {} vs Hertz {p0}",
+        fit.p0
+    );
+    (error_a, error_p0)
+}
+
+#[test]
+fn hertz_hemisphere_on_block_matches_theory() {
+    // Identical materials, E = 1000, nu = 0.3, pressed by 0.01 (a / R about 0.1); the contact
+    // zone is meshed at R/67. 1/E* = 2 (1 - nu^2) / E.
+    let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
+    let solution = solve(&text).unwrap();
+    let (error_a, error_p0) =
+        assert_hertz_3d(&solution, 1000.0 / (2.0 * (1.0 - 0.09)), "identical");
+    eprintln!("identical materials: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
+}
+
+#[test]
+fn hertz_with_dissimilar_materials_uses_the_combined_modulus() {
+    // The block ten times stiffer than the sphere: frictionless contact follows Hertz with
+    // 1/E* = (1 - nu^2) (1/E1 + 1/E2).
+    let e_star = 1.0 / ((1.0 - 0.09) * (1.0 / 1000.0 + 1.0 / 10000.0));
+    let frictionless = solve(&hemisphere_on_block(
+        "hemisphere_on_block_hertz.msh",
+        0.01,
+        1000.0,
+        10000.0,
+        "",
+    ))
+    .unwrap();
+    let (error_a, error_p0) = assert_hertz_3d(&frictionless, e_star, "frictionless");
+    eprintln!("E ratio 10, frictionless: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
+    assert!(frictionless.max_tangential_traction <= 1e-10 * frictionless.hertz_primary.unwrap().p0);
+
+    // Glued, the dissimilar surfaces cannot slide: the same case runs and the shear it carries
+    // is reported (it is not Hertz's problem any more, so only its presence is checked).
+    let tied = solve(&hemisphere_on_block(
+        "hemisphere_on_block_hertz.msh",
+        0.01,
+        1000.0,
+        10000.0,
+        "formulation = \"tied\"",
+    ))
+    .unwrap();
+    assert_eq!(tied.status, ContactStatus::Converged);
+    let p0 = tied.hertz_primary.unwrap().p0;
+    assert!(
+        tied.max_tangential_traction > 0.05 * p0,
+        "tied: tangential traction {} against p0 {p0}",
+        tied.max_tangential_traction
+    );
+    eprintln!(
+        "E ratio 10, tied: largest tangential traction {:.3e} ({:.2} p0)",
+        tied.max_tangential_traction,
+        tied.max_tangential_traction / p0
+    );
+}
+
 #[test]
 fn a_cycling_active_set_ends_with_the_cycling_status() {
-    // Pressed by 0.08 (a / R about 0.25) the half-disc's active set returns to an earlier one at
-    // the rim (measured: at iteration 8); the loop must stop there with its status.
-    let text = half_disc_on_block("").replace("uy = -0.02", "uy = -0.08");
+    // On the coarse hemisphere mesh (h about R/7 at the pole) a press of 0.008 gives a contact
+    // radius of about one spacing: the interface shrinks under tension until it is empty, and
+    // then the whole zone penetrates again (measured: the set of iteration 1 comes back at
+    // iteration 5). The loop must stop there with its status.
+    let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, "");
     let solution = solve(&text).unwrap();
     assert_eq!(solution.status, ContactStatus::Cycling);
     assert!(

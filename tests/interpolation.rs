@@ -4,9 +4,13 @@
 
 use std::f64::consts::PI;
 
+use internodes::contact::ContactSurface;
 use internodes::contact::rbf::{
-    C_MAX, Interpolation, RbfError, Side, interface_nodes, support_radii,
+    C_MAX, Interpolation, RbfError, Side, interface_nodes, interpolation_radii, support_radii,
 };
+use internodes::mesh::read_msh;
+
+mod common;
 
 /// Points on the circle of radius `radius` at the angles `theta`, in the plane z = 0 (2D).
 fn arc(radius: f64, theta: &[f64]) -> Vec<[f64; 3]> {
@@ -215,6 +219,50 @@ fn smooth_field_converges_on_plane_3d() {
     assert!(observed[2..].iter().all(|&r| r > 0.95), "{observed:?}");
     let overall = (errors[0] / errors[4]).log2() / 4.0;
     assert!(overall > 0.85, "overall rate {overall}");
+}
+
+#[test]
+fn larger_supports_interpolate_a_linear_field_better_on_contact_meshes() {
+    // The hemisphere-on-block contact surfaces refined to R/67 (the 3D Hertz test mesh): the
+    // linear field x interpolated both ways between the two surfaces, at the target nodes
+    // within 0.15 of the axis, for several multiples of the radii of seed Algorithm 1.
+    let mesh = read_msh(&common::fixture("hemisphere_on_block_hertz.msh")).unwrap();
+    let sphere = ContactSurface::new(mesh.body("sphere").unwrap(), "sphere_contact").unwrap();
+    let block = ContactSurface::new(mesh.body("block").unwrap(), "block_contact").unwrap();
+    let h = sphere.spacing.iter().sum::<f64>() / sphere.len() as f64;
+    let near = |s: &ContactSurface| -> Vec<[f64; 3]> {
+        s.coords
+            .iter()
+            .filter(|p| p[0].hypot(p[1]) < 0.15)
+            .copied()
+            .collect()
+    };
+    let error = |from: &ContactSurface, to: &ContactSurface, factor: f64| {
+        let radii = interpolation_radii(&from.coords, factor).unwrap();
+        let targets = near(to);
+        let interp = Interpolation::new(&from.coords, &radii, &targets).unwrap();
+        let x: Vec<f64> = from.coords.iter().map(|p| p[0]).collect();
+        interp
+            .apply(&x, 1)
+            .iter()
+            .zip(&targets)
+            .map(|(v, p)| (v - p[0]).abs() / h)
+            .fold(0.0, f64::max)
+    };
+    let factors = [1.0, 2.0, 3.0];
+    let to_sphere: Vec<f64> = factors.iter().map(|&f| error(&block, &sphere, f)).collect();
+    let to_block: Vec<f64> = factors.iter().map(|&f| error(&sphere, &block, f)).collect();
+    println!(
+        "largest error / h, factors {factors:?}: block to sphere {to_sphere:?}, sphere to block {to_block:?}"
+    );
+    // Measured: block to sphere 0.19, 0.061, 0.50; sphere to block 0.21, 0.068, 0.076. Twice
+    // the radii cut the error threefold both ways; three times the radii reach, from the
+    // graded part of the block surface (its spacing grows beyond r = 0.16), into the fine
+    // part, and the error there grows again: the default factor is 2.
+    for errors in [&to_sphere, &to_block] {
+        assert!(errors[0] > 0.1, "Algorithm 1's radii: {errors:?}");
+        assert!(errors[1] < 0.5 * errors[0], "{errors:?}");
+    }
 }
 
 /// Points `x0, x0 + h, ...` (`n` of them) on the line `y = y0`, `z = 0`.

@@ -31,9 +31,13 @@ pub struct ContactSettings {
     /// A candidate node penetrates when its gap along its normal is below `-tol * h`, `h` its
     /// distance to the nearest node of its own surface (default 1e-3).
     pub penetration_tolerance: f64,
-    /// An active node is in tension when `lambda . n > tol * p_max`, `p_max` the largest
-    /// contact pressure of the iteration (default 1e-8).
+    /// An active node is in tension when its mean pressure (the contact pressure averaged over
+    /// its patch, see [`ContactSurface::mean_pressure`]) is below `-tol * p_max`, `p_max` the
+    /// largest mean pressure of the iteration (default 1e-8).
     pub tension_tolerance: f64,
+    /// The RBF support radii are those of seed Algorithm 1 times this factor (default 2; 1 is
+    /// the seed's interpolation). See [`crate::contact::rbf`] for the measurements behind it.
+    pub radius_factor: f64,
 }
 
 impl Default for ContactSettings {
@@ -44,6 +48,7 @@ impl Default for ContactSettings {
             max_iterations: 50,
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
+            radius_factor: 2.0,
         }
     }
 }

@@ -33,7 +33,7 @@ pub struct IterationRecord {
     /// spacing h.
     pub max_penetration: f64,
     pub max_penetration_over_h: f64,
-    /// Largest tension `lambda . n` of an active node (0 when none is in tension).
+    /// Largest tension (negative mean pressure) of an active node (0 when none is in tension).
     pub max_tension: f64,
     pub relative_residual: f64,
     pub seconds: f64,
@@ -46,8 +46,13 @@ pub struct SurfaceFields {
     pub nodes: Vec<usize>,
     /// Contact traction on this body (zero at inactive nodes).
     pub traction: Vec<[f64; 3]>,
-    /// Contact pressure `p = -traction . n` (positive in compression).
+    /// Contact pressure `p = -traction . n` (positive in compression), nodal values of the P1
+    /// field.
     pub pressure: Vec<f64>,
+    /// The pressure averaged over each node's patch with the node's hat function as weight
+    /// ([`super::ContactSurface::mean_pressure`]): the quantity the tension check uses. Nonzero
+    /// also at the inactive neighbours of active nodes, which the P1 traction reaches.
+    pub mean_pressure: Vec<f64>,
     /// Gap to the other surface along the outward normal, deformed configuration (NaN where
     /// the other surface is out of interpolation range).
     pub normal_gap: Vec<f64>,
@@ -76,6 +81,9 @@ pub struct ContactSolution {
     pub force_primary: [f64; 3],
     pub force_secondary: [f64; 3],
     pub force_imbalance: f64,
+    /// Largest tangential traction `|lambda - (lambda . n) n|` on the primary surface: zero
+    /// for frictionless contact, the shear the glue carries for tied contact.
+    pub max_tangential_traction: f64,
     pub hertz_primary: Option<HertzFit>,
     /// The factor the loads and prescribed displacements were scaled by.
     pub load_factor: f64,

@@ -46,6 +46,8 @@ pub struct ContactSurface {
     pub normals: Vec<[f64; 3]>,
     /// Distance to the nearest other surface node (the local spacing h).
     pub spacing: Vec<f64>,
+    /// `int phi_s ds` over the candidate surface: the area (2D: length) a node stands for.
+    pub nodal_area: Vec<f64>,
     /// Facets as surface node indices, `dim` per facet.
     facets: Vec<usize>,
     facet_measures: Vec<f64>,
@@ -73,6 +75,7 @@ impl ContactSurface {
         let mut normals = vec![[0.0; 3]; nodes.len()];
         let mut facets = Vec::with_capacity(group.facets.len());
         let mut facet_measures = Vec::new();
+        let mut nodal_area = vec![0.0; nodes.len()];
         for f in 0..group.num_facets(dim) {
             let facet = group.facet(f, dim);
             let x: Vec<[f64; 3]> = facet.iter().map(|&n| body.coords[n]).collect();
@@ -80,6 +83,7 @@ impl ContactSurface {
             for &n in facet {
                 let s = index[&n];
                 facets.push(s);
+                nodal_area[s] += measure / dim as f64;
                 for k in 0..3 {
                     normals[s][k] += measure * normal[k];
                 }
@@ -103,6 +107,7 @@ impl ContactSurface {
             coords,
             normals,
             spacing,
+            nodal_area,
             facets,
             facet_measures,
         })
@@ -114,6 +119,17 @@ impl ContactSurface {
 
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
+    }
+
+    /// The contact pressure averaged over the patch of node `s` with its hat function as
+    /// weight, `int p phi_s ds / int phi_s ds`, from the nodal contact forces `force` that the
+    /// interface exerts on this body (body dofs, `dim` per node).
+    pub fn mean_pressure(&self, force: &[f64], s: usize) -> f64 {
+        let node = self.nodes[s];
+        let normal_force: f64 = (0..self.dim)
+            .map(|k| force[self.dim * node + k] * self.normals[s][k])
+            .sum();
+        -normal_force / self.nodal_area[s]
     }
 
     /// The interface mass matrix of the active nodes `active` (surface indices):

@@ -53,7 +53,9 @@ pub struct ContactSummary {
     /// Active nodes at the end, on each surface.
     pub active_primary: usize,
     pub active_secondary: usize,
+    /// Largest nodal contact pressure and tangential traction on the primary surface.
     pub max_pressure: f64,
+    pub max_tangential_traction: f64,
     /// Hertz ellipse fitted to the primary pressure (contact radius / half-width and peak).
     pub hertz_fit: Option<HertzFit>,
     /// Iteration history of the last load step.

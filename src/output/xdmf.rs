@@ -5,7 +5,8 @@
 //! `/mesh/node_body` (N), `/mesh/cell_body` (C), `/mesh/cell_tag` (C) gmsh element tags,
 //! `/fields/displacement` (N, 3), `/fields/strain` and `/fields/stress` (C, 9) row-major 3 x 3,
 //! `/fields/von_mises` (C); in contact runs also `/fields/contact_traction` (N, 3),
-//! `/fields/contact_pressure` (N), `/fields/normal_gap` (N) and `/fields/contact_active` (N),
+//! `/fields/contact_pressure` (N), `/fields/contact_mean_pressure` (N), `/fields/normal_gap` (N)
+//! and `/fields/contact_active` (N),
 //! zero at nodes off the candidate surfaces (gap NaN where the other surface is out of range).
 
 use std::path::Path;
@@ -44,6 +45,7 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
     let contact = bodies.iter().any(|b| b.surface.is_some());
     let mut traction = vec![0.0; 3 * num_nodes];
     let mut pressure = vec![0.0; num_nodes];
+    let mut mean_pressure = vec![0.0; num_nodes];
     let mut gap = vec![0.0; num_nodes];
     let mut active = vec![0i32; num_nodes];
     let mut offset = 0;
@@ -53,6 +55,7 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
                 let row = offset + node;
                 traction[3 * row..3 * row + 3].copy_from_slice(&surface.traction[s]);
                 pressure[row] = surface.pressure[s];
+                mean_pressure[row] = surface.mean_pressure[s];
                 gap[row] = surface.normal_gap[s];
                 active[row] = i32::from(surface.active[s]);
             }
@@ -131,6 +134,10 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
                 .new_dataset_builder()
                 .with_data(&Array1::from(pressure))
                 .create("contact_pressure")?;
+            fields
+                .new_dataset_builder()
+                .with_data(&Array1::from(mean_pressure))
+                .create("contact_mean_pressure")?;
             fields
                 .new_dataset_builder()
                 .with_data(&Array1::from(gap))
@@ -263,6 +270,15 @@ fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize, contact
             "Float",
             8,
             "/fields/contact_pressure",
+        );
+        s += &attribute(
+            "contact_mean_pressure",
+            "Scalar",
+            "Node",
+            n.to_string(),
+            "Float",
+            8,
+            "/fields/contact_mean_pressure",
         );
         s += &attribute(
             "normal_gap",
