@@ -643,7 +643,7 @@ uz = 0.0
 /// spacing wide), a small force imbalance, and the fitted contact radius and peak pressure
 /// within 5% of Hertz with the combined modulus `e_star` for the measured force. Returns the
 /// relative errors of a and p0.
-fn assert_hertz_3d(solution: &ContactSolution, e_star: f64, label: &str) -> (f64, f64) {
+fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &str) -> (f64, f64) {
     assert_eq!(solution.status, ContactStatus::Converged, "{label}");
     for fields in [&solution.primary_fields, &solution.secondary_fields] {
         for (s, _) in fields.active.iter().enumerate().filter(|&(_, &a)| a) {
@@ -678,7 +678,7 @@ fn assert_hertz_3d(solution: &ContactSolution, e_star: f64, label: &str) -> (f64
         "{label}: a/R about 0.1 (a = {a})"
     );
 
-    let mesh = read_msh(&fixture("hemisphere_on_block_hertz.msh")).unwrap();
+    let mesh = read_msh(&fixture(mesh)).unwrap();
     let sphere = ContactSurface::new(mesh.body("sphere").unwrap(), "sphere_contact").unwrap();
     let fields = &solution.primary_fields;
     for s in 0..sphere.len() {
@@ -712,9 +712,55 @@ fn hertz_hemisphere_on_block_matches_theory() {
     // zone is meshed at R/67. 1/E* = 2 (1 - nu^2) / E.
     let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
     let solution = solve(&text).unwrap();
-    let (error_a, error_p0) =
-        assert_hertz_3d(&solution, 1000.0 / (2.0 * (1.0 - 0.09)), "identical");
+    let (error_a, error_p0) = assert_hertz_3d(
+        &solution,
+        "hemisphere_on_block_hertz.msh",
+        1000.0 / (2.0 * (1.0 - 0.09)),
+        "identical",
+    );
     eprintln!("identical materials: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
+}
+
+#[test]
+fn bodies_meshed_overlapping_are_pushed_apart_into_hertz_contact() {
+    // The seed's set-up: no imposed displacement, the bodies meshed overlapping (pole 0.01
+    // below the block top in 3D, 0.02 in 2D, the same overlaps as the pressed cases), the
+    // sphere's top held and the block's base clamped.
+    let text = hemisphere_on_block("hemisphere_on_block_overlap.msh", 0.0, 1000.0, 1000.0, "");
+    let solution = solve(&text).unwrap();
+    let (error_a, error_p0) = assert_hertz_3d(
+        &solution,
+        "hemisphere_on_block_overlap.msh",
+        1000.0 / (2.0 * (1.0 - 0.09)),
+        "3D overlap",
+    );
+    eprintln!("3D overlap: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
+
+    let text = half_disc_on_block("")
+        .replace(
+            "half_disc_on_block_hertz.msh",
+            "half_disc_on_block_overlap.msh",
+        )
+        .replace("uy = -0.02", "uy = 0.0");
+    let solution = solve(&text).unwrap();
+    assert_eq!(solution.status, ContactStatus::Converged);
+    let fields = &solution.primary_fields;
+    assert!(
+        fields
+            .active
+            .iter()
+            .zip(&fields.mean_pressure)
+            .all(|(&a, &p)| !a || p >= 0.0)
+    );
+    let e_star = 1000.0 / (2.0 * (1.0 - 0.09));
+    let force = solution.force_primary[1].abs();
+    let a = (4.0 * force / (std::f64::consts::PI * e_star)).sqrt();
+    let p0 = 2.0 * force / (std::f64::consts::PI * a);
+    let fit = solution.hertz_primary.unwrap();
+    let (error_a, error_p0) = ((fit.a - a) / a, (fit.p0 - p0) / p0);
+    assert!(error_a.abs() <= 0.05, "2D overlap: a {} vs {a}", fit.a);
+    assert!(error_p0.abs() <= 0.05, "2D overlap: p0 {} vs {p0}", fit.p0);
+    eprintln!("2D overlap: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
 }
 
 #[test]
@@ -730,7 +776,12 @@ fn hertz_with_dissimilar_materials_uses_the_combined_modulus() {
         "",
     ))
     .unwrap();
-    let (error_a, error_p0) = assert_hertz_3d(&frictionless, e_star, "frictionless");
+    let (error_a, error_p0) = assert_hertz_3d(
+        &frictionless,
+        "hemisphere_on_block_hertz.msh",
+        e_star,
+        "frictionless",
+    );
     eprintln!("E ratio 10, frictionless: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
     assert!(frictionless.max_tangential_traction <= 1e-10 * frictionless.hertz_primary.unwrap().p0);
 

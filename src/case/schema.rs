@@ -57,8 +57,8 @@ pub struct ContactSpec {
     pub penetration_tolerance: Option<f64>,
     /// Fraction of the largest contact pressure, default 1e-8.
     pub tension_tolerance: Option<f64>,
-    /// Multiplies the RBF support radii of seed Algorithm 1, default 2 (1: the seed's radii).
-    pub radius_factor: Option<f64>,
+    /// RBF support radius in units of each node's nearest-node distance, default 2.
+    pub rbf_radius: Option<f64>,
     /// Load factors, applied in turn to every load and prescribed displacement of the two
     /// bodies; each step starts from the previous active set and reuses every factorization.
     /// Default: one step at factor 1.
@@ -271,14 +271,15 @@ impl Case {
                 .penetration_tolerance
                 .unwrap_or(defaults.penetration_tolerance),
             tension_tolerance: spec.tension_tolerance.unwrap_or(defaults.tension_tolerance),
-            radius_factor: spec.radius_factor.unwrap_or(defaults.radius_factor),
+            rbf_radius: spec.rbf_radius.unwrap_or(defaults.rbf_radius),
         };
-        if !(settings.radius_factor >= 1.0 && settings.radius_factor.is_finite()) {
+        // A support that does not reach the nearest node interpolates nothing.
+        if !(settings.rbf_radius > 1.0 && settings.rbf_radius.is_finite()) {
             return Err(self.invalid(
                 "[contact]",
                 format!(
-                    "radius_factor must be a finite number >= 1, got {}",
-                    settings.radius_factor
+                    "rbf_radius must be a finite number > 1 (units of the nearest-node distance), got {}",
+                    settings.rbf_radius
                 ),
             ));
         }

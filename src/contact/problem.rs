@@ -35,9 +35,10 @@ pub struct ContactSettings {
     /// its patch, see [`ContactSurface::mean_pressure`]) is below `-tol * p_max`, `p_max` the
     /// largest mean pressure of the iteration (default 1e-8).
     pub tension_tolerance: f64,
-    /// The RBF support radii are those of seed Algorithm 1 times this factor (default 2; 1 is
-    /// the seed's interpolation). See [`crate::contact::rbf`] for the measurements behind it.
-    pub radius_factor: f64,
+    /// Support radius of each node's RBF in the transfer operators, in units of the distance
+    /// to its nearest node (default 2, the radius seed Algorithm 1 starts from; see
+    /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
+    pub rbf_radius: f64,
 }
 
 impl Default for ContactSettings {
@@ -48,7 +49,7 @@ impl Default for ContactSettings {
             max_iterations: 50,
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
-            radius_factor: 2.0,
+            rbf_radius: 2.0,
         }
     }
 }

@@ -15,8 +15,9 @@
 //!   radius search, never by visiting all pairs.
 //! * Radii come from seed Algorithm 1 ([`support_radii`]); the interface nodes of two facing
 //!   surfaces, which satisfy Condition 3 of the seed, come from seed Algorithm 2
-//!   ([`interface_nodes`]). The transfer operators of a contact solve use those radii scaled by
-//!   a factor ([`interpolation_radii`]), for the accuracy reason given there.
+//!   ([`interface_nodes`]). The transfer operators of a contact solve use radii of the same
+//!   form with `c` held at Algorithm 1's starting value ([`interpolation_radii`]), for the
+//!   accuracy reason given there.
 //!
 //! Points are `[f64; 3]`; 2D problems pass `z = 0` (points on a curve), 3D problems points on a
 //! surface. Nothing here depends on the dimension.
@@ -208,35 +209,41 @@ pub fn support_radii(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
     }
 }
 
-/// Support radii for the transfer operators: those of seed Algorithm 1 times `factor` (>= 1).
+/// Support radii for the transfer operators: `r_i = radius * d_i`, `d_i` the distance from
+/// node `i` to its nearest other node.
 ///
-/// Algorithm 1 returns the smallest radii that make `Phi_MM` diagonally dominant. On a 2D
-/// surface triangulation that is about 1.33 times the distance to the nearest node (Condition
-/// 1 fails at `c = 0.5` because a node has more than five neighbours within twice that
-/// distance), so a target point sees little more than the nearest source node and even a
-/// linear field is interpolated with an error of a sizeable fraction of `h`. A linear field
-/// interpolated from one hemisphere-on-block contact surface to the nodes of the other near
-/// the contact zone, largest error in units of the mean spacing:
+/// This is the form of seed Algorithm 1 (`r_i = d_i / c`, one `c` for all nodes) with `c` held
+/// at `1 / radius` instead of raised until Condition 1 holds. With the default `radius = 2`,
+/// `c` stays at the value Algorithm 1 starts from, 0.5. On a curve (2D) Condition 1 holds there
+/// already, so the radii are Algorithm 1's. On a triangulated surface (3D) a node has more than
+/// five neighbours within `2 d_i`, so Algorithm 1 raises `c` to 0.75 and returns `r_i = 1.33
+/// d_i`: a target point then sees little more than its nearest source node, and even a linear
+/// field is interpolated with an error of a sizeable fraction of `h`. Every nodal gap of a
+/// contact solve carries that error, and the pressure answers it with `E* / h` per unit gap, so
+/// the pressure noise does not fall with `h`.
 ///
-/// | factor | uniform R/33 zone: sphere to block, block to sphere | R/67 zone graded beyond 1.5 a (the 3D test mesh, `tests/interpolation.rs`) |
-/// |---|---|---|
-/// | 1 | 0.28, 0.20 | 0.21, 0.19 |
-/// | 2 | 0.059, 0.035 | 0.068, 0.061 |
-/// | 3 | 0.055, 0.0055 | 0.076, 0.50 |
+/// Measured on the 3D Hertz test mesh (`tests/fixtures/hemisphere_on_block_hertz.msh`, contact
+/// zone at R/67 graded beyond 1.5 a), `radius` = 4/3 (Algorithm 1), 2 and 8/3:
+/// - a linear field interpolated between the two contact surfaces near the contact zone,
+///   largest error over `h` (block to sphere, sphere to block): 0.19 and 0.21, 0.041 and
+///   0.065, 0.061 and 0.068 (`tests/interpolation.rs`);
+/// - the contact solve at delta = 0.01: with 4/3 the loop cycles; with 2 the fitted contact
+///   radius is within +0.8% and the peak pressure within +4.0% of Hertz, the nodal pressure
+///   deviates from the Hertz ellipse by 15% RMS inside 0.8 a; with 8/3, +1.5%, +4.1% and 16%;
+///   with the bodies meshed overlapping by 0.01 instead, 2 gives +2.0%, +3.0%, 14.5% and 8/3
+///   gives +4.5%, +2.4%, 17%.
+/// - In 2D, a half-disc meshed overlapping a block by 0.02 (R/80): with 2 (Algorithm 1's radii)
+///   the pressure is within 0.4% RMS of the Hertz ellipse, with 4 it oscillates at the rim
+///   (6% RMS, a fitted 10% too large). Larger supports reach from targets off the source
+///   surface, or from the coarse part of a graded surface, into regions they do not represent.
 ///
-/// In a contact solve that error enters every nodal gap, and the pressure answers it with
-/// `E* / h` per unit gap: the noise does not vanish as `h` falls. With R/67 in a uniform zone
-/// the root-mean-square deviation of the nodal pressure from the Hertz ellipse (inside 0.8 a)
-/// was 19%, 13%, 12% and 12% for factors 1, 2, 3 and 4, and the fitted contact radius was off
-/// by +5.5%, +0.4%, +0.8% and +1.2%. Beyond 2, supports that start in a coarser part of a
-/// graded surface reach into its fine part and the error grows again (last column): the
-/// default is 2. Larger supports also give up the diagonal-dominance guarantee of Algorithm 1:
-/// the sparse LU of `Phi_MM` and the positivity of every rescaling factor are still checked in
+/// Radii above Algorithm 1's give up its diagonal-dominance guarantee: the sparse LU of
+/// `Phi_MM` and the positivity of every rescaling factor are still checked in
 /// [`Interpolation::new`].
-pub fn interpolation_radii(points: &[[f64; 3]], factor: f64) -> Result<Vec<f64>, RbfError> {
-    Ok(support_radii(points)?
+pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>, RbfError> {
+    Ok(nearest_distances(points)?
         .into_iter()
-        .map(|r| r * factor)
+        .map(|d| d * radius)
         .collect())
 }
 

@@ -103,15 +103,15 @@ impl<'a> ContactSolver<'a> {
             CoupledSolver::MonolithicLu => None,
         };
         // Interpolation between all candidates, for the contact checks of step 4.
-        let factor = problem.settings.radius_factor;
+        let radius = problem.settings.rbf_radius;
         let to_primary = Interpolation::new(
             &s2.coords,
-            &interpolation_radii(&s2.coords, factor)?,
+            &interpolation_radii(&s2.coords, radius)?,
             &s1.coords,
         )?;
         let to_secondary = Interpolation::new(
             &s1.coords,
-            &interpolation_radii(&s1.coords, factor)?,
+            &interpolation_radii(&s1.coords, radius)?,
             &s2.coords,
         )?;
         Ok(Self {
@@ -415,14 +415,14 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     // Likewise R12 interpolates the secondary displacement, which exists on the whole surface:
     // taking its sources from J and the ring around it avoids extrapolating at the rim of I.
     let ring2: Vec<[f64; 3]> = m2_rows.iter().map(|&s| s2.coords[s]).collect();
-    let factor = problem.settings.radius_factor;
-    let r12 = Interpolation::new(&ring2, &interpolation_radii(&ring2, factor)?, &x1)?;
+    let radius = problem.settings.rbf_radius;
+    let r12 = Interpolation::new(&ring2, &interpolation_radii(&ring2, radius)?, &x1)?;
     // R21 interpolates the multiplier field, a P1 field on the primary surface that vanishes at
     // inactive nodes: its sources are all nodes of the facets touching I (the zeros of the
     // inactive ring included), so that the traction passed to body 2 decays outside the contact
     // zone instead of carrying the rim value onto J nodes beyond it.
     let ring: Vec<[f64; 3]> = m1_rows.iter().map(|&s| s1.coords[s]).collect();
-    let r21_ring = Interpolation::new(&ring, &interpolation_radii(&ring, factor)?, &x2)?.matrix();
+    let r21_ring = Interpolation::new(&ring, &interpolation_radii(&ring, radius)?, &x2)?.matrix();
     let r21 = DMatrix::from_fn(x2.len(), x1.len(), |j, a| {
         let column = m1_rows
             .binary_search(&interface.primary[a])
