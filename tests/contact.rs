@@ -310,6 +310,22 @@ fn a_missing_candidate_group_is_named() {
 }
 
 #[test]
+fn a_candidate_group_empty_on_its_body_is_named() {
+    // "lower_contact" exists, but has no facet on the upper body.
+    let text = two_blocks(2, "frictionless", "", "").replace(
+        "primary_surface = \"upper_contact\"",
+        "primary_surface = \"lower_contact\"",
+    );
+    let message = solve(&text).err().expect("the case is invalid");
+    assert!(
+        message.contains("'upper'")
+            && message.contains("'lower_contact'")
+            && message.contains("upper_contact"),
+        "{message}"
+    );
+}
+
+#[test]
 fn a_contact_body_needs_a_body_table() {
     let text = two_blocks(
         2,
@@ -442,6 +458,7 @@ uy = -0.02
             .filter(|&s| fields.active[s])
             .collect();
         assert!(active.len() >= 5, "{name}: {} active nodes", active.len());
+        let mut largest = 0.0f64;
         for &s in &active {
             let node = fields.nodes[s];
             let y = body.coords[node][1] + body_solution.displacement[2 * node + 1];
@@ -450,8 +467,16 @@ uy = -0.02
                 "{name}: node at y = {y}, {:.2e} off the plane",
                 (y + 0.01).abs()
             );
+            largest = largest.max((y + 0.01).abs());
         }
+        eprintln!(
+            "{name}: largest distance of an active node from the plane {largest:.2e} (spacing {finest_spacing})"
+        );
     }
+    eprintln!(
+        "equal half-discs: force imbalance {:.2e}",
+        solution.force_imbalance
+    );
     // Symmetric pressure: no tangential resultant, pressure centred on x = 0.
     let force = solution.force_primary;
     assert!(
