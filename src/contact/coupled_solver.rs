@@ -3,19 +3,25 @@
 //! - [`CoupledSolver::Schur`] (default): each body's constrained stiffness is factored once
 //!   (sparse Cholesky) for the whole contact solve, and every iteration solves only the
 //!   interface problem by block elimination:
-//!   `Y = K^-1 B`, `z = K^-1 f`, `(D - C Y) lambda = g - C z`, `u = z - Y lambda`.
-//!   The Schur complement `S = D - C Y` is formed densely from multi-right-hand-side solves
-//!   (m columns) and factored by dense LU with partial pivoting: interfaces have hundreds to a
-//!   few thousand multipliers, where a dense m x m LU is negligible next to the m solves.
+//!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`.
+//!   `C K^-1 B = C G B` is formed densely from the interface compliance `G` of each body
+//!   ([`super::compliance`]), whose columns are computed once per loaded dof and reused by
+//!   every later iteration and load step; the Schur complement is factored by dense LU with
+//!   partial pivoting (interfaces have hundreds to a few thousand multipliers). Each iteration
+//!   then costs two single-column solves per body, plus one solve per dof the active set
+//!   reaches for the first time.
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
 
+use std::cell::RefCell;
+
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::ContactError;
+use super::compliance::SurfaceCompliance;
 use super::system::CoupledSystem;
 use crate::elastic::AssembledBody;
 use crate::linalg::{Cholesky, CholeskySymbolic, Ordering};
@@ -30,16 +36,24 @@ pub enum CoupledSolver {
     MonolithicLu,
 }
 
-/// The Cholesky factors of both bodies' constrained stiffness matrices.
+/// The Cholesky factors of both bodies' constrained stiffness matrices, and the interface
+/// compliance columns computed with them so far.
 pub struct BodyFactors {
     factor1: Cholesky,
     factor2: Cholesky,
+    compliance1: RefCell<SurfaceCompliance>,
+    compliance2: RefCell<SurfaceCompliance>,
 }
 
 impl BodyFactors {
+    /// Factors both bodies; `surface1`, `surface2` are the body nodes of their candidate
+    /// surfaces, `dim` the dofs per node.
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
+        surface1: &[usize],
+        surface2: &[usize],
+        dim: usize,
         ordering: Ordering,
     ) -> Result<Self, ContactError> {
         let factor = |body: &AssembledBody| {
@@ -50,6 +64,8 @@ impl BodyFactors {
         Ok(Self {
             factor1: factor(body1)?,
             factor2: factor(body2)?,
+            compliance1: RefCell::new(SurfaceCompliance::new(surface1, dim, body1.f_c.len())),
+            compliance2: RefCell::new(SurfaceCompliance::new(surface2, dim, body2.f_c.len())),
         })
     }
 }
@@ -87,66 +103,88 @@ fn solve_monolithic(
 
 fn solve_schur(system: &CoupledSystem, factors: &BodyFactors) -> Result<Vec<f64>, ContactError> {
     let (n1, n2, m) = (system.n1, system.n2, system.m);
-    // Y = K^-1 B, per body, m right-hand sides at once (column-major n_k x m).
-    let mut y1 = vec![0.0; n1 * m];
-    let mut y2 = vec![0.0; n2 * m];
-    for &(row, k, value) in &system.b {
-        if row < n1 {
-            y1[k * n1 + row] += value;
-        } else {
-            y2[k * n2 + row - n1] += value;
+    let mut compliance1 = factors.compliance1.borrow_mut();
+    let mut compliance2 = factors.compliance2.borrow_mut();
+    // The dofs B loads and C reads, per body (sorted, distinct).
+    let split = |dofs: &mut dyn Iterator<Item = usize>| {
+        let (mut first, mut second): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
+        for dof in dofs {
+            if dof < n1 {
+                first.push(dof);
+            } else {
+                second.push(dof - n1);
+            }
         }
-    }
+        for v in [&mut first, &mut second] {
+            v.sort_unstable();
+            v.dedup();
+        }
+        (first, second)
+    };
+    let (loaded1, loaded2) = split(&mut system.b.iter().map(|e| e.0));
+    let (read1, read2) = split(&mut system.c.iter().map(|e| e.1));
+
     // z = K^-1 f.
     let mut z1 = system.f[..n1].to_vec();
     let mut z2 = system.f[n1..].to_vec();
-    if m > 0 {
-        factors.factor1.solve_in_place(&mut y1, m);
-        factors.factor2.solve_in_place(&mut y2, m);
-    }
     factors.factor1.solve_in_place(&mut z1, 1);
     factors.factor2.solve_in_place(&mut z2, 1);
 
-    // S = D - C Y and r = g - C z.
-    let mut schur = DMatrix::<f64>::from_diagonal(&nalgebra::DVector::from_column_slice(&system.d));
-    let mut r = system.g.clone();
-    for &(k, col, value) in &system.c {
-        if col < n1 {
-            for j in 0..m {
-                schur[(k, j)] -= value * y1[j * n1 + col];
-            }
-            r[k] -= value * z1[col];
-        } else {
-            let col = col - n1;
-            for j in 0..m {
-                schur[(k, j)] -= value * y2[j * n2 + col];
-            }
-            r[k] -= value * z2[col];
+    // S = D - C G B, and r = g - C z.
+    compliance1.extend(&factors.factor1, loaded1.iter().copied());
+    compliance2.extend(&factors.factor2, loaded2.iter().copied());
+    let position = |dofs: &[usize], dof: usize| dofs.binary_search(&dof).expect("listed dof");
+    let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
+    for (compliance, loaded, read, dofs) in [
+        (&compliance1, &loaded1, &read1, 0..n1),
+        (&compliance2, &loaded2, &read2, n1..n1 + n2),
+    ] {
+        if loaded.is_empty() || read.is_empty() {
+            continue;
         }
+        let mut b = DMatrix::<f64>::zeros(loaded.len(), m);
+        for &(row, k, value) in &system.b {
+            if dofs.contains(&row) {
+                b[(position(loaded, row - dofs.start), k)] += value;
+            }
+        }
+        let mut c = DMatrix::<f64>::zeros(m, read.len());
+        for &(k, col, value) in &system.c {
+            if dofs.contains(&col) {
+                c[(k, position(read, col - dofs.start))] += value;
+            }
+        }
+        let g = DMatrix::from_fn(read.len(), loaded.len(), |i, j| {
+            compliance.entry(read[i], loaded[j])
+        });
+        schur -= c * (g * b);
+    }
+    let mut r = DVector::from_column_slice(&system.g);
+    for &(k, col, value) in &system.c {
+        r[k] -= value * if col < n1 { z1[col] } else { z2[col - n1] };
     }
     let lambda = if m > 0 {
-        schur
-            .lu()
-            .solve(&nalgebra::DVector::from_vec(r))
-            .ok_or_else(|| {
-                ContactError::Linalg("the interface Schur complement is singular".into())
-            })?
+        schur.lu().solve(&r).ok_or_else(|| {
+            ContactError::Linalg("the interface Schur complement is singular".into())
+        })?
     } else {
-        nalgebra::DVector::zeros(0)
+        DVector::zeros(0)
     };
 
-    // u = z - Y lambda.
-    for (z, y, n) in [(&mut z1, &y1, n1), (&mut z2, &y2, n2)] {
-        for (j, &l) in lambda.iter().enumerate() {
-            if l != 0.0 {
-                for (zi, yi) in z.iter_mut().zip(&y[j * n..(j + 1) * n]) {
-                    *zi -= yi * l;
-                }
-            }
+    // u = z - K^-1 (B lambda).
+    let mut w1 = vec![0.0; n1];
+    let mut w2 = vec![0.0; n2];
+    for &(row, k, value) in &system.b {
+        if row < n1 {
+            w1[row] += value * lambda[k];
+        } else {
+            w2[row - n1] += value * lambda[k];
         }
     }
-    let mut x = z1;
-    x.extend_from_slice(&z2);
+    factors.factor1.solve_in_place(&mut w1, 1);
+    factors.factor2.solve_in_place(&mut w2, 1);
+    let mut x: Vec<f64> = z1.iter().zip(&w1).map(|(z, w)| z - w).collect();
+    x.extend(z2.iter().zip(&w2).map(|(z, w)| z - w));
     x.extend(lambda.iter());
     Ok(x)
 }

@@ -7,6 +7,7 @@
 //! updated by the seed's Algorithm 3 ([`solve_contact`]). Method, signs and known traps:
 //! `shared/notes/method.md`.
 
+mod compliance;
 mod coupled_solver;
 mod hertz;
 mod problem;

@@ -43,7 +43,6 @@ use crate::elastic::{
     AssembledBody, ElasticProblem, ElasticSolution, SolveStats, SolverSettings, assemble, reactions,
 };
 use crate::fem::stress::cell_fields;
-use crate::linalg::relative_residual;
 use nalgebra::DMatrix;
 
 /// Solves a two-body contact problem at its full load.
@@ -91,7 +90,14 @@ impl<'a> ContactSolver<'a> {
         let factors = match problem.settings.solver {
             CoupledSolver::Schur => {
                 let start = Instant::now();
-                let factors = BodyFactors::new(&body1, &body2, solver.ordering)?;
+                let factors = BodyFactors::new(
+                    &body1,
+                    &body2,
+                    &s1.nodes,
+                    &s2.nodes,
+                    s1.dim,
+                    solver.ordering,
+                )?;
                 if solver.verbose {
                     eprintln!(
                         "  Cholesky of both bodies: {:.3} s",
@@ -190,7 +196,7 @@ impl<'a> ContactSolver<'a> {
             // 3. The coupled solve.
             let system = CoupledSystem::assemble(body1, body2, &coupling, dim, load_factor)?;
             let x = coupled_solver::solve(&system, body1, body2, factors)?;
-            let residual = relative_residual(&system.matrix(body1, body2)?, &x, &system.rhs());
+            let residual = system.relative_residual(body1, body2, &x);
             let solution = system.solution(&x, &coupling, dim, residual);
             if solution.relative_residual.is_nan()
                 || solution.relative_residual > solver.residual_tolerance

@@ -26,6 +26,7 @@ use nalgebra::DMatrix;
 
 use super::{ContactError, Formulation};
 use crate::elastic::AssembledBody;
+use crate::linalg::mat_vec;
 
 /// The interface operators of one iteration, on the active nodes (surface indices).
 pub struct Coupling {
@@ -237,6 +238,31 @@ impl CoupledSystem {
         );
         SparseColMat::<usize, f64>::try_new_from_triplets(n + self.m, n + self.m, &triplets)
             .map_err(|e| ContactError::Linalg(format!("assembling the coupled system: {e:?}")))
+    }
+
+    /// `||A x - [f; g]|| / ||[f; g]||` for the whole matrix `A` of [`Self::matrix`], applied
+    /// block by block without assembling it.
+    pub fn relative_residual(
+        &self,
+        body1: &AssembledBody,
+        body2: &AssembledBody,
+        x: &[f64],
+    ) -> f64 {
+        let (n1, n) = (self.n1, self.n1 + self.n2);
+        let mut ax = mat_vec(&body1.k_c, &x[..n1]);
+        ax.extend(mat_vec(&body2.k_c, &x[n1..n]));
+        ax.extend(self.d.iter().zip(&x[n..]).map(|(d, l)| d * l));
+        for &(row, k, value) in &self.b {
+            ax[row] += value * x[n + k];
+        }
+        for &(k, col, value) in &self.c {
+            ax[n + k] += value * x[col];
+        }
+        let rhs = self.rhs();
+        let norm = |v: &mut dyn Iterator<Item = f64>| v.map(|e| e * e).sum::<f64>().sqrt();
+        let r = norm(&mut ax.iter().zip(&rhs).map(|(a, b)| a - b));
+        let nb = norm(&mut rhs.iter().copied());
+        if nb > 0.0 { r / nb } else { r }
     }
 
     /// `[f; g]`.
