@@ -20,11 +20,13 @@ build: deps
 demo: build
 	$(BINARY) solve geo/hemisphere_on_block.toml --output out/demo
 
-# Unit and integration tests (no gmsh or Python needed), then the FEniCSx cross-checks.
+# Unit and integration tests (no gmsh or Python needed), then the quick validation: the
+# coarsest level of every suite, same thresholds (report in validation/build/report-quick/).
 test: build
 	cargo test --release
-	$(MAKE) --no-print-directory validate
+	$(PYTHON) validation/run.py --quick
 
+# The full validation: every suite at every level; writes validation/report/ (committed).
 validate: build
 	$(PYTHON) validation/run.py
 

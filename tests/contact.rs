@@ -217,6 +217,12 @@ fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
         "peak pressure {} vs Hertz {p0}",
         fit.p0
     );
+    eprintln!(
+        "2D half-disc: a {:+.4}, p0 {:+.4} against Hertz, imbalance {:.2e}",
+        fit.a / a - 1.0,
+        fit.p0 / p0 - 1.0,
+        solution.force_imbalance
+    );
 
     // The reported force is the integral of the P1 traction field (vanishing at inactive
     // nodes), and the block's base reaction balances the force the block receives.

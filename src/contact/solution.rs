@@ -59,13 +59,14 @@ pub struct SurfaceFields {
     pub active: Vec<bool>,
 }
 
-/// Least-squares fit of the Hertz ellipse `p^2 = p0^2 (1 - r^2 / a^2)` over the active nodes.
+/// Least-squares fit of the Hertz ellipse `p^2 = p0^2 (1 - r^2 / a^2)` to the mean pressures of
+/// the active nodes.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct HertzFit {
     /// Contact radius (3D) or half-width (2D).
     pub a: f64,
     pub p0: f64,
-    /// Centre of the contact zone (pressure-weighted centroid of the active nodes).
+    /// Centre of the contact zone (mean-pressure-weighted centroid of the active nodes).
     pub center: [f64; 3],
 }
 
