@@ -173,29 +173,7 @@ fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
     assert_eq!(solution.status, ContactStatus::Converged);
     let fields = &solution.primary_fields;
 
-    // No active node in tension (its contact force, i.e. its mean pressure, is compressive),
-    // no inactive candidate penetrating beyond the tolerance.
-    for (fields, body) in [(fields, "disc"), (&solution.secondary_fields, "block")] {
-        for (s, _) in fields.active.iter().enumerate().filter(|&(_, &a)| a) {
-            assert!(
-                fields.mean_pressure[s] >= 0.0,
-                "{body}: active node {} has mean pressure {}",
-                fields.nodes[s],
-                fields.mean_pressure[s]
-            );
-        }
-    }
-    let last = solution.history.last().unwrap();
-    assert!(
-        last.max_penetration_over_h <= 1e-3,
-        "penetration {} h",
-        last.max_penetration_over_h
-    );
-    assert!(
-        solution.force_imbalance < 0.01,
-        "imbalance {}",
-        solution.force_imbalance
-    );
+    assert_contact_conditions(&solution, 0.01, "2D half-disc");
 
     // Hertz for the measured force per unit length (method.md section 4):
     // a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), 1/E* = 2 (1 - nu^2) / E.
@@ -667,15 +645,11 @@ uz = 0.0
     )
 }
 
-/// What a converged 3D Hertz solve must show (issue: "hemisphere on a large block at a/R about
-/// 0.1"): no active node in tension on either surface, no candidate penetrating beyond the
-/// tolerance, no hole (every primary candidate closer to the axis than `a - h` is active, `a`
-/// Hertz's radius for the measured force and `h` the node's spacing: the discrete rim is one
-/// spacing wide), a small force imbalance, and the fitted contact radius and peak pressure
-/// within 5% of Hertz with the combined modulus `e_star` for the measured force. Returns the
-/// relative errors of a and p0.
-fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &str) -> (f64, f64) {
-    assert_eq!(solution.status, ContactStatus::Converged, "{label}");
+/// What converged means, checked on the result: no active node in tension on either surface
+/// (its contact force, i.e. its mean pressure, is compressive), no inactive candidate
+/// penetrating beyond the default tolerance 1e-3 h, and a force imbalance below
+/// `max_imbalance`.
+fn assert_contact_conditions(solution: &ContactSolution, max_imbalance: f64, label: &str) {
     for fields in [&solution.primary_fields, &solution.secondary_fields] {
         for (s, _) in fields.active.iter().enumerate().filter(|&(_, &a)| a) {
             assert!(
@@ -692,13 +666,26 @@ fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &
         "{label}: penetration {} h",
         last.max_penetration_over_h
     );
-    // Measured 1.6% (identical materials) and 2.2% (E ratio 10): INTERNODES transfers forces
-    // through R21, which is not the transpose of R12, so the balance is only approximate.
     assert!(
-        solution.force_imbalance < 0.03,
+        solution.force_imbalance < max_imbalance,
         "{label}: imbalance {}",
         solution.force_imbalance
     );
+    eprintln!("{label}: force imbalance {:.2e}", solution.force_imbalance);
+}
+
+/// What a converged 3D Hertz solve must show (issue: "hemisphere on a large block at a/R about
+/// 0.1"): no active node in tension on either surface, no candidate penetrating beyond the
+/// tolerance, no hole (every primary candidate closer to the axis than `a - h` is active, `a`
+/// Hertz's radius for the measured force and `h` the node's spacing: the discrete rim is one
+/// spacing wide), a small force imbalance, and the fitted contact radius and peak pressure
+/// within 5% of Hertz with the combined modulus `e_star` for the measured force. Returns the
+/// relative errors of a and p0.
+fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &str) -> (f64, f64) {
+    assert_eq!(solution.status, ContactStatus::Converged, "{label}");
+    // INTERNODES transfers forces through R21, which is not the transpose of R12: the balance
+    // is only approximate (measured: see the README's contact table).
+    assert_contact_conditions(solution, 0.03, label);
 
     // Hertz (method.md section 4): a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2), R = 1.
     let force = solution.force_primary[2].abs();
@@ -775,14 +762,7 @@ fn bodies_meshed_overlapping_are_pushed_apart_into_hertz_contact() {
         .replace("uy = -0.02", "uy = 0.0");
     let solution = solve(&text).unwrap();
     assert_eq!(solution.status, ContactStatus::Converged);
-    let fields = &solution.primary_fields;
-    assert!(
-        fields
-            .active
-            .iter()
-            .zip(&fields.mean_pressure)
-            .all(|(&a, &p)| !a || p >= 0.0)
-    );
+    assert_contact_conditions(&solution, 0.03, "2D overlap");
     let e_star = 1000.0 / (2.0 * (1.0 - 0.09));
     let force = solution.force_primary[1].abs();
     let a = (4.0 * force / (std::f64::consts::PI * e_star)).sqrt();
