@@ -114,8 +114,8 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
         ));
         // With a much stiffer primary body the multiplier is fixed only through R12 K2^-1 M2 R21,
         // and the loop was measured not to converge (README, "Contact", known limits).
-        let stiffness_ratio = problem.primary.material.youngs_modulus()
-            / problem.secondary.material.youngs_modulus();
+        let stiffness_ratio =
+            problem.primary.material.youngs_modulus() / problem.secondary.material.youngs_modulus();
         if stiffness_ratio > STIFF_PRIMARY_RATIO {
             eprintln!(
                 "warning: the primary body '{}' is {stiffness_ratio:.3e} times stiffer than '{}'; \

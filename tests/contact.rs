@@ -310,6 +310,29 @@ fn a_candidate_group_empty_on_its_body_is_named() {
 }
 
 #[test]
+fn a_much_stiffer_primary_body_is_warned_about() {
+    let text = two_blocks(
+        2,
+        "frictionless",
+        &rollers("lower", 2),
+        &rollers("upper", 2),
+    )
+    .replace(
+        "name = \"upper\"\nyoungs_modulus = 1000.0",
+        "name = \"upper\"\nyoungs_modulus = 1.0e5",
+    )
+    .replace("formulation = \"frictionless\"", "max_iterations = 1");
+    assert!(text.contains("1.0e5"), "{text}");
+    let (_dir, path) = write_case(&text);
+    let output = run_solve(&path);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("warning: the primary body 'upper' is 1.000e2 times stiffer than 'lower'"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn a_contact_body_needs_a_body_table() {
     let text = two_blocks(
         2,
