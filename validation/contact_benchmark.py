@@ -6,7 +6,7 @@ Problem: the 3D hemisphere-on-block contact of ``geo/hemisphere_on_block.toml``
 E = 1000, nu = 0.3, frictionless, contact radius a ~ 0.1 R), meshed with the
 case's geo parameters (h_c = R/67 in the contact zone r < 0.16, h_far = R/2)
 at three refinement levels of ``geo/hemisphere_on_block.geo`` (every mesh size
-times 2^-level): about 30k, 100k and 215k DOFs (both bodies). The contact zone
+times 2^-level): about 31k, 99k and 217k DOFs (both bodies). The contact zone
 stays resolved at every size (h_c = R/80 .. R/160).
 
 For every size, each of these runs is a separate process, run one after the
@@ -105,7 +105,7 @@ class Size:
 
 
 # With gmsh 4.8: 31 113, 98 700 and 216 537 DOFs (sphere + block).
-SIZES = (Size("30k", 0.25), Size("100k", 0.85), Size("215k", 1.25))
+SIZES = (Size("31k", 0.25), Size("99k", 0.85), Size("217k", 1.25))
 
 # name -> (label, load steps); dolfinx runs have no load steps.
 RUNS = {
@@ -543,15 +543,19 @@ def reading(sizes: list[dict]) -> list[str]:
         text.append("What bounds it (shares of the one-step contact total): " + "; ".join(shares) + ". The sparse "
                     "Cholesky factorization is a direct solver's cost (factor work ~ n^2 in 3D with nested "
                     "dissection) where GAMG's is ~ n: once it alone exceeds twice dolfinx's solve, the aim is out "
-                    "of reach for this design whatever the loop costs. The compliance solves are one pair of "
-                    "triangular solves per interface dof the active set reaches (three per node and body, with the "
-                    "ring of neighbours the interface mass matrices load); the second iteration pays most of them, "
-                    "because the unconstrained first iteration makes every geometrically overlapping node active "
-                    "at once (" + "; ".join(_overshoot(s) for s in done) + "), and the loop then removes the nodes "
-                    "in tension a rim at a time. The other iteration work is paid at every iteration: four "
-                    "single-right-hand-side solves with the factors (z = K^-1 f and the back-substitution, per "
-                    "body), the dense Schur complement gathered from the cached columns (C G B) and its LU, the "
-                    "interface operators and the contact checks; it grows with the iteration count.")
+                    "of reach for this design whatever the loop costs. The compliance solves are one full "
+                    "forward + backward solve with a body's factor per interface dof the active set reaches (three "
+                    "per node and body, with the ring of neighbours the interface mass matrices load), of which "
+                    "only the candidate-surface rows are kept; the second iteration pays most of them, because the "
+                    "unconstrained first iteration makes every geometrically overlapping node active at once ("
+                    + "; ".join(_overshoot(s) for s in done) + "), so columns are computed for more nodes than "
+                    "end in contact, and the loop then removes the nodes in tension a rim at a time. The other "
+                    "iteration work is paid at every iteration: mostly the dense Schur complement gathered "
+                    "entry by entry from the cached columns and multiplied out (C G B, dense products of "
+                    "(3 x active nodes)-sized blocks), then four single-right-hand-side solves with the factors "
+                    "(z = K^-1 f and the back-substitution, per body), the interface operators, the Schur LU and "
+                    "the contact checks (this order is from a timed build of one run, see `validation/README.md`); "
+                    "it grows with the iteration count.")
     stepped = [s for s in sizes if "step" in ratios(s)]
     if stepped:
         parts = []
@@ -683,7 +687,7 @@ def parse_args() -> argparse.Namespace:
     """Command line: sizes, binary (and the hidden worker mode)."""
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", choices=("small", "all"), default="all",
-                        help="small: the 30k-DOF mesh only (a quick check); all: 30k, 100k, 215k (default)")
+                        help="small: the 31k-DOF mesh only (a quick check); all: 31k, 99k, 217k (default)")
     parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes",
                         help="internodes executable (default: target/release/internodes)")
     parser.add_argument("--report-only", action="store_true",
