@@ -37,6 +37,7 @@ meshes: deps
 # Assembly and solve timings against dolfinx (several minutes; report in validation/BENCHMARK.md).
 bench: build
 	$(PYTHON) validation/benchmark.py --sizes all
+	$(PYTHON) validation/contact_benchmark.py --sizes all
 
 clean:
 	cargo clean

@@ -115,11 +115,13 @@ def _rss_gb(pid: int) -> float:
     return int(match[1]) / 2**20 if match else 0.0
 
 
-def measure(command: list, log: Path, env: dict | None = None) -> dict:
-    """Run ``command`` (output to ``log``); its wall time, CPU time, peak RSS, and
+def measure(command: list, log: Path, env: dict | None = None, *, max_seconds: float = MAX_SECONDS,
+            max_rss_gb: float = MAX_RSS_GB, check: bool = True) -> dict:
+    """Run ``command`` (output to ``log``); its wall time, CPU time, peak RSS, exit status and
     the 1-minute load average of the machine just before it.
 
-    The child is killed if it exceeds MAX_RSS_GB or MAX_SECONDS (RunFailed).
+    The child is killed if it exceeds ``max_rss_gb`` or ``max_seconds`` (RunFailed).
+    A non-zero exit status is a RunFailed too unless ``check`` is false.
     Peak RSS is the child's own ``ru_maxrss`` from ``os.wait4``.
     """
     load = os.getloadavg()[0]  # other processes on the machine (shared): reported with the run
@@ -133,19 +135,20 @@ def measure(command: list, log: Path, env: dict | None = None) -> dict:
             if pid:
                 break
             elapsed, rss = time.perf_counter() - start, _rss_gb(child.pid)
-            if stopped is None and (elapsed > MAX_SECONDS or rss > MAX_RSS_GB):
-                stopped = f"stopped after {elapsed:.0f} s at {rss:.1f} GB (limits {MAX_SECONDS:.0f} s, {MAX_RSS_GB:.0f} GB)"
+            if stopped is None and (elapsed > max_seconds or rss > max_rss_gb):
+                stopped = (f"stopped after {elapsed:.0f} s at {rss:.1f} GB "
+                           f"(limits {max_seconds:.0f} s, {max_rss_gb:.0f} GB)")
                 os.kill(child.pid, signal.SIGKILL)
             time.sleep(0.05)
         wall = time.perf_counter() - start
     child.returncode = os.waitstatus_to_exitcode(status)
     if stopped:
         raise RunFailed(stopped)
-    if child.returncode != 0:
+    if check and child.returncode != 0:
         tail = " | ".join(log.read_text().strip().splitlines()[-3:])
         raise RunFailed(f"exit status {child.returncode}: {tail}")
     return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_mb": usage.ru_maxrss / 1024,
-            "load_before": load}
+            "load_before": load, "exit_status": child.returncode}
 
 
 # ---------------------------------------------------------------------------
