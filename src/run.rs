@@ -16,7 +16,7 @@ use crate::mesh::BodyMesh;
 use crate::mesh::{Mesh, mesh_geo, read_msh};
 use crate::output::{
     BodyFields, BodySummary, CaseSummary, ContactSummary, OutputError, StepRecord,
-    write_matrix_market, write_xdmf,
+    write_force_displacement_png, write_matrix_market, write_xdmf,
 };
 
 /// A primary body more than this many times stiffer than the secondary gets a warning. The
@@ -50,8 +50,9 @@ pub struct RunReport {
     pub summary: CaseSummary,
 }
 
-/// Solves every body of a case and writes `solution.h5`, `solution.xdmf`, `summary.json` (and
-/// `matrices/` when asked) into the output folder.
+/// Solves every body of a case and writes `solution.h5`, `solution.xdmf`, `summary.json`,
+/// `force_displacement.csv` and `.png` (contact runs), and `matrices/` when asked, into the
+/// output folder.
 pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, RunError> {
     let start = Instant::now();
     let mut timings = Vec::new();
@@ -178,6 +179,17 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
         let csv = output_dir.join("force_displacement.csv");
         std::fs::write(&csv, StepRecord::csv(&steps))
             .map_err(|source| OutputError::Io { path: csv, source })?;
+        // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
+        // Warned even with --quiet, since a file the user expects is missing.
+        let png = output_dir.join("force_displacement.png");
+        let title = format!(
+            "{}: contact force on '{}' against load factor",
+            case_name(&case),
+            problem.primary.body.name
+        );
+        if let Err(e) = write_force_displacement_png(&png, &title, &steps) {
+            eprintln!("warning: {} not written: {e}", png.display());
+        }
         contact_summary = Some(summarize_contact(problem, &solution, steps));
         solved.push(SolvedBody {
             name: problem.primary.body.name.clone(),
@@ -255,6 +267,14 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
         output_dir,
         summary,
     })
+}
+
+/// The case file's name without its extension (the plot title).
+fn case_name(case: &Case) -> String {
+    case.path.file_stem().map_or_else(
+        || case.path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    )
 }
 
 /// Meshes the case's `.geo` into `<output>/mesh.msh` with its `geo_parameters`.

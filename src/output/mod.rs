@@ -1,10 +1,13 @@
-//! Result files: XDMF + HDF5 for ParaView and h5py, the JSON summary, Matrix Market matrices.
+//! Result files: XDMF + HDF5 for ParaView and h5py, the JSON summary, Matrix Market matrices,
+//! the force-displacement plot.
 
 mod matrix_market;
+mod plot;
 mod summary;
 mod xdmf;
 
 pub use matrix_market::write_matrix_market;
+pub use plot::{PlotError, write_force_displacement_png};
 pub use summary::{BodySummary, CaseSummary, ContactSummary, StepRecord};
 pub use xdmf::{BodyFields, write_xdmf};
 

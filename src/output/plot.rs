@@ -1,0 +1,155 @@
+//! `force_displacement.png`: the contact force of each load step against its load factor, the
+//! picture of `force_displacement.csv`.
+//!
+//! plotters draws text with a font it is given at run time (its pure-Rust `ab_glyph` backend,
+//! so no fontconfig or freetype): DejaVu Sans from Debian's `fonts-dejavu-core`, or the file
+//! named by `INTERNODES_PLOT_FONT`. Without a readable font no PNG can be drawn; the caller
+//! reports that as a warning, since the CSV already holds the same numbers.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
+
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use thiserror::Error;
+
+use super::StepRecord;
+
+/// The font used when `INTERNODES_PLOT_FONT` is not set (Debian package `fonts-dejavu-core`).
+const DEFAULT_PLOT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+/// The font family name the chart asks plotters for; [`register_font`] binds it to the file.
+const FAMILY: &str = "sans-serif";
+
+#[derive(Debug, Error)]
+pub enum PlotError {
+    #[error(
+        "cannot read the plot font {path}: {source} (install Debian's fonts-dejavu-core, or set \
+         INTERNODES_PLOT_FONT to a TrueType font file)"
+    )]
+    FontUnreadable {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("the plot font {path} is not a TrueType/OpenType font")]
+    FontInvalid { path: PathBuf },
+    #[error("cannot draw {path}: {message}")]
+    Draw { path: PathBuf, message: String },
+}
+
+/// Draws `steps` into the PNG file `path`: one line with markers per force component (named
+/// as the CSV columns), load factor on x, contact force on the primary body on y.
+pub fn write_force_displacement_png(
+    path: &Path,
+    title: &str,
+    steps: &[StepRecord],
+) -> Result<(), PlotError> {
+    register_font()?;
+    let draw_error = |e: &dyn std::fmt::Display| PlotError::Draw {
+        path: path.to_owned(),
+        message: e.to_string(),
+    };
+    let dim = steps.first().map_or(0, |s| s.force_primary.len());
+    let x_range = padded_range(steps.iter().map(|s| s.load_factor));
+    let y_range = padded_range(steps.iter().flat_map(|s| s.force_primary.iter().copied()));
+
+    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| draw_error(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, (FAMILY, 22))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(90)
+        .build_cartesian_2d(x_range, y_range)
+        .map_err(|e| draw_error(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("load factor (load_factor: scales every load and imposed displacement)")
+        .y_desc("contact force on the primary body (contact_force_*)")
+        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, 14))
+        .y_label_formatter(&|v| tick_label(*v))
+        .draw()
+        .map_err(|e| draw_error(&e))?;
+    for (component, axis) in ["x", "y", "z"].iter().enumerate().take(dim) {
+        let color = Palette99::pick(component).to_rgba();
+        let points: Vec<(f64, f64)> = steps
+            .iter()
+            .map(|s| (s.load_factor, s.force_primary[component]))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                color.stroke_width(2),
+            ))
+            .map_err(|e| draw_error(&e))?
+            .label(format!("contact_force_{axis}"))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(|e| draw_error(&e))?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font((FAMILY, 14))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| draw_error(&e))?;
+    root.present().map_err(|e| draw_error(&e))
+}
+
+/// Plain decimals for moderate magnitudes, scientific notation otherwise (forces range from
+/// micro-newtons to mega-newtons depending on the model's units).
+fn tick_label(v: f64) -> String {
+    if v == 0.0 || (1e-2..1e4).contains(&v.abs()) {
+        format!("{v:.3}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// `min(0, values) .. max(0, values)` widened by 5 % (and to a unit interval when all values
+/// are 0), so the origin, where a force-displacement curve starts, is always in view.
+fn padded_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (lo, hi) = values.fold((0.0f64, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let pad = if hi > lo { 0.05 * (hi - lo) } else { 1.0 };
+    (lo - pad)..(hi + pad)
+}
+
+/// Binds [`FAMILY`] to the font file, once per process: plotters keeps the font for the rest of
+/// the process and wants `'static` bytes, so the file's bytes are leaked (once, when valid).
+fn register_font() -> Result<(), PlotError> {
+    static REGISTERED: Mutex<bool> = Mutex::new(false);
+    let mut registered = REGISTERED.lock().unwrap_or_else(PoisonError::into_inner);
+    if *registered {
+        return Ok(());
+    }
+    let path = std::env::var_os("INTERNODES_PLOT_FONT")
+        .map_or_else(|| PathBuf::from(DEFAULT_PLOT_FONT), PathBuf::from);
+    let bytes = std::fs::read(&path).map_err(|source| PlotError::FontUnreadable {
+        path: path.clone(),
+        source,
+    })?;
+    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+    plotters::style::register_font(FAMILY, FontStyle::Normal, bytes)
+        .map_err(|_| PlotError::FontInvalid { path })?;
+    *registered = true;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_contain_the_origin_and_every_value() {
+        let r = padded_range([0.5, 1.0].into_iter());
+        assert!(r.start < 0.0 && r.end > 1.0);
+        let r = padded_range([-3.0, -1.0].into_iter());
+        assert!(r.start < -3.0 && r.end > 0.0);
+        let r = padded_range(std::iter::empty());
+        assert!(r.start < 0.0 && r.end > 0.0);
+    }
+}

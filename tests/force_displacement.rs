@@ -1,0 +1,122 @@
+//! The force-displacement outputs of a stepped contact run: the CSV and its PNG plot, and a run
+//! that cannot draw the plot (no font) still succeeds with the CSV and a warning.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use common::{fixture, write_case};
+
+/// The half-disc pressed onto the block (level-0 fixture) in two load steps.
+fn stepped_half_disc() -> String {
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "disc"
+primary_surface = "disc_contact"
+secondary = "block"
+secondary_surface = "block_contact"
+load_steps = [0.5, 1.0]
+
+[[body]]
+name = "disc"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "disc_top"
+ux = 0.0
+uy = -0.02
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+"#,
+        mesh = fixture("half_disc_on_block.msh").display()
+    )
+}
+
+/// `internodes solve CASE --quiet` with extra environment variables.
+fn run_solve_with(case: &Path, env: &[(&str, &str)]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_internodes"))
+        .args(["solve", case.to_str().expect("UTF-8 path"), "--quiet"])
+        .envs(env.iter().copied())
+        .output()
+        .expect("run the internodes binary")
+}
+
+#[test]
+fn stepped_contact_writes_the_csv_and_a_png_plot_of_it() {
+    let (dir, path) = write_case(&stepped_half_disc());
+    let output = run_solve_with(&path, &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
+    let csv = std::fs::read_to_string(dir.path().join("out/force_displacement.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+
+    // A PNG by its signature and header, then decoded in full by an independent decoder.
+    let bytes = std::fs::read(dir.path().join("out/force_displacement.png")).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&bytes[12..16], b"IHDR", "the first chunk is the header");
+    let width = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
+    let height = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
+    assert_eq!((width, height), (900, 600));
+    let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes))
+        .read_info()
+        .expect("a decodable PNG header");
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let frame = reader
+        .next_frame(&mut pixels)
+        .expect("decodable image data");
+    assert_eq!((frame.width, frame.height), (width, height));
+    // Something was drawn: axes, labels and curves are not white.
+    let drawn = pixels[..frame.buffer_size()]
+        .chunks(frame.color_type.samples())
+        .filter(|p| p.iter().any(|&c| c < 200))
+        .count();
+    let total = (width * height) as usize;
+    assert!(
+        drawn > total / 200 && drawn < total / 2,
+        "{drawn} of {total} pixels drawn"
+    );
+}
+
+#[test]
+fn without_a_font_the_run_succeeds_with_the_csv_and_a_warning() {
+    let (dir, path) = write_case(&stepped_half_disc());
+    let missing = dir.path().join("no-such-font.ttf");
+    let output = run_solve_with(
+        &path,
+        &[("INTERNODES_PLOT_FONT", missing.to_str().unwrap())],
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning") && stderr.contains(missing.to_str().unwrap()),
+        "the warning names the missing font: {stderr}"
+    );
+    assert!(dir.path().join("out/force_displacement.csv").is_file());
+    assert!(dir.path().join("out/summary.json").is_file());
+    assert!(!dir.path().join("out/force_displacement.png").exists());
+}
+
+#[test]
+fn a_file_that_is_not_a_font_is_reported() {
+    let (dir, path) = write_case(&stepped_half_disc());
+    let output = run_solve_with(&path, &[("INTERNODES_PLOT_FONT", path.to_str().unwrap())]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("is not a TrueType/OpenType font"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("out/force_displacement.png").exists());
+}
