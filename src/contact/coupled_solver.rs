@@ -47,9 +47,11 @@ impl BodyFactors {
                 .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
                 .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))
         };
+        // The two factorizations are independent: side by side.
+        let (factor1, factor2) = rayon::join(|| factor(body1), || factor(body2));
         Ok(Self {
-            factor1: factor(body1)?,
-            factor2: factor(body2)?,
+            factor1: factor1?,
+            factor2: factor2?,
         })
     }
 }
@@ -100,12 +102,17 @@ fn solve_schur(system: &CoupledSystem, factors: &BodyFactors) -> Result<Vec<f64>
     // z = K^-1 f.
     let mut z1 = system.f[..n1].to_vec();
     let mut z2 = system.f[n1..].to_vec();
-    if m > 0 {
-        factors.factor1.solve_in_place(&mut y1, m);
-        factors.factor2.solve_in_place(&mut y2, m);
-    }
-    factors.factor1.solve_in_place(&mut z1, 1);
-    factors.factor2.solve_in_place(&mut z2, 1);
+    // The bodies are independent: solved side by side (each also splits its columns).
+    rayon::join(
+        || {
+            factors.factor1.solve_in_place(&mut y1, m);
+            factors.factor1.solve_in_place(&mut z1, 1);
+        },
+        || {
+            factors.factor2.solve_in_place(&mut y2, m);
+            factors.factor2.solve_in_place(&mut z2, 1);
+        },
+    );
 
     // S = D - C Y and r = g - C z.
     let mut schur = DMatrix::<f64>::from_diagonal(&nalgebra::DVector::from_column_slice(&system.d));
