@@ -39,6 +39,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Results must not depend on the number of threads (RAYON_NUM_THREADS). The Cholesky
+    // solves guarantee it themselves; faer's sparse LUs (RBF interpolation, the monolithic
+    // reference solver) take faer's global setting, whose default splits work by thread count.
+    faer::set_global_parallelism(faer::Par::Seq);
     let result: Result<(), Box<dyn std::error::Error>> = match Cli::parse().command {
         Command::Solve {
             case,

@@ -61,9 +61,11 @@ impl BodyFactors {
                 .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
                 .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))
         };
+        // The two factorizations are independent: side by side.
+        let (factor1, factor2) = rayon::join(|| factor(body1), || factor(body2));
         Ok(Self {
-            factor1: factor(body1)?,
-            factor2: factor(body2)?,
+            factor1: factor1?,
+            factor2: factor2?,
             compliance1: RefCell::new(SurfaceCompliance::new(surface1, dim, body1.f_c.len())),
             compliance2: RefCell::new(SurfaceCompliance::new(surface2, dim, body2.f_c.len())),
         })
@@ -127,8 +129,12 @@ fn solve_schur(system: &CoupledSystem, factors: &BodyFactors) -> Result<Vec<f64>
     // z = K^-1 f.
     let mut z1 = system.f[..n1].to_vec();
     let mut z2 = system.f[n1..].to_vec();
-    factors.factor1.solve_in_place(&mut z1, 1);
-    factors.factor2.solve_in_place(&mut z2, 1);
+    // The bodies are independent: solved side by side.
+    let (factor1, factor2) = (&factors.factor1, &factors.factor2);
+    rayon::join(
+        || factor1.solve_in_place(&mut z1, 1),
+        || factor2.solve_in_place(&mut z2, 1),
+    );
 
     // S = D - C G B, and r = g - C z.
     compliance1.extend(&factors.factor1, loaded1.iter().copied());

@@ -1,6 +1,7 @@
 //! The numeric phase of assembly: element kernels scattered into a [`SparsityPattern`].
 
 use faer::sparse::SparseColMat;
+use rayon::prelude::*;
 
 use super::kernels::{
     facet_mass, facet_measure_and_normal, tetrahedron_stiffness, triangle_stiffness,
@@ -9,7 +10,7 @@ use super::{Material, SparsityPattern};
 use crate::mesh::{BodyMesh, FacetGroup};
 
 /// Coordinates of the `N` nodes of a cell or facet.
-pub(crate) fn node_coords<const N: usize>(coords: &[[f64; 3]], nodes: &[usize]) -> [[f64; 3]; N] {
+pub fn node_coords<const N: usize>(coords: &[[f64; 3]], nodes: &[usize]) -> [[f64; 3]; N] {
     std::array::from_fn(|k| coords[nodes[k]])
 }
 
@@ -23,22 +24,68 @@ pub fn stiffness_pattern(body: &BodyMesh) -> SparsityPattern {
     )
 }
 
+/// Cells per batch of [`assemble_stiffness`]: many per synchronisation, and the element
+/// matrices of two batches (2 x 9 MB in 3D) stay small next to `K`.
+const CELL_BATCH: usize = 8192;
+
 /// The (unconstrained) stiffness matrix `K` of a body, on `pattern` (from [`stiffness_pattern`]).
+///
+/// By batches of cells: while one batch's element matrices are scattered into `K`, one cell
+/// after another, the next batch's are computed in parallel. The scatter is the plain
+/// sequential sum in cell order, so `K` is the same, bit for bit, for any number of threads.
+///
+/// Measured on 189,489 tetrahedra (100,530 dofs; fastest runs, otherwise idle 2-core machine):
+/// element matrices 0.16 s on 1 thread, 0.09 s on 2; the scatter 0.31 s. The whole takes 0.46 s
+/// on 1 thread and 0.37 s on 2 (1.24x; 1.35x at 20k dofs): the sequential scatter bounds it.
+/// Scattering in parallel by ranges of columns, each range taking every cell in order (same
+/// bits), gained no more: 0.42 s to 0.34 s, as every range streams all element matrices.
+/// Assembly is about 5% of a single-body solve (`benches/threads.rs` prints these phases).
 pub fn assemble_stiffness(
     body: &BodyMesh,
     material: &Material,
     pattern: &SparsityPattern,
 ) -> SparseColMat<usize, f64> {
+    let nodes_per_cell = body.nodes_per_cell();
+    let size = (body.dim * nodes_per_cell).pow(2);
+    let batches: Vec<&[usize]> = body.cells.chunks(CELL_BATCH * nodes_per_cell).collect();
+    let element_matrices = |cells: &[usize], out: &mut [f64]| {
+        out[..cells.len() / nodes_per_cell * size]
+            .par_chunks_exact_mut(size)
+            .zip(cells.par_chunks_exact(nodes_per_cell))
+            .for_each(|(element, cell)| {
+                if body.dim == 2 {
+                    let ke = triangle_stiffness(&node_coords(&body.coords, cell), material);
+                    element.copy_from_slice(ke.as_slice());
+                } else {
+                    let ke = tetrahedron_stiffness(&node_coords(&body.coords, cell), material);
+                    element.copy_from_slice(ke.as_slice());
+                }
+            });
+    };
     let mut values = vec![0.0; pattern.nnz()];
-    for c in 0..body.num_cells() {
-        let cell = body.cell(c);
-        if body.dim == 2 {
-            let ke = triangle_stiffness(&node_coords(&body.coords, cell), material);
-            pattern.add_element(cell, ke.as_slice(), &mut values);
-        } else {
-            let ke = tetrahedron_stiffness(&node_coords(&body.coords, cell), material);
-            pattern.add_element(cell, ke.as_slice(), &mut values);
-        }
+    let batch_len = CELL_BATCH.min(body.num_cells()) * size;
+    let (mut current, mut next) = (vec![0.0; batch_len], vec![0.0; batch_len]);
+    if let Some(first) = batches.first() {
+        element_matrices(first, &mut current);
+    }
+    for (k, cells) in batches.iter().enumerate() {
+        // This batch into K, in cell order, while the next batch's matrices are computed.
+        rayon::join(
+            || {
+                for (cell, element) in cells
+                    .chunks_exact(nodes_per_cell)
+                    .zip(current.chunks_exact(size))
+                {
+                    pattern.add_element(cell, element, &mut values);
+                }
+            },
+            || {
+                if let Some(following) = batches.get(k + 1) {
+                    element_matrices(following, &mut next);
+                }
+            },
+        );
+        std::mem::swap(&mut current, &mut next);
     }
     pattern.matrix(values)
 }

@@ -7,6 +7,7 @@
 //! memory (benches/README.md has this machine's figures).
 
 use std::ptr;
+use std::sync::{Mutex, PoisonError};
 
 use super::LinalgError;
 use crate::fem::SparsityPattern;
@@ -33,6 +34,12 @@ pub fn nested_dissection(
     let mut node_inverse = vec![0 as metis_sys::idx_t; n];
     if n > 0 {
         let mut nvtxs = to_idx(n)?;
+        // METIS draws from the C library's `rand()`, one generator for the whole process,
+        // reseeded by each call: two orderings at once (the two bodies of a contact problem
+        // are factored in parallel) would interleave their draws and get permutations, hence
+        // factors and solutions, that depend on timing. One ordering at a time.
+        static METIS: Mutex<()> = Mutex::new(());
+        let _one_at_a_time = METIS.lock().unwrap_or_else(PoisonError::into_inner);
         // SAFETY: the arrays have the lengths METIS_NodeND requires (n + 1, xadj[n], n, n);
         // null vertex weights and options select METIS's defaults.
         let status = unsafe {
@@ -67,4 +74,34 @@ fn to_idx(k: usize) -> Result<metis_sys::idx_t, LinalgError> {
     metis_sys::idx_t::try_from(k).map_err(|_| {
         LinalgError::Ordering(format!("graph too large for METIS's 32-bit indices ({k})"))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orderings_computed_at_the_same_time_equal_one_computed_alone() {
+        // A 40 x 40 grid of quadrilaterals (as 4-node elements): enough for METIS to draw
+        // random numbers many times.
+        let m = 40;
+        let quads: Vec<usize> = (0..m * m)
+            .flat_map(|q| {
+                let (i, j) = (q % m, q / m);
+                let node = |di, dj| (j + dj) * (m + 1) + i + di;
+                [node(0, 0), node(1, 0), node(1, 1), node(0, 1)]
+            })
+            .collect();
+        let pattern = SparsityPattern::new((m + 1) * (m + 1), &quads, 4, 2);
+        let alone = nested_dissection(&pattern).unwrap();
+        let together: Vec<_> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..4)
+                .map(|_| s.spawn(|| nested_dissection(&pattern).unwrap()))
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        for ordering in together {
+            assert!(ordering == alone);
+        }
+    }
 }

@@ -1,0 +1,309 @@
+//! Results do not depend on the number of threads, bit for bit: assembly, Cholesky solves and an
+//! elastic solve in rayon pools of 1, 2 and 3 threads, on a cube large enough for faer's
+//! thread-split kernels (solves with faer's `Par::rayon(0)` fail here); and whole runs of the
+//! command line with `RAYON_NUM_THREADS` = 1, 2, 3 on fixtures (one body; two bodies in contact,
+//! in load steps). The fixtures are too small for those kernels: the runs check that the
+//! command line honours the variable and that the rest of the pipeline (interpolation, active
+//! sets, load steps, output) stays identical.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+
+use common::{fixture, write_case};
+use internodes::elastic::{
+    DirichletCondition, ElasticProblem, SolveStats, SolverSettings, assemble, solve,
+};
+use internodes::fem::Material;
+use internodes::fem::assembly::{assemble_stiffness, node_coords, stiffness_pattern};
+use internodes::fem::kernels::tetrahedron_stiffness;
+use internodes::linalg::{Cholesky, CholeskySymbolic, Ordering};
+use internodes::mesh::BodyMesh;
+
+const THREADS: [usize; 3] = [1, 2, 3];
+
+/// Runs `f` in a rayon pool of `threads` threads.
+fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
+}
+
+/// The unit cube cut into `n^3` cubes of 6 tetrahedra each, its nodes slightly and
+/// reproducibly moved off the grid so that no two element matrices are alike; its base
+/// (z = 0) is the point group `base`. At n = 12 (6,591 dofs) the top separator of the nested
+/// dissection holds about 500 dofs: large enough for dense kernels that split work by thread
+/// count (faer's parallel matrix-vector product starts at 256 x 256).
+fn jittered_cube(n: usize) -> BodyMesh {
+    let index = |i: usize, j: usize, k: usize| (k * (n + 1) + j) * (n + 1) + i;
+    let h = 1.0 / n as f64;
+    let mut coords = Vec::new();
+    for k in 0..=n {
+        for j in 0..=n {
+            for i in 0..=n {
+                let node = index(i, j, k);
+                let jitter = |axis: usize| {
+                    let hash = (node * 2654435761 + axis * 40503) % 1000;
+                    0.2 * h * (hash as f64 / 1000.0 - 0.5)
+                };
+                coords.push([
+                    i as f64 * h + jitter(0),
+                    j as f64 * h + jitter(1),
+                    k as f64 * h + jitter(2),
+                ]);
+            }
+        }
+    }
+    // Kuhn's 6 tetrahedra of a cube, all sharing its main diagonal 0-7.
+    const PATHS: [[usize; 2]; 6] = [[1, 3], [1, 5], [2, 3], [2, 6], [4, 5], [4, 6]];
+    let mut cells = Vec::new();
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let corner = |c: usize| index(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+                for [a, b] in PATHS {
+                    cells.extend([corner(0), corner(a), corner(b), corner(7)]);
+                }
+            }
+        }
+    }
+    let num_cells = cells.len() / 4;
+    BodyMesh {
+        name: "cube".into(),
+        physical_tag: 1,
+        dim: 3,
+        node_tags: (1..=coords.len() as u64).collect(),
+        coords,
+        cells,
+        cell_tags: (1..=num_cells as u64).collect(),
+        boundary_groups: BTreeMap::new(),
+        point_groups: BTreeMap::from([("base".to_string(), (0..(n + 1) * (n + 1)).collect())]),
+    }
+}
+
+fn material() -> Material {
+    Material::new(1000.0, 0.3).expect("valid material")
+}
+
+#[test]
+fn stiffness_assembly_is_identical_for_any_thread_count() {
+    let body = jittered_cube(12);
+    let material = material();
+    let pattern = stiffness_pattern(&body);
+    // The plain sequential scatter, one cell after another.
+    let mut sequential = vec![0.0; pattern.nnz()];
+    for c in 0..body.num_cells() {
+        let ke = tetrahedron_stiffness(&node_coords(&body.coords, body.cell(c)), &material);
+        pattern.add_element(body.cell(c), ke.as_slice(), &mut sequential);
+    }
+    for threads in THREADS {
+        let k = with_threads(threads, || assemble_stiffness(&body, &material, &pattern));
+        assert!(
+            k.val()
+                .iter()
+                .zip(&sequential)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "{threads} threads: K differs from the sequential assembly"
+        );
+    }
+}
+
+/// The cube clamped on its base (a point group of the nodes at z = 0) under an oblique body
+/// force.
+fn clamped_cube(body: &BodyMesh) -> ElasticProblem<'_> {
+    ElasticProblem::new(
+        body,
+        material(),
+        vec![DirichletCondition {
+            group: "base".into(),
+            components: [Some(0.0); 3],
+        }],
+        Vec::new(),
+        Some([0.3, 0.1, -1.0]),
+    )
+    .expect("a well-posed problem")
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+#[test]
+fn cholesky_solves_are_identical_for_any_thread_count() {
+    let body = jittered_cube(12);
+    let problem = clamped_cube(&body);
+    let system = assemble(&problem, &mut SolveStats::default(), false).unwrap();
+    let n = body.num_dofs();
+    let num_rhs = 40;
+    let rhs: Vec<f64> = (0..n * num_rhs)
+        .map(|i| ((i * 7919) % 1000) as f64 / 1000.0 - 0.5)
+        .collect();
+    let solve = |threads: usize| {
+        with_threads(threads, || {
+            let symbolic =
+                CholeskySymbolic::new(&system.pattern, Ordering::NestedDissection).unwrap();
+            let factor = Cholesky::factorize(symbolic, &system.k_c).unwrap();
+            let mut one = system.f_c.clone();
+            factor.solve_in_place(&mut one, 1);
+            let mut many = rhs.clone();
+            factor.solve_in_place(&mut many, num_rhs);
+            (one, many)
+        })
+    };
+    let (one, many) = solve(1);
+    assert!(one.iter().any(|&u| u != 0.0));
+    for threads in &THREADS[1..] {
+        let (one_t, many_t) = solve(*threads);
+        assert!(
+            bits(&one) == bits(&one_t),
+            "{threads} threads: one right-hand side differs"
+        );
+        assert!(
+            bits(&many) == bits(&many_t),
+            "{threads} threads: {num_rhs} right-hand sides differ"
+        );
+    }
+}
+
+#[test]
+fn an_elastic_solve_is_identical_for_any_thread_count() {
+    let body = jittered_cube(12);
+    let problem = clamped_cube(&body);
+    let settings = SolverSettings {
+        verbose: false,
+        ..SolverSettings::default()
+    };
+    let solve = |threads: usize| with_threads(threads, || solve(&problem, &settings).unwrap());
+    let reference = solve(1);
+    for threads in &THREADS[1..] {
+        let solution = solve(*threads);
+        assert!(
+            bits(&solution.displacement) == bits(&reference.displacement),
+            "{threads} threads: the displacement differs"
+        );
+        assert!(
+            bits(reference.cell_fields.stress.as_flattened())
+                == bits(solution.cell_fields.stress.as_flattened()),
+            "{threads} threads: the stress differs"
+        );
+    }
+}
+
+/// `internodes solve` of `case` with `RAYON_NUM_THREADS=threads` into `out`; returns the listed
+/// datasets of `solution.h5`.
+fn solve_with_threads(case: &Path, out: &Path, threads: usize, fields: &[&str]) -> Vec<Vec<f64>> {
+    let output = Command::new(env!("CARGO_BIN_EXE_internodes"))
+        .args(["solve", case.to_str().unwrap(), "--quiet", "--output"])
+        .arg(out)
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .output()
+        .expect("run the internodes binary");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let file = hdf5::File::open(out.join("solution.h5")).unwrap();
+    fields
+        .iter()
+        .map(|name| file.dataset(name).unwrap().read_raw::<f64>().unwrap())
+        .collect()
+}
+
+/// Solves `text` with 1, 2 and 3 threads and checks `fields` are equal bit for bit.
+fn assert_thread_independent(text: &str, fields: &[&str]) {
+    let (dir, path) = write_case(text);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let reference = solve_with_threads(&path, &dir.path().join("t1"), 1, fields);
+    for threads in &THREADS[1..] {
+        let out = dir.path().join(format!("t{threads}"));
+        let result = solve_with_threads(&path, &out, *threads, fields);
+        for ((name, a), b) in fields.iter().zip(&reference).zip(&result) {
+            assert!(!a.is_empty());
+            assert!(bits(a) == bits(b), "{name} differs with {threads} threads");
+        }
+    }
+}
+
+#[test]
+fn a_single_body_run_is_identical_for_any_thread_count() {
+    let text = format!(
+        r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+uz = 0.0
+
+[[body.load]]
+group = "block_top"
+hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
+"#,
+        fixture("block_3d.msh").display()
+    );
+    assert_thread_independent(&text, &["fields/displacement", "fields/stress"]);
+}
+
+#[test]
+fn a_contact_run_is_identical_for_any_thread_count() {
+    // Two stacked 3D blocks with non-matching meshes, the upper one pressed down, each pinned at
+    // corners only (the frictionless patch test of tests/contact.rs), in two load steps.
+    let pins = |body: &str| {
+        format!(
+            "[[body.dirichlet]]\ngroup = \"{body}_corner_a\"\nux = 0.0\nuy = 0.0\n\
+             [[body.dirichlet]]\ngroup = \"{body}_corner_b\"\nuy = 0.0"
+        )
+    };
+    let text = format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "upper"
+primary_surface = "upper_contact"
+secondary = "lower"
+secondary_surface = "lower_contact"
+load_steps = [0.5, 1.0]
+
+[[body]]
+name = "lower"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "lower_base"
+uz = 0.0
+{lower}
+
+[[body]]
+name = "upper"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "upper_top"
+uz = -0.01
+{upper}
+"#,
+        mesh = fixture("two_blocks_3d.msh").display(),
+        lower = pins("lower"),
+        upper = pins("upper"),
+    );
+    assert_thread_independent(
+        &text,
+        &[
+            "fields/displacement",
+            "fields/contact_pressure",
+            "fields/contact_traction",
+        ],
+    );
+}
