@@ -282,7 +282,6 @@ def dolfinx_worker(solver: str, case: Path, coordinates: Path, output: Path) -> 
     """Build, assemble and solve with dolfinx; timings and results to ``output`` (JSON, .u.npy)."""
     import h5py
     from dolfinx import fem
-    from dolfinx.fem import petsc
     from petsc4py import PETSc
 
     sys.path.insert(0, str(VALIDATION))
@@ -315,7 +314,28 @@ def dolfinx_worker(solver: str, case: Path, coordinates: Path, output: Path) -> 
         dofs = fem.locate_dofs_topological(model.V, model.dim - 1, model.facets(d.group))
         bcs.append(fem.dirichletbc(np.array(d.values, dtype=PETSc.ScalarType), dofs, model.V))
     lap("boundary conditions")
-    # d. Assembly of A (sparsity pattern, matrix, constrained rows / columns).
+    A, b, x, ksp, r = assemble_and_solve(solver, a, L, bcs, model, lap)
+    result = {"timings": timings, "assemble": timings["assemble"], "compile": timings["form compilation"],
+              "solver_total": timings["setup"] + timings["solve"], "iterations": ksp.getIterationNumber(),
+              "relative_residual": r.norm() / b.norm(), "matrix_nnz": int(A.getInfo()["nz_used"]),
+              "dofs": A.getSize()[0]}
+    if solver == "mumps":
+        factor = ksp.getPC().getFactorMatrix()
+        ordering = {0: "AMD", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 6: "QAMD"}
+        result["mumps_ordering"] = ordering.get(factor.getMumpsInfog(7), str(factor.getMumpsInfog(7)))
+        result["factor_nnz"] = int(factor.getMumpsInfog(29))  # entries in the factors (L, symmetric)
+    np.save(output.with_suffix(".u.npy"), x.array[model.dof_map(body.name)].reshape(-1, model.dim))
+    output.write_text(json.dumps(result, indent=2))
+
+
+def assemble_and_solve(solver: str, a, L, bcs: list, model, lap):
+    """Assembly of A and b, then the PETSc solve, each phase timed by ``lap``; returns
+    ``(A, b, x, ksp, r)`` with ``r = A x - b`` (raises RunFailed if the KSP did not converge)."""
+    from dolfinx.fem import petsc
+    from petsc4py import PETSc
+
+    # d. Assembly of A (sparsity pattern, matrix, constrained rows / columns), then the
+    #    right-hand side (lifting of the prescribed displacements).
     A = petsc.assemble_matrix(a, bcs=bcs)
     A.assemble()
     lap("assemble")
@@ -334,21 +354,10 @@ def dolfinx_worker(solver: str, case: Path, coordinates: Path, output: Path) -> 
     lap("solve")
     if ksp.getConvergedReason() <= 0:
         raise RunFailed(f"{solver}: KSP did not converge (reason {ksp.getConvergedReason()})")
-
     r = b.duplicate()
     A.mult(x, r)
     r.axpy(-1.0, b)
-    result = {"timings": timings, "assemble": timings["assemble"], "compile": timings["form compilation"],
-              "solver_total": timings["setup"] + timings["solve"], "iterations": ksp.getIterationNumber(),
-              "relative_residual": r.norm() / b.norm(), "matrix_nnz": int(A.getInfo()["nz_used"]),
-              "dofs": A.getSize()[0]}
-    if solver == "mumps":
-        factor = ksp.getPC().getFactorMatrix()
-        ordering = {0: "AMD", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 6: "QAMD"}
-        result["mumps_ordering"] = ordering.get(factor.getMumpsInfog(7), str(factor.getMumpsInfog(7)))
-        result["factor_nnz"] = int(factor.getMumpsInfog(29))  # entries in the factors (L, symmetric)
-    np.save(output.with_suffix(".u.npy"), x.array[model.dof_map(body.name)].reshape(-1, model.dim))
-    output.write_text(json.dumps(result, indent=2))
+    return A, b, x, ksp, r
 
 
 def _krylov_solver(solver: str, A, model):

@@ -305,10 +305,9 @@ def benchmark_size(size: Size, binary: Path) -> dict:
 def dolfinx_worker(solver: str, case_path: Path, output: Path) -> None:
     """Assemble and solve both bodies as one elastic problem; timings to ``output`` (JSON, .u.npy)."""
     from dolfinx import fem
-    from dolfinx.fem import petsc
     from petsc4py import PETSc
 
-    from benchmark import _krylov_solver
+    from benchmark import assemble_and_solve
     from dolfinx_reference import COMPONENTS, Body, Dirichlet, ReferenceModel
 
     timings = {}
@@ -343,29 +342,7 @@ def dolfinx_worker(solver: str, case_path: Path, output: Path) -> None:
             dofs = fem.locate_dofs_topological(model.V, model.dim - 1, model.facets(d.group))
             bcs.append(fem.dirichletbc(np.array(d.values, dtype=PETSc.ScalarType), dofs, model.V))
     lap("boundary conditions")
-    # d. Assembly of A, then the right-hand side (lifting of the prescribed displacement).
-    A = petsc.assemble_matrix(a, bcs=bcs)
-    A.assemble()
-    lap("assemble")
-    b = petsc.assemble_vector(L)
-    petsc.apply_lifting(b, [a], [bcs])
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    petsc.set_bc(b, bcs)
-    lap("assemble loads")
-    # e. Solve: setup (GAMG hierarchy / MUMPS analysis + factorization), then solve.
-    ksp = _krylov_solver(solver, A, model)
-    lap("solver creation")
-    ksp.setUp()
-    lap("setup")
-    x = A.createVecRight()
-    ksp.solve(b, x)
-    lap("solve")
-    if ksp.getConvergedReason() <= 0:
-        raise RunFailed(f"{solver}: KSP did not converge (reason {ksp.getConvergedReason()})")
-
-    r = b.duplicate()
-    A.mult(x, r)
-    r.axpy(-1.0, b)
+    A, b, x, ksp, r = assemble_and_solve(solver, a, L, bcs, model, lap)
     np.save(output.with_suffix(".u.npy"), x.array)
     output.write_text(json.dumps({
         "timings": timings, "assemble": timings["assemble"], "solver_total": timings["setup"] + timings["solve"],
