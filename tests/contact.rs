@@ -134,37 +134,7 @@ fn contact_patch_test_gives_the_uniform_applied_pressure() {
 /// The half-disc (R = 1) pressed by 0.02 onto the block, both E = 1000, nu = 0.3, on the mesh
 /// refined to R/80 in the contact zone.
 fn half_disc_on_block(extra: &str) -> String {
-    format!(
-        r#"mesh = "{mesh}"
-output = "out"
-
-[contact]
-primary = "disc"
-primary_surface = "disc_contact"
-secondary = "block"
-secondary_surface = "block_contact"
-{extra}
-
-[[body]]
-name = "disc"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "disc_top"
-ux = 0.0
-uy = -0.02
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-"#,
-        mesh = fixture("half_disc_on_block_hertz.msh").display()
-    )
+    common::half_disc_on_block("half_disc_on_block_hertz.msh", extra)
 }
 
 #[test]

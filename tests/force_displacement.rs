@@ -3,53 +3,11 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-use common::{fixture, write_case};
+use common::{run_solve_with, write_case};
 
 /// The half-disc pressed onto the block (level-0 fixture) in two load steps.
 fn stepped_half_disc() -> String {
-    format!(
-        r#"mesh = "{mesh}"
-output = "out"
-
-[contact]
-primary = "disc"
-primary_surface = "disc_contact"
-secondary = "block"
-secondary_surface = "block_contact"
-load_steps = [0.5, 1.0]
-
-[[body]]
-name = "disc"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "disc_top"
-ux = 0.0
-uy = -0.02
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-"#,
-        mesh = fixture("half_disc_on_block.msh").display()
-    )
-}
-
-/// `internodes solve CASE --quiet` with extra environment variables.
-fn run_solve_with(case: &Path, env: &[(&str, &str)]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_internodes"))
-        .args(["solve", case.to_str().expect("UTF-8 path"), "--quiet"])
-        .envs(env.iter().copied())
-        .output()
-        .expect("run the internodes binary")
+    common::half_disc_on_block("half_disc_on_block.msh", "load_steps = [0.5, 1.0]")
 }
 
 #[test]

@@ -40,8 +40,51 @@ pub fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
 
 /// Runs `internodes solve CASE --quiet`.
 pub fn run_solve(case: &Path) -> Output {
+    run_solve_with(case, &[])
+}
+
+/// Runs `internodes solve CASE --quiet` with extra environment variables.
+pub fn run_solve_with(case: &Path, env: &[(&str, &str)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_internodes"))
         .args(["solve", case.to_str().expect("UTF-8 path"), "--quiet"])
+        .envs(env.iter().copied())
         .output()
         .expect("run the internodes binary")
+}
+
+/// The contact case of `geo/half_disc_on_block.toml` on the fixture `mesh`: the half-disc
+/// (R = 1) pressed by 0.02 onto the block, both E = 1000, nu = 0.3; `extra` lines go into the
+/// `[contact]` table.
+pub fn half_disc_on_block(mesh: &str, extra: &str) -> String {
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+primary = "disc"
+primary_surface = "disc_contact"
+secondary = "block"
+secondary_surface = "block_contact"
+{extra}
+
+[[body]]
+name = "disc"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "disc_top"
+ux = 0.0
+uy = -0.02
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+"#,
+        mesh = fixture(mesh).display()
+    )
 }
