@@ -26,6 +26,10 @@
 //   r_c    radius of the uniformly refined contact zone              [R/4]
 //   d_far  distance from the contact point where h_far is reached;
 //          linear growth from h_c at r_c                             [2 R]
+//   block_ratio  block sizes = block_ratio * the sizes above, which
+//          then apply to the disc only (a coarser block is the
+//          stable choice when the block is the stiff primary body:
+//          see the README, "Choosing the primary")                   [1]
 //
 // Run :    gmsh -2 half_disc_on_block.geo -format msh41 -o hdob.msh
 //          gmsh -2 half_disc_on_block.geo -setnumber level 2 -setnumber gap -0.005 -o l2.msh
@@ -59,7 +63,8 @@ DefineConstant[
   h_c = {R / 40, Name "Parameters/h_c"},
   h_far = {R / 2, Name "Parameters/h_far"},
   r_c = {R / 4, Name "Parameters/r_c"},
-  d_far = {2 * R, Name "Parameters/d_far"}
+  d_far = {2 * R, Name "Parameters/d_far"},
+  block_ratio = {1, Name "Parameters/block_ratio"}
 ];
 
 Geometry.AutoCoherence = 0; // never merge coincident points (bodies are disjoint)
@@ -92,15 +97,34 @@ cl = newll; Curve Loop(cl) = {a1, a2, l_chord};
 s_disc = news; Plane Surface(s_disc) = {cl};
 
 // --- mesh size: refinement towards the contact point -----------------------------
+// Each body's sizes are restricted to its own entities, so the block can be coarser.
 Field[1] = Distance;
 Field[1].PointsList = {p0, q1};
-Field[2] = Threshold;
+Field[2] = Threshold;              // disc
 Field[2].InField = 1;
 Field[2].SizeMin = h_c * s;
 Field[2].SizeMax = h_far * s;
 Field[2].DistMin = r_c;
 Field[2].DistMax = d_far;
-Background Field = 2;
+Field[3] = Threshold;              // block (block_ratio x coarser)
+Field[3].InField = 1;
+Field[3].SizeMin = block_ratio * h_c * s;
+Field[3].SizeMax = block_ratio * h_far * s;
+Field[3].DistMin = r_c;
+Field[3].DistMax = d_far;
+Field[4] = Restrict;
+Field[4].InField = 2;
+Field[4].SurfacesList = {s_disc};
+Field[4].CurvesList = {a1, a2, l_chord};
+Field[4].PointsList = {q1, q2, q3};
+Field[5] = Restrict;
+Field[5].InField = 3;
+Field[5].SurfacesList = {s_block};
+Field[5].CurvesList = {l_base, l_right, l_top1, l_top2, l_left};
+Field[5].PointsList = {p0, p1, p2, p3, p4};
+Field[6] = Min;
+Field[6].FieldsList = {4, 5};
+Background Field = 6;
 
 Mesh.MeshSizeExtendFromBoundary = 0;
 Mesh.MeshSizeFromPoints = 0;

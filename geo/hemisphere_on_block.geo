@@ -30,6 +30,10 @@
 //   r_c      radius of the uniformly refined contact zone            [R/4]
 //   d_far    distance from the contact point where h_far is
 //            reached; linear growth from h_c at r_c                  [2 R]
+//   block_ratio  block sizes = block_ratio * the sizes above, which
+//            then apply to the hemisphere only (a coarser block
+//            is the stable choice when the block is the stiff
+//            primary body: see the README, "Choosing the primary") [1]
 //
 // Run :    gmsh -3 hemisphere_on_block.geo -format msh41 -o hob.msh
 //          gmsh -3 hemisphere_on_block.geo -setnumber level 1 -setnumber gap -0.01 -o hob_l1.msh
@@ -67,7 +71,8 @@ DefineConstant[
   h_c = {R / 15, Name "Parameters/h_c"},
   h_far = {R / 2, Name "Parameters/h_far"},
   r_c = {R / 4, Name "Parameters/r_c"},
-  d_far = {2 * R, Name "Parameters/d_far"}
+  d_far = {2 * R, Name "Parameters/d_far"},
+  block_ratio = {1, Name "Parameters/block_ratio"}
 ];
 
 Geometry.AutoCoherence = 0; // never merge coincident points (bodies are disjoint)
@@ -145,15 +150,36 @@ sl = newsl; Surface Loop(sl) = {cap[], ring[], s_flat};
 v_sphere = newv; Volume(v_sphere) = {sl};
 
 // --- mesh size: refinement towards the contact point -------------------------------
+// Each body's sizes are restricted to its own entities, so the block can be coarser.
 Field[1] = Distance;
 Field[1].PointsList = {p0, pP};
-Field[2] = Threshold;
+Field[2] = Threshold;              // hemisphere
 Field[2].InField = 1;
 Field[2].SizeMin = h_c * s;
 Field[2].SizeMax = h_far * s;
 Field[2].DistMin = r_c;
 Field[2].DistMax = d_far;
-Background Field = 2;
+Field[3] = Threshold;              // block (block_ratio x coarser)
+Field[3].InField = 1;
+Field[3].SizeMin = block_ratio * h_c * s;
+Field[3].SizeMax = block_ratio * h_far * s;
+Field[3].DistMin = r_c;
+Field[3].DistMax = d_far;
+Field[4] = Restrict;
+Field[4].InField = 2;
+Field[4].VolumesList = {v_sphere};
+Field[4].SurfacesList = {cap[], ring[], s_flat};
+Field[4].CurvesList = {lat[], eq[], mer[], pm[]};
+Field[4].PointsList = {pP, L[], E[]};
+Field[5] = Restrict;
+Field[5].InField = 3;
+Field[5].VolumesList = {v_block};
+Field[5].SurfacesList = {s_base, s_top, s_side1, s_side2, s_side3, s_side4};
+Field[5].CurvesList = {lb1, lb2, lb3, lb4, lt1, lt2, lt3, lt4, lv1, lv2, lv3, lv4};
+Field[5].PointsList = {p0, b1, b2, b3, b4, t1, t2, t3, t4};
+Field[6] = Min;
+Field[6].FieldsList = {4, 5};
+Background Field = 6;
 
 Mesh.MeshSizeExtendFromBoundary = 0;
 Mesh.MeshSizeFromPoints = 0;

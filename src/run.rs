@@ -160,6 +160,7 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
                 status: solution.status,
                 iterations: solution.history.len(),
                 force_primary: solution.force_primary[..mesh.dim].to_vec(),
+                force_secondary: solution.force_secondary[..mesh.dim].to_vec(),
                 force_imbalance: solution.force_imbalance,
                 hertz_a: solution.hertz_primary.map(|h| h.a),
                 hertz_p0: solution.hertz_primary.map(|h| h.p0),

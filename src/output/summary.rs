@@ -71,7 +71,9 @@ pub struct StepRecord {
     pub load_factor: f64,
     pub status: ContactStatus,
     pub iterations: usize,
+    /// Total contact force on each body (the CSV has the primary's).
     pub force_primary: Vec<f64>,
+    pub force_secondary: Vec<f64>,
     pub force_imbalance: f64,
     pub hertz_a: Option<f64>,
     pub hertz_p0: Option<f64>,
