@@ -302,6 +302,58 @@ fn a_much_stiffer_primary_body_is_warned_about() {
     );
 }
 
+/// The half-disc of `tests/fixtures/half_disc_on_block_coarse_block.msh` pressed by 0.02 onto
+/// a rigid flat: contact force per unit length computed by dolfinx (PETSc VI solver, exact
+/// node-to-plane constraint) on the same disc mesh, by `validation/rigid_flat.py`.
+const RIGID_FLAT_REFERENCE_FORCE_2D: f64 = 12.200145815310922;
+
+#[test]
+fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
+    // The block 1e4 times stiffer than the disc and the primary body, its contact surface meshed
+    // twice coarser: the loop converges, without the warning, to the dolfinx rigid-flat force.
+    let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
+        .replace("primary = \"disc\"", "primary = \"block\"")
+        .replace(
+            "primary_surface = \"disc_contact\"",
+            "primary_surface = \"block_contact\"",
+        )
+        .replace("secondary = \"block\"", "secondary = \"disc\"")
+        .replace(
+            "secondary_surface = \"block_contact\"",
+            "secondary_surface = \"disc_contact\"",
+        )
+        .replace(
+            "name = \"block\"\nyoungs_modulus = 1000.0",
+            "name = \"block\"\nyoungs_modulus = 1.0e7",
+        );
+    assert!(
+        text.contains("1.0e7") && text.contains("primary = \"block\""),
+        "{text}"
+    );
+    let (dir, path) = write_case(&text);
+    let output = run_solve(&path);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let contact = &summary["contact"];
+    assert_eq!(contact["status"], "converged", "{contact}");
+    let force_on_disc = contact["force_secondary"][1].as_f64().unwrap();
+    let error = (force_on_disc - RIGID_FLAT_REFERENCE_FORCE_2D) / RIGID_FLAT_REFERENCE_FORCE_2D;
+    assert!(
+        error.abs() <= 0.01,
+        "force on the disc {force_on_disc}: {error:+.4}"
+    );
+    let imbalance = contact["force_imbalance"].as_f64().unwrap();
+    assert!(imbalance <= 0.01, "imbalance {imbalance}");
+    eprintln!(
+        "stiff block primary, 2D: force {error:+.4} against dolfinx, imbalance {imbalance:.2e}"
+    );
+}
+
 #[test]
 fn a_contact_body_needs_a_body_table() {
     let text = two_blocks(
