@@ -409,9 +409,43 @@ fn describe(solution: &ContactSolution, formulation: Formulation) -> String {
             }
         ),
         ContactStatus::NoContact => "no contact: the candidate surfaces never come within interpolation range; each body was solved alone".to_string(),
-        ContactStatus::IterationLimit => format!("NOT converged: the iteration cap ({iterations}) was reached"),
-        ContactStatus::Cycling => format!("NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"),
+        ContactStatus::IterationLimit => format!(
+            "NOT converged: the iteration cap ({iterations}) was reached; {}",
+            violations(solution)
+        ),
+        ContactStatus::Cycling => format!(
+            "NOT converged: the active set cycles (an earlier set came back at iteration {iterations}); {}",
+            violations(solution)
+        ),
     }
+}
+
+/// How far the last iterate is from the contact conditions, for the user to judge a
+/// non-converged solve: a cycle between a node slightly in tension and the same node slightly
+/// penetrating is not the same failure as tensions of the order of the peak pressure.
+fn violations(solution: &ContactSolution) -> String {
+    let Some(last) = solution.history.last() else {
+        return String::new();
+    };
+    let peak = solution
+        .primary_fields
+        .mean_pressure
+        .iter()
+        .copied()
+        .fold(0.0, f64::max);
+    let tension = if peak > 0.0 {
+        format!(
+            "{:.2e} ({:.2e} of the peak mean pressure)",
+            last.max_tension,
+            last.max_tension / peak
+        )
+    } else {
+        format!("{:.2e}", last.max_tension)
+    };
+    format!(
+        "last iterate: largest tension {tension}, deepest penetration {:.2e} h",
+        last.max_penetration_over_h
+    )
 }
 
 fn norm(f: &[f64; 3]) -> f64 {

@@ -70,6 +70,38 @@ def _table(checks: list[Check]) -> list[str]:
             *map(_row, checks)]
 
 
+def _figure(c: Check) -> str:
+    return "n/a" if math.isnan(c.figure) else f"{c.figure:.3g}"
+
+
+def headline(gate: list[SuiteResult], targets: list[SuiteResult]) -> list[str]:
+    """The short table the repository README shows: one row per gate suite (checks passed, the
+    largest figure relative to its tolerance) and one per kind of target (met out of run, the
+    worst case and every missed case)."""
+    lines = ["| suite | check | result | worst figure (case) | tolerance | missed |", "|---|---|---|---|---|---|"]
+    for s in gate:
+        if not s.checks:
+            continue
+        worst = max(s.checks, key=lambda c: math.inf if math.isnan(c.figure) else
+                    (c.figure / c.tolerance if c.tolerance > 0 else c.figure))
+        passed = sum(c.passed for c in s.checks)
+        lines.append(f"| {s.title} | all (gate) | {passed} of {len(s.checks)} passed | {_figure(worst)} "
+                     f"({worst.check}, {worst.case}) | {worst.tolerance:g} | "
+                     f"{', '.join(f'{c.check}: {c.case}' for c in s.checks if not c.passed) or '-'} |")
+    for s in targets:
+        kinds: dict[str, list[Check]] = {}
+        for c in s.checks:
+            kinds.setdefault(c.check, []).append(c)
+        for kind, checks in kinds.items():
+            worst = max(checks, key=lambda c: math.inf if math.isnan(c.figure) else c.figure)
+            missed = [c for c in checks if not c.passed]
+            met = len(checks) - len(missed)
+            lines.append(f"| {s.title} | {kind} | {met} of {len(checks)} met | {_figure(worst)} ({worst.case}) "
+                         f"| {worst.tolerance:g} | "
+                         f"{'; '.join(f'{c.case} ({_figure(c)})' for c in missed) or '-'} |")
+    return lines
+
+
 def write(report_dir: Path, gate: list[SuiteResult], targets: list[SuiteResult], command: str) -> dict:
     """Writes README.md and results.json into ``report_dir``; returns the summary counts."""
     report_dir.mkdir(parents=True, exist_ok=True)
@@ -95,6 +127,10 @@ def write(report_dir: Path, gate: list[SuiteResult], targets: list[SuiteResult],
         "Gate checks hold to round-off when the code is right; one failure fails the run. Targets are "
         "the accuracy targets of the contact issue; each is reported with its figure, met or missed, "
         "and a miss is explained in its section.",
+        "",
+        "## Headline",
+        "",
+        *headline(gate, targets),
         "",
         "## Targets",
         "",
@@ -125,3 +161,22 @@ def write(report_dir: Path, gate: list[SuiteResult], targets: list[SuiteResult],
     }
     (report_dir / "results.json").write_text(json.dumps(results, indent=1, default=str) + "\n")
     return counts
+
+
+HEADLINE_START = "<!-- validation headline: written by make validate (validation/report.py) -->"
+HEADLINE_END = "<!-- end of validation headline -->"
+
+
+def update_readme(readme: Path, gate: list[SuiteResult], targets: list[SuiteResult], counts: dict) -> bool:
+    """Replaces the block between the headline markers of ``readme`` with this run's headline;
+    False (README untouched) when the markers are missing."""
+    text = readme.read_text()
+    start, end = text.find(HEADLINE_START), text.find(HEADLINE_END)
+    if start < 0 or end < start:
+        return False
+    block = [HEADLINE_START, "",
+             f"Gate checks: {counts['gate_passed']} passed, {counts['gate_failed']} failed. "
+             f"Targets: {counts['targets_met']} met, {counts['targets_missed']} missed "
+             f"({datetime.date.today().isoformat()}).", "", *headline(gate, targets), ""]
+    readme.write_text(text[:start] + "\n".join(block) + "\n" + text[end:])
+    return True
