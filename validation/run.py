@@ -22,7 +22,7 @@ README.md with every table and figure, and results.json.
 Exit status 1 if a gate check failed or anything is missing (report.py says
 which checks gate); missed accuracy targets are reported, not fatal.
 
-Usage:  /usr/bin/python3 validation/run.py [--binary PATH] [--quick] [--levels L ...]
+Usage:  /usr/bin/python3 validation/run.py [--binary PATH] [--quick] [--levels L ...] [--reuse]
         [--cases C ...] [--suites S ...]
 """
 
@@ -76,6 +76,9 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--cases", nargs="+", help="case names (default: all of validation/cases)")
     parser.add_argument("--suites", nargs="*", default=list(SUITES),
                         help=f"contact suites to run (default: {' '.join(SUITES)}; none: --suites)")
+    parser.add_argument("--reuse", action="store_true",
+                        help="Hertz suite: take each run's output from an earlier run of the same case, mesh and "
+                             "binary (binary modification time included) instead of solving again")
     args = parser.parse_args()
     if args.quick:
         args.levels = [min(args.levels)]
@@ -211,7 +214,10 @@ def main() -> int:
         print(f"== suite {name}", flush=True)
         start = time.perf_counter()
         try:
-            result = importlib.import_module(name).run_suite(args.binary, args.quick, report_dir / name)
+            module = importlib.import_module(name)
+            if hasattr(module, "REUSE"):
+                module.REUSE = args.reuse
+            result = module.run_suite(args.binary, args.quick, report_dir / name)
         except Exception as error:  # a suite that crashes is a failed gate check, with its reason
             result = SuiteResult(title=name, checks=[failure("suite", name, f"{type(error).__name__}: {error}")])
             gate.append(result)
