@@ -758,7 +758,8 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
                                   f"with least-squares rates", convergence_png))
         tables.append(f"### {case.name}\n\n{level_table(case, runs)}\n\n"
                       f"Wall time of the case (mesh + both formulations, all levels): "
-                      f"{time.perf_counter() - case_start:.0f} s.")
+                      f"{time.perf_counter() - case_start:.0f} s"
+                      f"{' (solves reused from an earlier run of the same binary)' if REUSE else ''}.")
 
     force_png = out_dir / "hertz_force_approach.png"
     plot_force_approach(list(CASES), results, force_png)
@@ -769,10 +770,12 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
     seconds = time.perf_counter() - start
     text = "\n\n".join([
         f"Hertz suite ({'quick: coarsest level only' if quick else 'levels ' + ', '.join(map(str, levels))}), "
-        f"total wall time {seconds:.0f} s.",
+        f"total wall time {seconds:.0f} s"
+        f"{'; the solves were reused from an earlier run of the same binary (run.py --reuse), whose solve times the tables list' if REUSE else ''}.",
         GEOMETRY_TEXT.format(e_star=E_STAR, geometry=geometry_lines(list(CASES), results)),
         "**Per level** (a, p0: the solver's Hertz fit; a_H, p0_H: Hertz for the measured force P; RMS: "
-        "nodal pressure against the Hertz ellipse over the active primary nodes, in units of p0_H; h: the "
+        "nodal pressure against the Hertz ellipse over the active primary nodes, in units of p0_H; RMS mean p: "
+        "the same for the mean pressure, nodal force / nodal area; h: the "
         "primary's interface spacing, the coarser one in the two-body cases; h_fine: the finer surface's; "
         "seconds: the solve's wall time).",
         *tables,
