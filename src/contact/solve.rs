@@ -10,7 +10,8 @@
 //!      the rim of the contact zone
 //!   3. solve the coupled system for u1, u2, lambda
 //!   4. tension:     active nodes whose mean pressure p_s < -tol_t p_max
-//!      penetration: candidate nodes with gap . n < -tol_p h    (deformed configuration)
+//!      penetration: candidate nodes with gap . n < -tol_p h    (deformed configuration;
+//!                   n the contact normal, below)
 //!   5. I^C <- I - tension + penetrating, same for J^C
 //! until nothing is in tension or penetrating (converged), an active set repeats (cycling),
 //! or the iteration cap is reached
@@ -26,6 +27,14 @@
 //! neighbour then penetrated, and the 3D Hertz case at R/67 cycled between the two (a rim node
 //! at 9% of p0 in nodal tension, then 1.8e-3 h of penetration). The nodal values are still
 //! written (`contact_pressure`), beside the mean pressure (`contact_mean_pressure`).
+//!
+//! The contact normal at a node bisects its own outward normal and the other surface's, interpolated
+//! there: `n = (n_own - R n_other) / |n_own - R n_other|`. The frictionless constraint and the
+//! penetration check both measure the gap along it. With the primary's own normal, a curved
+//! primary on a flat was held along a direction tilted by its slope, and the 2D half-disc on a
+//! stiff block lost 1.15% of its force (R/67 hemisphere: 1.29%) against the dolfinx rigid-flat
+//! reference; with the bisector, 0.53% and 0.47%. Between two equal bodies it is the symmetry
+//! plane's normal.
 //!
 //! An empty interface is a valid iterate: the bodies are then solved apart, and penetration
 //! adds the nodes that the loads push into the other body. Converging with an empty interface
@@ -437,15 +446,24 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     });
     let x2_flat: Vec<f64> = ring2.iter().flat_map(|x| x.iter().copied()).collect();
     let x2_at_1 = r12.apply(&x2_flat, 3);
+    // The contact normal (module doc): with the primary's own normal, a node of a curved primary
+    // that slides by u_t on a flat ends (x/R) u_t off it.
+    let n2_flat: Vec<f64> = m2_rows.iter().flat_map(|&s| s2.normals[s]).collect();
+    let n2_at_1 = r12.apply(&n2_flat, 3);
+    coupling.normals = interface
+        .primary
+        .iter()
+        .enumerate()
+        .map(|(a, &s)| bisector(&s1.normals[s], &n2_at_1[3 * a..3 * a + 3]))
+        .collect();
     // Only the normal part of R12 x2 - x1 is a gap: R reproduces constants but not the linear
     // coordinate field, so its tangential part is interpolation error, which the tied
     // constraint would otherwise impose as a spurious O(h) tangential jump.
     let gaps: Vec<[f64; 3]> = x1
         .iter()
-        .zip(&interface.primary)
+        .zip(&coupling.normals)
         .enumerate()
-        .map(|(a, (x, &s))| {
-            let n = s1.normals[s];
+        .map(|(a, (x, n))| {
             let normal_gap: f64 = (0..3).map(|k| n[k] * (x2_at_1[3 * a + k] - x[k])).sum();
             std::array::from_fn(|k| normal_gap * n[k])
         })
@@ -476,18 +494,35 @@ fn normal_gaps(
         .flat_map(|j| deformed(other, u_other, j))
         .collect();
     let other_at_own = to_own.apply(&other_flat, 3);
+    let other_normals: Vec<f64> = other.normals.iter().flatten().copied().collect();
+    let other_normals_at_own = to_own.apply(&other_normals, 3);
     let uncovered: HashSet<usize> = to_own.uncovered_targets().iter().copied().collect();
     (0..own.len())
         .map(|i| {
             if uncovered.contains(&i) {
                 return f64::NAN;
             }
+            let n = bisector(&own.normals[i], &other_normals_at_own[3 * i..3 * i + 3]);
             let x = deformed(own, u_own, i);
             (0..3)
-                .map(|k| own.normals[i][k] * (other_at_own[3 * i + k] - x[k]))
+                .map(|k| n[k] * (other_at_own[3 * i + k] - x[k]))
                 .sum()
         })
         .collect()
+}
+
+/// The contact normal at a node: the bisector `(n_own - n_other) / |n_own - n_other|` of its
+/// outward normal and the other surface's outward normal interpolated there (`n_own` if they
+/// cancel, which facing surfaces cannot do). The constraint holds the gap along it and the
+/// penetration check measures the gap along it, so that both judge the same distance.
+fn bisector(own: &[f64; 3], other: &[f64]) -> [f64; 3] {
+    let sum: [f64; 3] = std::array::from_fn(|k| own[k] - other[k]);
+    let length = dot(&sum, &sum).sqrt();
+    if length > 1e-12 {
+        std::array::from_fn(|k| sum[k] / length)
+    } else {
+        *own
+    }
 }
 
 fn penetrating(surface: &ContactSurface, gaps: &[f64], tolerance: f64) -> Vec<usize> {
@@ -614,9 +649,13 @@ impl ContactSolver<'_> {
             0.0
         };
         let hertz_primary = hertz::fit(s1, &primary_fields);
-        let max_tangential_traction = (0..s1.len())
-            .map(|s| {
-                let (t, n) = (&primary_fields.traction[s], &s1.normals[s]);
+        // Tangential with respect to the contact normal the constraint used (the bisector of
+        // the two surfaces' normals): zero for frictionless, the glue's shear for tied.
+        let max_tangential_traction = solution
+            .traction
+            .iter()
+            .zip(&coupling.normals)
+            .map(|(t, n)| {
                 let normal = dot(t, n);
                 let tangential: [f64; 3] = std::array::from_fn(|k| t[k] - normal * n[k]);
                 dot(&tangential, &tangential).sqrt()

@@ -34,7 +34,8 @@ pub struct Coupling {
     /// Body-local node of each active primary node (I) and secondary node (J).
     pub primary_nodes: Vec<usize>,
     pub secondary_nodes: Vec<usize>,
-    /// Outward normals of body 1 at I.
+    /// Contact normals at I: the bisectors of body 1's outward normals and body 2's, interpolated
+    /// (pointing out of body 1; see `solve`).
     pub normals: Vec<[f64; 3]>,
     /// `R12` (|I| x |r12_nodes|), interpolating the secondary displacement to I from the
     /// secondary nodes `r12_nodes` (J and the ring of nodes around it).
