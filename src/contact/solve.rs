@@ -3,7 +3,8 @@
 //! ```text
 //! I^C, J^C <- candidate nodes that touch or penetrate in the reference configuration
 //! repeat
-//!   1. I, J <- interface nodes among I^C, J^C                 (seed Algorithm 2)
+//!   1. I, J <- interface nodes among I^C, J^C                 (seed Algorithm 2, on the
+//!      configuration of the last iterate)
 //!   2. R12, R21, M1, M2, d on the reference geometry           (method.md section 2);
 //!      R12 takes its sources from J and the ring of secondary nodes around it, R21 from I and
 //!      the ring of inactive primary nodes around it (where lambda = 0): no extrapolation at
@@ -197,7 +198,10 @@ impl<'a> ContactSolver<'a> {
             // 1. Interface nodes among the candidates (Algorithm 2).
             let c1: Vec<usize> = candidates1.iter().copied().collect();
             let c2: Vec<usize> = candidates2.iter().copied().collect();
-            let interface = find_interface(s1, s2, &c1, &c2)?.unwrap_or_default();
+            let deformed = last
+                .as_ref()
+                .map(|(_, s): &(Coupling, CoupledSolution)| (&s.u1[..], &s.u2[..]));
+            let interface = find_interface(s1, s2, &c1, &c2, deformed)?.unwrap_or_default();
 
             // 2. Interface operators on the reference geometry.
             let coupling = coupling(problem, &interface)?;
@@ -380,17 +384,42 @@ struct Interface {
     secondary: Vec<usize>,
 }
 
+/// The search runs on the configuration of the last iterate (`deformed`: its displacements of
+/// both bodies), the reference one at the first iteration of a load step. On the reference
+/// geometry two curved surfaces are a gap `r^2 / R` apart at radius `r`, about one spacing at
+/// the rim of the finest two-hemisphere mesh: candidates added there because they penetrated
+/// were out of reach on the reference geometry, were dropped, and the loop repeated itself.
 fn find_interface(
     s1: &ContactSurface,
     s2: &ContactSurface,
     c1: &[usize],
     c2: &[usize],
+    deformed: Option<(&[f64], &[f64])>,
 ) -> Result<Option<Interface>, ContactError> {
     if c1.len() < 2 || c2.len() < 2 {
         return Ok(None);
     }
-    let x1: Vec<[f64; 3]> = c1.iter().map(|&s| s1.coords[s]).collect();
-    let x2: Vec<[f64; 3]> = c2.iter().map(|&s| s2.coords[s]).collect();
+    let position = |s: &ContactSurface, u: Option<&[f64]>, i: usize| -> [f64; 3] {
+        let dim = s.dim;
+        std::array::from_fn(|k| {
+            s.coords[i][k]
+                + u.map_or(0.0, |u| {
+                    if k < dim {
+                        u[dim * s.nodes[i] + k]
+                    } else {
+                        0.0
+                    }
+                })
+        })
+    };
+    let x1: Vec<[f64; 3]> = c1
+        .iter()
+        .map(|&s| position(s1, deformed.map(|d| d.0), s))
+        .collect();
+    let x2: Vec<[f64; 3]> = c2
+        .iter()
+        .map(|&s| position(s2, deformed.map(|d| d.1), s))
+        .collect();
     match interface_nodes(&x1, &x2) {
         Ok(found) if found.primary.len() >= 2 && found.secondary.len() >= 2 => {
             Ok(Some(Interface {
