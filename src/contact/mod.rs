@@ -35,6 +35,12 @@ pub enum ContactError {
     Problem(#[from] ProblemError),
     #[error("interpolation between the contact surfaces: {0}")]
     Interpolation(#[from] rbf::RbfError),
+    #[error(
+        "{nodes} active primary node(s) lie outside the interpolation supports of the secondary \
+         surface on the reference geometry, where the interface operators are built: the bodies \
+         moved by more than a spacing relative to each other along the interface"
+    )]
+    UncoveredInterface { nodes: usize },
     #[error("the active primary facets have no area: the interface mass matrix is zero")]
     EmptyInterfaceMass,
     #[error("{0}")]

@@ -200,7 +200,8 @@ impl<'a> ContactSolver<'a> {
             let c2: Vec<usize> = candidates2.iter().copied().collect();
             let deformed = last
                 .as_ref()
-                .map(|(_, s): &(Coupling, CoupledSolution)| (&s.u1[..], &s.u2[..]));
+                .filter(|(c, _): &&(Coupling, CoupledSolution)| !c.primary_nodes.is_empty())
+                .map(|(_, s)| (&s.u1[..], &s.u2[..]));
             let interface = find_interface(s1, s2, &c1, &c2, deformed)?.unwrap_or_default();
 
             // 2. Interface operators on the reference geometry.
@@ -384,8 +385,11 @@ struct Interface {
     secondary: Vec<usize>,
 }
 
-/// The search runs on the configuration of the last iterate (`deformed`: its displacements of
-/// both bodies), the reference one at the first iteration of a load step. On the reference
+/// The search runs on the configuration of the last coupled iterate (`deformed`: its
+/// displacements of both bodies), the reference one before any. An uncoupled iterate (empty
+/// interface) is not used: there the bodies were solved apart, and overlap by the whole
+/// approach (the tied two half-discs, pushed by five spacings in one step, then lost every
+/// candidate). On the reference
 /// geometry two curved surfaces are a gap `r^2 / R` apart at radius `r`, about one spacing at
 /// the rim of the finest two-hemisphere mesh: candidates added there because they penetrated
 /// were out of reach on the reference geometry, were dropped, and the loop repeated itself.
@@ -461,6 +465,13 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     let ring2: Vec<[f64; 3]> = m2_rows.iter().map(|&s| s2.coords[s]).collect();
     let radius = problem.settings.rbf_radius;
     let r12 = Interpolation::new(&ring2, &interpolation_radii(&ring2, radius)?, &x1)?;
+    // The interface was found on the last iterate's configuration; every active node must
+    // still be within the other side's supports on the reference geometry, where R is built.
+    if !r12.uncovered_targets().is_empty() {
+        return Err(ContactError::UncoveredInterface {
+            nodes: r12.uncovered_targets().len(),
+        });
+    }
     // R21 interpolates the multiplier field, a P1 field on the primary surface that vanishes at
     // inactive nodes: its sources are all nodes of the facets touching I (the zeros of the
     // inactive ring included), so that the traction passed to body 2 decays outside the contact
