@@ -404,17 +404,7 @@ fn find_interface(
         return Ok(None);
     }
     let position = |s: &ContactSurface, u: Option<&[f64]>, i: usize| -> [f64; 3] {
-        let dim = s.dim;
-        std::array::from_fn(|k| {
-            s.coords[i][k]
-                + u.map_or(0.0, |u| {
-                    if k < dim {
-                        u[dim * s.nodes[i] + k]
-                    } else {
-                        0.0
-                    }
-                })
-        })
+        u.map_or(s.coords[i], |u| s.deformed(u, i))
     };
     let x1: Vec<[f64; 3]> = c1
         .iter()
@@ -525,13 +515,8 @@ fn normal_gaps(
     u_own: &[f64],
     u_other: &[f64],
 ) -> Vec<f64> {
-    let dim = own.dim;
-    let deformed = |s: &ContactSurface, u: &[f64], i: usize| -> [f64; 3] {
-        let node = s.nodes[i];
-        std::array::from_fn(|k| s.coords[i][k] + if k < dim { u[dim * node + k] } else { 0.0 })
-    };
     let other_flat: Vec<f64> = (0..other.len())
-        .flat_map(|j| deformed(other, u_other, j))
+        .flat_map(|j| other.deformed(u_other, j))
         .collect();
     let other_at_own = to_own.apply(&other_flat, 3);
     let other_normals: Vec<f64> = other.normals.iter().flatten().copied().collect();
@@ -543,7 +528,7 @@ fn normal_gaps(
                 return f64::NAN;
             }
             let n = bisector(&own.normals[i], &other_normals_at_own[3 * i..3 * i + 3]);
-            let x = deformed(own, u_own, i);
+            let x = own.deformed(u_own, i);
             (0..3)
                 .map(|k| n[k] * (other_at_own[3 * i + k] - x[k]))
                 .sum()

@@ -121,6 +121,13 @@ impl ContactSurface {
         self.nodes.is_empty()
     }
 
+    /// The position of node `s` displaced by the body's displacement `u` (body dofs, `dim`
+    /// per node).
+    pub fn deformed(&self, u: &[f64], s: usize) -> [f64; 3] {
+        let (dim, node) = (self.dim, self.nodes[s]);
+        std::array::from_fn(|k| self.coords[s][k] + if k < dim { u[dim * node + k] } else { 0.0 })
+    }
+
     /// The contact pressure averaged over the patch of node `s` with its hat function as
     /// weight, `int p phi_s ds / int phi_s ds`, from the nodal contact forces `force` that the
     /// interface exerts on this body (body dofs, `dim` per node).
