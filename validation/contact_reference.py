@@ -723,14 +723,20 @@ def plot_force_approach(data: dict, path: Path) -> None:
         dd = np.linspace(0, d.max(), 101)
         ax.plot(dd, [hertz_force(x, data["radius"], data["youngs_modulus"], data["poisson_ratio"], 3) for x in dd],
                 "k--", lw=1, label="Hertz (half-space), 4/3 E* R^1/2 delta^3/2")
-    ax.set_xlabel("approach delta (top-face displacement)")
-    ax.set_ylabel("contact force P" + (" per unit length" if data["dimension"] == 2 else ""))
-    ax.set_title(f"{data['body']} on a rigid flat: force against approach")
+    finish_force_approach_plot(fig, ax, f"{data['body']} on a rigid flat: force against approach",
+                               data["dimension"], path)
+
+
+def finish_force_approach_plot(fig, ax, title: str, dim: int, path: Path) -> None:
+    """Axis labels, title, legend and grid of a P(delta) plot; writes it to ``path``."""
+    ax.set_xlabel("approach delta (displacement of the curved body's top face)")
+    ax.set_ylabel("contact force P" + (" per unit length" if dim == 2 else ""))
+    ax.set_title(title)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _pyplot().close(fig)
 
 
 # ---------------------------------------------------------------------------

@@ -235,14 +235,7 @@ def plot_force_approach(label: str, entry: dict, dim: int, path: Path) -> None:
     if dim == 3 and entry.get("geometry_effect") is not None:
         ax.plot(d, [0.0] + [r["hertz_force_for_delta"] for r in ref], "k--", lw=1,
                 label=f"Hertz half-space law (differs by up to {entry['geometry_effect']:.1%})")
-    ax.set_xlabel("approach delta (displacement of the curved body's top face)")
-    ax.set_ylabel("contact force P" + (" per unit length" if dim == 2 else ""))
-    ax.set_title(f"{label}: force against approach")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    contact_reference.finish_force_approach_plot(fig, ax, f"{label}: force against approach", dim, path)
 
 
 def _copy(source: Path, target: Path) -> Path:
