@@ -70,6 +70,36 @@ pub struct Candidates {
     pub secondary: BTreeSet<usize>,
 }
 
+/// The other candidate surface as seen from one surface: the interpolation of its fields to this
+/// surface's nodes, and the contact normal at each of them ([`bisector`]), built once.
+struct Facing {
+    interpolation: Interpolation,
+    normals: Vec<[f64; 3]>,
+}
+
+impl Facing {
+    fn new(
+        own: &ContactSurface,
+        other: &ContactSurface,
+        radius: f64,
+    ) -> Result<Self, ContactError> {
+        let interpolation = Interpolation::new(
+            &other.coords,
+            &interpolation_radii(&other.coords, radius)?,
+            &own.coords,
+        )?;
+        let other_normals: Vec<f64> = other.normals.iter().flatten().copied().collect();
+        let at_own = interpolation.apply(&other_normals, 3);
+        let normals = (0..own.len())
+            .map(|i| bisector(&own.normals[i], &at_own[3 * i..3 * i + 3]))
+            .collect();
+        Ok(Self {
+            interpolation,
+            normals,
+        })
+    }
+}
+
 /// A contact problem set up once: both bodies assembled (and, on the Schur path, factored) and
 /// the candidate-to-candidate interpolations built. Every load step reuses all of it: loads and
 /// prescribed displacements enter the system linearly, `f_c(s) = s f_c(1)`, while `K`, its
@@ -82,8 +112,8 @@ pub struct ContactSolver<'a> {
     stats1: SolveStats,
     stats2: SolveStats,
     factors: Option<BodyFactors>,
-    to_primary: Interpolation,
-    to_secondary: Interpolation,
+    to_primary: Facing,
+    to_secondary: Facing,
 }
 
 impl<'a> ContactSolver<'a> {
@@ -120,16 +150,8 @@ impl<'a> ContactSolver<'a> {
         };
         // Interpolation between all candidates, for the contact checks of step 4.
         let radius = problem.settings.rbf_radius;
-        let to_primary = Interpolation::new(
-            &s2.coords,
-            &interpolation_radii(&s2.coords, radius)?,
-            &s1.coords,
-        )?;
-        let to_secondary = Interpolation::new(
-            &s1.coords,
-            &interpolation_radii(&s1.coords, radius)?,
-            &s2.coords,
-        )?;
+        let to_primary = Facing::new(s1, s2, radius)?;
+        let to_secondary = Facing::new(s2, s1, radius)?;
         Ok(Self {
             problem,
             solver: *solver,
@@ -334,8 +356,8 @@ fn contact_checks(
     problem: &ContactProblem,
     interface: &Interface,
     solution: &CoupledSolution,
-    to_primary: &Interpolation,
-    to_secondary: &Interpolation,
+    to_primary: &Facing,
+    to_secondary: &Facing,
 ) -> Checks {
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let settings = &problem.settings;
@@ -506,28 +528,31 @@ fn coupling(problem: &ContactProblem, interface: &Interface) -> Result<Coupling,
     Ok(coupling)
 }
 
-/// Gap of each node of `own` to the deformed `other` surface along its outward normal:
+/// Gap of each node of `own` to the deformed `other` surface along its contact normal:
 /// `n . (R x_other(u) - x_own(u))`; NaN where `other` is out of interpolation range.
 fn normal_gaps(
     own: &ContactSurface,
     other: &ContactSurface,
-    to_own: &Interpolation,
+    to_own: &Facing,
     u_own: &[f64],
     u_other: &[f64],
 ) -> Vec<f64> {
     let other_flat: Vec<f64> = (0..other.len())
         .flat_map(|j| other.deformed(u_other, j))
         .collect();
-    let other_at_own = to_own.apply(&other_flat, 3);
-    let other_normals: Vec<f64> = other.normals.iter().flatten().copied().collect();
-    let other_normals_at_own = to_own.apply(&other_normals, 3);
-    let uncovered: HashSet<usize> = to_own.uncovered_targets().iter().copied().collect();
+    let other_at_own = to_own.interpolation.apply(&other_flat, 3);
+    let uncovered: HashSet<usize> = to_own
+        .interpolation
+        .uncovered_targets()
+        .iter()
+        .copied()
+        .collect();
     (0..own.len())
         .map(|i| {
             if uncovered.contains(&i) {
                 return f64::NAN;
             }
-            let n = bisector(&own.normals[i], &other_normals_at_own[3 * i..3 * i + 3]);
+            let n = to_own.normals[i];
             let x = own.deformed(u_own, i);
             (0..3)
                 .map(|k| n[k] * (other_at_own[3 * i + k] - x[k]))
