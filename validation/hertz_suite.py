@@ -60,7 +60,7 @@ REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
 from compare import Check  # noqa: E402
-from suite import Figure, SuiteResult  # noqa: E402
+from suite import Figure, MeshFailed, SuiteResult, mesh_geo  # noqa: E402
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
@@ -167,22 +167,12 @@ def boussinesq_correction(force: np.ndarray, depths: tuple) -> np.ndarray:
 
 
 def mesh(case: HertzCase, level: int) -> Path:
-    """gmsh the case's geo script at a level into build/hertz_suite/meshes (cached by parameters)."""
-    parameters = case.gmsh_parameters(level)
-    path = BUILD / "meshes" / f"{case.name}_l{level}.msh"
-    stamp = path.with_suffix(".json")
-    if path.is_file() and stamp.is_file() and json.loads(stamp.read_text()) == parameters:
-        return path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    command = ["gmsh", f"-{case.dim}", str(REPO / "geo" / f"{case.name}.geo"), "-format", "msh41", "-v", "1",
-               "-o", str(path)]
-    for key, value in parameters.items():
-        command += ["-setnumber", key, str(value)]
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0 or not path.is_file():
-        raise RunFailed(f"gmsh {case.name} level {level} failed: {(result.stdout + result.stderr)[-400:]}")
-    stamp.write_text(json.dumps(parameters))
-    return path
+    """gmsh the case's geo script at a level into build/hertz_suite/meshes (cached)."""
+    try:
+        return mesh_geo(case.name, case.dim, case.gmsh_parameters(level),
+                        BUILD / "meshes" / f"{case.name}_l{level}.msh")
+    except MeshFailed as error:
+        raise RunFailed(str(error)) from error
 
 
 def case_file(case: HertzCase, msh: Path, formulation: str) -> str:

@@ -43,7 +43,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, SuiteResult  # noqa: E402
+from suite import Figure, SuiteResult, mesh_geo  # noqa: E402
 
 BUILD = VALIDATION / "build" / "rigid_flat"
 STIFFNESS_RATIO = 1e4
@@ -68,17 +68,9 @@ BODIES = {
 
 
 def mesh(script: str, dim: int, parameters: dict) -> Path:
-    """gmsh the geo script with the parameters into build/."""
+    """gmsh the geo script with the parameters into build/ (cached)."""
     name = script + "".join(f"_{k}{v}" for k, v in parameters.items()) + ".msh"
-    path = BUILD / name
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if not path.exists():
-        command = ["gmsh", f"-{dim}", str(REPO / "geo" / f"{script}.geo"), "-format", "msh41", "-o", str(path),
-                   "-v", "1"]
-        for key, value in parameters.items():
-            command += ["-setnumber", key, str(value)]
-        subprocess.run(command, check=True, capture_output=True)
-    return path
+    return mesh_geo(script, dim, parameters, BUILD / name)
 
 
 def case_text(msh: Path, dim: int, primary: str, output: Path, fraction: float) -> str:

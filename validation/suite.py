@@ -13,6 +13,9 @@ reference) go in ``text`` and ``data``, never in ``checks``.
 
 from __future__ import annotations
 
+import hashlib
+import json
+import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,3 +39,32 @@ class SuiteResult:
     figures: list[Figure] = field(default_factory=list)
     text: str = ""
     data: dict = field(default_factory=dict)
+
+
+GEO = Path(__file__).resolve().parent.parent / "geo"
+
+
+class MeshFailed(RuntimeError):
+    """gmsh could not mesh a geo script (the message ends with gmsh's output)."""
+
+
+def mesh_geo(script: str, dim: int, parameters: dict, path: Path) -> Path:
+    """gmsh ``geo/<script>.geo`` with ``-setnumber`` parameters into ``path`` (MSH 4.1).
+
+    Cached: a stamp next to the mesh records the parameters and a hash of the geo script, so an
+    edited script or other parameters mesh again.
+    """
+    geo = GEO / f"{script}.geo"
+    stamp = path.with_suffix(".json")
+    key = {"parameters": parameters, "geo_sha256": hashlib.sha256(geo.read_bytes()).hexdigest()}
+    if path.is_file() and stamp.is_file() and json.loads(stamp.read_text()) == key:
+        return path
+    path.parent.mkdir(parents=True, exist_ok=True)
+    command = ["gmsh", f"-{dim}", str(geo), "-format", "msh41", "-v", "1", "-o", str(path)]
+    for name, value in parameters.items():
+        command += ["-setnumber", name, str(value)]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0 or not path.is_file():
+        raise MeshFailed(f"gmsh {geo.name} {parameters} failed: {(result.stdout + result.stderr)[-400:]}")
+    stamp.write_text(json.dumps(key))
+    return path
