@@ -270,10 +270,9 @@ fn a_contact_run_is_identical_for_any_thread_count() {
 output = "out"
 
 [contact]
+bodies = ["upper", "lower"]
+surfaces = ["upper_contact", "lower_contact"]
 primary = "upper"
-primary_surface = "upper_contact"
-secondary = "lower"
-secondary_surface = "lower_contact"
 load_steps = [0.5, 1.0]
 
 [[body]]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::CaseError;
-use crate::contact::{ContactProblem, ContactSettings, ContactSurface, CoupledSolver, Formulation};
+use crate::contact::{ContactProblem, ContactSettings, ContactSide, ContactSurface, PrimaryChoice};
 use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
@@ -37,32 +37,62 @@ pub struct Case {
     pub path: PathBuf,
 }
 
-/// The `[contact]` table: which bodies and surfaces meet, and how.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// The `[contact]` table: which bodies and surfaces meet, which carries the multiplier, the
+/// load steps, and the loop's settings ([`ContactSettings`], deserialized from the same table's
+/// remaining keys, so that the library's own type and defaults are the schema).
+#[derive(Debug, Clone)]
 pub struct ContactSpec {
-    /// The body that carries the multiplier (often the finer interface mesh).
-    pub primary: String,
-    /// Its candidate contact surface (a boundary group).
-    pub primary_surface: String,
-    pub secondary: String,
-    pub secondary_surface: String,
-    /// "frictionless" (default) or "tied".
-    pub formulation: Option<Formulation>,
-    /// "schur" (default) or "monolithic-lu".
-    pub solver: Option<CoupledSolver>,
-    /// Default 50.
-    pub max_iterations: Option<usize>,
-    /// Fraction of the local nodal spacing, default 1e-3.
-    pub penetration_tolerance: Option<f64>,
-    /// Fraction of the largest contact pressure, default 1e-8.
-    pub tension_tolerance: Option<f64>,
-    /// RBF support radius in units of each node's nearest-node distance, default 2.
-    pub rbf_radius: Option<f64>,
+    /// The two bodies in contact.
+    pub bodies: [String; 2],
+    /// Their candidate contact surfaces (boundary groups), in the same order.
+    pub surfaces: [String; 2],
+    /// "auto" (default) or one of the two bodies.
+    pub primary: PrimaryChoice,
     /// Load factors, applied in turn to every load and prescribed displacement of the two
     /// bodies; each step starts from the previous active set and reuses every factorization.
     /// Default: one step at factor 1.
     pub load_steps: Option<Vec<f64>>,
+    pub settings: ContactSettings,
+}
+
+impl<'de> Deserialize<'de> for ContactSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut table = toml::Table::deserialize(deserializer)?;
+        fn take<T: serde::de::DeserializeOwned, E: Error>(
+            table: &mut toml::Table,
+            key: &str,
+            expected: &str,
+        ) -> Result<Option<T>, E> {
+            table
+                .remove(key)
+                .map(|value| {
+                    value
+                        .try_into()
+                        .map_err(|e| E::custom(format!("[contact] {key}: expected {expected} ({e})")))
+                })
+                .transpose()
+        }
+        let required = |key: &str| {
+            D::Error::custom(format!(
+                "[contact] needs `{key}` (e.g. bodies = [\"disc\", \"block\"], surfaces = [\"disc_contact\", \"block_contact\"])"
+            ))
+        };
+        let pair = "a list of two names";
+        let bodies = take(&mut table, "bodies", pair)?.ok_or_else(|| required("bodies"))?;
+        let surfaces = take(&mut table, "surfaces", pair)?.ok_or_else(|| required("surfaces"))?;
+        let primary = take(&mut table, "primary", "\"auto\" or a body name")?.unwrap_or_default();
+        let load_steps = take(&mut table, "load_steps", "a list of load factors")?;
+        let settings = ContactSettings::deserialize(toml::Value::Table(table))
+            .map_err(|e| D::Error::custom(format!("[contact]: {e}")))?;
+        Ok(Self {
+            bodies,
+            surfaces,
+            primary,
+            load_steps,
+            settings,
+        })
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -248,7 +278,7 @@ impl Case {
             .unwrap_or_else(|| vec![1.0])
     }
 
-    /// The contact problem of the `[contact]` table, if any.
+    /// The contact problem of the `[contact]` table, if any, with its primary body chosen.
     pub fn contact_problem<'m>(
         &self,
         mesh: &'m Mesh,
@@ -256,44 +286,12 @@ impl Case {
         let Some(spec) = &self.contact else {
             return Ok(None);
         };
-        if spec.primary == spec.secondary {
-            return Err(self.invalid(
-                "[contact]",
-                "primary and secondary must be different bodies",
-            ));
+        if spec.bodies[0] == spec.bodies[1] {
+            return Err(self.invalid("[contact]", "bodies must name two different bodies"));
         }
-        let defaults = ContactSettings::default();
-        let settings = ContactSettings {
-            formulation: spec.formulation.unwrap_or(defaults.formulation),
-            solver: spec.solver.unwrap_or(defaults.solver),
-            max_iterations: spec.max_iterations.unwrap_or(defaults.max_iterations),
-            penetration_tolerance: spec
-                .penetration_tolerance
-                .unwrap_or(defaults.penetration_tolerance),
-            tension_tolerance: spec.tension_tolerance.unwrap_or(defaults.tension_tolerance),
-            rbf_radius: spec.rbf_radius.unwrap_or(defaults.rbf_radius),
-        };
-        // A support that does not reach the nearest node interpolates nothing.
-        if !(settings.rbf_radius > 1.0 && settings.rbf_radius.is_finite()) {
-            return Err(self.invalid(
-                "[contact]",
-                format!(
-                    "rbf_radius must be a finite number > 1 (units of the nearest-node distance), got {}",
-                    settings.rbf_radius
-                ),
-            ));
-        }
-        for (name, value) in [
-            ("penetration_tolerance", settings.penetration_tolerance),
-            ("tension_tolerance", settings.tension_tolerance),
-        ] {
-            if value.is_nan() || value < 0.0 {
-                return Err(self.invalid(
-                    "[contact]",
-                    format!("{name} must be non-negative, got {value}"),
-                ));
-            }
-        }
+        spec.settings
+            .validate()
+            .map_err(|e| self.invalid("[contact]", e.to_string()))?;
         if let Some(steps) = &spec.load_steps
             && (steps.is_empty() || steps.iter().any(|f| !f.is_finite()))
         {
@@ -302,12 +300,7 @@ impl Case {
                 "load_steps must be a non-empty list of finite factors",
             ));
         }
-        if settings.max_iterations == 0 {
-            return Err(self.invalid("[contact]", "max_iterations must be at least 1"));
-        }
-        let side = |body: &str,
-                    surface: &str|
-         -> Result<(ElasticProblem<'m>, ContactSurface), CaseError> {
+        let side = |body: &str, surface: &str| -> Result<ContactSide<'m>, CaseError> {
             let body_spec = self.bodies.iter().find(|b| b.name == body).ok_or_else(|| {
                 self.invalid(
                     "[contact]",
@@ -321,14 +314,12 @@ impl Case {
                 .map_err(|e| self.invalid("[contact]", e.to_string()))?;
             Ok((self.elastic_problem(body_mesh, body_spec)?, surface))
         };
-        let (primary, primary_surface) = side(&spec.primary, &spec.primary_surface)?;
-        let (secondary, secondary_surface) = side(&spec.secondary, &spec.secondary_surface)?;
-        Ok(Some(ContactProblem {
-            primary,
-            secondary,
-            primary_surface,
-            secondary_surface,
-            settings,
-        }))
+        let sides = [
+            side(&spec.bodies[0], &spec.surfaces[0])?,
+            side(&spec.bodies[1], &spec.surfaces[1])?,
+        ];
+        ContactProblem::new(sides, &spec.primary, spec.settings)
+            .map(Some)
+            .map_err(|message| self.invalid("[contact]", message))
     }
 }

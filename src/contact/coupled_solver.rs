@@ -13,14 +13,12 @@
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
 
-use std::cell::RefCell;
-
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::ContactError;
+use super::{ContactError, ContactSurface};
 use super::compliance::SurfaceCompliance;
 use super::system::CoupledSystem;
 use crate::elastic::AssembledBody;
@@ -41,21 +39,20 @@ pub enum CoupledSolver {
 pub struct BodyFactors {
     factor1: Cholesky,
     factor2: Cholesky,
-    compliance1: RefCell<SurfaceCompliance>,
-    compliance2: RefCell<SurfaceCompliance>,
+    compliance1: SurfaceCompliance,
+    compliance2: SurfaceCompliance,
 }
 
 impl BodyFactors {
-    /// Factors both bodies; `surface1`, `surface2` are the body nodes of their candidate
-    /// surfaces, `dim` the dofs per node.
+    /// Factors both bodies; the compliance caches cover their candidate surfaces.
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
-        surface1: &[usize],
-        surface2: &[usize],
-        dim: usize,
+        surface1: &ContactSurface,
+        surface2: &ContactSurface,
         ordering: Ordering,
     ) -> Result<Self, ContactError> {
+        let dim = surface1.dim;
         let factor = |body: &AssembledBody| {
             CholeskySymbolic::new(&body.pattern, ordering)
                 .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
@@ -66,8 +63,8 @@ impl BodyFactors {
         Ok(Self {
             factor1: factor1?,
             factor2: factor2?,
-            compliance1: RefCell::new(SurfaceCompliance::new(surface1, dim, body1.f_c.len())),
-            compliance2: RefCell::new(SurfaceCompliance::new(surface2, dim, body2.f_c.len())),
+            compliance1: SurfaceCompliance::new(&surface1.nodes, dim, body1.f_c.len()),
+            compliance2: SurfaceCompliance::new(&surface2.nodes, dim, body2.f_c.len()),
         })
     }
 }
@@ -77,7 +74,7 @@ pub fn solve(
     system: &CoupledSystem,
     body1: &AssembledBody,
     body2: &AssembledBody,
-    factors: Option<&BodyFactors>,
+    factors: Option<&mut BodyFactors>,
 ) -> Result<Vec<f64>, ContactError> {
     match factors {
         Some(factors) => solve_schur(system, factors),
@@ -103,10 +100,11 @@ fn solve_monolithic(
     Ok(x)
 }
 
-fn solve_schur(system: &CoupledSystem, factors: &BodyFactors) -> Result<Vec<f64>, ContactError> {
+fn solve_schur(
+    system: &CoupledSystem,
+    factors: &mut BodyFactors,
+) -> Result<Vec<f64>, ContactError> {
     let (n1, n2, m) = (system.n1, system.n2, system.m);
-    let mut compliance1 = factors.compliance1.borrow_mut();
-    let mut compliance2 = factors.compliance2.borrow_mut();
     // The dofs B loads and C reads, per body (sorted, distinct).
     let split = |dofs: &mut dyn Iterator<Item = usize>| {
         let (mut first, mut second): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
@@ -137,13 +135,17 @@ fn solve_schur(system: &CoupledSystem, factors: &BodyFactors) -> Result<Vec<f64>
     );
 
     // S = D - C G B, and r = g - C z.
-    compliance1.extend(&factors.factor1, loaded1.iter().copied());
-    compliance2.extend(&factors.factor2, loaded2.iter().copied());
+    factors
+        .compliance1
+        .extend(&factors.factor1, loaded1.iter().copied());
+    factors
+        .compliance2
+        .extend(&factors.factor2, loaded2.iter().copied());
     let position = |dofs: &[usize], dof: usize| dofs.binary_search(&dof).expect("listed dof");
     let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
     for (compliance, loaded, read, dofs) in [
-        (&compliance1, &loaded1, &read1, 0..n1),
-        (&compliance2, &loaded2, &read2, n1..n1 + n2),
+        (&factors.compliance1, &loaded1, &read1, 0..n1),
+        (&factors.compliance2, &loaded2, &read2, n1..n1 + n2),
     ] {
         if loaded.is_empty() || read.is_empty() {
             continue;

@@ -1,26 +1,42 @@
 //! Two elastic bodies in contact, coupled by INTERNODES.
 //!
 //! Body 1 (primary) carries the multiplier `lambda`, the contact traction on it; body 2
-//! (secondary) receives `-R21 lambda`. The interface operators are built on the reference
-//! geometry (small deformations): rescaled Wendland C2 interpolation [`rbf`] between the active
-//! nodes, interface (surface) mass matrices and nodal gaps ([`system`]); the active set is
-//! updated by the seed's Algorithm 3 ([`solve_contact`]). Method, signs and known traps:
-//! `shared/notes/method.md`.
+//! (secondary) receives `-R21 lambda`. One solve, in the order of the files:
+//! - [`problem`]: the two bodies, their candidate surfaces ([`surface`]) and the settings;
+//! - [`interface`]: the interface operators, built once over all candidates: rescaled Wendland
+//!   C2 interpolation ([`rbf`]) evaluated at each node's closest point on the other surface
+//!   ([`projection`]), the lumped interface mass, the contact normal and the gaps;
+//! - [`solve`]: the active-set loop (primal-dual active set), each iteration assembling the
+//!   coupled system ([`system`]) and solving it ([`coupled_solver`], [`compliance`]);
+//! - [`certificate`]: independent checks of the answer; [`post`]: fields, forces, Hertz fit.
+//!
+//! Method, signs and known traps: `shared/notes/method.md`.
 
+mod boundary;
+mod certificate;
 mod compliance;
 mod coupled_solver;
 mod hertz;
+mod interface;
+mod post;
 mod problem;
+pub mod projection;
 pub mod rbf;
 mod solution;
 mod solve;
 mod surface;
 pub mod system;
 
+pub use certificate::{Certificate, CertificateCheck};
 pub use coupled_solver::CoupledSolver;
-pub use problem::{ContactProblem, ContactSettings, Formulation};
-pub use solution::{ContactSolution, ContactStatus, HertzFit, IterationRecord, SurfaceFields};
-pub use solve::{Candidates, ContactSolver, solve_contact};
+pub use problem::{
+    ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,
+    SettingsError,
+};
+pub use solution::{
+    ContactSolution, ContactStatus, HertzFit, IterationRecord, PhaseSeconds, SurfaceFields,
+};
+pub use solve::{ActiveSet, ContactSolver, solve_contact};
 pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;
@@ -31,16 +47,26 @@ use crate::elastic::ProblemError;
 /// [`ContactStatus`], not an error).
 #[derive(Debug, Error)]
 pub enum ContactError {
+    #[error("contact settings: {0}")]
+    Settings(#[from] SettingsError),
     #[error(transparent)]
     Problem(#[from] ProblemError),
     #[error("interpolation between the contact surfaces: {0}")]
     Interpolation(#[from] rbf::RbfError),
+    #[error("contact surface '{group}' of body '{body}' has no facets to project onto")]
+    NoFacets { body: String, group: String },
     #[error(
-        "{nodes} active primary node(s) lie outside the interpolation supports of the secondary \
-         surface on the reference geometry, where the interface operators are built: the bodies \
-         moved by more than a spacing relative to each other along the interface"
+        "node {tag} of body '{body}' (and {} more) is not covered by the interpolation from \
+         body '{other}': its closest point on that surface lies outside every RBF support \
+         (a surface whose spacing varies by more than the support radius between neighbours?)",
+        .count - 1
     )]
-    UncoveredInterface { nodes: usize },
+    Uncovered {
+        body: String,
+        tag: u64,
+        other: String,
+        count: usize,
+    },
     #[error("the active primary facets have no area: the interface mass matrix is zero")]
     EmptyInterfaceMass,
     #[error("{0}")]

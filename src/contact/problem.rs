@@ -1,6 +1,8 @@
-//! What to solve: two elastic bodies, their candidate surfaces, and how to treat the contact.
+//! What to solve: two elastic bodies, their candidate surfaces, which one carries the
+//! multiplier, and the settings of the active-set loop.
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
+use thiserror::Error;
 
 use super::ContactSurface;
 use super::coupled_solver::CoupledSolver;
@@ -17,7 +19,17 @@ pub enum Formulation {
     Tied,
 }
 
-/// Settings of the active-set loop; every field has a documented default.
+/// A setting outside its range.
+#[derive(Debug, Error, PartialEq)]
+#[error("{name} must be {expected}, got {value}")]
+pub struct SettingsError {
+    pub name: &'static str,
+    pub expected: &'static str,
+    pub value: f64,
+}
+
+/// Settings of the active-set loop and its certificate; every field has a documented default,
+/// and [`ContactSettings::validate`] checks them all (the solver calls it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ContactSettings {
@@ -28,13 +40,30 @@ pub struct ContactSettings {
     pub solver: CoupledSolver,
     /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
     pub max_iterations: usize,
-    /// A candidate node penetrates when its gap along its normal is below `-tol * h`, `h` its
-    /// distance to the nearest node of its own surface (default 1e-3).
+    /// A node penetrates when its geometric gap is below `-tol * h`, `h` its distance to the
+    /// nearest node of its own surface (default 1e-3); the same bound holds the active nodes
+    /// on the other surface and certifies the answer.
     pub penetration_tolerance: f64,
-    /// An active node is in tension when its mean pressure (the contact pressure averaged over
-    /// its patch, see [`ContactSurface::mean_pressure`]) is below `-tol * p_max`, `p_max` the
-    /// largest mean pressure of the iteration (default 1e-8).
+    /// An active node is in tension when its pressure is below `-tol * p_max`, `p_max` the
+    /// largest pressure of the iteration (default 1e-8).
     pub tension_tolerance: f64,
+    /// The certificate's bound on the penetration of a SECONDARY node into the primary body,
+    /// over its spacing (default 0.05). The constraint holds the primary nodes on the
+    /// secondary surface; the secondary nodes between them can cross the primary's P1 surface
+    /// by the transfer's consistency error (measured up to 0.016 h on a 3D mesh with three
+    /// spacings across the contact zone, falling with h), far below the spacing-sized
+    /// penetration of a wrong active set.
+    pub secondary_penetration_tolerance: f64,
+    /// The certificate's bound on the tensile normal force a SECONDARY node receives over its
+    /// area, relative to the largest pressure (default 0.1). The secondary pressure is the RBF
+    /// transfer `R21 lambda` of the multiplier, which is not positivity preserving: it
+    /// undershoots just outside the rim of the contact zone (measured up to 0.067 on the 3D
+    /// hemisphere meshes), where a wrong active set leaves tensions of the order of the peak
+    /// pressure.
+    pub secondary_tension_tolerance: f64,
+    /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
+    /// is known to this fraction.
+    pub imbalance_tolerance: f64,
     /// Support radius of each node's RBF in the transfer operators, in units of the distance
     /// to its nearest node (default 2, the radius seed Algorithm 1 starts from; see
     /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
@@ -49,10 +78,82 @@ impl Default for ContactSettings {
             max_iterations: 50,
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
+            secondary_penetration_tolerance: 0.05,
+            secondary_tension_tolerance: 0.1,
+            imbalance_tolerance: 0.01,
             rbf_radius: 2.0,
         }
     }
 }
+
+impl ContactSettings {
+    /// Checks every setting's range.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let error = |name, expected, value| Err(SettingsError {
+            name,
+            expected,
+            value,
+        });
+        if self.max_iterations == 0 {
+            return error("max_iterations", "at least 1", 0.0);
+        }
+        // A support that does not reach the nearest node interpolates nothing.
+        if !(self.rbf_radius > 1.0 && self.rbf_radius.is_finite()) {
+            return error(
+                "rbf_radius",
+                "a finite number > 1 (units of the nearest-node distance)",
+                self.rbf_radius,
+            );
+        }
+        for (name, value) in [
+            ("penetration_tolerance", self.penetration_tolerance),
+            ("tension_tolerance", self.tension_tolerance),
+            ("secondary_penetration_tolerance", self.secondary_penetration_tolerance),
+            ("secondary_tension_tolerance", self.secondary_tension_tolerance),
+            ("imbalance_tolerance", self.imbalance_tolerance),
+        ] {
+            if !(value >= 0.0 && value.is_finite()) {
+                return error(name, "a finite number >= 0", value);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Which body carries the multiplier: `"auto"` (default) or a body's name.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum PrimaryChoice {
+    /// The more compliant body (contact modulus `E / (1 - nu^2)` at least 2 times lower); at
+    /// similar stiffness the one with the finer contact surface (smaller finest spacing).
+    #[default]
+    Auto,
+    Body(String),
+}
+
+impl<'de> Deserialize<'de> for PrimaryChoice {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        Ok(if name == "auto" {
+            Self::Auto
+        } else {
+            Self::Body(name)
+        })
+    }
+}
+
+/// Which body was made primary, and why (printed, and in the summary).
+#[derive(Debug, Clone, Serialize)]
+pub struct PrimaryReport {
+    /// "auto" or "explicit".
+    pub mode: &'static str,
+    pub reason: String,
+}
+
+/// Contact moduli within this ratio count as similar stiffness for [`PrimaryChoice::Auto`].
+const SIMILAR_STIFFNESS: f64 = 2.0;
+
+/// One body of a contact pair: its elastic problem and candidate surface.
+pub type ContactSide<'m> = (ElasticProblem<'m>, ContactSurface);
 
 /// Two bodies in contact: body 1 (primary) carries the multiplier.
 pub struct ContactProblem<'m> {
@@ -61,4 +162,71 @@ pub struct ContactProblem<'m> {
     pub primary_surface: ContactSurface,
     pub secondary_surface: ContactSurface,
     pub settings: ContactSettings,
+    pub primary_report: PrimaryReport,
+}
+
+impl<'m> ContactProblem<'m> {
+    /// The problem of two bodies with the primary chosen by `choice`. An explicit choice must
+    /// name one of the two bodies (`Err` gives the names).
+    ///
+    /// Why the compliant body: the multiplier lives on the primary surface and is controlled
+    /// through the secondary's interpolated response `R12 K2^-1 M2 R21`, of rank at most the
+    /// secondary's node count; on a nearly rigid primary as finely meshed as the secondary,
+    /// multiplier modes are left that nothing controls (the inf-sup condition of Lagrange
+    /// multipliers). On the compliant body `K1^-1` controls every mode.
+    pub fn new(
+        sides: [ContactSide<'m>; 2],
+        choice: &PrimaryChoice,
+        settings: ContactSettings,
+    ) -> Result<Self, String> {
+        let modulus = |side: &ContactSide| {
+            let m = &side.0.material;
+            m.youngs_modulus() / (1.0 - m.poisson_ratio().powi(2))
+        };
+        let finest = |side: &ContactSide| side.1.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+        let name = |side: &ContactSide| side.0.body.name.clone();
+        let (first, report) = match choice {
+            PrimaryChoice::Body(body) => {
+                let first = sides
+                    .iter()
+                    .position(|s| &s.0.body.name == body)
+                    .ok_or_else(|| {
+                        format!(
+                            "primary = '{body}' is neither of the contact bodies '{}' and '{}' (or \"auto\")",
+                            name(&sides[0]),
+                            name(&sides[1])
+                        )
+                    })?;
+                (first, PrimaryReport { mode: "explicit", reason: "named in the case file".into() })
+            }
+            PrimaryChoice::Auto => {
+                let ratio = modulus(&sides[1]) / modulus(&sides[0]);
+                let (first, reason) = if !(1.0 / SIMILAR_STIFFNESS..=SIMILAR_STIFFNESS).contains(&ratio) {
+                    let first = usize::from(ratio < 1.0);
+                    (first, format!(
+                        "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
+                        modulus(&sides[first]), modulus(&sides[1 - first]), name(&sides[1 - first])
+                    ))
+                } else {
+                    let first = usize::from(finest(&sides[1]) < finest(&sides[0]));
+                    (first, format!(
+                        "similar stiffness (ratio {:.2}); the finer contact surface: finest spacing {:.3e} against {:.3e} for '{}'",
+                        ratio.max(1.0 / ratio), finest(&sides[first]), finest(&sides[1 - first]), name(&sides[1 - first])
+                    ))
+                };
+                (first, PrimaryReport { mode: "auto", reason })
+            }
+        };
+        let [a, b] = sides;
+        let ((primary, primary_surface), (secondary, secondary_surface)) =
+            if first == 0 { (a, b) } else { (b, a) };
+        Ok(Self {
+            primary,
+            secondary,
+            primary_surface,
+            secondary_surface,
+            settings,
+            primary_report: report,
+        })
+    }
 }

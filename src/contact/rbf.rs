@@ -504,11 +504,81 @@ impl Interpolation {
         nalgebra::DMatrix::from_row_slice(self.num_targets(), m, &self.apply(&identity, m))
     }
 
+    /// Rows `targets` of `R_NM`, each as its entries `(source, weight)` with `|weight| >`
+    /// [`DROP_TOL`]: `R[t, :] = D_tt^-1 Phi_NM[t, :] Phi_MM^-1`, one transposed solve with
+    /// `Phi_MM` per row (in blocks). `Phi_MM^-1` is dense but its entries decay fast away from
+    /// the diagonal, so the rows are short.
+    pub fn rows(&self, targets: &[usize]) -> Vec<Vec<(usize, f64)>> {
+        let m = self.num_sources;
+        let mut rows = Vec::with_capacity(targets.len());
+        for block in targets.chunks(BLOCK) {
+            let mut z = vec![0.0; m * block.len()];
+            for (k, &t) in block.iter().enumerate() {
+                for p in self.phi_rows[t]..self.phi_rows[t + 1] {
+                    z[k * m + self.phi_cols[p]] = self.phi_vals[p];
+                }
+            }
+            self.lu.solve_transpose_in_place(MatMut::from_column_major_slice_mut(
+                &mut z,
+                m,
+                block.len(),
+            ));
+            for (k, &t) in block.iter().enumerate() {
+                let scale = self.inv_d[t];
+                rows.push(sparse(z[k * m..(k + 1) * m].iter().map(|v| scale * v)));
+            }
+        }
+        rows
+    }
+
+    /// Columns `sources` of `R_NM`, each as its entries `(target, weight)` with `|weight| >`
+    /// [`DROP_TOL`]: `R[:, j] = D^-1 Phi_NM Phi_MM^-1 e_j`, one solve with `Phi_MM` per column
+    /// (in blocks).
+    pub fn columns(&self, sources: &[usize]) -> Vec<Vec<(usize, f64)>> {
+        let m = self.num_sources;
+        let mut columns = Vec::with_capacity(sources.len());
+        for block in sources.chunks(BLOCK) {
+            let mut x = vec![0.0; m * block.len()];
+            for (k, &j) in block.iter().enumerate() {
+                x[k * m + j] = 1.0;
+            }
+            self.lu
+                .solve_in_place(MatMut::from_column_major_slice_mut(&mut x, m, block.len()));
+            for k in 0..block.len() {
+                let x = &x[k * m..(k + 1) * m];
+                columns.push(sparse((0..self.num_targets()).map(|t| {
+                    let value: f64 = (self.phi_rows[t]..self.phi_rows[t + 1])
+                        .map(|p| self.phi_vals[p] * x[self.phi_cols[p]])
+                        .sum();
+                    self.inv_d[t] * value
+                })));
+            }
+        }
+        columns
+    }
+
     /// Targets outside every source support: `D_ii` not clearly positive (see
     /// [`UNCOVERED_TOL`]). Their rows of `R` are zero. Sorted increasingly.
     pub fn uncovered_targets(&self) -> &[usize] {
         &self.uncovered
     }
+}
+
+/// Entries of `R` at or below this magnitude are dropped from the rows and columns returned by
+/// [`Interpolation::rows`] and [`Interpolation::columns`]. Entries of `R` are of order one (its
+/// rows sum to one), so the dropped part of a row changes an interpolated value by at most
+/// `M * DROP_TOL` of the field's size.
+pub const DROP_TOL: f64 = 1e-13;
+
+/// Right-hand sides per block of the row and column solves.
+const BLOCK: usize = 64;
+
+/// The entries of a dense vector above [`DROP_TOL`], with their positions.
+fn sparse(values: impl Iterator<Item = f64>) -> Vec<(usize, f64)> {
+    values
+        .enumerate()
+        .filter(|(_, v)| v.abs() > DROP_TOL)
+        .collect()
 }
 
 /// Euclidean distance.

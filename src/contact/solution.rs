@@ -2,7 +2,8 @@
 
 use serde::Serialize;
 
-use super::solve::Candidates;
+use super::certificate::Certificate;
+use super::solve::ActiveSet;
 use crate::elastic::ElasticSolution;
 
 /// How the active-set loop ended. Only `Converged` is a contact solution; the others carry the
@@ -10,33 +11,79 @@ use crate::elastic::ElasticSolution;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ContactStatus {
-    /// No active node in tension, no candidate node penetrating beyond the tolerance.
+    /// The active set settled and the certificate passed: no node of either surface penetrates
+    /// the other body or receives a tensile force beyond the tolerances, and the contact forces
+    /// balance.
     Converged,
-    /// The candidate surfaces never come within interpolation range: each body was solved
-    /// alone.
+    /// The active set settled but the certificate failed (it says which check, where, and by
+    /// how much): not a contact solution.
+    NotCertified,
+    /// The active set settled empty and the certificate passed: the bodies do not touch.
     NoContact,
     /// The iteration cap was reached.
     IterationLimit,
+    /// An active node ended a spacing or more off the other body's surface: the interpolated
+    /// constraint no longer controls the geometry. Seen with a primary body much stiffer than
+    /// the secondary and a contact surface as fine as the secondary's, whose multiplier has
+    /// modes that nothing controls (the inf-sup condition; `primary = "auto"` avoids it).
+    Unstable,
     /// An active set seen before came back: the loop would repeat forever.
     Cycling,
+}
+
+/// Wall-clock seconds of the phases of one iteration.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct PhaseSeconds {
+    /// Rows and columns of the interface operators for the active set.
+    pub operators: f64,
+    /// Assembly and solution of the coupled system, residual check.
+    pub solve: f64,
+    /// The interface search: closest-point projection of every candidate (geometric gaps) and
+    /// the linearized gaps.
+    pub search: f64,
+    /// The active-set update.
+    pub checks: f64,
 }
 
 /// One line of the iteration history.
 #[derive(Debug, Clone, Serialize)]
 pub struct IterationRecord {
     pub iteration: usize,
-    pub active_primary: usize,
-    pub active_secondary: usize,
+    /// Active primary nodes of this iteration.
+    pub active: usize,
+    /// Nodes the update adds (inactive, penetrating) and removes (active, in tension).
     pub added: usize,
     pub removed: usize,
-    /// Largest penetration of an inactive candidate node, absolute and relative to its
-    /// spacing h.
-    pub max_penetration: f64,
+    /// Largest penetration of an inactive primary candidate over its spacing h (0 if none).
     pub max_penetration_over_h: f64,
-    /// Largest tension (negative mean pressure) of an active node (0 when none is in tension).
-    pub max_tension: f64,
+    /// Largest tension of an active node over the largest pressure (0 if none).
+    pub max_tension_over_p: f64,
+    /// Largest |geometric gap| of an active node over its h: how far the active nodes are
+    /// from the other body's discrete surface.
+    pub max_gap_error_over_h: f64,
     pub relative_residual: f64,
-    pub seconds: f64,
+    pub seconds: PhaseSeconds,
+}
+
+impl IterationRecord {
+    /// The progress line printed for this iteration.
+    pub fn line(&self) -> String {
+        let t = &self.seconds;
+        format!(
+            "  iteration {:>3}: active {:>5}, +{:<4} -{:<4} penetration {:.1e} h, tension {:.1e} p_max, active gap {:.1e} h; {:.3} s (operators {:.3}, solve {:.3}, search {:.3})",
+            self.iteration,
+            self.active,
+            self.added,
+            self.removed,
+            self.max_penetration_over_h,
+            self.max_tension_over_p,
+            self.max_gap_error_over_h,
+            t.operators + t.solve + t.search + t.checks,
+            t.operators,
+            t.solve,
+            t.search
+        )
+    }
 }
 
 /// Interface fields on a candidate surface, one entry per surface node.
@@ -46,15 +93,14 @@ pub struct SurfaceFields {
     pub nodes: Vec<usize>,
     /// Contact traction on this body (zero at inactive nodes).
     pub traction: Vec<[f64; 3]>,
-    /// Contact pressure `p = -traction . n` (positive in compression), nodal values of the P1
-    /// field.
+    /// Contact pressure `p = -traction . n` (positive in compression), `n` the node's outward
+    /// normal.
     pub pressure: Vec<f64>,
-    /// The pressure averaged over each node's patch with the node's hat function as weight
-    /// ([`super::ContactSurface::mean_pressure`]): the quantity the tension check uses. Nonzero
-    /// also at the inactive neighbours of active nodes, which the P1 traction reaches.
+    /// Normal contact force of each node over its area ([`super::ContactSurface::mean_pressure`]);
+    /// with the lumped interface mass, equal to `pressure` on the primary surface.
     pub mean_pressure: Vec<f64>,
-    /// Gap to the other surface along the outward normal, deformed configuration (NaN where
-    /// the other surface is out of interpolation range).
+    /// Geometric gap to the other body's surface in the deformed configuration: signed distance
+    /// to its closest point, negative inside the other body (defined at any distance).
     pub normal_gap: Vec<f64>,
     pub active: Vec<bool>,
 }
@@ -85,9 +131,11 @@ pub struct ContactSolution {
     /// Largest tangential traction `|lambda - (lambda . n) n|` on the primary surface: zero
     /// for frictionless contact, the shear the glue carries for tied contact.
     pub max_tangential_traction: f64,
+    /// The independent checks of the answer.
+    pub certificate: Certificate,
     pub hertz_primary: Option<HertzFit>,
     /// The factor the loads and prescribed displacements were scaled by.
     pub load_factor: f64,
-    /// The candidate sets at the end, from which a next load step starts.
-    pub candidates: Candidates,
+    /// The active set at the end, from which a next load step starts.
+    pub active_set: ActiveSet,
 }

@@ -1,17 +1,25 @@
-//! A body's contact candidate surface: its nodes, their outward normals and spacing, and the
-//! interface mass matrix of any active subset.
+//! A body's contact candidate surface: its nodes, their outward normals, spacing and areas, and
+//! its facets for the geometric gap ([`super::projection`]).
 //!
 //! Nodal normals are area-weighted averages of the normals of ALL candidate facets touching a
 //! node (not only active ones, so rim nodes have well-defined normals), each facet oriented out
 //! of its adjacent cell by the mesh reader (method.md section 3).
+//!
+//! The interface mass matrix is lumped: node `s` stands for the area `A_s = int phi_s ds`
+//! ([`ContactSurface::nodal_area`]), so a nodal traction `t_s` exerts the force `A_s t_s` and the
+//! mean pressure of a node (its normal force over its area) is its nodal pressure. The contact
+//! conditions are then nodewise, `p_s >= 0, g_s >= 0, p_s g_s = 0`, and the active-set test on
+//! the pressure judges exactly the unknown the system solves for (method.md section 3; with the
+//! consistent matrix the two differ at the rim, where the P1 multiplier undershoots).
 
 use std::collections::HashMap;
 
-use nalgebra::DMatrix;
 use thiserror::Error;
 
+use super::boundary::BodyBoundary;
+use super::projection::SurfaceIndex;
 use super::rbf::nearest_distances;
-use crate::fem::kernels::{facet_mass, facet_measure_and_normal};
+use crate::fem::kernels::facet_measure_and_normal;
 use crate::mesh::BodyMesh;
 
 #[derive(Debug, Error, PartialEq)]
@@ -40,6 +48,8 @@ pub struct ContactSurface {
     pub dim: usize,
     /// Body-local node indices, sorted.
     pub nodes: Vec<usize>,
+    /// gmsh node tag of each surface node (for messages and output).
+    pub tags: Vec<u64>,
     /// Reference coordinates of the surface nodes.
     pub coords: Vec<[f64; 3]>,
     /// Outward unit normals.
@@ -50,7 +60,8 @@ pub struct ContactSurface {
     pub nodal_area: Vec<f64>,
     /// Facets as surface node indices, `dim` per facet.
     facets: Vec<usize>,
-    facet_measures: Vec<f64>,
+    /// The body's whole boundary, which tells inside from outside.
+    pub boundary: BodyBoundary,
 }
 
 impl ContactSurface {
@@ -74,7 +85,6 @@ impl ContactSurface {
         let coords: Vec<[f64; 3]> = nodes.iter().map(|&n| body.coords[n]).collect();
         let mut normals = vec![[0.0; 3]; nodes.len()];
         let mut facets = Vec::with_capacity(group.facets.len());
-        let mut facet_measures = Vec::new();
         let mut nodal_area = vec![0.0; nodes.len()];
         for f in 0..group.num_facets(dim) {
             let facet = group.facet(f, dim);
@@ -88,7 +98,6 @@ impl ContactSurface {
                     normals[s][k] += measure * normal[k];
                 }
             }
-            facet_measures.push(measure);
         }
         for n in &mut normals {
             let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
@@ -103,13 +112,14 @@ impl ContactSurface {
             body: body.name.clone(),
             group: group_name.to_string(),
             dim,
+            tags: nodes.iter().map(|&n| body.node_tags[n]).collect(),
             nodes,
             coords,
             normals,
             spacing,
             nodal_area,
             facets,
-            facet_measures,
+            boundary: BodyBoundary::new(body),
         })
     }
 
@@ -139,49 +149,13 @@ impl ContactSurface {
         -normal_force / self.nodal_area[s]
     }
 
-    /// The interface mass matrix of the active nodes `active` (surface indices):
-    /// `M[a, b] = int phi_a phi_b ds` for every node `a` of a facet that has an active node,
-    /// and active `b`.
-    ///
-    /// The multiplier is a P1 field that vanishes at inactive nodes, so the force it exerts,
-    /// `M lambda`, also reaches the inactive neighbours on the rim; dropping those rows would
-    /// lose part of the contact force. Returns the rows (surface indices) and the dense
-    /// `|rows| x |active|` matrix, columns in the order of `active`.
-    pub fn mass_matrix(&self, active: &[usize]) -> (Vec<usize>, DMatrix<f64>) {
-        let dim = self.dim;
-        let mut column = vec![usize::MAX; self.len()];
-        for (k, &s) in active.iter().enumerate() {
-            column[s] = k;
-        }
-        let touched: Vec<usize> = (0..self.facet_measures.len())
-            .filter(|&f| {
-                self.facets[dim * f..dim * (f + 1)]
-                    .iter()
-                    .any(|&s| column[s] != usize::MAX)
-            })
-            .collect();
-        let mut rows: Vec<usize> = touched
-            .iter()
-            .flat_map(|&f| self.facets[dim * f..dim * (f + 1)].to_vec())
-            .collect();
-        rows.sort_unstable();
-        rows.dedup();
-        let mut row = vec![usize::MAX; self.len()];
-        for (k, &s) in rows.iter().enumerate() {
-            row[s] = k;
-        }
-        let mut m = DMatrix::zeros(rows.len(), active.len());
-        for &f in &touched {
-            let facet = &self.facets[dim * f..dim * (f + 1)];
-            let local = facet_mass(self.facet_measures[f], dim);
-            for (a, &sa) in facet.iter().enumerate() {
-                for (b, &sb) in facet.iter().enumerate() {
-                    if column[sb] != usize::MAX {
-                        m[(row[sa], column[sb])] += local[a][b];
-                    }
-                }
-            }
-        }
-        (rows, m)
+    /// The surface's facets at its nodes' positions displaced by `u` (body dofs; `None`: the
+    /// reference positions), indexed for closest-point projection.
+    pub fn index(&self, u: Option<&[f64]>) -> SurfaceIndex {
+        let positions: Vec<[f64; 3]> = match u {
+            Some(u) => (0..self.len()).map(|s| self.deformed(u, s)).collect(),
+            None => self.coords.clone(),
+        };
+        SurfaceIndex::new(&self.facets, self.dim, &positions)
     }
 }

@@ -1,14 +1,15 @@
 //! The linear system of one active-set iteration (method.md section 2), assembled in one place.
 //!
 //! ```text
-//! [ K1        0        -M1 (rows I)  ] [u1    ]   [f1]
-//! [ 0         K2     M2 R21 (rows J) ] [u2    ] = [f2]
-//! [ I (cols I)  -R12 (cols J)    0   ] [lambda]   [d ]
+//! [ K1        0        -M1 (rows I) ] [u1    ]   [f1]
+//! [ 0         K2         M2 R21     ] [u2    ] = [f2]
+//! [ I (cols I)  -R12          0     ] [lambda]   [d ]
 //! ```
 //!
 //! `K_k`, `f_k` are Dirichlet-constrained (rows and columns of prescribed dofs hold only their
 //! diagonal, and carry no coupling). `lambda` is the traction on body 1 at its active nodes I;
-//! body 2 receives `lambda_2 = -R21 lambda`. Tied: one vector multiplier per node and the vector
+//! body 2 receives `lambda_2 = -R21 lambda` on its whole candidate surface. `M1`, `M2` are the
+//! lumped interface mass matrices ([`super::surface`]). Tied: one vector multiplier per node and the vector
 //! constraint `u1 - R12 u2 = d`. Frictionless: `lambda = lambda_n n1`, one scalar per node, and
 //! only the normal constraint `n1 . (u1 - R12 u2) = n1 . d`.
 //!
@@ -22,35 +23,28 @@
 //! the magnitude of `K`; the solution is unscaled on return.
 
 use faer::sparse::{SparseColMat, Triplet};
-use nalgebra::DMatrix;
 
 use super::{ContactError, Formulation};
 use crate::elastic::AssembledBody;
 use crate::linalg::mat_vec;
 
-/// The interface operators of one iteration, on the active nodes (surface indices).
+/// The interface operators of one iteration, on the active primary nodes I (built by
+/// [`super::interface::InterfaceOperators::coupling`]).
 pub struct Coupling {
     pub formulation: Formulation,
-    /// Body-local node of each active primary node (I) and secondary node (J).
+    /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
-    pub secondary_nodes: Vec<usize>,
-    /// Contact normals at I: the bisectors of body 1's outward normals and body 2's, interpolated
-    /// (pointing out of body 1; see `solve`).
+    /// Contact normal at each active node (pointing out of body 1).
     pub normals: Vec<[f64; 3]>,
-    /// `R12` (|I| x |r12_nodes|), interpolating the secondary displacement to I from the
-    /// secondary nodes `r12_nodes` (J and the ring of nodes around it).
-    pub r12: DMatrix<f64>,
-    pub r12_nodes: Vec<usize>,
-    /// `R21` (|J| x |I|), interpolating from I to J.
-    pub r21: DMatrix<f64>,
-    /// Interface mass matrices of the facets with an active node: rows are the body nodes of
-    /// those facets (`m1_rows`, `m2_rows`), columns the active nodes I (resp. J). Body 2's is
-    /// kept multiplied by `R21` (|m2_rows| x |I|), the only form the system uses.
-    pub m1_rows: Vec<usize>,
-    pub m1: DMatrix<f64>,
-    pub m2_rows: Vec<usize>,
-    pub m2_r21: DMatrix<f64>,
-    /// Nodal gaps in the reference configuration: the normal part of `R12 x2(J) - x1(I)`.
+    /// Lumped interface mass of each active node: its area `A_i`.
+    pub areas1: Vec<f64>,
+    /// Row of `R12` of each active node: `(secondary body node, weight)`.
+    pub r12: Vec<Vec<(usize, f64)>>,
+    /// Column of `M2 R21` of each active node: `(secondary body node, A2_j R21[j, i])`, the
+    /// force a unit traction at node `i` puts on body 2's nodes (with the sign of `lambda_2 =
+    /// -R21 lambda` applied by the system).
+    pub loads2: Vec<Vec<(usize, f64)>>,
+    /// Gap each active node is held at, as a vector along its contact normal.
     pub gaps: Vec<[f64; 3]>,
 }
 
@@ -137,7 +131,7 @@ impl CoupledSystem {
         let n2 = body2.f_c.len();
         let m = coupling.num_multipliers(dim);
         let k_scale = diagonal_max(&body1.k_c).max(diagonal_max(&body2.k_c));
-        let m_scale = coupling.m1.iter().cloned().fold(0.0, f64::max);
+        let m_scale = coupling.areas1.iter().cloned().fold(0.0, f64::max);
         if m > 0 && m_scale <= 0.0 {
             return Err(ContactError::EmptyInterfaceMass);
         }
@@ -146,25 +140,25 @@ impl CoupledSystem {
         let dropped: Vec<bool> = (0..m)
             .map(|col| coupling.is_dropped(col, body1, dim))
             .collect();
+        let free1 = |dof: usize| !body1.constraints.is_fixed(dof);
+        let free2 = |dof: usize| !body2.constraints.is_fixed(dof);
 
         // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2.
         let mut b = Vec::new();
-        for (nodes, matrix, sign, offset, body) in [
-            (&coupling.m1_rows, &coupling.m1, -1.0, 0, body1),
-            (&coupling.m2_rows, &coupling.m2_r21, 1.0, n1, body2),
-        ] {
-            for (a, &node) in nodes.iter().enumerate() {
-                for c in 0..dim {
-                    let dof = dim * node + c;
-                    if body.constraints.is_fixed(dof) {
-                        continue;
-                    }
-                    for k in 0..coupling.primary_nodes.len() {
-                        let (col, weight) = coupling.multiplier_terms(k, c, dim);
-                        let value = sign * s * matrix[(a, k)] * weight;
-                        if !dropped[col] && value != 0.0 {
-                            b.push((offset + dof, col, value));
-                        }
+        for (k, &node) in coupling.primary_nodes.iter().enumerate() {
+            for c in 0..dim {
+                let (col, weight) = coupling.multiplier_terms(k, c, dim);
+                if dropped[col] || weight == 0.0 {
+                    continue;
+                }
+                let dof = dim * node + c;
+                if free1(dof) {
+                    b.push((dof, col, -s * coupling.areas1[k] * weight));
+                }
+                for &(node2, load) in &coupling.loads2[k] {
+                    let dof2 = dim * node2 + c;
+                    if free2(dof2) {
+                        b.push((n1 + dof2, col, s * load * weight));
                     }
                 }
             }
@@ -176,15 +170,12 @@ impl CoupledSystem {
         for (a, &node) in coupling.primary_nodes.iter().enumerate() {
             for c in 0..dim {
                 let (row, weight) = coupling.multiplier_terms(a, c, dim);
-                if dropped[row] {
+                if dropped[row] || weight == 0.0 {
                     continue;
                 }
                 c_entries.push((row, dim * node + c, t * weight));
-                for (j, &node2) in coupling.r12_nodes.iter().enumerate() {
-                    let value = -t * coupling.r12[(a, j)] * weight;
-                    if value != 0.0 {
-                        c_entries.push((row, n1 + dim * node2 + c, value));
-                    }
+                for &(node2, w) in &coupling.r12[a] {
+                    c_entries.push((row, n1 + dim * node2 + c, -t * w * weight));
                 }
                 g[row] += t * weight * coupling.gaps[a][c];
             }
@@ -295,20 +286,12 @@ impl CoupledSystem {
             .collect();
         let mut contact_force1 = vec![0.0; n1];
         let mut contact_force2 = vec![0.0; n2];
-        for (nodes, matrix, sign, force) in [
-            (&coupling.m1_rows, &coupling.m1, 1.0, &mut contact_force1),
-            (
-                &coupling.m2_rows,
-                &coupling.m2_r21,
-                -1.0,
-                &mut contact_force2,
-            ),
-        ] {
-            for (a, &node) in nodes.iter().enumerate() {
-                for (k, lambda) in traction.iter().enumerate() {
-                    for c in 0..dim {
-                        force[dim * node + c] += sign * matrix[(a, k)] * lambda[c];
-                    }
+        for (k, lambda) in traction.iter().enumerate() {
+            let node = coupling.primary_nodes[k];
+            for c in 0..dim {
+                contact_force1[dim * node + c] += coupling.areas1[k] * lambda[c];
+                for &(node2, load) in &coupling.loads2[k] {
+                    contact_force2[dim * node2 + c] -= load * lambda[c];
                 }
             }
         }

@@ -6,7 +6,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::OutputError;
-use crate::contact::{ContactSettings, ContactStatus, HertzFit, IterationRecord};
+use crate::contact::{
+    Certificate, ContactSettings, ContactStatus, HertzFit, IterationRecord, PrimaryReport,
+};
 use crate::elastic::SolveStats;
 
 #[derive(Debug, Serialize)]
@@ -45,6 +47,10 @@ pub struct ContactSummary {
     pub status: ContactStatus,
     pub primary: String,
     pub secondary: String,
+    /// Which body carries the multiplier, chosen how and why.
+    pub primary_choice: PrimaryReport,
+    /// The independent checks of the answer of the last load step.
+    pub certificate: Certificate,
     pub settings: ContactSettings,
     /// Total contact force on each body, and `|F1 + F2| / |F1|`.
     pub force_primary: Vec<f64>,

@@ -61,10 +61,9 @@ pub fn half_disc_on_block(mesh: &str, extra: &str) -> String {
 output = "out"
 
 [contact]
+bodies = ["disc", "block"]
+surfaces = ["disc_contact", "block_contact"]
 primary = "disc"
-primary_surface = "disc_contact"
-secondary = "block"
-secondary_surface = "block_contact"
 {extra}
 
 [[body]]

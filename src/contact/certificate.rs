@@ -1,0 +1,176 @@
+//! The certificate of a contact answer: checks that do not reuse the active-set loop's
+//! operators (method.md section 3, "Certify the result").
+//!
+//! - **Penetration.** Every candidate node of BOTH bodies, active or not, is projected onto the
+//!   other body's displaced P1 surface ([`geometric_gaps`]); the largest penetration over the
+//!   node's spacing must not exceed `penetration_tolerance` on the primary surface, whose
+//!   nodes the constraint holds, and `secondary_penetration_tolerance` on the secondary one,
+//!   whose nodes only the transfer holds (see [`super::ContactSettings`] for the figures).
+//! - **Tension.** The normal force every surface node of both bodies receives from the
+//!   interface (active or not: the inactive ring next to the contact zone included), over its
+//!   area, is its mean pressure ([`ContactSurface::mean_pressure`]); the largest tension over
+//!   the largest pressure of either surface must not exceed `tension_tolerance` on the primary
+//!   surface (where the loop enforces it; reported for every exit of the loop) and
+//!   `secondary_tension_tolerance` on the secondary one, whose pressure is the RBF transfer of
+//!   the multiplier, not positivity preserving.
+//! - **Force balance.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
+//!   exceed `imbalance_tolerance`: the transfer `R21` conserves force only to its accuracy.
+//!
+//! A failed check names the body, the gmsh node tag and the figure.
+
+use serde::Serialize;
+
+use super::interface::geometric_gaps;
+use super::system::CoupledSolution;
+use super::{ContactProblem, ContactSurface};
+
+/// The checks of one contact answer.
+#[derive(Debug, Clone, Serialize)]
+pub struct Certificate {
+    pub passed: bool,
+    pub checks: Vec<CertificateCheck>,
+}
+
+/// One check: its figure against its tolerance, and where the worst value is.
+#[derive(Debug, Clone, Serialize)]
+pub struct CertificateCheck {
+    /// "penetration" and "secondary penetration" (over h), "tension" and "secondary tension"
+    /// (over the largest pressure), or "imbalance".
+    pub name: &'static str,
+    pub value: f64,
+    pub tolerance: f64,
+    pub passed: bool,
+    /// Body and gmsh node tag of the worst node (penetration, tension).
+    pub body: Option<String>,
+    pub node_tag: Option<u64>,
+}
+
+impl Certificate {
+    /// The failed checks in one line, e.g. for a status message.
+    pub fn failures(&self) -> String {
+        self.checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(CertificateCheck::describe)
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
+impl CertificateCheck {
+    pub fn describe(&self) -> String {
+        let at = match (&self.body, self.node_tag) {
+            (Some(body), Some(tag)) => format!(" at node {tag} of '{body}'"),
+            _ => String::new(),
+        };
+        let unit = if self.name.ends_with("penetration") {
+            " h"
+        } else if self.name.ends_with("tension") {
+            " of the largest pressure"
+        } else {
+            ""
+        };
+        format!(
+            "{} {:.3e}{unit}{at} (tolerance {:.1e})",
+            self.name, self.value, self.tolerance
+        )
+    }
+}
+
+/// Certifies the displacements and interface forces of a solution (module doc).
+pub fn certify(problem: &ContactProblem, solution: &CoupledSolution) -> Certificate {
+    let settings = &problem.settings;
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+    let sides = [
+        (s1, s2, u1, u2, &solution.contact_force1[..]),
+        (s2, s1, u2, u1, &solution.contact_force2[..]),
+    ];
+
+    let mut penetration = [Worst::default(), Worst::default()];
+    for (worst, &(own, other, u_own, u_other, _)) in penetration.iter_mut().zip(&sides) {
+        let gaps = geometric_gaps(own, other, Some(u_own), Some(u_other));
+        for (s, g) in gaps.iter().enumerate() {
+            worst.offer(-g / own.spacing[s], own, s);
+        }
+    }
+
+    let mean: Vec<Vec<f64>> = sides
+        .iter()
+        .map(|&(own, _, _, _, force)| (0..own.len()).map(|s| own.mean_pressure(force, s)).collect())
+        .collect();
+    let p_max = mean.iter().flatten().copied().fold(0.0, f64::max);
+    let mut tension = [Worst::default(), Worst::default()];
+    if p_max > 0.0 {
+        for (worst, (&(own, ..), pressures)) in tension.iter_mut().zip(sides.iter().zip(&mean)) {
+            for (s, p) in pressures.iter().enumerate() {
+                worst.offer(-p / p_max, own, s);
+            }
+        }
+    }
+
+    let total = |force: &[f64]| -> [f64; 3] {
+        let dim = s1.dim;
+        std::array::from_fn(|c| if c < dim { force.iter().skip(c).step_by(dim).sum() } else { 0.0 })
+    };
+    let (f1, f2) = (total(&solution.contact_force1), total(&solution.contact_force2));
+    let norm = |f: [f64; 3]| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+    let imbalance = if norm(f1) > 0.0 {
+        norm(std::array::from_fn(|c| f1[c] + f2[c])) / norm(f1)
+    } else {
+        norm(f2)
+    };
+
+    let [penetration1, penetration2] = penetration;
+    let [tension1, tension2] = tension;
+    let checks = vec![
+        penetration1.check("penetration", settings.penetration_tolerance),
+        penetration2.check(
+            "secondary penetration",
+            settings.secondary_penetration_tolerance,
+        ),
+        tension1.check("tension", settings.tension_tolerance),
+        tension2.check("secondary tension", settings.secondary_tension_tolerance),
+        CertificateCheck {
+            name: "imbalance",
+            value: imbalance,
+            tolerance: settings.imbalance_tolerance,
+            passed: imbalance <= settings.imbalance_tolerance,
+            body: None,
+            node_tag: None,
+        },
+    ];
+    Certificate {
+        passed: checks.iter().all(|c| c.passed),
+        checks,
+    }
+}
+
+/// The largest value seen and its node (0 with no node when nothing is positive).
+#[derive(Default)]
+struct Worst {
+    value: f64,
+    node: Option<(String, u64)>,
+}
+
+impl Worst {
+    fn offer(&mut self, value: f64, surface: &ContactSurface, s: usize) {
+        // A NaN fails: it must never read as "no violation".
+        if value > self.value || value.is_nan() && !self.value.is_nan() {
+            self.value = value;
+            self.node = Some((surface.body.clone(), surface.tags[s]));
+        }
+    }
+
+    fn check(self, name: &'static str, tolerance: f64) -> CertificateCheck {
+        let (body, node_tag) = self.node.map_or((None, None), |(b, t)| (Some(b), Some(t)));
+        CertificateCheck {
+            name,
+            value: self.value,
+            tolerance,
+            passed: self.value <= tolerance,
+            body,
+            node_tag,
+        }
+    }
+}

@@ -1,0 +1,284 @@
+//! The interface operators of a contact solve, built once over ALL candidate nodes: the
+//! transfers `R12`, `R21`, the (lumped) interface mass, the contact normal, and the gaps.
+//!
+//! **Interpolation along the surfaces.** Every primary candidate `x_i` is projected onto the
+//! secondary surface along its outward normal (point `p_i`, reference geometry,
+//! [`super::projection`]), and `R12`
+//! is the rescaled Wendland interpolation (seed eqs. 2.4-2.7) from all secondary candidates to
+//! the points `p_i`; likewise `R21` from all primary candidates to the projections of the
+//! secondary candidates onto the primary surface. The targets lie on the source surface, so
+//! every node is covered however far apart the two surfaces start (a rim many spacings from
+//! the other body, or bodies meshed overlapping), and the interpolation runs along the surface,
+//! not across the gap. An active set only selects rows of these operators: the complementarity
+//! problem the active-set loop solves does not change from one iteration to the next.
+//!
+//! **The contact normal** at a primary candidate is the bisector of its outward normal and the
+//! secondary surface's outward normal interpolated at `p_i`,
+//! `n_i = (n1_i - R12 n2) / |n1_i - R12 n2|` ([`contact_normal`]): with the primary's own
+//! normal, a node of a curved primary sliding by `u_t` on a flat ends `(x / R) u_t` off it
+//! (the rigid-flat force was 1.2% low); between two equal bodies it is the symmetry plane's
+//! normal.
+//!
+//! **Gaps.** The reference gap `d_i = n_i . (p_i - x_i)` is exact against a flat at any
+//! distance. The linearized gap of a displacement is
+//! `g_i(u) = d_i - n_i . (u1_i - (R12 u2)_i)` ([`InterfaceOperators::linearized_gaps`]); the
+//! frictionless constraint of an active node is `g_i(u) + e_i = 0`, `e_i` the difference between
+//! the geometric gap of the last iterate ([`geometric_gaps`]: closest-point projection onto the
+//! displaced P1 facets) and its linearized gap. That difference is the interpolation error of
+//! `R12 u2` against the P1 surface (first order in `h`, times the displacement gradient): with
+//! it, an active node ends ON the other body's discrete surface, as the certificate measures
+//! it, not on the RBF reconstruction of that surface.
+//!
+//! **Lumped interface mass.** Node `s` stands for its area `A_s` ([`ContactSurface`]): the
+//! multiplier `lambda_i` exerts `-A_i lambda_i` on body 1 and `+A2_j (R21 lambda)_j` on body
+//! 2, which balance to the interpolation's accuracy.
+
+use std::collections::HashMap;
+
+use super::projection::Projection;
+use super::rbf::{Interpolation, interpolation_radii};
+use super::system::Coupling;
+use super::{ContactError, ContactSurface, Formulation};
+
+/// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
+/// rows and columns of the transfers computed so far (an explicit cache: callers hold it `mut`).
+pub struct InterfaceOperators {
+    /// From the secondary candidates to the projections of the primary candidates.
+    r12: Interpolation,
+    /// From the primary candidates to the projections of the secondary candidates that face
+    /// the primary surface, `receiving` (surface indices).
+    r21: Interpolation,
+    receiving: Vec<usize>,
+    /// Whether each primary candidate faces the secondary surface (only those can be active).
+    pub facing: Vec<bool>,
+    /// Contact normal at each primary candidate (pointing out of body 1).
+    pub normals: Vec<[f64; 3]>,
+    /// Reference gap `d_i` of each primary candidate along its contact normal.
+    pub reference_gaps: Vec<f64>,
+    /// Row of `R12` of each primary candidate used so far: `(secondary surface index, weight)`.
+    rows12: HashMap<usize, Vec<(usize, f64)>>,
+    /// Column of `R21` of each primary candidate used so far: `(secondary surface index, weight)`.
+    columns21: HashMap<usize, Vec<(usize, f64)>>,
+}
+
+impl InterfaceOperators {
+    /// Projects each surface's candidates onto the other (reference geometry) and builds the two
+    /// interpolations; `radius` is the RBF support radius in units of each source node's
+    /// nearest-node distance.
+    pub fn new(
+        primary: &ContactSurface,
+        secondary: &ContactSurface,
+        radius: f64,
+    ) -> Result<Self, ContactError> {
+        let (on_secondary, facing) = projections(primary, secondary)?;
+        let (on_primary, facing2) = projections(secondary, primary)?;
+        let r12_targets: Vec<[f64; 3]> = on_secondary.iter().map(|p| p.point).collect();
+        let r12 = covering_interpolation(secondary, radius, &r12_targets, primary, |t| t)?;
+        // Only the secondary nodes that face the primary surface receive its traction.
+        let receiving: Vec<usize> = (0..secondary.len()).filter(|&j| facing2[j]).collect();
+        let r21_targets: Vec<[f64; 3]> = receiving.iter().map(|&j| on_primary[j].point).collect();
+        let r21 = covering_interpolation(primary, radius, &r21_targets, secondary, |t| {
+            receiving[t]
+        })?;
+        let n2_flat: Vec<f64> = secondary.normals.iter().flatten().copied().collect();
+        let n2_at_1 = r12.apply(&n2_flat, 3);
+        let normals: Vec<[f64; 3]> = (0..primary.len())
+            .map(|i| contact_normal(&primary.normals[i], &n2_at_1[3 * i..3 * i + 3]))
+            .collect();
+        let reference_gaps = (0..primary.len())
+            .map(|i| {
+                let (x, p, n) = (primary.coords[i], on_secondary[i].point, normals[i]);
+                (0..3).map(|k| n[k] * (p[k] - x[k])).sum()
+            })
+            .collect();
+        Ok(Self {
+            r12,
+            r21,
+            receiving,
+            facing,
+            normals,
+            reference_gaps,
+            rows12: HashMap::new(),
+            columns21: HashMap::new(),
+        })
+    }
+
+    /// The coupling of the active primary candidates `active` (surface indices), each held at
+    /// the gap correction `corrections[i]` (module doc: the constraint is `g_i(u) + e_i = 0`).
+    pub fn coupling(
+        &mut self,
+        primary: &ContactSurface,
+        secondary: &ContactSurface,
+        formulation: Formulation,
+        active: &[usize],
+        corrections: &[f64],
+    ) -> Coupling {
+        let missing: Vec<usize> = active
+            .iter()
+            .copied()
+            .filter(|i| !self.rows12.contains_key(i))
+            .collect();
+        self.rows12
+            .extend(missing.iter().copied().zip(self.r12.rows(&missing)));
+        self.columns21
+            .extend(missing.iter().copied().zip(self.r21.columns(&missing)));
+        let to_body2 = |entries: &[(usize, f64)], weight: &dyn Fn(usize, f64) -> f64| {
+            entries
+                .iter()
+                .map(|&(j, w)| (secondary.nodes[j], weight(j, w)))
+                .collect()
+        };
+        Coupling {
+            formulation,
+            primary_nodes: active.iter().map(|&i| primary.nodes[i]).collect(),
+            normals: active.iter().map(|&i| self.normals[i]).collect(),
+            areas1: active.iter().map(|&i| primary.nodal_area[i]).collect(),
+            r12: active
+                .iter()
+                .map(|i| to_body2(&self.rows12[i], &|_, w| w))
+                .collect(),
+            loads2: active
+                .iter()
+                .map(|i| {
+                    let column: Vec<(usize, f64)> = self.columns21[i]
+                        .iter()
+                        .map(|&(t, w)| (self.receiving[t], w))
+                        .collect();
+                    to_body2(&column, &|j, w| secondary.nodal_area[j] * w)
+                })
+                .collect(),
+            // Only the normal part is a gap: the tied constraint would otherwise impose the
+            // tangential offset between x_i and p_i (nonzero off a flat) as a spurious jump.
+            gaps: active
+                .iter()
+                .map(|&i| {
+                    let g = self.reference_gaps[i] + corrections[i];
+                    self.normals[i].map(|n| g * n)
+                })
+                .collect(),
+        }
+    }
+
+    /// The linearized gap of every primary candidate, `g_i(u) = d_i - n_i . (u1_i - (R12
+    /// u2)_i)`, for the bodies' displacements `u1`, `u2` (body dofs).
+    pub fn linearized_gaps(
+        &self,
+        primary: &ContactSurface,
+        secondary: &ContactSurface,
+        u1: &[f64],
+        u2: &[f64],
+    ) -> Vec<f64> {
+        let dim = primary.dim;
+        let u2_flat: Vec<f64> = secondary
+            .nodes
+            .iter()
+            .flat_map(|&node| (0..3).map(move |k| if k < dim { u2[dim * node + k] } else { 0.0 }))
+            .collect();
+        let u2_at_1 = self.r12.apply(&u2_flat, 3);
+        (0..primary.len())
+            .map(|i| {
+                let node = primary.nodes[i];
+                let jump: f64 = (0..dim)
+                    .map(|k| self.normals[i][k] * (u1[dim * node + k] - u2_at_1[3 * i + k]))
+                    .sum();
+                self.reference_gaps[i] - jump
+            })
+            .collect()
+    }
+}
+
+/// The contact normal at a node: the bisector `(n_own - n_other) / |n_own - n_other|` of its
+/// outward normal and the other surface's outward normal there (`n_own` if they cancel, which
+/// facing surfaces cannot do).
+pub fn contact_normal(own: &[f64; 3], other: &[f64]) -> [f64; 3] {
+    let sum: [f64; 3] = std::array::from_fn(|k| own[k] - other[k]);
+    let length = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]).sqrt();
+    if length > 1e-12 {
+        sum.map(|v| v / length)
+    } else {
+        *own
+    }
+}
+
+/// The geometric gap of every node of `own` to the `other` body, each displaced by its body's
+/// displacement (`None`: reference geometry): the distance to the closest point of the other
+/// candidate surface's P1 facets ([`super::projection`]), negative when the node is inside the
+/// other body (decided on that body's closed boundary, [`super::boundary`]). Defined at any
+/// distance; exact against a flat.
+pub fn geometric_gaps(
+    own: &ContactSurface,
+    other: &ContactSurface,
+    u_own: Option<&[f64]>,
+    u_other: Option<&[f64]>,
+) -> Vec<f64> {
+    let surface = other.index(u_other);
+    let boundary = other.boundary.index(u_other);
+    (0..own.len())
+        .map(|s| {
+            let x = u_own.map_or(own.coords[s], |u| own.deformed(u, s));
+            let distance = surface
+                .project(&x)
+                .expect("a contact surface has facets")
+                .signed_distance
+                .abs();
+            let inside = boundary
+                .project(&x)
+                .is_some_and(|p| p.signed_distance < 0.0);
+            if inside { -distance } else { distance }
+        })
+        .collect()
+}
+
+/// The point of `other` (reference geometry) that each node of `own` faces: where the line
+/// through the node along its outward normal meets `other` (the closest point where it misses),
+/// and whether the node faces `other` there (the line meets it where its outward normal
+/// opposes the node's). Along the normal rather than to the closest point: between bodies
+/// meshed overlapping by `delta`, the closest point on a sphere of radius `R` of a point of a
+/// flat lies `delta / R` farther out than the point facing it, which stretched the transfer of
+/// the pressure to the flat by as much and unbalanced the contact forces by 1.6% (3D, overlap
+/// 0.01 R). A node that does not face the other surface (the far side of a disc, the block
+/// beyond the sphere's candidate cap) can neither be activated nor receive a contact force.
+fn projections(
+    own: &ContactSurface,
+    other: &ContactSurface,
+) -> Result<(Vec<Projection>, Vec<bool>), ContactError> {
+    let index = other.index(None);
+    own.coords
+        .iter()
+        .zip(&own.normals)
+        .map(|(x, n)| {
+            let (p, hit) = index
+                .project_along(x, n)
+                .ok_or_else(|| ContactError::NoFacets {
+                    body: other.body.clone(),
+                    group: other.group.clone(),
+                })?;
+            let m = index.normal(p.facet);
+            Ok((p, hit && n[0] * m[0] + n[1] * m[1] + n[2] * m[2] < 0.0))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(|v| v.into_iter().unzip())
+}
+
+/// The interpolation from the nodes of `sources` to `targets` (points on that surface; target
+/// `t` belongs to node `target_node(t)` of `target_surface`); a target outside every support is
+/// an error that names its node.
+fn covering_interpolation(
+    sources: &ContactSurface,
+    radius: f64,
+    targets: &[[f64; 3]],
+    target_surface: &ContactSurface,
+    target_node: impl Fn(usize) -> usize,
+) -> Result<Interpolation, ContactError> {
+    let radii = interpolation_radii(&sources.coords, radius)?;
+    let interpolation = Interpolation::new(&sources.coords, &radii, targets)?;
+    if let Some(&t) = interpolation.uncovered_targets().first() {
+        return Err(ContactError::Uncovered {
+            body: target_surface.body.clone(),
+            tag: target_surface.tags[target_node(t)],
+            other: sources.body.clone(),
+            count: interpolation.uncovered_targets().len(),
+        });
+    }
+    Ok(interpolation)
+}

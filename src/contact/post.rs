@@ -1,0 +1,154 @@
+//! Post-processing of the last iterate: each body's solution (reactions, cell strains and
+//! stresses), the interface fields of both surfaces, total forces and the Hertz fit.
+
+use super::certificate::Certificate;
+use super::interface::geometric_gaps;
+use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
+use super::solve::{ActiveSet, ContactSolver};
+use super::system::{CoupledSolution, Coupling};
+use super::{ContactError, ContactSurface, hertz};
+use crate::elastic::{AssembledBody, ElasticProblem, ElasticSolution, SolveStats, reactions};
+use crate::fem::stress::cell_fields;
+
+/// The solution of the last iterate, with surface fields, forces and the Hertz fit.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn finish(
+    solver: &ContactSolver,
+    load_factor: f64,
+    status: ContactStatus,
+    history: Vec<IterationRecord>,
+    certificate: Certificate,
+    coupling: &Coupling,
+    solution: CoupledSolution,
+    active_set: ActiveSet,
+) -> Result<ContactSolution, ContactError> {
+    let problem = solver.problem;
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let dim = s1.dim;
+    let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+    let primary_fields = surface_fields(
+        s1,
+        &solution.contact_force1,
+        geometric_gaps(s1, s2, Some(u1), Some(u2)),
+        |s| active_set.nodes.contains(&s),
+    );
+    let mut secondary_fields = surface_fields(
+        s2,
+        &solution.contact_force2,
+        geometric_gaps(s2, s1, Some(u2), Some(u1)),
+        |_| false,
+    );
+    // The secondary surface has no active set of its own: a node is in contact where it
+    // receives a compressive force.
+    secondary_fields.active = secondary_fields
+        .mean_pressure
+        .iter()
+        .map(|&p| p > 0.0)
+        .collect();
+    let total = |force: &[f64]| -> [f64; 3] {
+        std::array::from_fn(|c| if c < dim { force.iter().skip(c).step_by(dim).sum() } else { 0.0 })
+    };
+    let force_primary = total(&solution.contact_force1);
+    let force_secondary = total(&solution.contact_force2);
+    let force_imbalance = certificate
+        .checks
+        .iter()
+        .find(|c| c.name == "imbalance")
+        .map_or(f64::NAN, |c| c.value);
+    let hertz_primary = hertz::fit(s1, &primary_fields);
+    // Tangential with respect to the contact normal the constraint used: zero for
+    // frictionless, the glue's shear for tied.
+    let max_tangential_traction = solution
+        .traction
+        .iter()
+        .zip(&coupling.normals)
+        .map(|(t, n)| {
+            let normal = dot(t, n);
+            let tangential: [f64; 3] = std::array::from_fn(|k| t[k] - normal * n[k]);
+            dot(&tangential, &tangential).sqrt()
+        })
+        .fold(0.0, f64::max);
+    let residual = solution.relative_residual;
+    let body = |p: &ElasticProblem, body: &AssembledBody, u: Vec<f64>, force: &[f64], stats: &SolveStats| {
+        ElasticSolution {
+            reactions: reactions(p, body, &u, load_factor, force),
+            cell_fields: cell_fields(p.body, &p.material, &u),
+            displacement: u,
+            stats: SolveStats {
+                relative_residual: residual,
+                ..stats.clone()
+            },
+        }
+    };
+    let primary = body(
+        &problem.primary,
+        &solver.body1,
+        solution.u1,
+        &solution.contact_force1,
+        &solver.stats1,
+    );
+    let secondary = body(
+        &problem.secondary,
+        &solver.body2,
+        solution.u2,
+        &solution.contact_force2,
+        &solver.stats2,
+    );
+    Ok(ContactSolution {
+        status,
+        history,
+        primary,
+        secondary,
+        primary_fields,
+        secondary_fields,
+        force_primary,
+        force_secondary,
+        force_imbalance,
+        max_tangential_traction,
+        certificate,
+        hertz_primary,
+        load_factor,
+        active_set,
+    })
+}
+
+/// The interface fields of a surface from the nodal forces the interface puts on its body:
+/// with the lumped interface mass the traction of node `s` is its force over its area.
+fn surface_fields(
+    surface: &ContactSurface,
+    force: &[f64],
+    gaps: Vec<f64>,
+    active: impl Fn(usize) -> bool,
+) -> SurfaceFields {
+    let dim = surface.dim;
+    let traction: Vec<[f64; 3]> = (0..surface.len())
+        .map(|s| {
+            let node = surface.nodes[s];
+            std::array::from_fn(|c| {
+                if c < dim {
+                    force[dim * node + c] / surface.nodal_area[s]
+                } else {
+                    0.0
+                }
+            })
+        })
+        .collect();
+    SurfaceFields {
+        nodes: surface.nodes.clone(),
+        pressure: traction
+            .iter()
+            .zip(&surface.normals)
+            .map(|(t, n)| -dot(t, n))
+            .collect(),
+        mean_pressure: (0..surface.len())
+            .map(|s| surface.mean_pressure(force, s))
+            .collect(),
+        traction,
+        normal_gap: gaps,
+        active: (0..surface.len()).map(active).collect(),
+    }
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
