@@ -63,7 +63,7 @@ sys.path.insert(0, str(VALIDATION))
 
 from compare import ERRORS, Check, InternodesOutput, cell_order, failure, pad3, reaction_check, relative_max  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case  # noqa: E402
-from suite import SuiteResult  # noqa: E402
+from suite import SuiteResult, contact_sides, modern_contact  # noqa: E402
 
 BUILD = VALIDATION / "build" / "body_by_body"
 # Fields go through one linear solve on each side: round-off times cond(K_FF).
@@ -147,7 +147,7 @@ def write_cases(case: ContactCase, formulation: str, mesh: Path, folder: Path) -
     data.pop("geo_parameters", None)
     data["mesh"] = str(mesh)
     data["output"] = str(folder / "internodes")
-    data["contact"]["formulation"] = formulation
+    data["contact"] = modern_contact(data["contact"]) | {"formulation": formulation}
     folder.mkdir(parents=True, exist_ok=True)
     case_file, bodies_file = folder / "case.toml", folder / "bodies.toml"
     case_file.write_text(f"# {case.description()}, {formulation} (written by body_by_body.py)\n"
@@ -303,8 +303,11 @@ def check_case(binary: Path, case: ContactCase, mesh: Path, formulation: str) ->
     bodies = read_case(bodies_file).bodies
     model = TractionModel(mesh, {b.name: out.body(b.name).geometry for b in bodies})
     tractions = contact_tractions(output, out)
-    sides = {contact["primary"]: (contact["primary_surface"], summary["force_primary"]),
-             contact["secondary"]: (contact["secondary_surface"], summary["force_secondary"])}
+    surfaces = contact_sides(contact)
+    primary = summary.get("primary", contact.get("primary"))  # as solved (the case may say "auto")
+    secondary = next(b for b in surfaces if b != primary)
+    sides = {primary: (surfaces[primary], summary["force_primary"]),
+             secondary: (surfaces[secondary], summary["force_secondary"])}
     record["bodies"] = {}
     for body in bodies:
         group, force = sides[body.name]

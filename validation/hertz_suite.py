@@ -60,7 +60,7 @@ REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
 from compare import Check  # noqa: E402
-from suite import Figure, MeshFailed, SuiteResult, mesh_geo  # noqa: E402
+from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo  # noqa: E402
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
@@ -186,10 +186,9 @@ def case_file(case: HertzCase, msh: Path, formulation: str) -> str:
         bodies += (f'\n[[body]]\nname = "{body}"\nyoungs_modulus = {YOUNGS_MODULUS}\n'
                    f'poisson_ratio = {POISSON_RATIO}\n\n[[body.dirichlet]]\ngroup = "{support}"\n'
                    + "\n".join(values) + "\n")
-    return (f'mesh = "{msh}"\noutput = "internodes"\n\n[contact]\nprimary = "{case.primary}"\n'
-            f'primary_surface = "{case.primary_surface}"\nsecondary = "{case.secondary}"\n'
-            f'secondary_surface = "{case.secondary_surface}"\n'
-            f'formulation = "{formulation}"\n{steps}' + bodies)
+    contact = contact_table((case.primary, case.secondary), (case.primary_surface, case.secondary_surface),
+                            case.primary, formulation)
+    return f'mesh = "{msh}"\noutput = "internodes"\n\n{contact}{steps}' + bodies
 
 
 def solve(binary: Path, case: HertzCase, level: int, formulation: str) -> tuple[Path, Path, float]:

@@ -43,7 +43,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, SuiteResult, mesh_geo  # noqa: E402
+from suite import Figure, SuiteResult, contact_table, mesh_geo  # noqa: E402
 
 BUILD = VALIDATION / "build" / "rigid_flat"
 STIFFNESS_RATIO = 1e4
@@ -78,16 +78,12 @@ def case_text(msh: Path, dim: int, primary: str, output: Path, fraction: float) 
     at `fraction` of the full approach (one load step from the reference configuration)."""
     b = BODIES[dim]
     secondary = "block" if primary == b["curved"] else b["curved"]
+    contact = contact_table((primary, secondary), (f"{primary}_contact", f"{secondary}_contact"), primary,
+                            load_steps=[fraction])
     return f"""mesh = {json.dumps(str(msh))}
 output = {json.dumps(str(output))}
 
-[contact]
-primary = "{primary}"
-primary_surface = "{primary}_contact"
-secondary = "{secondary}"
-secondary_surface = "{secondary}_contact"
-load_steps = [{fraction}]
-
+{contact}
 [[body]]
 name = "{b['curved']}"
 youngs_modulus = {YOUNGS_MODULUS}

@@ -15,8 +15,9 @@ to ``validation/build/results.json``.
 
 Then the contact suites (``suite.py``): the body-by-body FEniCSx check of
 contact solutions (``body_by_body.py``), the Hertz suite with its convergence
-study (``hertz_suite.py``) and the independent dolfinx rigid-flat reference
-(``rigid_flat.py``). Everything goes into ``validation/report/`` (``report.py``):
+study (``hertz_suite.py``), the independent dolfinx rigid-flat reference
+(``rigid_flat.py``) and the gated sweep of the contact solver over the issue's
+parameter ranges (``sweep.py``; ``--quick``: its quick subset). Everything goes into ``validation/report/`` (``report.py``):
 README.md with every table and figure, and results.json.
 
 Exit status 1 if a gate check failed or anything is missing (report.py says
@@ -56,7 +57,7 @@ BUILD = VALIDATION / "build"
 REPORT = VALIDATION / "report"
 QUICK_REPORT = BUILD / "report-quick"
 # Contact suites: module name, whether its checks gate the run.
-SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False}
+SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False, "sweep": True}
 DEFAULT_LEVELS = (0, 1)
 MESH_NAME = re.compile(r"(?P<script>.+)_l(?P<level>-?\d+)\.msh")
 

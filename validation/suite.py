@@ -68,3 +68,48 @@ def mesh_geo(script: str, dim: int, parameters: dict, path: Path) -> Path:
         raise MeshFailed(f"gmsh {geo.name} {parameters} failed: {(result.stdout + result.stderr)[-400:]}")
     stamp.write_text(json.dumps(key))
     return path
+
+
+# ---------------------------------------------------------------------------
+# The [contact] table of a case file
+# ---------------------------------------------------------------------------
+
+# Keys of the [contact] table before the solver rewrite (issue 11), replaced by bodies / surfaces / primary.
+OLD_CONTACT_KEYS = ("primary_surface", "secondary", "secondary_surface")
+
+
+def contact_table(bodies: tuple[str, str], surfaces: tuple[str, str], primary: str = "auto",
+                  formulation: str = "frictionless", **extra) -> str:
+    """The ``[contact]`` table of a case file, in the form of the rewritten solver (issue 11).
+
+    ``bodies`` are the two bodies in contact, ``surfaces`` their candidate surfaces in the same
+    order, ``primary`` "auto" or one of the two body names (an explicit choice). ``extra`` are
+    further keys written verbatim as TOML values (``load_steps = [...]``, ``max_iterations``...).
+    """
+    if primary != "auto" and primary not in bodies:
+        raise ValueError(f"primary '{primary}' is neither 'auto' nor one of the bodies {bodies}")
+    lines = ["[contact]", f"bodies = {json.dumps(list(bodies))}", f"surfaces = {json.dumps(list(surfaces))}",
+             f'primary = "{primary}"', f'formulation = "{formulation}"']
+    lines += [f"{key} = {json.dumps(value)}" for key, value in extra.items()]
+    return "\n".join(lines) + "\n"
+
+
+def modern_contact(table: dict) -> dict:
+    """A ``[contact]`` table (parsed TOML) in the rewritten form: the old ``primary`` /
+    ``primary_surface`` / ``secondary`` / ``secondary_surface`` keys become ``bodies``, ``surfaces``
+    and an explicit ``primary``; a table already in the new form is returned unchanged.
+
+    Lets the suites that take their case from ``geo/*.toml`` write the new form whichever form
+    those templates are in."""
+    if not any(key in table for key in OLD_CONTACT_KEYS):
+        return dict(table)
+    new = {k: v for k, v in table.items() if k not in OLD_CONTACT_KEYS + ("primary",)}
+    return {"bodies": [table["primary"], table["secondary"]],
+            "surfaces": [table["primary_surface"], table["secondary_surface"]],
+            "primary": table["primary"], **new}
+
+
+def contact_sides(table: dict) -> dict[str, str]:
+    """Body name -> candidate surface of a ``[contact]`` table (either form)."""
+    table = modern_contact(table)
+    return dict(zip(table["bodies"], table["surfaces"]))
