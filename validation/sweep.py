@@ -724,7 +724,9 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
     for case in cases:
         overlay = records[case.name].get("overlay")
         if overlay and Path(overlay).is_file():
-            figures.append(Figure(f"{case.name}: contact pressure of internodes and the dolfinx rigid flat", Path(overlay)))
+            figures.append(Figure(f"{case.name}: contact pressure of internodes and the dolfinx rigid flat on the "
+                                  f"curved body's nodes (the title's |da| counts the curved body's flagged nodes, "
+                                  f"also as secondary; the radius check uses the primary's active set)", Path(overlay)))
     seconds = time.perf_counter() - start
     text = report_text(cases, checks, records, quick, seconds)
     data = {"quick": quick, "seconds": seconds, "cases": _json_safe(records)}
@@ -750,7 +752,7 @@ DECISIONS = """\
 * *Hertz validity a/R <= 0.1*: the 3D R/100 case with 30 spacings across (a/R = 0.15) and the rim
   case (a/R = 0.21) are rigid-flat cases, judged against dolfinx on the same mesh, which has no such
   limit.
-* *Meshed overlapping*: the 2D overlap case is meshed 2.6 spacings deep with no imposed
+* *Meshed overlapping*: the 2D overlap case is meshed 2.7 spacings deep with no imposed
   displacement (the overlap alone); the 3D one half overlapping, half imposed. Rigid-flat cases are
   pressed only: the reference needs the body above the flat on the same mesh.
 * *Certificate*: read from summary.json; a missing certificate, a missing check (penetration,
