@@ -132,7 +132,7 @@ fn main() {
                 }
                 match &contact {
                     Some(problem) => {
-                        let (seconds, solver) =
+                        let (seconds, mut solver) =
                             timed(|| ContactSolver::new(problem, &case.solver).unwrap());
                         record("contact set-up".into(), threads, seconds);
                         let (seconds, solution) = timed(|| solver.solve(1.0, None).unwrap());

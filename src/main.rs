@@ -58,12 +58,26 @@ fn main() -> ExitCode {
             },
         )
         .map_err(Into::into)
-        .and_then(|report| match report.summary.contact.as_ref().map(|c| c.status) {
-            Some(ContactStatus::IterationLimit | ContactStatus::Cycling) => Err(format!(
-                "the contact solve did not converge (see {}/summary.json); the last iterate was written for inspection",
-                report.output_dir.display()
-            )
-            .into()),
+        .and_then(|report| match report.summary.contact.as_ref() {
+            Some(contact)
+                if !matches!(
+                    contact.status,
+                    ContactStatus::Converged | ContactStatus::NoContact
+                ) =>
+            {
+                let status = serde_json::to_value(contact.status).unwrap_or_default();
+                let failures = contact.certificate.failures();
+                Err(format!(
+                    "the contact solve did not converge: status {status}{} (see {}/summary.json); the last iterate was written for inspection",
+                    if failures.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", certificate failed: {failures}")
+                    },
+                    report.output_dir.display()
+                )
+                .into())
+            }
             _ => Ok(()),
         }),
         Command::Info { mesh } => read_msh(&mesh)

@@ -405,7 +405,10 @@ fn describe(solution: &ContactSolution, formulation: Formulation) -> String {
         }
         ContactStatus::Unstable => format!(
             "NOT converged: at iteration {iterations} an active node is {:.1e} spacings off the other body's surface: the interpolated constraint does not control the geometry, typically a primary much stiffer than the secondary with as fine a contact surface (inf-sup); use primary = \"auto\"",
-            solution.history.last().map_or(f64::NAN, |r| r.max_gap_error_over_h)
+            solution
+                .history
+                .last()
+                .map_or(f64::NAN, |r| r.max_gap_error_over_h)
         ),
         ContactStatus::Cycling => format!(
             "NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"

@@ -272,7 +272,10 @@ fn a_candidate_group_empty_on_its_body_is_named() {
         "surfaces = [\"upper_contact\"",
         "surfaces = [\"lower_contact\"",
     );
-    assert!(text.contains("[\"lower_contact\", \"lower_contact\"]"), "{text}");
+    assert!(
+        text.contains("[\"lower_contact\", \"lower_contact\"]"),
+        "{text}"
+    );
     let message = solve(&text).err().expect("the case is invalid");
     assert!(
         message.contains("'upper'")
@@ -282,27 +285,66 @@ fn a_candidate_group_empty_on_its_body_is_named() {
     );
 }
 
-#[test]
-fn a_much_stiffer_primary_body_is_warned_about() {
-    let text = two_blocks(
-        2,
-        "frictionless",
-        &rollers("lower", 2),
-        &rollers("upper", 2),
-    )
-    .replace(
-        "name = \"upper\"\nyoungs_modulus = 1000.0",
-        "name = \"upper\"\nyoungs_modulus = 1.0e5",
-    )
-    .replace("formulation = \"frictionless\"", "max_iterations = 1");
-    assert!(text.contains("1.0e5"), "{text}");
-    let (_dir, path) = write_case(&text);
+/// The block 1e4 times stiffer than the disc, on `mesh` (R = 1, pressed by 0.02), with the
+/// primary body `primary` ("auto", "disc" or "block").
+fn stiff_block(mesh: &str, primary: &str) -> String {
+    common::half_disc_on_block(mesh, "")
+        .replace("primary = \"disc\"", &format!("primary = \"{primary}\""))
+        .replace(
+            "name = \"block\"\nyoungs_modulus = 1000.0",
+            "name = \"block\"\nyoungs_modulus = 1.0e7",
+        )
+}
+
+/// Solves `text` on the command line: exit status and summary.json.
+fn solve_cli(text: &str) -> (Option<i32>, serde_json::Value) {
+    let (dir, path) = write_case(text);
     let output = run_solve(&path);
-    let stderr = String::from_utf8_lossy(&output.stderr);
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
+    (
+        output.status.code(),
+        serde_json::from_str(&summary).unwrap(),
+    )
+}
+
+#[test]
+fn auto_primary_is_the_more_compliant_body() {
+    let text = stiff_block("half_disc_on_block.msh", "auto");
     assert!(
-        stderr.contains("warning: the primary body 'upper' is 1.000e2 times stiffer than 'lower'"),
-        "{stderr}"
+        text.contains("1.0e7") && text.contains("\"auto\""),
+        "{text}"
     );
+    let (code, summary) = solve_cli(&text);
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(0), "{contact}");
+    assert_eq!(contact["primary"], "disc", "{contact}");
+    assert_eq!(contact["primary_choice"]["mode"], "auto");
+    let reason = contact["primary_choice"]["reason"].as_str().unwrap();
+    assert!(reason.contains("more compliant"), "{reason}");
+    assert_eq!(contact["status"], "converged");
+}
+
+#[test]
+fn a_stiff_primary_as_fine_as_the_other_is_right_or_says_why() {
+    // The block made primary by hand, its contact surface as fine as the disc's (R/80): the
+    // answer must be the dolfinx rigid-flat force (same disc mesh as the coarse-block fixture)
+    // or a status that is not "converged", with an exit status of 1.
+    let (code, summary) = solve_cli(&stiff_block("half_disc_on_block_hertz.msh", "block"));
+    let contact = &summary["contact"];
+    assert_eq!(contact["primary"], "block");
+    assert_eq!(contact["primary_choice"]["mode"], "explicit");
+    if contact["status"] == "converged" {
+        assert_eq!(code, Some(0));
+        let force = contact["force_secondary"][1].as_f64().unwrap();
+        let error = (force - RIGID_FLAT_REFERENCE_FORCE_2D) / RIGID_FLAT_REFERENCE_FORCE_2D;
+        assert!(
+            error.abs() <= 0.01,
+            "force on the disc {force}: {error:+.4}"
+        );
+        eprintln!("stiff block primary as fine as the disc (R/80): force {error:+.4}");
+    } else {
+        assert_eq!(code, Some(1), "{contact}");
+    }
 }
 
 /// The half-disc of `tests/fixtures/half_disc_on_block_coarse_block.msh` pressed by 0.02 onto
@@ -356,7 +398,10 @@ fn a_contact_body_needs_a_body_table() {
         &rollers("lower", 2),
         &rollers("upper", 2),
     )
-    .replace("bodies = [\"upper\", \"lower\"]", "bodies = [\"upper\", \"base\"]");
+    .replace(
+        "bodies = [\"upper\", \"lower\"]",
+        "bodies = [\"upper\", \"base\"]",
+    );
     assert!(text.contains("\"base\""), "{text}");
     let message = solve(&text).err().expect("the case is invalid");
     assert!(
@@ -708,7 +753,12 @@ fn assert_contact_conditions(solution: &ContactSolution, max_imbalance: f64, lab
 /// within 5% of Hertz with the combined modulus `e_star` for the measured force. Returns the
 /// relative errors of a and p0.
 fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &str) -> (f64, f64) {
-    assert_eq!(solution.status, ContactStatus::Converged, "{label}");
+    assert_eq!(
+        solution.status,
+        ContactStatus::Converged,
+        "{label}: {}",
+        solution.certificate.failures()
+    );
     // INTERNODES transfers forces through R21, which is not the transpose of R12: the balance
     // is only approximate (measured: see the README's contact table).
     assert_contact_conditions(solution, 0.03, label);
@@ -847,28 +897,39 @@ fn hertz_with_dissimilar_materials_uses_the_combined_modulus() {
 }
 
 #[test]
-fn a_cycling_active_set_ends_with_the_cycling_status() {
-    // On the coarse hemisphere mesh (h about R/7 at the pole) a press of 0.008 gives a contact
-    // radius of about one spacing: the interface shrinks under tension until it is empty, and
-    // then the whole zone penetrates again (measured: the set of iteration 1 comes back at
-    // iteration 5). The loop must stop there with its status.
+fn a_contact_zone_of_one_node_is_not_certified_and_says_why() {
+    // On the coarse hemisphere mesh (h about R/7 at the pole) a press of 0.008 touches at the
+    // pole node alone: the active set settles, but the transfer of a one-node multiplier to
+    // the block does not balance the forces to 1% (measured 3.4%). That answer must not be
+    // called converged, and the check that failed must be named.
     let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, "");
     let solution = solve(&text).unwrap();
-    assert_eq!(solution.status, ContactStatus::Cycling);
-    assert!(
-        solution.history.len() >= 2 && solution.history.len() < 50,
-        "{} iterations",
-        solution.history.len()
-    );
+    assert_eq!(solution.status, ContactStatus::NotCertified);
+    assert!(!solution.certificate.passed);
+    let failed: Vec<&str> = solution
+        .certificate
+        .checks
+        .iter()
+        .filter(|c| !c.passed)
+        .map(|c| c.name)
+        .collect();
+    assert!(!failed.is_empty());
 
-    // The command line writes the last iterate and exits with a failure status.
+    // The command line writes the last iterate, names the failed check, exits with status 1.
     let (dir, path) = write_case(&text);
     let output = run_solve(&path);
     assert_eq!(output.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("did not converge"), "{stderr}");
+    assert!(
+        stderr.contains("certificate failed") && stderr.contains(failed[0]),
+        "{stderr}"
+    );
     let summary = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
-    assert!(summary.contains("\"status\": \"cycling\""), "{summary}");
+    assert!(
+        summary.contains("\"status\": \"not-certified\""),
+        "{summary}"
+    );
 }
 
 #[test]
@@ -888,6 +949,15 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     let half = solver.solve(0.5, None).unwrap();
     let full = solver.solve(1.0, Some(&half.active_set)).unwrap();
     let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // Both paths end when every active node lies within 0.01 tol_p h of the other surface
+    // (the loop's stopping rule, tol_p = 1e-3): their displacements agree to that order.
+    let h_min = problem
+        .primary_surface
+        .spacing
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let settled = 1e-2 * 1e-3 * h_min;
     for (factor, stepped) in [(0.5, &half), (1.0, &full)] {
         let alone = solver.solve(factor, None).unwrap();
         assert_eq!(stepped.status, ContactStatus::Converged);
@@ -903,8 +973,8 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
             .map(|(a, b)| a - b)
             .collect();
         assert!(
-            max(&diff) <= 1e-8 * max(&alone.primary.displacement),
-            "factor {factor}: differs by {:.2e}",
+            max(&diff) <= settled,
+            "factor {factor}: differs by {:.2e} (bound {settled:.2e})",
             max(&diff)
         );
     }

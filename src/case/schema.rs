@@ -67,9 +67,9 @@ impl<'de> Deserialize<'de> for ContactSpec {
             table
                 .remove(key)
                 .map(|value| {
-                    value
-                        .try_into()
-                        .map_err(|e| E::custom(format!("[contact] {key}: expected {expected} ({e})")))
+                    value.try_into().map_err(|e| {
+                        E::custom(format!("[contact] {key}: expected {expected} ({e})"))
+                    })
                 })
                 .transpose()
         }

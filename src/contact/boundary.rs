@@ -58,7 +58,9 @@ impl BodyBoundary {
         for (mut facet, opposite) in boundary {
             let x: Vec<[f64; 3]> = facet.iter().map(|&n| body.coords[n]).collect();
             let (_, normal) = facet_measure_and_normal(&x, dim);
-            let inward: f64 = (0..3).map(|k| normal[k] * (body.coords[opposite][k] - x[0][k])).sum();
+            let inward: f64 = (0..3)
+                .map(|k| normal[k] * (body.coords[opposite][k] - x[0][k]))
+                .sum();
             if inward > 0.0 {
                 facet.swap(0, 1);
             }
@@ -88,7 +90,9 @@ impl BodyBoundary {
                 .nodes
                 .iter()
                 .zip(&self.coords)
-                .map(|(&n, x)| std::array::from_fn(|k| x[k] + if k < dim { u[dim * n + k] } else { 0.0 }))
+                .map(|(&n, x)| {
+                    std::array::from_fn(|k| x[k] + if k < dim { u[dim * n + k] } else { 0.0 })
+                })
                 .collect(),
             None => self.coords.clone(),
         };

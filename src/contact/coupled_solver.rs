@@ -18,9 +18,9 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::{ContactError, ContactSurface};
 use super::compliance::SurfaceCompliance;
 use super::system::CoupledSystem;
+use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
 use crate::linalg::{Cholesky, CholeskySymbolic, Ordering};
 

@@ -77,9 +77,8 @@ impl InterfaceOperators {
         // Only the secondary nodes that face the primary surface receive its traction.
         let receiving: Vec<usize> = (0..secondary.len()).filter(|&j| facing2[j]).collect();
         let r21_targets: Vec<[f64; 3]> = receiving.iter().map(|&j| on_primary[j].point).collect();
-        let r21 = covering_interpolation(primary, radius, &r21_targets, secondary, |t| {
-            receiving[t]
-        })?;
+        let r21 =
+            covering_interpolation(primary, radius, &r21_targets, secondary, |t| receiving[t])?;
         let n2_flat: Vec<f64> = secondary.normals.iter().flatten().copied().collect();
         let n2_at_1 = r12.apply(&n2_flat, 3);
         let normals: Vec<[f64; 3]> = (0..primary.len())

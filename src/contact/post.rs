@@ -39,14 +39,22 @@ pub(super) fn finish(
         |_| false,
     );
     // The secondary surface has no active set of its own: a node is in contact where it
-    // receives a compressive force.
-    secondary_fields.active = secondary_fields
-        .mean_pressure
-        .iter()
-        .map(|&p| p > 0.0)
+    // receives a compressive force and touches the primary body to the certified accuracy.
+    let touching = problem.settings.secondary_penetration_tolerance;
+    secondary_fields.active = (0..s2.len())
+        .map(|j| {
+            secondary_fields.mean_pressure[j] > 0.0
+                && secondary_fields.normal_gap[j].abs() <= touching * s2.spacing[j]
+        })
         .collect();
     let total = |force: &[f64]| -> [f64; 3] {
-        std::array::from_fn(|c| if c < dim { force.iter().skip(c).step_by(dim).sum() } else { 0.0 })
+        std::array::from_fn(|c| {
+            if c < dim {
+                force.iter().skip(c).step_by(dim).sum()
+            } else {
+                0.0
+            }
+        })
     };
     let force_primary = total(&solution.contact_force1);
     let force_secondary = total(&solution.contact_force2);
@@ -69,7 +77,11 @@ pub(super) fn finish(
         })
         .fold(0.0, f64::max);
     let residual = solution.relative_residual;
-    let body = |p: &ElasticProblem, body: &AssembledBody, u: Vec<f64>, force: &[f64], stats: &SolveStats| {
+    let body = |p: &ElasticProblem,
+                body: &AssembledBody,
+                u: Vec<f64>,
+                force: &[f64],
+                stats: &SolveStats| {
         ElasticSolution {
             reactions: reactions(p, body, &u, load_factor, force),
             cell_fields: cell_fields(p.body, &p.material, &u),

@@ -54,13 +54,13 @@ pub struct ContactSettings {
     /// spacings across the contact zone, falling with h), far below the spacing-sized
     /// penetration of a wrong active set.
     pub secondary_penetration_tolerance: f64,
-    /// The certificate's bound on the tensile normal force a SECONDARY node receives over its
-    /// area, relative to the largest pressure (default 0.1). The secondary pressure is the RBF
-    /// transfer `R21 lambda` of the multiplier, which is not positivity preserving: it
-    /// undershoots just outside the rim of the contact zone (measured up to 0.067 on the 3D
-    /// hemisphere meshes), where a wrong active set leaves tensions of the order of the peak
-    /// pressure.
-    pub secondary_tension_tolerance: f64,
+    /// The certificate's bound on the tensile normal force any surface node receives over its
+    /// area (along the node's own outward normal), relative to the largest pressure (default
+    /// 0.1). The secondary pressure is the RBF transfer `R21 lambda` of the multiplier, which
+    /// is not positivity preserving: it undershoots just outside the rim of the contact zone
+    /// (measured up to 0.067 on the 3D hemisphere meshes); a wrong active set leaves tensions
+    /// of the order of the peak pressure.
+    pub certificate_tension_tolerance: f64,
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
@@ -79,7 +79,7 @@ impl Default for ContactSettings {
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
             secondary_penetration_tolerance: 0.05,
-            secondary_tension_tolerance: 0.1,
+            certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
             rbf_radius: 2.0,
         }
@@ -89,11 +89,13 @@ impl Default for ContactSettings {
 impl ContactSettings {
     /// Checks every setting's range.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let error = |name, expected, value| Err(SettingsError {
-            name,
-            expected,
-            value,
-        });
+        let error = |name, expected, value| {
+            Err(SettingsError {
+                name,
+                expected,
+                value,
+            })
+        };
         if self.max_iterations == 0 {
             return error("max_iterations", "at least 1", 0.0);
         }
@@ -108,8 +110,14 @@ impl ContactSettings {
         for (name, value) in [
             ("penetration_tolerance", self.penetration_tolerance),
             ("tension_tolerance", self.tension_tolerance),
-            ("secondary_penetration_tolerance", self.secondary_penetration_tolerance),
-            ("secondary_tension_tolerance", self.secondary_tension_tolerance),
+            (
+                "secondary_penetration_tolerance",
+                self.secondary_penetration_tolerance,
+            ),
+            (
+                "certificate_tension_tolerance",
+                self.certificate_tension_tolerance,
+            ),
             ("imbalance_tolerance", self.imbalance_tolerance),
         ] {
             if !(value >= 0.0 && value.is_finite()) {
@@ -183,7 +191,8 @@ impl<'m> ContactProblem<'m> {
             let m = &side.0.material;
             m.youngs_modulus() / (1.0 - m.poisson_ratio().powi(2))
         };
-        let finest = |side: &ContactSide| side.1.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+        let finest =
+            |side: &ContactSide| side.1.spacing.iter().copied().fold(f64::INFINITY, f64::min);
         let name = |side: &ContactSide| side.0.body.name.clone();
         let (first, report) = match choice {
             PrimaryChoice::Body(body) => {
@@ -197,24 +206,49 @@ impl<'m> ContactProblem<'m> {
                             name(&sides[1])
                         )
                     })?;
-                (first, PrimaryReport { mode: "explicit", reason: "named in the case file".into() })
+                (
+                    first,
+                    PrimaryReport {
+                        mode: "explicit",
+                        reason: "named in the case file".into(),
+                    },
+                )
             }
             PrimaryChoice::Auto => {
                 let ratio = modulus(&sides[1]) / modulus(&sides[0]);
-                let (first, reason) = if !(1.0 / SIMILAR_STIFFNESS..=SIMILAR_STIFFNESS).contains(&ratio) {
+                let (first, reason) = if !(1.0 / SIMILAR_STIFFNESS..=SIMILAR_STIFFNESS)
+                    .contains(&ratio)
+                {
                     let first = usize::from(ratio < 1.0);
-                    (first, format!(
-                        "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
-                        modulus(&sides[first]), modulus(&sides[1 - first]), name(&sides[1 - first])
-                    ))
+                    (
+                        first,
+                        format!(
+                            "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
+                            modulus(&sides[first]),
+                            modulus(&sides[1 - first]),
+                            name(&sides[1 - first])
+                        ),
+                    )
                 } else {
                     let first = usize::from(finest(&sides[1]) < finest(&sides[0]));
-                    (first, format!(
-                        "similar stiffness (ratio {:.2}); the finer contact surface: finest spacing {:.3e} against {:.3e} for '{}'",
-                        ratio.max(1.0 / ratio), finest(&sides[first]), finest(&sides[1 - first]), name(&sides[1 - first])
-                    ))
+                    (
+                        first,
+                        format!(
+                            "similar stiffness (ratio {:.2}); the finer contact surface: finest spacing {:.3e} against {:.3e} for '{}'",
+                            ratio.max(1.0 / ratio),
+                            finest(&sides[first]),
+                            finest(&sides[1 - first]),
+                            name(&sides[1 - first])
+                        ),
+                    )
                 };
-                (first, PrimaryReport { mode: "auto", reason })
+                (
+                    first,
+                    PrimaryReport {
+                        mode: "auto",
+                        reason,
+                    },
+                )
             }
         };
         let [a, b] = sides;

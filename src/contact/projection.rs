@@ -134,11 +134,7 @@ impl SurfaceIndex {
     /// the distance plus the facet size (the line misses the surface, e.g. beyond its edge).
     /// The flag says whether
     /// the line met the surface.
-    pub fn project_along(
-        &self,
-        x: &[f64; 3],
-        direction: &[f64; 3],
-    ) -> Option<(Projection, bool)> {
+    pub fn project_along(&self, x: &[f64; 3], direction: &[f64; 3]) -> Option<(Projection, bool)> {
         let closest = self.project(x)?;
         let scale = dot(&sub(&closest.point, x), &sub(&closest.point, x)).sqrt();
         let mut p = closest;
@@ -184,10 +180,7 @@ fn closest_point(corners: &[[f64; 3]], x: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
             } else {
                 0.0
             };
-            (
-                std::array::from_fn(|k| a[k] + t * ab[k]),
-                [1.0 - t, t, 0.0],
-            )
+            (std::array::from_fn(|k| a[k] + t * ab[k]), [1.0 - t, t, 0.0])
         }
         [a, b, c] => closest_point_on_triangle(a, b, c, x),
         _ => unreachable!("facets have 2 or 3 corners"),

@@ -518,11 +518,12 @@ impl Interpolation {
                     z[k * m + self.phi_cols[p]] = self.phi_vals[p];
                 }
             }
-            self.lu.solve_transpose_in_place(MatMut::from_column_major_slice_mut(
-                &mut z,
-                m,
-                block.len(),
-            ));
+            self.lu
+                .solve_transpose_in_place(MatMut::from_column_major_slice_mut(
+                    &mut z,
+                    m,
+                    block.len(),
+                ));
             for (k, &t) in block.iter().enumerate() {
                 let scale = self.inv_d[t];
                 rows.push(sparse(z[k * m..(k + 1) * m].iter().map(|v| scale * v)));

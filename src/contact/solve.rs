@@ -25,7 +25,12 @@
 //! next), the pressure `p_i = -lambda_i . n_i` tested is the unknown of the system (lumped
 //! interface mass, [`super::surface`]), and the gap is the geometric one.
 //!
-//! An update that would return to an active set seen before takes a single switch instead:
+//! An update that would return to an active set seen before first keeps active (pins, for the
+//! rest of the solve) the nodes it removes for tension that had been removed before and came
+//! back for penetration, and leaves their tension to the certificate: at the rim of a contact
+//! zone a node can be in tension while active and penetrate while inactive (seen with tied
+//! contact between dissimilar materials: 2% of the peak pressure, then 4e-3 h), and no active
+//! set satisfies both tests. If the set still repeats, it takes a single switch instead:
 //! only the node with the largest violation (penetration over `h`, tension over `p_max`)
 //! changes; if that set was seen too the loop stops as [`ContactStatus::Cycling`]. It never
 //! declares convergence. Running out of iterations is [`ContactStatus::IterationLimit`]; an
@@ -126,7 +131,10 @@ impl<'a> ContactSolver<'a> {
     /// The primary candidates that touch or penetrate in the reference configuration, with no
     /// gap correction.
     pub fn initial_active_set(&self) -> ActiveSet {
-        let (s1, s2) = (&self.problem.primary_surface, &self.problem.secondary_surface);
+        let (s1, s2) = (
+            &self.problem.primary_surface,
+            &self.problem.secondary_surface,
+        );
         let tol = self.problem.settings.penetration_tolerance;
         let gaps = geometric_gaps(s1, s2, None, None);
         ActiveSet {
@@ -150,6 +158,10 @@ impl<'a> ContactSolver<'a> {
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
         let (mut active, mut corrections) = (start.nodes, start.corrections);
         let mut seen: HashSet<BTreeSet<usize>> = HashSet::new();
+        // Nodes removed for tension, those of them added back for penetration, and those kept
+        // active against a repeat (module doc).
+        let (mut released, mut readded, mut pinned) =
+            (HashSet::new(), HashSet::new(), HashSet::new());
         let mut history = Vec::new();
         let mut status = ContactStatus::IterationLimit;
         let mut last = None;
@@ -159,13 +171,9 @@ impl<'a> ContactSolver<'a> {
             // 1. The coupling of the active set: rows and columns of the fixed operators.
             let clock = Instant::now();
             let nodes: Vec<usize> = active.iter().copied().collect();
-            let coupling = self.operators.coupling(
-                s1,
-                s2,
-                settings.formulation,
-                &nodes,
-                &corrections,
-            );
+            let coupling =
+                self.operators
+                    .coupling(s1, s2, settings.formulation, &nodes, &corrections);
             seconds.operators = clock.elapsed().as_secs_f64();
 
             // 2. The coupled solve, checked by its residual.
@@ -173,9 +181,10 @@ impl<'a> ContactSolver<'a> {
             let dim = s1.dim;
             let system =
                 CoupledSystem::assemble(&self.body1, &self.body2, &coupling, dim, load_factor)?;
-            let x = coupled_solver::solve(&system, &self.body1, &self.body2, self.factors.as_mut())?;
+            let x =
+                coupled_solver::solve(&system, &self.body1, &self.body2, self.factors.as_mut())?;
             let residual = system.relative_residual(&self.body1, &self.body2, &x);
-            if !(residual <= self.solver.residual_tolerance) {
+            if residual.is_nan() || residual > self.solver.residual_tolerance {
                 return Err(ContactError::Inaccurate {
                     residual,
                     tolerance: self.solver.residual_tolerance,
@@ -201,7 +210,16 @@ impl<'a> ContactSolver<'a> {
                 &coupling.normals,
                 &gaps,
                 &self.operators.facing,
+                &pinned,
             );
+            readded.extend(
+                update
+                    .penetrating
+                    .iter()
+                    .map(|&(i, _)| i)
+                    .filter(|i| released.contains(i)),
+            );
+            released.extend(update.tension.iter().map(|&(i, _)| i));
             corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
             seconds.checks = clock.elapsed().as_secs_f64();
             let record = update.record(iteration, residual, seconds);
@@ -223,17 +241,32 @@ impl<'a> ContactSolver<'a> {
                 continue; // same set, corrected gaps: solve again
             }
             seen.insert(active.clone());
-            active = if seen.contains(&update.next) {
+            let mut next = update.next.clone();
+            if seen.contains(&next) {
+                // A repeat. First keep active the nodes in tension that came back after an
+                // earlier removal (a rim node alternating between the two tests).
+                let alternating: Vec<usize> = update
+                    .tension
+                    .iter()
+                    .map(|&(i, _)| i)
+                    .filter(|i| readded.contains(i))
+                    .collect();
+                pinned.extend(alternating.iter().copied());
+                next.extend(alternating);
+                if next == active {
+                    continue;
+                }
+            }
+            if seen.contains(&next) {
                 match update.single_switch(&active) {
-                    Some(next) if !seen.contains(&next) => next,
+                    Some(switched) if !seen.contains(&switched) => next = switched,
                     _ => {
                         status = ContactStatus::Cycling;
                         break;
                     }
                 }
-            } else {
-                update.next
-            };
+            }
+            active = next;
         }
 
         let (coupling, solution) = last.expect("max_iterations >= 1 is validated");
@@ -247,14 +280,23 @@ impl<'a> ContactSolver<'a> {
             nodes: active,
             corrections,
         };
-        post::finish(self, load_factor, status, history, certificate, &coupling, solution, next_start)
+        post::finish(
+            self,
+            load_factor,
+            status,
+            history,
+            certificate,
+            &coupling,
+            solution,
+            next_start,
+        )
     }
 }
 
 /// The active-set update of one iteration (step 4 of the module doc), in surface indices.
 struct Update {
     next: BTreeSet<usize>,
-    /// Active nodes with `p_i < -tol_t p_max`, with their tension over `p_max`.
+    /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
     tension: Vec<(usize, f64)>,
     /// Inactive nodes facing the other surface with `g_i < -tol_p h_i`, with their penetration
     /// over `h_i` (a penetrating node that does not face the other candidate surface is left
@@ -274,6 +316,7 @@ impl Update {
         normals: &[[f64; 3]],
         gaps: &[f64],
         facing: &[bool],
+        pinned: &HashSet<usize>,
     ) -> Self {
         let settings = &problem.settings;
         let s1 = &problem.primary_surface;
@@ -286,7 +329,7 @@ impl Update {
         let tension: Vec<(usize, f64)> = active
             .iter()
             .zip(&pressure)
-            .filter(|&(_, &p)| p < -settings.tension_tolerance * p_max)
+            .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
             .map(|(&i, &p)| (i, -p / p_max.max(f64::MIN_POSITIVE)))
             .collect();
         let is_active: HashSet<usize> = active.iter().copied().collect();
