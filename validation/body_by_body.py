@@ -9,17 +9,16 @@ inactive nodes). The coupled system makes each body satisfy
 
     K_k u_k = f_k + M_k t_k     (free dofs; u_k = g_k on the Dirichlet dofs),
 
-with M_k the P1 surface mass matrix of G_k: the contact force on a node is
-int_{G_k} t_h . phi_a ds, t_h the P1 interpolant of the nodal tractions
-(which decays to zero across the facets between an active node and its
-inactive neighbours).
+with M_k the lumped P1 surface mass matrix of G_k: the contact force on a
+node is A_a t_a, A_a = int_{G_k} phi_a ds its area (the interface mass of
+internodes is lumped, so that the pressure its active-set test reads is the
+nodal multiplier).
 
 This suite takes those tractions and, for each body **alone**, solves in
 dolfinx (``dolfinx_reference.py``: same ``.msh`` file, same material, same
 Dirichlet data, nothing else from internodes) the linear elasticity problem
-with the surface load t_h: the nodal values are put into a P1 vector
-Function and ``inner(t_h, v) * ds(G_k)`` is added to the right-hand side
-(degree-2 quadrature: exact for P1 x P1). Then it compares node by node and
+with the nodal loads A_a t_a added to the right-hand side, A_a the row sums
+of the P1 surface mass matrix that dolfinx assembles for G_k. Then it compares node by node and
 cell by cell:
 
 * ``displacement``: max |u - u_ref| / max |u_ref| over the body's nodes;
@@ -52,7 +51,6 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
@@ -206,26 +204,23 @@ class TractionModel(ReferenceModel):
             raise ReferenceFailure(f"body '{body}': nonzero out-of-plane traction in a 2D run")
         self.tractions[body] = (group, nodal[:, : self.dim])
 
-    def traction_form(self, body: str) -> ufl.Form:
-        """int_G t_h . v ds, t_h the P1 interpolant of the nodal tractions (exact at degree 2)."""
+    def traction_load(self, body: str) -> np.ndarray:
+        """The lumped contact load A_a t_a (n * dim,), internodes numbering; A_a = sum_b M[a, b], M the
+        group's P1 surface mass assembled by dolfinx."""
         group, nodal = self.tractions[body]
-        t = fem.Function(self.V)
-        t.x.array[self.dof_map(body)] = nodal.ravel()
-        ds = self.ds(self.group_tag(group, self.dim - 1), metadata={"quadrature_degree": 2})
-        return ufl.inner(t, ufl.TestFunction(self.V)) * ds
+        areas = np.asarray(self.surface_mass(body, group).sum(axis=1)).ravel()
+        return (areas[:, None] * nodal).ravel()
 
-    def load_form(self, body: Body) -> ufl.Form:
-        """The case's loads of the body, plus its contact traction if one is set."""
-        form = super().load_form(body)
+    def load_vector(self, body: Body) -> np.ndarray:
+        """The case's loads of the body, plus its lumped contact load if a traction is set."""
+        f = super().load_vector(body)
         if body.name in self.tractions:
-            form += self.traction_form(body.name)
-        return form
+            f = f + self.traction_load(body.name)
+        return f
 
     def contact_force(self, body: str) -> np.ndarray:
-        """Total force of the traction, sum_a int_G t_h phi_a ds (dim,), from the assembled load vector."""
-        f = petsc.assemble_vector(fem.form(self.traction_form(body)))
-        f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        return f.array[self.dof_map(body)].reshape(-1, self.dim).sum(axis=0)
+        """Total force of the traction, sum_a A_a t_a (dim,)."""
+        return self.traction_load(body).reshape(-1, self.dim).sum(axis=0)
 
 
 def contact_tractions(folder: Path, out: InternodesOutput) -> dict[str, np.ndarray]:

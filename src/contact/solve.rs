@@ -115,7 +115,12 @@ impl<'a> ContactSolver<'a> {
             }
             CoupledSolver::MonolithicLu => None,
         };
-        let operators = InterfaceOperators::new(s1, s2, problem.settings.rbf_radius)?;
+        let operators = InterfaceOperators::new(
+            s1,
+            s2,
+            problem.settings.rbf_radius,
+            problem.normal_weights(),
+        )?;
         Ok(Self {
             problem,
             solver: *solver,
