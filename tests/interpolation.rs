@@ -1,13 +1,12 @@
 //! Rescaled localized RBF interpolation between non-matching interfaces (`contact::rbf`):
-//! exact reproduction of constants, convergence on smooth fields, and the interface-node search
-//! (seed Algorithms 1 and 2). Everything is deterministic.
+//! exact reproduction of constants, convergence on smooth fields, radii (seed Algorithm 1 against
+//! twice the spacing), and the sparse rows and columns the contact operators use. Everything is
+//! deterministic.
 
 use std::f64::consts::PI;
 
 use internodes::contact::ContactSurface;
-use internodes::contact::rbf::{
-    C_MAX, Interpolation, RbfError, Side, interface_nodes, interpolation_radii, support_radii,
-};
+use internodes::contact::rbf::{DROP_TOL, Interpolation, interpolation_radii, support_radii};
 use internodes::mesh::read_msh;
 
 mod common;
@@ -271,165 +270,49 @@ fn twice_the_spacing_interpolates_a_linear_field_better_than_algorithm_1_on_cont
     }
 }
 
-/// Points `x0, x0 + h, ...` (`n` of them) on the line `y = y0`, `z = 0`.
-fn row(x0: f64, h: f64, n: usize, y0: f64) -> Vec<[f64; 3]> {
-    (0..n).map(|k| [x0 + k as f64 * h, y0, 0.0]).collect()
-}
-
 #[test]
-fn interface_nodes_keep_only_overlap_2d() {
-    // Primary on x in [0, 2] (h = 0.1), secondary on x in [1.03, 3.03] (h = 0.08), 0.02 apart.
-    let primary = row(0.0, 0.1, 21, 0.0);
-    let secondary = row(1.03, 0.08, 26, 0.02);
-    let found = interface_nodes(&primary, &secondary).expect("interface");
-    let max_r = found
-        .primary_radii
-        .iter()
-        .chain(&found.secondary_radii)
-        .copied()
-        .fold(0.0, f64::max);
-    for (i, p) in primary.iter().enumerate() {
-        let kept = found.primary.contains(&i);
-        if p[0] >= 1.03 {
-            assert!(kept, "primary {i} at x = {} lies in the overlap", p[0]);
-        }
-        if p[0] < 1.03 - C_MAX * max_r {
-            assert!(!kept, "primary {i} at x = {} is outside the overlap", p[0]);
-        }
-    }
-    for (j, p) in secondary.iter().enumerate() {
-        let kept = found.secondary.contains(&j);
-        if p[0] <= 2.0 {
-            assert!(kept, "secondary {j} at x = {} lies in the overlap", p[0]);
-        }
-        if p[0] > 2.0 + C_MAX * max_r {
-            assert!(
-                !kept,
-                "secondary {j} at x = {} is outside the overlap",
-                p[0]
-            );
-        }
-    }
-    assert!(found.primary.len() < primary.len() && found.secondary.len() < secondary.len());
-    assert_eq!(found.primary.len(), found.primary_radii.len());
-    assert_eq!(found.secondary.len(), found.secondary_radii.len());
-    // Exact sets: radii 0.2 (primary) and 0.16 (secondary), so primary x > 1.03 - 0.152 and
-    // secondary x < 2 + 0.19 are kept.
-    assert_eq!(found.primary, (9..21).collect::<Vec<_>>());
-    assert_eq!(found.secondary, (0..15).collect::<Vec<_>>());
-    // Interpolation both ways between the kept nodes covers every target.
-    let sub = |pts: &[[f64; 3]], idx: &[usize]| idx.iter().map(|&i| pts[i]).collect::<Vec<_>>();
-    let (xp, xs) = (
-        sub(&primary, &found.primary),
-        sub(&secondary, &found.secondary),
+fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
+    // Sources on an arc, targets on a shifted arc: R is dense, its rows and columns computed by
+    // transposed and plain solves must match it to round-off, dropping only entries <= DROP_TOL.
+    let sources = arc(1.0, &(0..40).map(|k| 0.02 * k as f64).collect::<Vec<_>>());
+    let targets = arc(
+        1.0,
+        &(0..30)
+            .map(|k| 0.011 + 0.025 * k as f64)
+            .collect::<Vec<_>>(),
     );
-    let to_s = Interpolation::new(&xp, &found.primary_radii, &xs).expect("primary -> secondary");
-    let to_p = Interpolation::new(&xs, &found.secondary_radii, &xp).expect("secondary -> primary");
-    assert!(to_s.uncovered_targets().is_empty() && to_p.uncovered_targets().is_empty());
-}
-
-#[test]
-fn interface_nodes_keep_only_overlap_3d() {
-    // Two flat patches 0.01 apart, the secondary shifted by half its width in x.
-    let primary = patch(10, 0.0, 0.0, |u, v| [u, v, 0.0]);
-    let secondary = patch(12, 0.0, 0.0, |u, v| [u + 0.5, v, 0.01]);
-    let found = interface_nodes(&primary, &secondary).expect("interface");
-    for (i, p) in primary.iter().enumerate() {
-        let kept = found.primary.contains(&i);
-        // Supports: C r = 0.95 * 0.1 / 0.75 (primary), 0.95 * (1 / 12) / 0.75 (secondary).
-        if p[0] >= 0.5 {
-            assert!(kept, "primary {i} at {p:?} lies in the overlap");
+    let radii = interpolation_radii(&sources, 2.0).unwrap();
+    let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+    let dense = r.matrix();
+    let dense_of = |entries: &[(usize, f64)], len: usize| {
+        let mut v = vec![0.0; len];
+        for &(k, w) in entries {
+            v[k] = w;
         }
-        if p[0] <= 0.5 - 0.11 {
-            assert!(
-                !kept,
-                "primary {i} at {p:?} is outside every secondary support"
-            );
-        }
-    }
-    for (j, p) in secondary.iter().enumerate() {
-        let kept = found.secondary.contains(&j);
-        if p[0] <= 1.0 {
-            assert!(kept, "secondary {j} at {p:?} lies in the overlap");
-        }
-        if p[0] >= 1.0 + 0.13 {
-            assert!(
-                !kept,
-                "secondary {j} at {p:?} is outside every primary support"
-            );
-        }
-    }
-}
-
-#[test]
-fn far_apart_surfaces_have_no_interface() {
-    let primary = row(0.0, 0.1, 21, 0.0);
-    let secondary = row(0.0, 0.08, 26, 10.0);
-    assert!(matches!(
-        interface_nodes(&primary, &secondary),
-        Err(RbfError::EmptyInterface { .. })
-    ));
-    let primary = patch(6, 0.0, 0.0, plane);
-    let secondary = patch(7, 0.0, 0.0, |u, v| [u + 5.0, v, 0.3]);
-    assert!(matches!(
-        interface_nodes(&primary, &secondary),
-        Err(RbfError::EmptyInterface { .. })
-    ));
-    // Empty input is an empty interface too.
-    assert!(matches!(
-        interface_nodes(&[], &secondary),
-        Err(RbfError::EmptyInterface {
-            side: Side::Primary
-        })
-    ));
-}
-
-#[test]
-fn interface_search_stops_only_when_both_sides_are_unchanged() {
-    // Primary: a row of 11 nodes (h = 0.1) plus an isolated node P at (2, 0.3) whose support is
-    // large (its nearest neighbour is ~1 away). Secondary: a matching row (shifted by h/2) plus a
-    // close pair Q at (2, -0.9), (2.05, -0.9), with small supports.
-    //
-    // Pass 1: P is dropped (no secondary support reaches it) but Q is kept, being within
-    // C r_P of P: only the primary side changes. Pass 2: without P nothing covers Q, so the
-    // secondary side changes. Pass 3: nothing changes. Stopping on the first unchanged side
-    // (OR) would return after pass 1 with Q still in the interface.
-    let mut primary = row(0.0, 0.1, 11, 0.0);
-    primary.push([2.0, 0.3, 0.0]);
-    let mut secondary = row(0.05, 0.1, 10, 0.0);
-    secondary.extend([[2.0, -0.9, 0.0], [2.05, -0.9, 0.0]]);
-
-    // Check the premise of pass 1 with the radii of Algorithm 1 on the full sets.
-    let rp = support_radii(&primary).expect("primary radii");
-    let rs = support_radii(&secondary).expect("secondary radii");
-    let dist = |a: &[f64; 3], b: &[f64; 3]| {
-        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        v
     };
-    let p = &primary[11];
-    assert!(
-        secondary
-            .iter()
-            .zip(&rs)
-            .all(|(s, r)| dist(p, s) >= C_MAX * r),
-        "P is isolated in pass 1"
-    );
-    for q in &secondary[10..] {
-        assert!(dist(p, q) < C_MAX * rp[11], "Q is covered by P in pass 1");
+    let all_targets: Vec<usize> = (0..targets.len()).collect();
+    for (t, row) in r.rows(&all_targets).iter().enumerate() {
+        let row = dense_of(row, sources.len());
+        for (j, value) in row.iter().enumerate() {
+            assert!(
+                (value - dense[(t, j)]).abs() <= 1e-12 + DROP_TOL,
+                "R[{t}, {j}]"
+            );
+        }
+        assert!(
+            (row.iter().sum::<f64>() - 1.0).abs() < 1e-10,
+            "row {t} sums to one"
+        );
     }
-
-    let found = interface_nodes(&primary, &secondary).expect("interface");
-    assert_eq!(found.primary, (0..11).collect::<Vec<_>>());
-    assert_eq!(found.secondary, (0..10).collect::<Vec<_>>());
-
-    // The result is a fixed point: searching again on the kept nodes keeps all of them.
-    let sub = |pts: &[[f64; 3]], idx: &[usize]| idx.iter().map(|&i| pts[i]).collect::<Vec<_>>();
-    let again = interface_nodes(
-        &sub(&primary, &found.primary),
-        &sub(&secondary, &found.secondary),
-    )
-    .expect("fixed point");
-    assert_eq!(again.primary.len(), found.primary.len());
-    assert_eq!(again.secondary.len(), found.secondary.len());
-    assert_eq!(again.primary_radii, found.primary_radii);
-    assert_eq!(again.secondary_radii, found.secondary_radii);
+    let all_sources: Vec<usize> = (0..sources.len()).collect();
+    for (j, column) in r.columns(&all_sources).iter().enumerate() {
+        let column = dense_of(column, targets.len());
+        for (t, value) in column.iter().enumerate() {
+            assert!(
+                (value - dense[(t, j)]).abs() <= 1e-12 + DROP_TOL,
+                "R[{t}, {j}]"
+            );
+        }
+    }
 }

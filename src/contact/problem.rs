@@ -131,9 +131,10 @@ impl ContactSettings {
 /// Which body carries the multiplier: `"auto"` (default) or a body's name.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum PrimaryChoice {
-    /// The body with the clearly coarser contact surface (finest spacing at least
+    /// The body with the clearly coarser contact surface (spacing near the other body at least
     /// [`COARSER`] times the other's); between surfaces of similar spacing, the more compliant
-    /// body (lower contact modulus `E / (1 - nu^2)`). See [`ContactProblem::new`] for why.
+    /// body (contact modulus `E / (1 - nu^2)` at least [`SIMILAR_STIFFNESS`] times lower); between
+    /// bodies similar in both, the coarser surface. See [`ContactProblem::new`] for why.
     #[default]
     Auto,
     Body(String),
@@ -158,9 +159,26 @@ pub struct PrimaryReport {
     pub reason: String,
 }
 
-/// A contact surface whose finest spacing is at least this many times the other's is "clearly
-/// coarser" for [`PrimaryChoice::Auto`].
+/// A contact surface whose spacing near the other body ([`contact_zone_spacing`]) is at least
+/// this many times the other's is "clearly coarser" for [`PrimaryChoice::Auto`].
 pub const COARSER: f64 = 1.5;
+
+/// Contact moduli within this ratio are "similar stiffness" for [`PrimaryChoice::Auto`].
+pub const SIMILAR_STIFFNESS: f64 = 2.0;
+
+/// The median spacing of the surface's nodes nearest to the other surface in the reference
+/// configuration (a tenth of them, at least ten): the spacing where contact starts. Surfaces
+/// are graded towards the contact, so the finest spacing of a surface is one close pair of
+/// nodes somewhere there, too noisy to compare two surfaces meshed alike.
+pub fn contact_zone_spacing(surface: &ContactSurface, other: &ContactSurface) -> f64 {
+    let gaps = super::interface::geometric_gaps(surface, other, None, None);
+    let mut order: Vec<usize> = (0..surface.len()).collect();
+    order.sort_by(|&a, &b| gaps[a].abs().total_cmp(&gaps[b].abs()));
+    let count = (surface.len() / 10).max(10).min(surface.len());
+    let mut near: Vec<f64> = order[..count].iter().map(|&s| surface.spacing[s]).collect();
+    near.sort_by(f64::total_cmp);
+    near[count / 2]
+}
 
 /// One body of a contact pair: its elastic problem and candidate surface.
 pub type ContactSide<'m> = (ElasticProblem<'m>, ContactSurface);
@@ -213,8 +231,17 @@ impl<'m> ContactProblem<'m> {
             let m = &side.0.material;
             m.youngs_modulus() / (1.0 - m.poisson_ratio().powi(2))
         };
-        let finest =
-            |side: &ContactSide| side.1.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+        let spacing_near = [
+            contact_zone_spacing(&sides[0].1, &sides[1].1),
+            contact_zone_spacing(&sides[1].1, &sides[0].1),
+        ];
+        let finest = |side: &ContactSide| {
+            if std::ptr::eq(side, &sides[0]) {
+                spacing_near[0]
+            } else {
+                spacing_near[1]
+            }
+        };
         let name = |side: &ContactSide| side.0.body.name.clone();
         let (first, report) = match choice {
             PrimaryChoice::Body(body) => {
@@ -244,13 +271,13 @@ impl<'m> ContactProblem<'m> {
                     (
                         first,
                         format!(
-                            "the coarser contact surface: finest spacing {:.3e} against {:.3e} for '{}'",
+                            "the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
                             finest(&sides[first]),
                             finest(&sides[1 - first]),
                             name(&sides[1 - first])
                         ),
                     )
-                } else {
+                } else if !(1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS).contains(&stiffness) {
                     let first = usize::from(stiffness < 1.0);
                     (
                         first,
@@ -259,6 +286,18 @@ impl<'m> ContactProblem<'m> {
                             spacing.max(1.0 / spacing),
                             modulus(&sides[first]),
                             modulus(&sides[1 - first]),
+                            name(&sides[1 - first])
+                        ),
+                    )
+                } else {
+                    let first = usize::from(spacing > 1.0);
+                    (
+                        first,
+                        format!(
+                            "similar stiffness (ratio {:.2}) and spacing; the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
+                            stiffness.max(1.0 / stiffness),
+                            finest(&sides[first]),
+                            finest(&sides[1 - first]),
                             name(&sides[1 - first])
                         ),
                     )

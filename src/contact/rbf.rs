@@ -13,11 +13,12 @@
 //! * Because column `j` uses its own radius `r_j`, `Phi_MM` is not symmetric; it is factored with a
 //!   sparse LU. Both RBF matrices are sparse (compact support) and are assembled with a k-d tree
 //!   radius search, never by visiting all pairs.
-//! * Radii come from seed Algorithm 1 ([`support_radii`]); the interface nodes of two facing
-//!   surfaces, which satisfy Condition 3 of the seed, come from seed Algorithm 2
-//!   ([`interface_nodes`]). The transfer operators of a contact solve use radii of the same
-//!   form with `c` held at Algorithm 1's starting value ([`interpolation_radii`]), for the
-//!   accuracy reason given there.
+//! * Radii: seed Algorithm 1 ([`support_radii`]) is the reference; the transfer operators of a
+//!   contact solve use radii of the same form with `c` held at Algorithm 1's starting value
+//!   ([`interpolation_radii`]), for the accuracy reason given there. Seed Algorithm 2 (keeping
+//!   only the nodes within reach of the other side) is not needed: the operators interpolate
+//!   at each node's projection onto the source surface, which every support covers
+//!   ([`super::interface`]).
 //!
 //! Points are `[f64; 3]`; 2D problems pass `z = 0` (points on a curve), 3D problems points on a
 //! surface. Nothing here depends on the dimension.
@@ -36,8 +37,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 /// Starting value of the constant `c` of seed Algorithm 1 (`r_i = d_i / c`).
 pub const C_START: f64 = 0.5;
 
-/// Upper bound `C` of seed Conditions 1-3: Algorithm 1 fails when `c` would exceed it, and
-/// Algorithm 2 keeps a node only if it lies within `C r_j` of a node `j` of the other side.
+/// Upper bound `C` of seed Condition 1: Algorithm 1 fails when `c` would exceed it.
 pub const C_MAX: f64 = 0.95;
 
 /// Relative threshold for the rescaling factors `D_ii` (eq. 2.7).
@@ -81,12 +81,6 @@ pub enum RbfError {
         /// The last `c` tried.
         c: f64,
     },
-    /// Algorithm 2 removed every node of one side: the surfaces do not face each other.
-    #[error("the {side} interface is empty: the surfaces do not face each other")]
-    EmptyInterface {
-        /// The side that became empty.
-        side: Side,
-    },
     /// An interpolation was requested without source nodes.
     #[error("no source nodes to interpolate from")]
     NoSources,
@@ -120,24 +114,6 @@ pub enum RbfError {
     Assembly(String),
 }
 
-/// One of the two contact interfaces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Side {
-    /// The primary interface (nodes `xi` in the seed).
-    Primary,
-    /// The secondary interface (nodes `zeta` in the seed).
-    Secondary,
-}
-
-impl std::fmt::Display for Side {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Side::Primary => "primary",
-            Side::Secondary => "secondary",
-        })
-    }
-}
-
 /// Wendland C2 radial basis function (seed eq. 2.2): `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`
 /// for `delta >= 0`. It is `1` at `0`, vanishes with its first and second derivatives at `1` and is
 /// zero beyond.
@@ -161,7 +137,7 @@ pub fn wendland_c2(delta: f64) -> f64 {
 /// `j` has fewer than `1 / phi(c)` off-diagonal entries, each at most `phi(c)`), hence invertible.
 ///
 /// An empty set gives no radii. A single node has no neighbour and gives
-/// [`RbfError::SingleNode`] ([`interface_nodes`] has its own rule for that case). Coincident nodes
+/// [`RbfError::SingleNode`]. Coincident nodes
 /// give [`RbfError::CoincidentNodes`]; if `c` would exceed `C_MAX` the result is
 /// [`RbfError::NoRadius`].
 pub fn support_radii(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
@@ -245,83 +221,6 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
         .into_iter()
         .map(|d| d * radius)
         .collect())
-}
-
-/// The interface nodes found by seed Algorithm 2, with their support radii.
-///
-/// Indices refer to the slices given to [`interface_nodes`], in increasing order; the radii are
-/// those of Algorithm 1 on the returned sets (`primary_radii[k]` belongs to `primary[k]`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct InterfaceNodes {
-    /// Kept primary nodes.
-    pub primary: Vec<usize>,
-    /// Support radii of the kept primary nodes.
-    pub primary_radii: Vec<f64>,
-    /// Kept secondary nodes.
-    pub secondary: Vec<usize>,
-    /// Support radii of the kept secondary nodes.
-    pub secondary_radii: Vec<f64>,
-}
-
-/// Interface nodes of two facing surfaces by seed Algorithm 2.
-///
-/// Starting from all nodes, `I` (primary) and `J` (secondary), each pass
-/// 1. computes the radii `r^xi` of `I` and `r^zeta` of `J` by Algorithm 1 on the current sets;
-/// 2. keeps `i in I` only if some `j in J` has `D^{xi,zeta}(i, j) = |xi_i - zeta_j| < C r^zeta_j`
-///    (distance matrix of eq. 2.8, evaluated through a k-d tree rather than stored), and keeps
-///    `j in J` only if some `i in I` has `|xi_i - zeta_j| < C r^xi_i` (Condition 3,
-///    `C =` [`C_MAX`]).
-///
-/// Both removals of a pass use the sets and radii at the start of the pass, so the result does
-/// not depend on which side is called primary. The loop stops only when a pass changes neither
-/// side (the AND of the two stopping conditions): removing nodes of one side changes what the
-/// other side covers, so a pass in which only one side changed is not final. Every pass that
-/// does not stop removes at least one node, hence at most `primary.len() + secondary.len()`
-/// passes.
-///
-/// A side reduced to a single node has no neighbour for Algorithm 1; its radius is then the
-/// largest radius of the other side (that side's spacing). If both sides are single nodes, each
-/// gets `|xi - zeta| / C_START`, so each covers the other; if they coincide the result is
-/// [`RbfError::SingleNode`].
-///
-/// If a side becomes empty the surfaces do not face each other: [`RbfError::EmptyInterface`].
-pub fn interface_nodes(
-    primary: &[[f64; 3]],
-    secondary: &[[f64; 3]],
-) -> Result<InterfaceNodes, RbfError> {
-    check_finite(primary)?;
-    check_finite(secondary)?;
-    let mut active_p: Vec<usize> = (0..primary.len()).collect();
-    let mut active_s: Vec<usize> = (0..secondary.len()).collect();
-    loop {
-        if active_p.is_empty() {
-            return Err(RbfError::EmptyInterface {
-                side: Side::Primary,
-            });
-        }
-        if active_s.is_empty() {
-            return Err(RbfError::EmptyInterface {
-                side: Side::Secondary,
-            });
-        }
-        let xp: Vec<[f64; 3]> = active_p.iter().map(|&i| primary[i]).collect();
-        let xs: Vec<[f64; 3]> = active_s.iter().map(|&j| secondary[j]).collect();
-        let (rp, rs) = pair_radii(&xp, &xs)?;
-        let keep_p = covered_by(&xp, &xs, &rs)?;
-        let keep_s = covered_by(&xs, &xp, &rp)?;
-        let unchanged_p = keep_p.iter().all(|&k| k);
-        let unchanged_s = keep_s.iter().all(|&k| k);
-        if unchanged_p && unchanged_s {
-            return Ok(InterfaceNodes {
-                primary: active_p,
-                primary_radii: rp,
-                secondary: active_s,
-                secondary_radii: rs,
-            });
-        }
-        active_p = retain(&active_p, &keep_p);
-        active_s = retain(&active_s, &keep_s);
-    }
 }
 
 /// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` (seed eq. 2.6) from
@@ -637,65 +536,6 @@ fn nearest_other_distances(
                 })
             }
         })
-        .collect()
-}
-
-/// Radii of both sides for one pass of Algorithm 2, with the single-node rule of
-/// [`interface_nodes`]. Both sets are non-empty.
-fn pair_radii(xp: &[[f64; 3]], xs: &[[f64; 3]]) -> Result<(Vec<f64>, Vec<f64>), RbfError> {
-    match (xp.len(), xs.len()) {
-        (1, 1) => {
-            let d = distance(&xp[0], &xs[0]);
-            if d > 0.0 {
-                Ok((vec![d / C_START], vec![d / C_START]))
-            } else {
-                Err(RbfError::SingleNode)
-            }
-        }
-        (1, _) => {
-            let rs = support_radii(xs)?;
-            let r = rs.iter().copied().fold(0.0, f64::max);
-            Ok((vec![r], rs))
-        }
-        (_, 1) => {
-            let rp = support_radii(xp)?;
-            let r = rp.iter().copied().fold(0.0, f64::max);
-            Ok((rp, vec![r]))
-        }
-        _ => Ok((support_radii(xp)?, support_radii(xs)?)),
-    }
-}
-
-/// For each point, whether some node `j` has it strictly within `C_MAX * radii[j]`
-/// (Condition 3).
-fn covered_by(
-    points: &[[f64; 3]],
-    nodes: &[[f64; 3]],
-    radii: &[f64],
-) -> Result<Vec<bool>, RbfError> {
-    let tree = ImmutableKdTree::<f64, 3>::new_from_slice(nodes)?;
-    let reach = C_MAX * radii.iter().copied().fold(0.0, f64::max);
-    Ok(points
-        .iter()
-        .map(|p| {
-            tree.query(p)
-                .within::<SquaredEuclidean<f64>>(search_radius_squared(reach))
-                .unsorted()
-                .execute()
-                .into_iter()
-                .any(|hit| {
-                    let j = hit.item as usize;
-                    distance(p, &nodes[j]) < C_MAX * radii[j]
-                })
-        })
-        .collect())
-}
-
-fn retain(indices: &[usize], keep: &[bool]) -> Vec<usize> {
-    indices
-        .iter()
-        .zip(keep)
-        .filter_map(|(&i, &k)| k.then_some(i))
         .collect()
 }
 
