@@ -162,6 +162,14 @@ def print_table(checks: list[Check]) -> None:
 def main() -> int:
     """Run every case at every level, print and save the table; 0 if all checks pass."""
     args = parse_args()
+    # The committed report must describe a commit: refuse to start from uncommitted changes.
+    if not args.quick:
+        dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip()
+        if dirty:
+            print("run.py: the tree has uncommitted changes; commit them first, so that the report "
+                  "written to validation/report/ names the code it describes:\n" + dirty, file=sys.stderr)
+            return 2
     cases = sorted((VALIDATION / "cases").glob("*.toml"))
     if args.cases:
         cases = [VALIDATION / "cases" / f"{name}.toml" for name in args.cases]
