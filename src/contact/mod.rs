@@ -8,12 +8,13 @@
 //!   ([`projection`]), the lumped interface mass, the contact normal and the gaps;
 //! - [`solve`]: the active-set loop (primal-dual active set), each iteration assembling the
 //!   coupled system ([`system`]) and solving it ([`coupled_solver`], [`compliance`]);
-//! - [`certificate`]: independent checks of the answer; [`post`]: fields, forces, Hertz fit.
+//! - [`checks`]: the active-set update of each iteration and the certificate of the answer,
+//!   checked independently of the loop's operators; [`post`]: fields, forces, Hertz fit.
 //!
 //! Method, signs and known traps: `shared/notes/method.md`.
 
 mod boundary;
-mod certificate;
+mod checks;
 mod compliance;
 mod coupled_solver;
 mod hertz;
@@ -27,7 +28,7 @@ mod solve;
 mod surface;
 pub mod system;
 
-pub use certificate::{Certificate, CertificateCheck};
+pub use checks::{Certificate, CertificateCheck};
 pub use coupled_solver::CoupledSolver;
 pub use problem::{
     ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,

@@ -1,7 +1,7 @@
 //! Post-processing of the last iterate: each body's solution (reactions, cell strains and
 //! stresses), the interface fields of both surfaces, total forces and the Hertz fit.
 
-use super::certificate::Certificate;
+use super::checks::Certificate;
 use super::interface::geometric_gaps;
 use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
 use super::solve::{ActiveSet, ContactSolver};

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::certificate::Certificate;
+use super::checks::Certificate;
 use super::solve::ActiveSet;
 use crate::elastic::ElasticSolution;
 

@@ -39,11 +39,11 @@
 use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
 
-use super::certificate::certify;
+use super::checks::{Update, certify};
 use super::coupled_solver::{self, BodyFactors, CoupledSolver};
 use super::interface::{InterfaceOperators, geometric_gaps};
-use super::solution::{ContactSolution, ContactStatus, IterationRecord, PhaseSeconds};
-use super::system::CoupledSystem;
+use super::solution::{ContactSolution, ContactStatus, PhaseSeconds};
+use super::system::{CoupledSolution, CoupledSystem, Coupling};
 use super::{ContactError, ContactProblem, post};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 
@@ -66,7 +66,7 @@ const UNSTABLE_GAP_OVER_H: f64 = 1.0;
 /// iteration, so settling to well inside the tolerance costs a solve or two with an unchanged
 /// active set, and makes the answer independent of the path (load steps or one solve) to that
 /// precision.
-const SETTLED: f64 = 0.01;
+pub(super) const SETTLED: f64 = 0.01;
 
 /// Where an active-set loop starts: the active primary candidates (surface indices) and the
 /// gap corrections `e` (one per primary candidate; [`super::interface`]).
@@ -162,11 +162,7 @@ impl<'a> ContactSolver<'a> {
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
         let (mut active, mut corrections) = (start.nodes, start.corrections);
-        let mut seen: HashSet<BTreeSet<usize>> = HashSet::new();
-        // Nodes removed for tension, those of them added back for penetration, and those kept
-        // active against a repeat (module doc).
-        let (mut released, mut readded, mut pinned) =
-            (HashSet::new(), HashSet::new(), HashSet::new());
+        let mut safeguard = Safeguard::default();
         let mut history = Vec::new();
         let mut status = ContactStatus::IterationLimit;
         let mut last = None;
@@ -174,104 +170,50 @@ impl<'a> ContactSolver<'a> {
         for iteration in 1..=settings.max_iterations {
             let mut seconds = PhaseSeconds::default();
             // 1. The coupling of the active set: rows and columns of the fixed operators.
-            let clock = Instant::now();
             let nodes: Vec<usize> = active.iter().copied().collect();
-            let coupling =
-                self.operators
-                    .coupling(s1, s2, settings.formulation, &nodes, &corrections);
-            seconds.operators = clock.elapsed().as_secs_f64();
-
+            let coupling = timed(&mut seconds.operators, || {
+                let formulation = settings.formulation;
+                (self.operators).coupling(s1, s2, formulation, &nodes, &corrections)
+            });
             // 2. The coupled solve, checked by its residual.
-            let clock = Instant::now();
-            let dim = s1.dim;
-            let system =
-                CoupledSystem::assemble(&self.body1, &self.body2, &coupling, dim, load_factor)?;
-            let x =
-                coupled_solver::solve(&system, &self.body1, &self.body2, self.factors.as_mut())?;
-            let residual = system.relative_residual(&self.body1, &self.body2, &x);
-            if residual.is_nan() || residual > self.solver.residual_tolerance {
-                return Err(ContactError::Inaccurate {
-                    residual,
-                    tolerance: self.solver.residual_tolerance,
-                });
-            }
-            let solution = system.solution(&x, &coupling, dim, residual);
-            seconds.solve = clock.elapsed().as_secs_f64();
-
+            let solution = timed(&mut seconds.solve, || {
+                self.coupled_solve(&coupling, load_factor)
+            })?;
             // 3. Gaps of every primary candidate: geometric (the search) and linearized.
-            let clock = Instant::now();
-            let gaps = geometric_gaps(s1, s2, Some(&solution.u1), Some(&solution.u2));
-            let linear = self
-                .operators
-                .linearized_gaps(s1, s2, &solution.u1, &solution.u2);
-            seconds.search = clock.elapsed().as_secs_f64();
-
+            let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+            let (gaps, linear) = timed(&mut seconds.search, || {
+                let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
+                (gaps, self.operators.linearized_gaps(s1, s2, u1, u2))
+            });
             // 4. The primal-dual active set update, and the gap corrections.
-            let clock = Instant::now();
-            let update = Update::new(
-                problem,
-                &nodes,
-                &solution.traction,
-                &coupling.normals,
-                &gaps,
-                &self.operators.facing,
-                &pinned,
-            );
-            readded.extend(
-                update
-                    .penetrating
-                    .iter()
-                    .map(|&(i, _)| i)
-                    .filter(|i| released.contains(i)),
-            );
-            released.extend(update.tension.iter().map(|&(i, _)| i));
+            let update = timed(&mut seconds.checks, || {
+                let (traction, normals) = (&solution.traction, &coupling.normals);
+                let facing = &self.operators.facing;
+                Update::new(
+                    problem,
+                    &nodes,
+                    traction,
+                    normals,
+                    &gaps,
+                    facing,
+                    &safeguard.pinned,
+                )
+            });
             corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
-            seconds.checks = clock.elapsed().as_secs_f64();
-            let record = update.record(iteration, residual, seconds);
+            let record = update.record(iteration, solution.relative_residual, seconds);
             if self.solver.verbose {
                 eprintln!("{}", record.line());
             }
             history.push(record);
             last = Some((coupling, solution));
-
-            if update.max_gap_error_over_h > UNSTABLE_GAP_OVER_H {
-                status = ContactStatus::Unstable;
-                break;
-            }
-            if update.next == active {
-                if update.settled {
-                    status = ContactStatus::Converged;
+            // 5. Stop, or go on with the next set (safeguarded against repeats).
+            match safeguard.next(&active, &update) {
+                Step::Solve(next) => active = next,
+                Step::Stop(end) => {
+                    status = end;
                     break;
                 }
-                continue; // same set, corrected gaps: solve again
             }
-            seen.insert(active.clone());
-            let mut next = update.next.clone();
-            if seen.contains(&next) {
-                // A repeat. First keep active the nodes in tension that came back after an
-                // earlier removal (a rim node alternating between the two tests).
-                let alternating: Vec<usize> = update
-                    .tension
-                    .iter()
-                    .map(|&(i, _)| i)
-                    .filter(|i| readded.contains(i))
-                    .collect();
-                pinned.extend(alternating.iter().copied());
-                next.extend(alternating);
-                if next == active {
-                    continue;
-                }
-            }
-            if seen.contains(&next) {
-                match update.single_switch(&active) {
-                    Some(switched) if !seen.contains(&switched) => next = switched,
-                    _ => {
-                        status = ContactStatus::Cycling;
-                        break;
-                    }
-                }
-            }
-            active = next;
         }
 
         let (coupling, solution) = last.expect("max_iterations >= 1 is validated");
@@ -298,95 +240,91 @@ impl<'a> ContactSolver<'a> {
     }
 }
 
-/// The active-set update of one iteration (step 4 of the module doc), in surface indices.
-struct Update {
-    next: BTreeSet<usize>,
-    /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
-    tension: Vec<(usize, f64)>,
-    /// Inactive nodes facing the other surface with `g_i < -tol_p h_i`, with their penetration
-    /// over `h_i` (a penetrating node that does not face the other candidate surface is left
-    /// to the certificate, which names it).
-    penetrating: Vec<(usize, f64)>,
-    /// Every active node lies on the other surface: `|g_i| <= SETTLED tol_p h_i`.
-    settled: bool,
-    active: usize,
-    max_gap_error_over_h: f64,
+impl ContactSolver<'_> {
+    /// The coupled system of `coupling`, solved and checked by its relative residual.
+    fn coupled_solve(
+        &mut self,
+        coupling: &Coupling,
+        load_factor: f64,
+    ) -> Result<CoupledSolution, ContactError> {
+        let dim = self.problem.primary_surface.dim;
+        let system = CoupledSystem::assemble(&self.body1, &self.body2, coupling, dim, load_factor)?;
+        let x = coupled_solver::solve(&system, &self.body1, &self.body2, self.factors.as_mut())?;
+        let residual = system.relative_residual(&self.body1, &self.body2, &x);
+        if residual.is_nan() || residual > self.solver.residual_tolerance {
+            return Err(ContactError::Inaccurate {
+                residual,
+                tolerance: self.solver.residual_tolerance,
+            });
+        }
+        Ok(system.solution(&x, coupling, dim, residual))
+    }
 }
 
-impl Update {
-    fn new(
-        problem: &ContactProblem,
-        active: &[usize],
-        traction: &[[f64; 3]],
-        normals: &[[f64; 3]],
-        gaps: &[f64],
-        facing: &[bool],
-        pinned: &HashSet<usize>,
-    ) -> Self {
-        let settings = &problem.settings;
-        let s1 = &problem.primary_surface;
-        let pressure: Vec<f64> = traction
-            .iter()
-            .zip(normals)
-            .map(|(t, n)| -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]))
-            .collect();
-        let p_max = pressure.iter().copied().fold(0.0, f64::max);
-        let tension: Vec<(usize, f64)> = active
-            .iter()
-            .zip(&pressure)
-            .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
-            .map(|(&i, &p)| (i, -p / p_max.max(f64::MIN_POSITIVE)))
-            .collect();
-        let is_active: HashSet<usize> = active.iter().copied().collect();
-        let penetrating: Vec<(usize, f64)> = (0..s1.len())
-            .filter(|&i| facing[i] && !is_active.contains(&i))
-            .map(|i| (i, -gaps[i] / s1.spacing[i]))
-            .filter(|&(_, over_h)| over_h > settings.penetration_tolerance)
-            .collect();
-        let max_gap_error_over_h = active
-            .iter()
-            .map(|&i| gaps[i].abs() / s1.spacing[i])
-            .fold(0.0, f64::max);
-        let mut next: BTreeSet<usize> = active.iter().copied().collect();
-        for (i, _) in &tension {
-            next.remove(i);
-        }
-        next.extend(penetrating.iter().map(|&(i, _)| i));
-        Self {
-            next,
-            settled: max_gap_error_over_h <= SETTLED * settings.penetration_tolerance,
-            tension,
-            penetrating,
-            active: active.len(),
-            max_gap_error_over_h,
-        }
-    }
+/// What the loop does after an iteration.
+enum Step {
+    /// Solve again with this active set (possibly the same, with corrected gaps).
+    Solve(BTreeSet<usize>),
+    Stop(ContactStatus),
+}
 
-    /// The active set with only the worst violation switched, if any.
-    fn single_switch(&self, active: &BTreeSet<usize>) -> Option<BTreeSet<usize>> {
-        let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
-        let mut next = active.clone();
-        match (worst(&self.tension), worst(&self.penetrating)) {
-            (Some(t), Some(p)) if p.1 >= t.1 => next.insert(p.0),
-            (Some(t), _) => next.remove(&t.0),
-            (None, Some(p)) => next.insert(p.0),
-            (None, None) => return None,
-        };
-        Some(next)
-    }
+/// The loop's memory against repeats (module doc): the sets seen, the nodes removed for
+/// tension, those of them added back for penetration, and those kept active for good.
+#[derive(Default)]
+struct Safeguard {
+    seen: HashSet<BTreeSet<usize>>,
+    released: HashSet<usize>,
+    readded: HashSet<usize>,
+    pinned: HashSet<usize>,
+}
 
-    fn record(&self, iteration: usize, residual: f64, seconds: PhaseSeconds) -> IterationRecord {
-        let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
-        IterationRecord {
-            iteration,
-            active: self.active,
-            added: self.penetrating.len(),
-            removed: self.tension.len(),
-            max_penetration_over_h: max(&self.penetrating),
-            max_tension_over_p: max(&self.tension),
-            max_gap_error_over_h: self.max_gap_error_over_h,
-            relative_residual: residual,
-            seconds,
+impl Safeguard {
+    fn next(&mut self, active: &BTreeSet<usize>, update: &Update) -> Step {
+        let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
+        let added_back = nodes(&update.penetrating);
+        let released = &self.released;
+        self.readded
+            .extend(added_back.into_iter().filter(|i| released.contains(i)));
+        self.released.extend(nodes(&update.tension));
+        if update.max_gap_error_over_h > UNSTABLE_GAP_OVER_H {
+            return Step::Stop(ContactStatus::Unstable);
         }
+        if update.next == *active {
+            return if update.settled {
+                Step::Stop(ContactStatus::Converged)
+            } else {
+                Step::Solve(active.clone())
+            };
+        }
+        self.seen.insert(active.clone());
+        let mut next = update.next.clone();
+        if self.seen.contains(&next) {
+            // First keep active the nodes in tension that came back after an earlier removal.
+            let readded = &self.readded;
+            let alternating: Vec<usize> = nodes(&update.tension)
+                .into_iter()
+                .filter(|i| readded.contains(i))
+                .collect();
+            self.pinned.extend(alternating.iter().copied());
+            next.extend(alternating);
+            if next == *active {
+                return Step::Solve(next);
+            }
+        }
+        if self.seen.contains(&next) {
+            match update.single_switch(active) {
+                Some(switched) if !self.seen.contains(&switched) => next = switched,
+                _ => return Step::Stop(ContactStatus::Cycling),
+            }
+        }
+        Step::Solve(next)
     }
+}
+
+/// Runs `f`, adding its wall-clock seconds to `slot`.
+fn timed<T>(slot: &mut f64, f: impl FnOnce() -> T) -> T {
+    let clock = Instant::now();
+    let value = f();
+    *slot += clock.elapsed().as_secs_f64();
+    value
 }

@@ -1,6 +1,9 @@
-//! The certificate of a contact answer: checks that do not reuse the active-set loop's
-//! operators (method.md section 3, "Certify the result").
+//! The contact checks: the active-set update of each iteration ([`Update`]: tension of the
+//! active nodes, penetration of the inactive ones), and the certificate of the answer, with
+//! checks that do not reuse the active-set loop's operators (method.md section 3, "Certify the
+//! result").
 //!
+//! The certificate:
 //! - **Penetration.** Every candidate node of BOTH bodies, active or not, is projected onto the
 //!   other body's displaced P1 surface ([`geometric_gaps`]); the largest penetration over the
 //!   node's spacing must not exceed `penetration_tolerance` on the primary surface, whose
@@ -19,7 +22,10 @@
 
 use serde::Serialize;
 
+use std::collections::{BTreeSet, HashSet};
+
 use super::interface::geometric_gaps;
+use super::solution::{IterationRecord, PhaseSeconds};
 use super::system::CoupledSolution;
 use super::{ContactProblem, ContactSurface};
 
@@ -181,6 +187,104 @@ impl Worst {
             passed: self.value <= tolerance,
             body,
             node_tag,
+        }
+    }
+}
+
+/// The active-set update of one iteration (step 4 of the module doc), in surface indices.
+pub(super) struct Update {
+    pub(super) next: BTreeSet<usize>,
+    /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
+    pub(super) tension: Vec<(usize, f64)>,
+    /// Inactive nodes facing the other surface with `g_i < -tol_p h_i`, with their penetration
+    /// over `h_i` (a penetrating node that does not face the other candidate surface is left
+    /// to the certificate, which names it).
+    pub(super) penetrating: Vec<(usize, f64)>,
+    /// Every active node lies on the other surface: `|g_i| <= SETTLED tol_p h_i`.
+    pub(super) settled: bool,
+    pub(super) active: usize,
+    pub(super) max_gap_error_over_h: f64,
+}
+
+impl Update {
+    pub(super) fn new(
+        problem: &ContactProblem,
+        active: &[usize],
+        traction: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        gaps: &[f64],
+        facing: &[bool],
+        pinned: &HashSet<usize>,
+    ) -> Self {
+        let settings = &problem.settings;
+        let s1 = &problem.primary_surface;
+        let pressure: Vec<f64> = traction
+            .iter()
+            .zip(normals)
+            .map(|(t, n)| -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]))
+            .collect();
+        let p_max = pressure.iter().copied().fold(0.0, f64::max);
+        let tension: Vec<(usize, f64)> = active
+            .iter()
+            .zip(&pressure)
+            .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
+            .map(|(&i, &p)| (i, -p / p_max.max(f64::MIN_POSITIVE)))
+            .collect();
+        let is_active: HashSet<usize> = active.iter().copied().collect();
+        let penetrating: Vec<(usize, f64)> = (0..s1.len())
+            .filter(|&i| facing[i] && !is_active.contains(&i))
+            .map(|i| (i, -gaps[i] / s1.spacing[i]))
+            .filter(|&(_, over_h)| over_h > settings.penetration_tolerance)
+            .collect();
+        let max_gap_error_over_h = active
+            .iter()
+            .map(|&i| gaps[i].abs() / s1.spacing[i])
+            .fold(0.0, f64::max);
+        let mut next: BTreeSet<usize> = active.iter().copied().collect();
+        for (i, _) in &tension {
+            next.remove(i);
+        }
+        next.extend(penetrating.iter().map(|&(i, _)| i));
+        Self {
+            next,
+            settled: max_gap_error_over_h <= super::solve::SETTLED * settings.penetration_tolerance,
+            tension,
+            penetrating,
+            active: active.len(),
+            max_gap_error_over_h,
+        }
+    }
+
+    /// The active set with only the worst violation switched, if any.
+    pub(super) fn single_switch(&self, active: &BTreeSet<usize>) -> Option<BTreeSet<usize>> {
+        let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+        let mut next = active.clone();
+        match (worst(&self.tension), worst(&self.penetrating)) {
+            (Some(t), Some(p)) if p.1 >= t.1 => next.insert(p.0),
+            (Some(t), _) => next.remove(&t.0),
+            (None, Some(p)) => next.insert(p.0),
+            (None, None) => return None,
+        };
+        Some(next)
+    }
+
+    pub(super) fn record(
+        &self,
+        iteration: usize,
+        residual: f64,
+        seconds: PhaseSeconds,
+    ) -> IterationRecord {
+        let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
+        IterationRecord {
+            iteration,
+            active: self.active,
+            added: self.penetrating.len(),
+            removed: self.tension.len(),
+            max_penetration_over_h: max(&self.penetrating),
+            max_tension_over_p: max(&self.tension),
+            max_gap_error_over_h: self.max_gap_error_over_h,
+            relative_residual: residual,
+            seconds,
         }
     }
 }
