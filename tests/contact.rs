@@ -870,7 +870,6 @@ fn hertz_with_dissimilar_materials_uses_the_combined_modulus() {
         "frictionless",
     );
     eprintln!("E ratio 10, frictionless: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
-    assert!(frictionless.max_tangential_traction <= 1e-10 * frictionless.hertz_primary.unwrap().p0);
 
     // Glued, the dissimilar surfaces cannot slide: the same case runs and the shear it carries
     // is reported (it is not Hertz's problem any more, so only its presence is checked).

@@ -58,6 +58,16 @@ REPORT = VALIDATION / "report"
 QUICK_REPORT = BUILD / "report-quick"
 # Contact suites: module name, whether its checks gate the run.
 SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False, "sweep": True}
+# Regression bands on the target suites' figures (issue 11, item 6), one section per mode.
+BANDS = VALIDATION / "bands.json"
+# A figure may grow to BAND_RELATIVE times its committed value plus BAND_ABSOLUTE before the band
+# fails. The figures are deterministic for a given binary and mesh (results do not depend on the
+# thread count, tests/threads.rs), so a band only has to absorb deliberate changes of the code
+# that leave the method as it is (a refactoring moves figures at round-off); the changes that
+# matter moved them by far more (the contact normal took the 2D rigid-flat force error from 1.15%
+# to 0.53%). 1.25 x + 1e-3 (0.1% for relative errors, 0.001 h for distances) is the margin.
+BAND_RELATIVE = 1.25
+BAND_ABSOLUTE = 1e-3
 DEFAULT_LEVELS = (0, 1)
 MESH_NAME = re.compile(r"(?P<script>.+)_l(?P<level>-?\d+)\.msh")
 
@@ -77,6 +87,9 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--cases", nargs="+", help="case names (default: all of validation/cases)")
     parser.add_argument("--suites", nargs="*", default=list(SUITES),
                         help=f"contact suites to run (default: {' '.join(SUITES)}; none: --suites)")
+    parser.add_argument("--write-bands", action="store_true",
+                        help="record this run's target figures as the regression bands of its mode "
+                             "(validation/bands.json) instead of checking them against the committed ones")
     parser.add_argument("--reuse", action="store_true",
                         help="Hertz suite: take each run's output from an earlier run of the same case, mesh and "
                              "binary (binary modification time included) instead of solving again")
@@ -84,6 +97,35 @@ def parse_args() -> argparse.Namespace:
     if args.quick:
         args.levels = [min(args.levels)]
     return args
+
+
+def regression_bands(targets: list[SuiteResult], mode: str, write: bool) -> SuiteResult:
+    """Gate checks: every finite figure of the target suites within its committed band
+    (``BAND_RELATIVE`` x the committed figure + ``BAND_ABSOLUTE``). With ``write``, this run's
+    figures become the bands of ``mode`` first. A figure without a band fails: a new target must
+    be recorded deliberately."""
+    figures = {f"{c.check} | {c.case}": c.figure for suite in targets for c in suite.checks
+               if math.isfinite(c.figure)}
+    bands = json.loads(BANDS.read_text()) if BANDS.exists() else {}
+    if write:
+        bands[mode] = {key: {"figure": value, "band": BAND_RELATIVE * value + BAND_ABSOLUTE}
+                       for key, value in sorted(figures.items())}
+        BANDS.write_text(json.dumps(bands, indent=1) + "\n")
+    committed = bands.get(mode, {})
+    checks = []
+    for key, value in figures.items():
+        check, case = key.split(" | ", 1)
+        band = committed.get(key)
+        if band is None:
+            checks.append(failure(f"band: {check}", case, f"no committed band in {BANDS.name} ({mode})"))
+        else:
+            checks.append(Check(f"band: {check}", case, value, band["band"],
+                                f"committed figure {band['figure']:.4g}"))
+    return SuiteResult(title="Regression bands on the Hertz and rigid-flat figures", checks=checks,
+                       text=f"Each finite figure of the target suites against its committed band ({BANDS.name}, "
+                            f"mode {mode}): {BAND_RELATIVE} x the figure measured when the band was recorded, "
+                            f"plus {BAND_ABSOLUTE:g}. A miss means the code moved a validated figure the wrong "
+                            "way by more than a refactoring could.")
 
 
 def run(command: list, what: str) -> None:
@@ -235,6 +277,7 @@ def main() -> int:
         for c in result.checks:
             print(f"   {'PASS' if c.passed else 'FAIL'}  {c.check}: {c.case}: {c.figure:.3g} (<= {c.tolerance:g})")
         print(f"   {time.perf_counter() - start:.1f} s", flush=True)
+    gate.append(regression_bands(targets, "quick" if args.quick else "full", args.write_bands))
     command = "make validate" if not args.quick else "make test (run.py --quick)"
     counts = report.write(report_dir, gate, targets, command)
     print(f"\nreport written to {report_dir / 'README.md'}")
