@@ -7,10 +7,8 @@
 //! normal of the loaded nodes (in 2D, along the surface line).
 //!
 //! `p_i` is the mean pressure of node `i` (its normal contact force over its area), the
-//! recovery that FE contact codes and our dolfinx reference use, not the nodal value of the P1
-//! multiplier: on the 3D demo (R/67) the nodal values scatter by 15% RMS around the Hertz
-//! ellipse inside 0.8 a and the mean pressures by 5.4%; the fit moved from a +0.8%, p0 +4.0%
-//! to a -1.8%, p0 +2.7%, and in 2D (R/80) from a +3.5%, p0 +0.4% to a +0.5%, p0 +0.7%.
+//! recovery that FE contact codes and our dolfinx reference use; with the lumped interface mass
+//! it is the nodal pressure itself.
 
 use super::ContactSurface;
 use super::solution::{HertzFit, SurfaceFields};

@@ -198,20 +198,10 @@ pub fn support_radii(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
 /// contact solve carries that error, and the pressure answers it with `E* / h` per unit gap, so
 /// the pressure noise does not fall with `h`.
 ///
-/// Measured on the 3D Hertz test mesh (`tests/fixtures/hemisphere_on_block_hertz.msh`, contact
-/// zone at R/67 graded beyond 1.5 a), `radius` = 4/3 (Algorithm 1), 2 and 8/3:
-/// - a linear field interpolated between the two contact surfaces near the contact zone,
-///   largest error over `h` (block to sphere, sphere to block): 0.19 and 0.21, 0.041 and
-///   0.065, 0.061 and 0.068 (`tests/interpolation.rs`);
-/// - the contact solve at delta = 0.01: with 4/3 the loop cycles; with 2 the fitted contact
-///   radius is within +0.8% and the peak pressure within +4.0% of Hertz, the nodal pressure
-///   deviates from the Hertz ellipse by 15% RMS inside 0.8 a; with 8/3, +1.5%, +4.1% and 16%;
-///   with the bodies meshed overlapping by 0.01 instead, 2 gives +2.0%, +3.0%, 14.5% and 8/3
-///   gives +4.5%, +2.4%, 17%.
-/// - In 2D, a half-disc meshed overlapping a block by 0.02 (R/80): with 2 (Algorithm 1's radii)
-///   the pressure is within 0.4% RMS of the Hertz ellipse, with 4 it oscillates at the rim
-///   (6% RMS, a fitted 10% too large). Larger supports reach from targets off the source
-///   surface, or from the coarse part of a graded surface, into regions they do not represent.
+/// On the 3D Hertz test mesh a linear field interpolated between the two contact surfaces is
+/// off by up to 0.19-0.21 h with Algorithm 1's radii and 0.041-0.065 h with `radius = 2`
+/// (`tests/interpolation.rs`); larger supports (8/3) did no better, and on graded or
+/// overlapping meshes reach from targets into regions their sources do not represent.
 ///
 /// Radii above Algorithm 1's give up its diagonal-dominance guarantee: the sparse LU of
 /// `Phi_MM` and the positivity of every rescaling factor are still checked in
