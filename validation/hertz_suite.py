@@ -60,7 +60,7 @@ REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
 from compare import Check  # noqa: E402
-from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo  # noqa: E402
+from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing  # noqa: E402
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
@@ -231,33 +231,6 @@ def solve(binary: Path, case: HertzCase, level: int, formulation: str) -> tuple[
 # ---------------------------------------------------------------------------
 
 
-def surface_spacing(msh: Path, group: str, dim: int) -> float:
-    """Mean length of the edges of a candidate surface within SPACING_RADIUS of the contact axis."""
-    import gmsh
-
-    gmsh.initialize(["gmsh", "-v", "0"])
-    try:
-        gmsh.open(str(msh))
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        x = np.zeros((int(tags.max()) + 1, 3))
-        x[tags.astype(int)] = coords.reshape(-1, 3)
-        groups = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in gmsh.model.getPhysicalGroups(dim - 1)}
-        if group not in groups:
-            raise RunFailed(f"{msh}: no physical group '{group}'")
-        facets = []
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(*groups[group]):
-            types, _, nodes = gmsh.model.mesh.getElements(dim - 1, entity)
-            facets += [n.astype(int).reshape(-1, dim) for n in nodes]
-    finally:
-        gmsh.finalize()
-    facets = np.concatenate(facets)
-    edges = np.concatenate([facets[:, [i, (i + 1) % dim]] for i in range(dim if dim == 3 else 1)])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
-    r = np.linalg.norm(x[:, : dim - 1], axis=1)
-    near = edges[(r[edges] <= SPACING_RADIUS).all(axis=1)]
-    return float(np.linalg.norm(x[near[:, 0]] - x[near[:, 1]], axis=1).mean())
-
-
 def analyse(case: HertzCase, msh: Path, output: Path, formulation: str) -> dict:
     """Every number of one run (see the module doc), plus the per-node profile for the plots."""
     summary = json.loads((output / "summary.json").read_text())
@@ -275,8 +248,8 @@ def analyse(case: HertzCase, msh: Path, output: Path, formulation: str) -> dict:
     force = abs(contact["force_primary"][v])
     theory = hertz(force, case.radius, case.dim)
     fit = contact.get("hertz_fit") or {"a": math.nan, "p0": math.nan}
-    h_primary = surface_spacing(msh, case.primary_surface, case.dim)
-    h_secondary = surface_spacing(msh, case.secondary_surface, case.dim)
+    h_primary = surface_spacing(msh, case.primary_surface, case.dim, SPACING_RADIUS)
+    h_secondary = surface_spacing(msh, case.secondary_surface, case.dim, SPACING_RADIUS)
 
     on_primary = active & (body == names.index(case.primary))
     r = np.linalg.norm(x[on_primary][:, :v], axis=1)

@@ -111,7 +111,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo  # noqa: E402
+from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing  # noqa: E402
 
 BUILD = VALIDATION / "build" / "sweep"
 RADIUS = 1.0
@@ -364,35 +364,6 @@ def solve(binary: Path, case: Case, msh: Path) -> tuple[Path, dict]:
 # ---------------------------------------------------------------------------
 # What is measured
 # ---------------------------------------------------------------------------
-
-
-def surface_spacing(msh: Path, group: str, dim: int, radius: float) -> float:
-    """Mean length of the edges of a surface group with both ends within ``radius`` of the contact axis."""
-    import gmsh
-
-    gmsh.initialize(["gmsh", "-v", "0"])
-    try:
-        gmsh.open(str(msh))
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        x = np.zeros((int(tags.max()) + 1, 3))
-        x[tags.astype(int)] = coords.reshape(-1, 3)
-        groups = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in gmsh.model.getPhysicalGroups(dim - 1)}
-        if group not in groups:
-            raise RunFailed(f"{msh}: no physical group '{group}'")
-        facets = []
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(*groups[group]):
-            _, _, nodes = gmsh.model.mesh.getElements(dim - 1, entity)
-            facets += [n.astype(int).reshape(-1, dim) for n in nodes]
-    finally:
-        gmsh.finalize()
-    facets = np.concatenate(facets)
-    edges = np.concatenate([facets[:, [i, (i + 1) % dim]] for i in range(dim if dim == 3 else 1)])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
-    r = np.linalg.norm(x[:, : dim - 1], axis=1)
-    near = edges[(r[edges] <= radius).all(axis=1)]
-    if len(near) == 0:
-        return math.nan
-    return float(np.linalg.norm(x[near[:, 0]] - x[near[:, 1]], axis=1).mean())
 
 
 def spacings(case: Case, msh: Path) -> dict:
