@@ -11,6 +11,7 @@
 mod error;
 mod generate;
 mod gmsh;
+mod msh41;
 mod quality;
 mod summary;
 
