@@ -86,4 +86,6 @@ pub enum MeshError {
          a 3D body is a named physical volume (Physical Volume(\"name\") = {{...}} in the .geo)"
     )]
     NoPhysicalVolume { path: PathBuf, volumes: u64 },
+    #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
+    EmptyBody { path: PathBuf, body: String },
 }

@@ -29,7 +29,13 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_owned(),
         source,
     })?;
-    let msh = msh41::parse(path, &bytes)?;
+    read_msh_bytes(path, &bytes)
+}
+
+/// [`read_msh`] on the bytes of a file already read; `path` names it in the mesh and in errors.
+/// Any bytes give a mesh or an error, never a panic (the fuzz target in `fuzz/` checks this).
+pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let msh = msh41::parse(path, bytes)?;
     let physical_names: BTreeMap<(Dim, i32), String> = msh
         .physical_names
         .iter()
@@ -69,6 +75,12 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
             continue;
         }
         let mut body = file.body(name_of(d, tag), tag, elements)?;
+        if body.cells.is_empty() {
+            return Err(MeshError::EmptyBody {
+                path: path.to_owned(),
+                body: body.name,
+            });
+        }
         for (&(fd, ftag), facets) in &file.groups {
             if fd + 1 == dim {
                 let group = file.facet_group(&body, ftag, facets);

@@ -1,0 +1,190 @@
+//! The output folder of a run: it holds one run's complete results, or a failure mark and
+//! nothing that looks like a result.
+//!
+//! A run removes the result files of earlier runs when it starts (so a run that is killed
+//! leaves no stale results), writes its own into a private staging folder inside the output
+//! folder, and moves them into place only when every body has been solved and every file
+//! written ([`ResultFolder::commit`]). A run that fails removes its staging folder and writes
+//! [`FAILURE_MARK`] with the error ([`ResultFolder::fail`]); the next successful run removes it.
+//! The staging folder's name carries the process id and a counter, so concurrent runs never
+//! write into each other's files; the run that commits last owns the folder.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use super::OutputError;
+
+/// The results a run writes into its output folder, as file or folder names.
+pub const RESULT_FILES: [&str; 6] = [
+    "solution.xdmf",
+    "solution.h5",
+    "summary.json",
+    "force_displacement.csv",
+    "force_displacement.png",
+    "matrices",
+];
+
+/// The mesh gmsh made for a `.geo` case: the run's input, kept when the run fails so that the
+/// mesh an error names can be inspected.
+pub const GENERATED_MESH: &str = "mesh.msh";
+
+/// Written into the output folder by a run that failed, with its error.
+pub const FAILURE_MARK: &str = "FAILED.txt";
+
+/// Prefix of the staging folders of running (or killed) runs.
+const STAGING_PREFIX: &str = ".internodes-partial-";
+
+/// Distinguishes staging folders of runs in one process (tests run cases in parallel).
+static RUNS: AtomicUsize = AtomicUsize::new(0);
+
+/// An output folder with a run's staging folder in it.
+#[derive(Debug)]
+pub struct ResultFolder {
+    dir: PathBuf,
+    staging: PathBuf,
+}
+
+impl ResultFolder {
+    /// Creates `dir` if needed, removes earlier results (and mesh) and creates the staging
+    /// folder.
+    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+        create_dir(dir)?;
+        remove_results(dir)?;
+        remove_any(&dir.join(GENERATED_MESH))?;
+        let run = RUNS.fetch_add(1, Ordering::Relaxed);
+        let staging = dir.join(format!("{STAGING_PREFIX}{}-{run}", std::process::id()));
+        remove_any(&staging)?;
+        create_dir(&staging)?;
+        Ok(ResultFolder {
+            dir: dir.to_owned(),
+            staging,
+        })
+    }
+
+    /// The output folder the results end up in.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Where this run writes its result files until [`ResultFolder::commit`].
+    pub fn staging(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Moves a staged file into the output folder at once: the mesh gmsh made, which is the
+    /// run's input and is kept even if the run fails.
+    pub fn publish(&self, name: &str) -> Result<PathBuf, OutputError> {
+        let target = self.dir.join(name);
+        rename(&self.staging.join(name), &target)?;
+        Ok(target)
+    }
+
+    /// Moves every staged result into the output folder, replacing earlier ones, and removes
+    /// the failure mark of an earlier run.
+    pub fn commit(&self) -> Result<(), OutputError> {
+        for name in RESULT_FILES {
+            let staged = self.staging.join(name);
+            if staged.exists() {
+                let target = self.dir.join(name);
+                remove_any(&target)?;
+                rename(&staged, &target)?;
+            }
+        }
+        remove_any(&self.staging)?;
+        remove_any(&self.dir.join(FAILURE_MARK))
+    }
+
+    /// Removes this run's staged files and results, and writes [`FAILURE_MARK`] with `error`.
+    /// Best effort: the error itself is what the caller reports, so a folder that cannot be
+    /// cleaned is reported on stderr only.
+    pub fn fail(&self, command: &str, error: &dyn std::error::Error) {
+        if let Err(e) = mark_failed(&self.dir, Some(&self.staging), command, error) {
+            eprintln!("warning: {e}");
+        }
+    }
+}
+
+/// Marks `dir` as holding the failure of a run that stopped before it had a
+/// [`ResultFolder`] (a case file that does not parse): earlier results and mesh are removed
+/// and [`FAILURE_MARK`] written. Nothing is done if `dir` does not exist.
+pub fn mark_failed_folder(dir: &Path, command: &str, error: &dyn std::error::Error) {
+    if !dir.is_dir() {
+        return;
+    }
+    let marked =
+        remove_any(&dir.join(GENERATED_MESH)).and_then(|()| mark_failed(dir, None, command, error));
+    if let Err(e) = marked {
+        eprintln!("warning: {e}");
+    }
+}
+
+fn mark_failed(
+    dir: &Path,
+    staging: Option<&Path>,
+    command: &str,
+    error: &dyn std::error::Error,
+) -> Result<(), OutputError> {
+    if let Some(staging) = staging {
+        remove_any(staging)?;
+    }
+    remove_results(dir)?;
+    let path = dir.join(FAILURE_MARK);
+    std::fs::write(&path, failure_text(command, error))
+        .map_err(|source| OutputError::Io { path, source })
+}
+
+/// The failure mark's text: what ran, when, and the error with its causes.
+fn failure_text(command: &str, error: &dyn std::error::Error) -> String {
+    let seconds = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let mut text = format!(
+        "The last run into this folder failed; it wrote no results, and the results of earlier \
+         runs were removed.\ncommand: {command}\ntime: {seconds} s since 1970-01-01 UTC\n\
+         error: {error}\n"
+    );
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let _ = writeln!(text, "  caused by: {cause}");
+        source = cause.source();
+    }
+    text
+}
+
+/// Removes the result files of earlier runs from `dir`.
+fn remove_results(dir: &Path) -> Result<(), OutputError> {
+    for name in RESULT_FILES {
+        remove_any(&dir.join(name))?;
+    }
+    Ok(())
+}
+
+fn create_dir(dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+        path: dir.to_owned(),
+        source,
+    })
+}
+
+fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
+    std::fs::rename(from, to).map_err(|source| OutputError::Io {
+        path: to.to_owned(),
+        source,
+    })
+}
+
+/// Removes a file or a folder with its contents; a missing one is fine.
+fn remove_any(path: &Path) -> Result<(), OutputError> {
+    let result = match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => Err(e),
+        Ok(meta) if meta.is_dir() => std::fs::remove_dir_all(path),
+        Ok(_) => std::fs::remove_file(path),
+    };
+    result.map_err(|source| OutputError::Io {
+        path: path.to_owned(),
+        source,
+    })
+}
