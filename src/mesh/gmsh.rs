@@ -94,7 +94,6 @@ pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                 }
             }
         }
-        check_cells(path, &body)?;
         bodies.push(body);
     }
     if bodies.is_empty() {
@@ -103,8 +102,12 @@ pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             expected: "surface (2D) or volume (3D) of triangles / tetrahedra",
         });
     }
+    // A 2D mesh off the xy plane has cells that look degenerate in xy: say why first.
     if dim == 2 {
         check_planar(path, &bodies)?;
+    }
+    for body in &bodies {
+        check_cells(path, body)?;
     }
     Ok(Mesh {
         path: path.to_owned(),

@@ -7,12 +7,13 @@
 //! written ([`ResultFolder::commit`]). A run that fails removes its staging folder and writes
 //! [`FAILURE_MARK`] with the error ([`ResultFolder::fail`]); the next successful run removes it.
 //! The staging folder's name carries the process id and a counter, so concurrent runs never
-//! write into each other's files; the run that commits last owns the folder.
+//! write into each other's files, and a lock file makes each commit (or failure mark) whole:
+//! the run that finishes last owns the folder, with all of its files.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use super::OutputError;
 
@@ -35,6 +36,14 @@ pub const FAILURE_MARK: &str = "FAILED.txt";
 
 /// Prefix of the staging folders of running (or killed) runs.
 const STAGING_PREFIX: &str = ".internodes-partial-";
+
+/// Held while results are moved into place, so that two runs finishing together do not mix
+/// their files.
+const COMMIT_LOCK: &str = ".internodes-commit.lock";
+
+/// A lock older than this belongs to a run that was killed while committing (a commit is a few
+/// renames): it is removed.
+const STALE_LOCK: Duration = Duration::from_secs(30);
 
 /// Distinguishes staging folders of runs in one process (tests run cases in parallel).
 static RUNS: AtomicUsize = AtomicUsize::new(0);
@@ -84,6 +93,7 @@ impl ResultFolder {
     /// Moves every staged result into the output folder, replacing earlier ones, and removes
     /// the failure mark of an earlier run.
     pub fn commit(&self) -> Result<(), OutputError> {
+        let _lock = CommitLock::acquire(&self.dir)?;
         for name in RESULT_FILES {
             let staged = self.staging.join(name);
             if staged.exists() {
@@ -129,6 +139,7 @@ fn mark_failed(
     if let Some(staging) = staging {
         remove_any(staging)?;
     }
+    let _lock = CommitLock::acquire(dir)?;
     remove_results(dir)?;
     let path = dir.join(FAILURE_MARK);
     std::fs::write(&path, failure_text(command, error))
@@ -187,4 +198,40 @@ fn remove_any(path: &Path) -> Result<(), OutputError> {
         path: path.to_owned(),
         source,
     })
+}
+
+/// The commit lock of an output folder, released when dropped.
+struct CommitLock(PathBuf);
+
+impl CommitLock {
+    fn acquire(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join(COMMIT_LOCK);
+        loop {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(_) => return Ok(CommitLock(path)),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let age = std::fs::metadata(&path)
+                        .and_then(|m| m.modified())
+                        .ok()
+                        .and_then(|t| t.elapsed().ok());
+                    if age.is_some_and(|a| a > STALE_LOCK) {
+                        remove_any(&path)?;
+                    } else {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                }
+                Err(source) => return Err(OutputError::Io { path, source }),
+            }
+        }
+    }
+}
+
+impl Drop for CommitLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
 }
