@@ -391,6 +391,14 @@ fn truncated_and_bit_flipped_meshes_give_errors_or_meshes_never_panics() {
         for cut in (0..bytes.len()).step_by(bytes.len() / 200 + 1) {
             let _ = read_msh_bytes(Path::new(name), &bytes[..cut]);
         }
+        // Every single-bit flip of the header (the data size of '4.1 1 8' among them).
+        for at in 0..64 {
+            for bit in 0..8 {
+                let mut flipped = bytes.clone();
+                flipped[at] ^= 1 << bit;
+                let _ = read_msh_bytes(Path::new(name), &flipped);
+            }
+        }
         for _ in 0..1000 {
             let mut flipped = bytes.clone();
             for _ in 0..1 + xorshift(&mut state) % 4 {
@@ -523,7 +531,7 @@ fn a_contact_case_with_a_bad_extra_body_fails_before_solving() {
 
 #[test]
 fn concurrent_runs_into_one_folder_leave_one_runs_complete_results() {
-    // Two cases that differ in Young's modulus, run together into one folder, four times.
+    // Two cases that differ in Young's modulus, run together into one folder, ten times.
     let dir = tempfile::tempdir().unwrap();
     let cases: Vec<PathBuf> = ["100.0", "400.0"]
         .iter()
@@ -537,7 +545,7 @@ fn concurrent_runs_into_one_folder_leave_one_runs_complete_results() {
         })
         .collect();
     let out = dir.path().join("shared");
-    for _ in 0..4 {
+    for _ in 0..10 {
         std::thread::scope(|s| {
             for case in &cases {
                 s.spawn(move || run_quiet(case).unwrap());

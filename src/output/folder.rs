@@ -60,8 +60,11 @@ impl ResultFolder {
     /// folder.
     pub fn create(dir: &Path) -> Result<Self, OutputError> {
         create_dir(dir)?;
-        remove_results(dir)?;
-        remove_any(&dir.join(GENERATED_MESH))?;
+        {
+            let _lock = CommitLock::acquire(dir)?;
+            remove_results(dir)?;
+            remove_any(&dir.join(GENERATED_MESH))?;
+        }
         let run = RUNS.fetch_add(1, Ordering::Relaxed);
         let staging = dir.join(format!("{STAGING_PREFIX}{}-{run}", std::process::id()));
         remove_any(&staging)?;
@@ -186,18 +189,23 @@ fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
     })
 }
 
-/// Removes a file or a folder with its contents; a missing one is fine.
+/// Removes a file or a folder with its contents; a missing one is fine (also one that another
+/// run removes at the same time).
 fn remove_any(path: &Path) -> Result<(), OutputError> {
-    let result = match std::fs::symlink_metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => Err(e),
-        Ok(meta) if meta.is_dir() => std::fs::remove_dir_all(path),
-        Ok(_) => std::fs::remove_file(path),
-    };
-    result.map_err(|source| OutputError::Io {
-        path: path.to_owned(),
-        source,
-    })
+    let result = std::fs::symlink_metadata(path).and_then(|meta| {
+        if meta.is_dir() {
+            std::fs::remove_dir_all(path)
+        } else {
+            std::fs::remove_file(path)
+        }
+    });
+    match result {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
+            path: path.to_owned(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// The commit lock of an output folder, released when dropped.
