@@ -488,6 +488,31 @@ fn a_failed_run_removes_earlier_results_and_marks_the_folder() {
 }
 
 #[test]
+fn runs_remove_only_their_own_files_from_the_output_folder() {
+    // An output folder the user keeps other files in, also inside matrices/.
+    let (dir, good) = write_case(&two_blocks_case(
+        &fixture("two_blocks_2d.msh"),
+        "upper",
+        "export_matrices = true",
+    ));
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("matrices")).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    std::fs::write(out.join("matrices/notes.txt"), "mine").unwrap();
+    run_quiet(&good).unwrap();
+    assert!(exists(&out, "matrices/lower_stiffness.mtx"));
+    let text = std::fs::read_to_string(&good).unwrap();
+    std::fs::write(
+        &good,
+        text.replace("name = \"upper\"", "name = \"nowhere\""),
+    )
+    .unwrap();
+    run_error(&good, "no body 'nowhere'");
+    assert!(!exists(&out, "matrices/lower_stiffness.mtx"));
+    assert!(exists(&out, "notes.txt") && exists(&out, "matrices/notes.txt"));
+}
+
+#[test]
 fn a_case_file_that_does_not_parse_marks_the_folder_it_names() {
     let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
     run_quiet(&good).unwrap();

@@ -24,8 +24,11 @@ pub const RESULT_FILES: [&str; 6] = [
     "summary.json",
     "force_displacement.csv",
     "force_displacement.png",
-    "matrices",
+    MATRICES,
 ];
+
+/// The folder of exported matrices, one of [`RESULT_FILES`].
+const MATRICES: &str = "matrices";
 
 /// The mesh gmsh made for a `.geo` case: the run's input, kept when the run fails so that the
 /// mesh an error names can be inspected.
@@ -63,11 +66,11 @@ impl ResultFolder {
         {
             let _lock = CommitLock::acquire(dir)?;
             remove_results(dir)?;
-            remove_any(&dir.join(GENERATED_MESH))?;
+            remove_file(&dir.join(GENERATED_MESH))?;
         }
         let run = RUNS.fetch_add(1, Ordering::Relaxed);
         let staging = dir.join(format!("{STAGING_PREFIX}{}-{run}", std::process::id()));
-        remove_any(&staging)?;
+        remove_staging(&staging)?;
         create_dir(&staging)?;
         Ok(ResultFolder {
             dir: dir.to_owned(),
@@ -97,16 +100,22 @@ impl ResultFolder {
     /// the failure mark of an earlier run.
     pub fn commit(&self) -> Result<(), OutputError> {
         let _lock = CommitLock::acquire(&self.dir)?;
+        remove_results(&self.dir)?;
         for name in RESULT_FILES {
             let staged = self.staging.join(name);
-            if staged.exists() {
-                let target = self.dir.join(name);
-                remove_any(&target)?;
+            let target = self.dir.join(name);
+            if staged.is_dir() {
+                // File by file: the folder may hold files of the user's beside ours.
+                create_dir(&target)?;
+                for entry in read_dir(&staged)? {
+                    rename(&entry, &target.join(entry.file_name().unwrap_or_default()))?;
+                }
+            } else if staged.exists() {
                 rename(&staged, &target)?;
             }
         }
-        remove_any(&self.staging)?;
-        remove_any(&self.dir.join(FAILURE_MARK))
+        remove_staging(&self.staging)?;
+        remove_file(&self.dir.join(FAILURE_MARK))
     }
 
     /// Removes this run's staged files and results, and writes [`FAILURE_MARK`] with `error`.
@@ -126,8 +135,8 @@ pub fn mark_failed_folder(dir: &Path, command: &str, error: &dyn std::error::Err
     if !dir.is_dir() {
         return;
     }
-    let marked =
-        remove_any(&dir.join(GENERATED_MESH)).and_then(|()| mark_failed(dir, None, command, error));
+    let marked = remove_file(&dir.join(GENERATED_MESH))
+        .and_then(|()| mark_failed(dir, None, command, error));
     if let Err(e) = marked {
         eprintln!("warning: {e}");
     }
@@ -140,7 +149,7 @@ fn mark_failed(
     error: &dyn std::error::Error,
 ) -> Result<(), OutputError> {
     if let Some(staging) = staging {
-        remove_any(staging)?;
+        remove_staging(staging)?;
     }
     let _lock = CommitLock::acquire(dir)?;
     remove_results(dir)?;
@@ -168,11 +177,37 @@ fn failure_text(command: &str, error: &dyn std::error::Error) -> String {
 }
 
 /// Removes the result files of earlier runs from `dir`.
+/// Removes the result files of earlier runs from `dir`. In `matrices/` only the `.mtx` files
+/// go (and the folder, if that empties it): the output folder may be one the user keeps other
+/// files in, and nothing but our own files may be removed.
 fn remove_results(dir: &Path) -> Result<(), OutputError> {
     for name in RESULT_FILES {
-        remove_any(&dir.join(name))?;
+        let path = dir.join(name);
+        if name == MATRICES && path.is_dir() {
+            for file in read_dir(&path)? {
+                if file.extension().is_some_and(|e| e == "mtx") && file.is_file() {
+                    remove_file(&file)?;
+                }
+            }
+            // Not empty: the user's files stay, and so does the folder.
+            let _ = std::fs::remove_dir(&path);
+        } else {
+            remove_file(&path)?;
+        }
     }
     Ok(())
+}
+
+/// The paths of the entries of a folder.
+fn read_dir(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    let io = |source| OutputError::Io {
+        path: dir.to_owned(),
+        source,
+    };
+    std::fs::read_dir(dir)
+        .map_err(io)?
+        .map(|entry| entry.map(|e| e.path()).map_err(io))
+        .collect()
 }
 
 fn create_dir(dir: &Path) -> Result<(), OutputError> {
@@ -189,16 +224,21 @@ fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
     })
 }
 
-/// Removes a file or a folder with its contents; a missing one is fine (also one that another
-/// run removes at the same time).
-fn remove_any(path: &Path) -> Result<(), OutputError> {
-    let result = std::fs::symlink_metadata(path).and_then(|meta| {
-        if meta.is_dir() {
-            std::fs::remove_dir_all(path)
-        } else {
-            std::fs::remove_file(path)
-        }
-    });
+/// Removes a file; a missing one is fine (also one that another run removes at the same time),
+/// and a folder of that name is the user's and stays.
+fn remove_file(path: &Path) -> Result<(), OutputError> {
+    if path.is_dir() {
+        return Ok(());
+    }
+    not_found_is_fine(path, std::fs::remove_file(path))
+}
+
+/// Removes a staging folder of ours with its contents.
+fn remove_staging(path: &Path) -> Result<(), OutputError> {
+    not_found_is_fine(path, std::fs::remove_dir_all(path))
+}
+
+fn not_found_is_fine(path: &Path, result: std::io::Result<()>) -> Result<(), OutputError> {
     match result {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
             path: path.to_owned(),
@@ -227,7 +267,7 @@ impl CommitLock {
                         .ok()
                         .and_then(|t| t.elapsed().ok());
                     if age.is_some_and(|a| a > STALE_LOCK) {
-                        remove_any(&path)?;
+                        remove_file(&path)?;
                     } else {
                         std::thread::sleep(Duration::from_millis(10));
                     }
