@@ -165,8 +165,8 @@ fn failure_text(command: &str, error: &dyn std::error::Error) -> String {
         .map_or(0, |d| d.as_secs());
     let mut text = format!(
         "The last run into this folder failed; it wrote no results, and the results of earlier \
-         runs were removed.\ncommand: {command}\ntime: {seconds} s since 1970-01-01 UTC\n\
-         error: {error}\n"
+         runs were removed.\ncommand: {command}\ntime: {}\nerror: {error}\n",
+        utc(seconds)
     );
     let mut source = error.source();
     while let Some(cause) = source {
@@ -176,7 +176,32 @@ fn failure_text(command: &str, error: &dyn std::error::Error) -> String {
     text
 }
 
-/// Removes the result files of earlier runs from `dir`.
+/// `seconds` since 1970 as a UTC date and time (the civil-from-days algorithm of H. Hinnant's
+/// "chrono-compatible low-level date algorithms"; no date crate for one line of a text file).
+fn utc(seconds: u64) -> String {
+    let days = i64::try_from(seconds / 86_400).unwrap_or(0) + 719_468;
+    let era = days.div_euclid(146_097);
+    let day_of_era = days - era * 146_097;
+    let year_of_era =
+        (day_of_era - day_of_era / 1460 + day_of_era / 36_524 - day_of_era / 146_096) / 365;
+    let day_of_year = day_of_era - (365 * year_of_era + year_of_era / 4 - year_of_era / 100);
+    let shifted_month = (5 * day_of_year + 2) / 153;
+    let day = day_of_year - (153 * shifted_month + 2) / 5 + 1;
+    let month = if shifted_month < 10 {
+        shifted_month + 3
+    } else {
+        shifted_month - 9
+    };
+    let year = year_of_era + era * 400 + i64::from(month <= 2);
+    let time = seconds % 86_400;
+    format!(
+        "{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02} UTC",
+        time / 3600,
+        time % 3600 / 60,
+        time % 60
+    )
+}
+
 /// Removes the result files of earlier runs from `dir`. In `matrices/` only the `.mtx` files
 /// go (and the folder, if that empties it): the output folder may be one the user keeps other
 /// files in, and nothing but our own files may be removed.
@@ -281,5 +306,17 @@ impl CommitLock {
 impl Drop for CommitLock {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::utc;
+
+    #[test]
+    fn utc_dates_match_known_timestamps() {
+        assert_eq!(utc(0), "1970-01-01 00:00:00 UTC");
+        assert_eq!(utc(951_782_400), "2000-02-29 00:00:00 UTC");
+        assert_eq!(utc(1_795_589_057), "2026-11-25 06:44:17 UTC");
     }
 }
