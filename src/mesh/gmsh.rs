@@ -197,7 +197,7 @@ impl FileContents {
                 .element_tags
                 .iter()
                 .zip(block.node_tags.chunks_exact(block.nodes_per_element));
-            for (&element_tag, nodes) in elements.clone() {
+            for (&element_tag, nodes) in elements {
                 if let Some(&node_tag) = nodes.iter().find(|t| !msh.nodes.contains_key(t)) {
                     return Err(MeshError::UndefinedNode {
                         path: path.to_owned(),

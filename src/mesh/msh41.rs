@@ -214,6 +214,7 @@ fn entities(cursor: &mut Cursor, contents: &mut MshContents) -> Result<(), MeshE
     contents.num_volumes = counts[3] as u64;
     for (dim, &count) in counts.iter().enumerate() {
         for _ in 0..count {
+            let at = cursor.value_start();
             let tag = cursor.int("an entity tag")?;
             // A point has its coordinates, the others their bounding box.
             let coordinates = if dim == 0 { 3 } else { 6 };
@@ -231,7 +232,12 @@ fn entities(cursor: &mut Cursor, contents: &mut MshContents) -> Result<(), MeshE
                     cursor.int("a bounding entity tag")?;
                 }
             }
-            contents.entity_groups.insert((dim, tag), tags);
+            if contents.entity_groups.insert((dim, tag), tags).is_some() {
+                return Err(cursor.error_at(
+                    at,
+                    format!("entity (dimension {dim}, tag {tag}) is defined twice in $Entities"),
+                ));
+            }
         }
     }
     Ok(())
