@@ -300,6 +300,19 @@ fn a_node_tag_defined_twice_is_an_error_naming_the_tag_and_lines() {
     );
 }
 
+#[test]
+fn an_entity_defined_twice_is_an_error() {
+    // The right edge's entity line with the left edge's tag: its physical tag would replace
+    // the left edge's.
+    let text = SQUARE_3412.replacen("2 1 0 0 1 1 0 1 2 0", "1 1 0 0 1 1 0 1 2 0", 1);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("entity.msh");
+    std::fs::write(&path, text).unwrap();
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::Syntax { line: 13, .. }), "{message}");
+    assert!(message.contains("defined twice in $Entities"), "{message}");
+}
+
 // ---------------------------------------------------------------------------------------------
 // 2. Corrupt headers are errors, not panics
 // ---------------------------------------------------------------------------------------------
@@ -336,16 +349,20 @@ fn binary_data_sizes_other_than_8_are_errors() {
 }
 
 #[test]
-fn empty_node_blocks_are_read() {
-    // gmsh's API writes a block of 0 nodes for each curve of the square (mshio's reader
-    // overflowed on them in debug builds).
-    let text = std::fs::read_to_string(fixture("square_sorted.msh")).unwrap();
-    assert!(
-        text.contains("\n1 1 0 0\n"),
-        "the fixture has an empty block"
-    );
-    let mesh = read_fixture("square_sorted.msh");
-    assert_eq!(mesh.bodies[0].num_nodes(), 25);
+fn a_nodes_section_announcing_zero_nodes_is_an_error_not_an_overflow() {
+    // numNodes = 0 with tags 1..1: mshio computed numNodes - 1 and overflowed (a panic in debug
+    // builds). The elements then refer to nodes the file does not define.
+    let (_dir, path) = edited_fixture("square_sorted.msh", |text| {
+        let start = text.find("$Nodes").unwrap();
+        let end = text.find("$EndNodes").unwrap();
+        format!(
+            "{}$Nodes\n1 0 1 1\n2 1 0 0\n{}",
+            &text[..start],
+            &text[end..]
+        )
+    });
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::UndefinedNode { .. }), "{message}");
 }
 
 #[test]
