@@ -1,5 +1,7 @@
 //! The `internodes` command line: `solve CASE` and `info MESH`.
 
+use std::error::Error;
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -43,7 +45,7 @@ fn main() -> ExitCode {
     // solves guarantee it themselves; faer's sparse LUs (RBF interpolation, the monolithic
     // reference solver) take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
-    let result: Result<(), Box<dyn std::error::Error>> = match Cli::parse().command {
+    let result: Result<(), Box<dyn Error>> = match Cli::parse().command {
         Command::Solve {
             case,
             output,
@@ -81,8 +83,8 @@ fn main() -> ExitCode {
             _ => Ok(()),
         }),
         Command::Info { mesh } => read_msh(&mesh)
-            .map(|m| print!("{}", MeshSummary(&m)))
-            .map_err(Into::into),
+            .map_err(Into::into)
+            .and_then(|m| print_stdout(&MeshSummary(&m).to_string())),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -95,5 +97,14 @@ fn main() -> ExitCode {
             }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Writes `text` to stdout. A reader that stops early (`internodes info m.msh | head`) closes
+/// the pipe: that is not an error, and `print!` would panic on it.
+fn print_stdout(text: &str) -> Result<(), Box<dyn Error>> {
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.map_err(Into::into),
     }
 }

@@ -6,4 +6,4 @@ mod error;
 mod schema;
 
 pub use error::CaseError;
-pub use schema::{BodySpec, Case, ContactSpec, DirichletSpec, HertzSpec, LoadSpec};
+pub use schema::{BodySpec, Case, ContactSpec, DirichletSpec, HertzSpec, LoadSpec, MAX_LOAD_STEPS};

@@ -12,6 +12,9 @@ use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
 use crate::mesh::{BodyMesh, Mesh};
 
+/// The most load steps a case may list (see [`Case::load`]).
+pub const MAX_LOAD_STEPS: usize = 1000;
+
 /// A case file. Relative paths are relative to the case file's folder.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -163,7 +166,119 @@ impl Case {
         if case.solver.residual_tolerance.is_nan() || case.solver.residual_tolerance <= 0.0 {
             return Err(case.invalid("[solver]", "residual_tolerance must be positive"));
         }
+        case.check_unique_bodies()?;
+        case.check_geo_parameters()?;
+        case.check_load_step_count()?;
         Ok(case)
+    }
+
+    /// The output folder a case file names, read from its raw TOML: where a run whose case
+    /// does not parse as a whole can still mark its failure.
+    pub fn output_folder_of(path: &Path) -> Option<PathBuf> {
+        let text = std::fs::read_to_string(path).ok()?;
+        let table: toml::Table = toml::from_str(&text).ok()?;
+        let output = table.get("output")?.as_str()?;
+        Some(path.parent().unwrap_or(Path::new("")).join(output))
+    }
+
+    /// A body listed in two `[[body]]` tables would be solved with the first and silently
+    /// ignore the second.
+    fn check_unique_bodies(&self) -> Result<(), CaseError> {
+        for (k, body) in self.bodies.iter().enumerate() {
+            if let Some(j) = self.bodies[..k].iter().position(|b| b.name == body.name) {
+                return Err(self.invalid(
+                    "[[body]]",
+                    format!(
+                        "body '{}' has two [[body]] tables (number {} and {}); give each body one",
+                        body.name,
+                        j + 1,
+                        k + 1
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `geo_parameters` must be finite, belong to a `.geo` mesh and be names the script uses:
+    /// gmsh ignores a `-setnumber` the script never reads and meshes its defaults.
+    fn check_geo_parameters(&self) -> Result<(), CaseError> {
+        if self.geo_parameters.is_empty() {
+            return Ok(());
+        }
+        if self.mesh.extension().is_none_or(|e| e != "geo") {
+            return Err(self.invalid(
+                "geo_parameters",
+                format!(
+                    "they are gmsh parameters of a .geo script, but the mesh {} is not a .geo: \
+                     they would be ignored; remove them or name the .geo",
+                    self.mesh.display()
+                ),
+            ));
+        }
+        for (name, value) in &self.geo_parameters {
+            if !value.is_finite() {
+                return Err(self.invalid(
+                    format!("geo_parameters.{name}"),
+                    format!("expected a finite number, got {value}"),
+                ));
+            }
+        }
+        // Without the script, gmsh's own error says so when the run meshes it.
+        let Ok(script) = std::fs::read_to_string(&self.mesh) else {
+            return Ok(());
+        };
+        let used = geo_identifiers(&script);
+        for name in self.geo_parameters.keys() {
+            if !used.contains(name.as_str()) {
+                let defined = geo_defined_constants(&script);
+                return Err(self.invalid(
+                    format!("geo_parameters.{name}"),
+                    format!(
+                        "{} does not use a parameter '{name}', so gmsh would ignore it \
+                         (the parameters it defines: {})",
+                        self.mesh.display(),
+                        if defined.is_empty() {
+                            "none".to_string()
+                        } else {
+                            defined.join(", ")
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Each load step is a whole contact solve, and its record goes into the summary: a list
+    /// longer than [`MAX_LOAD_STEPS`] is a mistake (it once took minutes and wrote a 490 MB
+    /// summary), not a load history.
+    fn check_load_step_count(&self) -> Result<(), CaseError> {
+        let count = self
+            .contact
+            .as_ref()
+            .and_then(|c| c.load_steps.as_ref())
+            .map_or(0, Vec::len);
+        if count > MAX_LOAD_STEPS {
+            return Err(self.invalid(
+                "[contact] load_steps",
+                format!(
+                    "{count} load steps; at most {MAX_LOAD_STEPS} are allowed (each step is a \
+                     whole contact solve)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Builds the problem of every body, so that a wrong group, material, load or support of
+    /// any body is an error before anything is solved or written.
+    pub fn check_bodies(&self, mesh: &Mesh) -> Result<(), CaseError> {
+        for spec in &self.bodies {
+            let body = self.body_mesh(mesh, spec)?;
+            self.elastic_problem(body, spec)?;
+        }
+        Ok(())
     }
 
     fn invalid(&self, context: impl Into<String>, message: impl Into<String>) -> CaseError {
@@ -196,7 +311,23 @@ impl Case {
     ) -> Result<ElasticProblem<'m>, CaseError> {
         let dim = body.dim;
         let context = |what: &str| format!("body '{}', {what}", spec.name);
+        let finite = |value: f64, what: &str| -> Result<f64, CaseError> {
+            if value.is_finite() {
+                Ok(value)
+            } else {
+                Err(self.invalid(
+                    context(what),
+                    format!("expected a finite number, got {value}"),
+                ))
+            }
+        };
         let vector = |v: &[f64], what: &str| -> Result<[f64; 3], CaseError> {
+            if let Some(bad) = v.iter().find(|x| !x.is_finite()) {
+                return Err(self.invalid(
+                    context(what),
+                    format!("expected finite components, got {bad} in {v:?}"),
+                ));
+            }
             if v.len() != dim {
                 return Err(self.invalid(
                     context(what),
@@ -229,10 +360,25 @@ impl Case {
         let mut loads = Vec::new();
         for l in &spec.loads {
             let what = format!("load on '{}'", l.group);
+            if body.point_groups.contains_key(&l.group) && body.boundary_group(&l.group).is_none() {
+                return Err(self.invalid(
+                    context(&what),
+                    format!(
+                        "'{}' is a group of points; a load needs a boundary group (a physical {} \
+                         of this body) to act on",
+                        l.group,
+                        if dim == 2 { "curve" } else { "surface" }
+                    ),
+                ));
+            }
             let load = match (&l.traction, l.pressure, &l.hertz_pressure) {
                 (Some(t), None, None) => SurfaceLoad::Traction(vector(t, &what)?),
-                (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(p)),
+                (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(finite(
+                    p,
+                    &format!("{what}, pressure"),
+                )?)),
                 (None, None, Some(h)) => {
+                    finite(h.p0, &format!("{what}, hertz_pressure.p0"))?;
                     if h.a.is_nan() || h.a <= 0.0 {
                         return Err(self.invalid(
                             context(&what),
@@ -322,4 +468,40 @@ impl Case {
             .map(Some)
             .map_err(|message| self.invalid("[contact]", message))
     }
+}
+
+/// The identifiers a gmsh script mentions outside `//` comments: a parameter the script never
+/// mentions cannot change its mesh.
+fn geo_identifiers(script: &str) -> std::collections::BTreeSet<&str> {
+    script
+        .lines()
+        .map(|line| line.split("//").next().unwrap_or(""))
+        .flat_map(|line| line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')))
+        .filter(|word| word.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_'))
+        .collect()
+}
+
+/// The names a gmsh script declares in `DefineConstant[ name = {...}, ... ]`, for messages.
+fn geo_defined_constants(script: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut rest = script;
+    while let Some(start) = rest.find("DefineConstant[") {
+        rest = &rest[start + "DefineConstant[".len()..];
+        let block = rest.split(']').next().unwrap_or("");
+        for (k, _) in block.match_indices("= {") {
+            let before = block[..k].trim_end();
+            let name: String = before
+                .chars()
+                .rev()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect();
+            if !name.is_empty() {
+                names.push(name);
+            }
+        }
+    }
+    names
 }

@@ -70,4 +70,22 @@ pub enum MeshError {
         element_tag: u64,
         majority: usize,
     },
+    #[error(
+        "{path}: the file is 2D (its bodies are physical surfaces) but its nodes do not lie in one \
+         plane z = const (z from {z_min:e} to {z_max:e}: {bodies}); a 2D mesh must be drawn in \
+         the xy plane, with the same z for every body"
+    )]
+    NotPlanar {
+        path: PathBuf,
+        z_min: f64,
+        z_max: f64,
+        bodies: String,
+    },
+    #[error(
+        "{path}: the geometry has {volumes} volume(s) but no physical volume, so no 3D body: \
+         a 3D body is a named physical volume (Physical Volume(\"name\") = {{...}} in the .geo)"
+    )]
+    NoPhysicalVolume { path: PathBuf, volumes: u64 },
+    #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
+    EmptyBody { path: PathBuf, body: String },
 }

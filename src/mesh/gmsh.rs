@@ -1,15 +1,23 @@
-//! Reader for gmsh MSH 4.1 files (ASCII and binary) through the `mshio` crate.
-//!
-//! `mshio` parses `$Entities`, `$Nodes` and `$Elements` but ignores `$PhysicalNames`, which is
-//! ASCII even in binary files, so that section is parsed here.
+//! Splitting a gmsh MSH 4.1 file (parsed by [`super::msh41`]) into bodies, boundary groups and
+//! point groups.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs;
 use std::path::Path;
 
-use mshio::{ElementType, MshFile};
-
+use super::msh41::{self, MshContents, element_type_name};
 use super::{BodyMesh, Dim, FacetGroup, Mesh, MeshError, PhysicalGroup, check_cells};
+
+/// gmsh element types: 1 the 2-node line, 2 the 3-node triangle, 4 the 4-node tetrahedron, 15
+/// the point.
+const LIN2: i32 = 1;
+const TRI3: i32 = 2;
+const TET4: i32 = 4;
+const PNT: i32 = 15;
+
+/// A 2D mesh must lie in a plane z = const: its z is dropped, so any spread of z beyond this
+/// fraction of the mesh size would be solved as a projection the user did not mesh.
+const PLANAR_RELATIVE_TOLERANCE: f64 = 1e-9;
 
 /// Reads a gmsh MSH 4.1 file and splits it into bodies and boundary groups.
 ///
@@ -21,10 +29,19 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_owned(),
         source,
     })?;
-    check_format_version(path, &bytes)?;
-    let physical_names = parse_physical_names(path, &bytes)?;
-    let msh = mshio::parse_msh_bytes(&bytes).map_err(|e| syntax_error(path, &bytes, &e))?;
-    let file = FileContents::new(path, &msh)?;
+    read_msh_bytes(path, &bytes)
+}
+
+/// [`read_msh`] on the bytes of a file already read; `path` names it in the mesh and in errors.
+/// Any bytes give a mesh or an error, never a panic (the fuzz target in `fuzz/` checks this).
+pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let msh = msh41::parse(path, bytes)?;
+    let physical_names: BTreeMap<(Dim, i32), String> = msh
+        .physical_names
+        .iter()
+        .map(|n| ((n.dim, n.tag), n.name.clone()))
+        .collect();
+    let file = FileContents::new(path, msh)?;
 
     let dim = file.dim;
     let name_of = |d: Dim, tag: i32| -> String {
@@ -58,6 +75,12 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
             continue;
         }
         let mut body = file.body(name_of(d, tag), tag, elements)?;
+        if body.cells.is_empty() {
+            return Err(MeshError::EmptyBody {
+                path: path.to_owned(),
+                body: body.name,
+            });
+        }
         for (&(fd, ftag), facets) in &file.groups {
             if fd + 1 == dim {
                 let group = file.facet_group(&body, ftag, facets);
@@ -71,7 +94,6 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
                 }
             }
         }
-        check_cells(path, &body)?;
         bodies.push(body);
     }
     if bodies.is_empty() {
@@ -79,6 +101,13 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
             path: path.to_owned(),
             expected: "surface (2D) or volume (3D) of triangles / tetrahedra",
         });
+    }
+    // A 2D mesh off the xy plane has cells that look degenerate in xy: say why first.
+    if dim == 2 {
+        check_planar(path, &bodies)?;
+    }
+    for body in &bodies {
+        check_cells(path, body)?;
     }
     Ok(Mesh {
         path: path.to_owned(),
@@ -105,44 +134,15 @@ struct FileContents {
 }
 
 impl FileContents {
-    fn new(path: &Path, msh: &MshFile<u64, i32, f64>) -> Result<Self, MeshError> {
-        let mut coords = HashMap::new();
-        if let Some(nodes) = &msh.data.nodes {
-            // With contiguous tags mshio drops the per-block maps: tags then run from
-            // `min_node_tag` through the blocks in file order.
-            let mut next_implicit_tag = nodes.min_node_tag;
-            for block in &nodes.node_blocks {
-                let mut tags: Vec<(u64, usize)> = match &block.node_tags {
-                    Some(map) => map.iter().map(|(&t, &i)| (t, i)).collect(),
-                    None => (0..block.nodes.len())
-                        .map(|i| (next_implicit_tag + i as u64, i))
-                        .collect(),
-                };
-                tags.sort_unstable();
-                next_implicit_tag += block.nodes.len() as u64;
-                for (tag, i) in tags {
-                    let n = &block.nodes[i];
-                    coords.insert(tag, [n.x, n.y, n.z]);
-                }
-            }
-        }
-
-        let physical_tags = entity_physical_tags(msh);
-        let blocks = msh
-            .data
-            .elements
-            .as_ref()
-            .map(|e| e.element_blocks.as_slice())
-            .unwrap_or_default();
-        let in_group = |d: i32, tag: i32| {
-            physical_tags
-                .get(&(d as Dim, tag))
-                .is_some_and(|t| !t.is_empty())
-        };
+    fn new(path: &Path, msh: MshContents) -> Result<Self, MeshError> {
+        let physical_tags = &msh.entity_groups;
+        let blocks = &msh.element_blocks;
+        let in_group =
+            |d: Dim, tag: i32| physical_tags.get(&(d, tag)).is_some_and(|t| !t.is_empty());
         let dim = blocks
             .iter()
             .filter(|b| in_group(b.entity_dim, b.entity_tag))
-            .map(|b| b.entity_dim as Dim)
+            .map(|b| b.entity_dim)
             .max()
             .unwrap_or(0);
         if dim < 2 {
@@ -151,10 +151,18 @@ impl FileContents {
                 expected: "surface (2D) or volume (3D)",
             });
         }
+        // gmsh saves only the elements of physical groups: a 3D geometry with physical surfaces
+        // but no physical volume gives a file of surface triangles, which is not a 2D body.
+        if dim == 2 && msh.num_volumes > 0 {
+            return Err(MeshError::NoPhysicalVolume {
+                path: path.to_owned(),
+                volumes: msh.num_volumes,
+            });
+        }
 
         let mut groups: BTreeMap<(Dim, i32), GroupElements> = BTreeMap::new();
         for block in blocks {
-            let d = block.entity_dim as Dim;
+            let d = block.entity_dim;
             let Some(tags) = physical_tags.get(&(d, block.entity_tag)) else {
                 continue;
             };
@@ -166,14 +174,14 @@ impl FileContents {
             let expected_type = if d == dim {
                 cell_type(dim)
             } else if d == 0 {
-                ElementType::Pnt
+                PNT
             } else {
                 facet_type(dim)
             };
             if block.element_type != expected_type {
                 return Err(MeshError::UnsupportedElement {
                     path: path.to_owned(),
-                    element_type: format!("{:?}", block.element_type),
+                    element_type: element_type_name(block.element_type),
                     location: format!(
                         "entity {} of dimension {} (physical group {:?})",
                         block.entity_tag, d, tags
@@ -185,26 +193,28 @@ impl FileContents {
                     },
                 });
             }
+            let elements = block
+                .element_tags
+                .iter()
+                .zip(block.node_tags.chunks_exact(block.nodes_per_element));
+            for (&element_tag, nodes) in elements {
+                if let Some(&node_tag) = nodes.iter().find(|t| !msh.nodes.contains_key(t)) {
+                    return Err(MeshError::UndefinedNode {
+                        path: path.to_owned(),
+                        element_tag,
+                        node_tag,
+                    });
+                }
+            }
             for &tag in tags {
                 let group = groups.entry((d, tag)).or_default();
-                for element in &block.elements {
-                    for node in &element.nodes {
-                        if !coords.contains_key(node) {
-                            return Err(MeshError::UndefinedNode {
-                                path: path.to_owned(),
-                                element_tag: element.element_tag,
-                                node_tag: *node,
-                            });
-                        }
-                    }
-                    group.element_tags.push(element.element_tag);
-                    group.node_tags.extend_from_slice(&element.nodes);
-                }
+                group.element_tags.extend_from_slice(&block.element_tags);
+                group.node_tags.extend_from_slice(&block.node_tags);
             }
         }
         Ok(FileContents {
             dim,
-            coords,
+            coords: msh.nodes,
             groups,
         })
     }
@@ -289,20 +299,43 @@ impl FileContents {
     }
 }
 
-fn cell_type(dim: Dim) -> ElementType {
-    if dim == 2 {
-        ElementType::Tri3
-    } else {
-        ElementType::Tet4
-    }
+fn cell_type(dim: Dim) -> i32 {
+    if dim == 2 { TRI3 } else { TET4 }
 }
 
-fn facet_type(dim: Dim) -> ElementType {
-    if dim == 2 {
-        ElementType::Lin2
-    } else {
-        ElementType::Tri3
+fn facet_type(dim: Dim) -> i32 {
+    if dim == 2 { LIN2 } else { TRI3 }
+}
+
+/// Rejects a 2D mesh whose nodes do not share one z: the solver works on x and y only, while
+/// the contact search measures 3D distances, so such a mesh would be solved as a projection.
+fn check_planar(path: &Path, bodies: &[BodyMesh]) -> Result<(), MeshError> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for body in bodies {
+        let (l, h) = body.bounding_box();
+        for k in 0..3 {
+            lo[k] = lo[k].min(l[k]);
+            hi[k] = hi[k].max(h[k]);
+        }
     }
+    let size = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(hi[2] - lo[2]);
+    if hi[2] - lo[2] > PLANAR_RELATIVE_TOLERANCE * size {
+        let body_z = bodies
+            .iter()
+            .map(|b| {
+                let (l, h) = b.bounding_box();
+                format!("'{}' z in [{:e}, {:e}]", b.name, l[2], h[2])
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(MeshError::NotPlanar {
+            path: path.to_owned(),
+            z_min: lo[2],
+            z_max: hi[2],
+            bodies: body_z,
+        });
+    }
+    Ok(())
 }
 
 /// Reorders `face` so that its right-hand normal points away from the cell's `opposite` node.
@@ -316,146 +349,5 @@ fn orient_outward(coords: &[[f64; 3]], face: &mut [usize], opposite: usize, dim:
     };
     if normal.dot(&(p(opposite) - p(face[0]))) > 0.0 {
         face.swap(0, 1);
-    }
-}
-
-/// (entity dimension, entity tag) -> physical tags, from the `$Entities` section.
-fn entity_physical_tags(msh: &MshFile<u64, i32, f64>) -> HashMap<(Dim, i32), Vec<i32>> {
-    let mut map = HashMap::new();
-    if let Some(e) = &msh.data.entities {
-        for p in &e.points {
-            map.insert((0, p.tag), p.physical_tags.clone());
-        }
-        for c in &e.curves {
-            map.insert((1, c.tag), c.physical_tags.clone());
-        }
-        for s in &e.surfaces {
-            map.insert((2, s.tag), s.physical_tags.clone());
-        }
-        for v in &e.volumes {
-            map.insert((3, v.tag), v.physical_tags.clone());
-        }
-    }
-    map
-}
-
-/// Rejects anything but MSH 4.1 with a message that says how to fix it (mshio would only say
-/// "invalid header").
-fn check_format_version(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
-    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(256)]);
-    let mut lines = head.lines();
-    if lines.next().map(str::trim) != Some("$MeshFormat") {
-        return Err(MeshError::Syntax {
-            path: path.to_owned(),
-            line: 1,
-            message: "expected '$MeshFormat': this is not a gmsh MSH file".into(),
-        });
-    }
-    let version = lines
-        .next()
-        .and_then(|l| l.split_whitespace().next())
-        .unwrap_or("")
-        .to_string();
-    if version != "4.1" {
-        return Err(MeshError::UnsupportedVersion {
-            path: path.to_owned(),
-            version,
-        });
-    }
-    Ok(())
-}
-
-/// Parses `$PhysicalNames`: a count, then one `dim tag "name"` line per group.
-fn parse_physical_names(
-    path: &Path,
-    bytes: &[u8],
-) -> Result<BTreeMap<(Dim, i32), String>, MeshError> {
-    let mut names = BTreeMap::new();
-    let Some(start) = find(bytes, b"$PhysicalNames") else {
-        return Ok(names);
-    };
-    let first_line = 1 + bytes[..start].iter().filter(|&&b| b == b'\n').count();
-    let syntax = |offset: usize, message: String| MeshError::Syntax {
-        path: path.to_owned(),
-        line: first_line + offset,
-        message,
-    };
-    let section = &bytes[start..];
-    let end = find(section, b"$EndPhysicalNames").ok_or_else(|| {
-        syntax(
-            0,
-            "$PhysicalNames is not closed by $EndPhysicalNames".into(),
-        )
-    })?;
-    let text = String::from_utf8_lossy(&section[..end]);
-    let lines: Vec<&str> = text.lines().collect();
-    let count: usize = lines
-        .get(1)
-        .and_then(|l| l.trim().parse().ok())
-        .ok_or_else(|| syntax(1, "expected the number of physical names".into()))?;
-    if lines.len() < count + 2 {
-        return Err(syntax(
-            lines.len(),
-            format!(
-                "$PhysicalNames announces {count} names but lists {}",
-                lines.len().saturating_sub(2)
-            ),
-        ));
-    }
-    for (k, line) in lines[2..2 + count].iter().enumerate() {
-        let bad = || {
-            syntax(
-                k + 2,
-                format!("expected 'dim tag \"name\"' in $PhysicalNames, found '{line}'"),
-            )
-        };
-        let mut parts = line.splitn(3, char::is_whitespace);
-        let d: Dim = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
-        let tag: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
-        let name = parts.next().map(str::trim).ok_or_else(bad)?;
-        let name = name
-            .strip_prefix('"')
-            .and_then(|s| s.strip_suffix('"'))
-            .ok_or_else(bad)?;
-        names.insert((d, tag), name.to_string());
-    }
-    Ok(names)
-}
-
-fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
-    haystack.windows(needle.len()).position(|w| w == needle)
-}
-
-/// Turns a parser error into one message with the line where parsing failed.
-fn syntax_error(path: &Path, bytes: &[u8], error: &mshio::MshParserError<&[u8]>) -> MeshError {
-    let line = error
-        .backtrace
-        .first()
-        .map(|(rest, _)| {
-            let offset = bytes.len().saturating_sub(rest.len());
-            1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count()
-        })
-        .unwrap_or(1);
-    let mut context: Vec<String> = error
-        .filter_msh_errors()
-        .map(|(_, kind)| kind.to_string())
-        .collect();
-    context.reverse();
-    let mut message = if context.is_empty() {
-        "the file ends early or is malformed".to_string()
-    } else {
-        context.join(": ")
-    };
-    if error
-        .backtrace
-        .first()
-        .is_some_and(|(rest, _)| rest.is_empty())
-    {
-        message.push_str(" (the file ends early: truncated?)");
-    }
-    MeshError::Syntax {
-        path: path.to_owned(),
-        line,
-        message,
     }
 }

@@ -11,12 +11,13 @@
 mod error;
 mod generate;
 mod gmsh;
+mod msh41;
 mod quality;
 mod summary;
 
 pub use error::MeshError;
 pub use generate::mesh_geo;
-pub use gmsh::read_msh;
+pub use gmsh::{read_msh, read_msh_bytes};
 pub use quality::{check_cells, signed_measure};
 pub use summary::MeshSummary;
 

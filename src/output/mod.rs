@@ -1,11 +1,13 @@
 //! Result files: XDMF + HDF5 for ParaView and h5py, the JSON summary, Matrix Market matrices,
 //! the force-displacement plot.
 
+mod folder;
 mod matrix_market;
 mod plot;
 mod summary;
 mod xdmf;
 
+pub use folder::{FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, mark_failed_folder};
 pub use matrix_market::write_matrix_market;
 pub use plot::{PlotError, write_force_displacement_png};
 pub use summary::{BodySummary, CaseSummary, ContactSummary, StepRecord};

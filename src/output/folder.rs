@@ -1,0 +1,322 @@
+//! The output folder of a run: it holds one run's complete results, or a failure mark and
+//! nothing that looks like a result.
+//!
+//! A run removes the result files of earlier runs when it starts (so a run that is killed
+//! leaves no stale results), writes its own into a private staging folder inside the output
+//! folder, and moves them into place only when every body has been solved and every file
+//! written ([`ResultFolder::commit`]). A run that fails removes its staging folder and writes
+//! [`FAILURE_MARK`] with the error ([`ResultFolder::fail`]); the next successful run removes it.
+//! The staging folder's name carries the process id and a counter, so concurrent runs never
+//! write into each other's files, and a lock file makes each commit (or failure mark) whole:
+//! the run that finishes last owns the folder, with all of its files.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use super::OutputError;
+
+/// The results a run writes into its output folder, as file or folder names.
+pub const RESULT_FILES: [&str; 6] = [
+    "solution.xdmf",
+    "solution.h5",
+    "summary.json",
+    "force_displacement.csv",
+    "force_displacement.png",
+    MATRICES,
+];
+
+/// The folder of exported matrices, one of [`RESULT_FILES`].
+const MATRICES: &str = "matrices";
+
+/// The mesh gmsh made for a `.geo` case: the run's input, kept when the run fails so that the
+/// mesh an error names can be inspected.
+pub const GENERATED_MESH: &str = "mesh.msh";
+
+/// Written into the output folder by a run that failed, with its error.
+pub const FAILURE_MARK: &str = "FAILED.txt";
+
+/// Prefix of the staging folders of running (or killed) runs.
+const STAGING_PREFIX: &str = ".internodes-partial-";
+
+/// Held while results are moved into place, so that two runs finishing together do not mix
+/// their files.
+const COMMIT_LOCK: &str = ".internodes-commit.lock";
+
+/// A lock older than this belongs to a run that was killed while committing (a commit is a few
+/// renames): it is removed.
+const STALE_LOCK: Duration = Duration::from_secs(30);
+
+/// Distinguishes staging folders of runs in one process (tests run cases in parallel).
+static RUNS: AtomicUsize = AtomicUsize::new(0);
+
+/// An output folder with a run's staging folder in it.
+#[derive(Debug)]
+pub struct ResultFolder {
+    dir: PathBuf,
+    staging: PathBuf,
+}
+
+impl ResultFolder {
+    /// Creates `dir` if needed, removes earlier results (and mesh) and creates the staging
+    /// folder.
+    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+        create_dir(dir)?;
+        {
+            let _lock = CommitLock::acquire(dir)?;
+            remove_results(dir)?;
+            remove_file(&dir.join(GENERATED_MESH))?;
+        }
+        let run = RUNS.fetch_add(1, Ordering::Relaxed);
+        let staging = dir.join(format!("{STAGING_PREFIX}{}-{run}", std::process::id()));
+        remove_staging(&staging)?;
+        create_dir(&staging)?;
+        Ok(ResultFolder {
+            dir: dir.to_owned(),
+            staging,
+        })
+    }
+
+    /// The output folder the results end up in.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Where this run writes its result files until [`ResultFolder::commit`].
+    pub fn staging(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Moves a staged file into the output folder at once: the mesh gmsh made, which is the
+    /// run's input and is kept even if the run fails.
+    pub fn publish(&self, name: &str) -> Result<PathBuf, OutputError> {
+        let target = self.dir.join(name);
+        rename(&self.staging.join(name), &target)?;
+        Ok(target)
+    }
+
+    /// Moves every staged result into the output folder, replacing earlier ones, and removes
+    /// the failure mark of an earlier run.
+    pub fn commit(&self) -> Result<(), OutputError> {
+        let _lock = CommitLock::acquire(&self.dir)?;
+        remove_results(&self.dir)?;
+        for name in RESULT_FILES {
+            let staged = self.staging.join(name);
+            let target = self.dir.join(name);
+            if staged.is_dir() {
+                // File by file: the folder may hold files of the user's beside ours.
+                create_dir(&target)?;
+                for entry in read_dir(&staged)? {
+                    rename(&entry, &target.join(entry.file_name().unwrap_or_default()))?;
+                }
+            } else if staged.exists() {
+                rename(&staged, &target)?;
+            }
+        }
+        remove_staging(&self.staging)?;
+        remove_file(&self.dir.join(FAILURE_MARK))
+    }
+
+    /// Removes this run's staged files and results, and writes [`FAILURE_MARK`] with `error`.
+    /// Best effort: the error itself is what the caller reports, so a folder that cannot be
+    /// cleaned is reported on stderr only.
+    pub fn fail(&self, command: &str, error: &dyn std::error::Error) {
+        if let Err(e) = mark_failed(&self.dir, Some(&self.staging), command, error) {
+            eprintln!("warning: {e}");
+        }
+    }
+}
+
+/// Marks `dir` as holding the failure of a run that stopped before it had a
+/// [`ResultFolder`] (a case file that does not parse): earlier results and mesh are removed
+/// and [`FAILURE_MARK`] written. Nothing is done if `dir` does not exist.
+pub fn mark_failed_folder(dir: &Path, command: &str, error: &dyn std::error::Error) {
+    if !dir.is_dir() {
+        return;
+    }
+    let marked = remove_file(&dir.join(GENERATED_MESH))
+        .and_then(|()| mark_failed(dir, None, command, error));
+    if let Err(e) = marked {
+        eprintln!("warning: {e}");
+    }
+}
+
+fn mark_failed(
+    dir: &Path,
+    staging: Option<&Path>,
+    command: &str,
+    error: &dyn std::error::Error,
+) -> Result<(), OutputError> {
+    if let Some(staging) = staging {
+        remove_staging(staging)?;
+    }
+    let _lock = CommitLock::acquire(dir)?;
+    remove_results(dir)?;
+    let path = dir.join(FAILURE_MARK);
+    std::fs::write(&path, failure_text(command, error))
+        .map_err(|source| OutputError::Io { path, source })
+}
+
+/// The failure mark's text: what ran, when, and the error with its causes.
+fn failure_text(command: &str, error: &dyn std::error::Error) -> String {
+    let seconds = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let mut text = format!(
+        "The last run into this folder failed; it wrote no results, and the results of earlier \
+         runs were removed.\ncommand: {command}\ntime: {}\nerror: {error}\n",
+        utc(seconds)
+    );
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let _ = writeln!(text, "  caused by: {cause}");
+        source = cause.source();
+    }
+    text
+}
+
+/// `seconds` since 1970 as a UTC date and time (the civil-from-days algorithm of H. Hinnant's
+/// "chrono-compatible low-level date algorithms"; no date crate for one line of a text file).
+fn utc(seconds: u64) -> String {
+    let days = i64::try_from(seconds / 86_400).unwrap_or(0) + 719_468;
+    let era = days.div_euclid(146_097);
+    let day_of_era = days - era * 146_097;
+    let year_of_era =
+        (day_of_era - day_of_era / 1460 + day_of_era / 36_524 - day_of_era / 146_096) / 365;
+    let day_of_year = day_of_era - (365 * year_of_era + year_of_era / 4 - year_of_era / 100);
+    let shifted_month = (5 * day_of_year + 2) / 153;
+    let day = day_of_year - (153 * shifted_month + 2) / 5 + 1;
+    let month = if shifted_month < 10 {
+        shifted_month + 3
+    } else {
+        shifted_month - 9
+    };
+    let year = year_of_era + era * 400 + i64::from(month <= 2);
+    let time = seconds % 86_400;
+    format!(
+        "{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02} UTC",
+        time / 3600,
+        time % 3600 / 60,
+        time % 60
+    )
+}
+
+/// Removes the result files of earlier runs from `dir`. In `matrices/` only the `.mtx` files
+/// go (and the folder, if that empties it): the output folder may be one the user keeps other
+/// files in, and nothing but our own files may be removed.
+fn remove_results(dir: &Path) -> Result<(), OutputError> {
+    for name in RESULT_FILES {
+        let path = dir.join(name);
+        if name == MATRICES && path.is_dir() {
+            for file in read_dir(&path)? {
+                if file.extension().is_some_and(|e| e == "mtx") && file.is_file() {
+                    remove_file(&file)?;
+                }
+            }
+            // Not empty: the user's files stay, and so does the folder.
+            let _ = std::fs::remove_dir(&path);
+        } else {
+            remove_file(&path)?;
+        }
+    }
+    Ok(())
+}
+
+/// The paths of the entries of a folder.
+fn read_dir(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    let io = |source| OutputError::Io {
+        path: dir.to_owned(),
+        source,
+    };
+    std::fs::read_dir(dir)
+        .map_err(io)?
+        .map(|entry| entry.map(|e| e.path()).map_err(io))
+        .collect()
+}
+
+fn create_dir(dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+        path: dir.to_owned(),
+        source,
+    })
+}
+
+fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
+    std::fs::rename(from, to).map_err(|source| OutputError::Io {
+        path: to.to_owned(),
+        source,
+    })
+}
+
+/// Removes a file; a missing one is fine (also one that another run removes at the same time),
+/// and a folder of that name is the user's and stays.
+fn remove_file(path: &Path) -> Result<(), OutputError> {
+    if path.is_dir() {
+        return Ok(());
+    }
+    not_found_is_fine(path, std::fs::remove_file(path))
+}
+
+/// Removes a staging folder of ours with its contents.
+fn remove_staging(path: &Path) -> Result<(), OutputError> {
+    not_found_is_fine(path, std::fs::remove_dir_all(path))
+}
+
+fn not_found_is_fine(path: &Path, result: std::io::Result<()>) -> Result<(), OutputError> {
+    match result {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
+            path: path.to_owned(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The commit lock of an output folder, released when dropped.
+struct CommitLock(PathBuf);
+
+impl CommitLock {
+    fn acquire(dir: &Path) -> Result<Self, OutputError> {
+        let path = dir.join(COMMIT_LOCK);
+        loop {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(_) => return Ok(CommitLock(path)),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let age = std::fs::metadata(&path)
+                        .and_then(|m| m.modified())
+                        .ok()
+                        .and_then(|t| t.elapsed().ok());
+                    if age.is_some_and(|a| a > STALE_LOCK) {
+                        remove_file(&path)?;
+                    } else {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                }
+                Err(source) => return Err(OutputError::Io { path, source }),
+            }
+        }
+    }
+}
+
+impl Drop for CommitLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::utc;
+
+    #[test]
+    fn utc_dates_match_known_timestamps() {
+        assert_eq!(utc(0), "1970-01-01 00:00:00 UTC");
+        assert_eq!(utc(951_782_400), "2000-02-29 00:00:00 UTC");
+        assert_eq!(utc(1_795_589_057), "2026-11-25 06:44:17 UTC");
+    }
+}

@@ -1,0 +1,866 @@
+//! Hostile but fair input (issue 12): every case here once gave a misread mesh, a panic, a
+//! stale result or a vague message. Each test names what must happen instead; future fixes of
+//! bad-input handling add their case here.
+
+mod common;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{edited_fixture, fixture, read_fixture, write_case};
+use internodes::mesh::{Mesh, MeshError, read_msh, read_msh_bytes};
+use internodes::run::{RunError, RunOptions, solve_case};
+
+const BINARY: &str = env!("CARGO_BIN_EXE_internodes");
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------------
+
+/// The coordinates of every node of every body, by gmsh node tag.
+fn coords_by_tag(mesh: &Mesh) -> HashMap<u64, [f64; 3]> {
+    mesh.bodies
+        .iter()
+        .flat_map(|b| b.node_tags.iter().copied().zip(b.coords.iter().copied()))
+        .collect()
+}
+
+/// Every cell of every body as its gmsh node tags, by gmsh element tag.
+fn cells_by_tag(mesh: &Mesh) -> HashMap<u64, Vec<u64>> {
+    mesh.bodies
+        .iter()
+        .flat_map(|b| {
+            (0..b.num_cells()).map(move |c| {
+                (
+                    b.cell_tags[c],
+                    b.cell(c).iter().map(|&n| b.node_tags[n]).collect(),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Rewrites every coordinate line of the `$Nodes` section of an ASCII MSH 4.1 text with
+/// `edit(tag, [x, y, z])`.
+fn edit_nodes(text: &str, edit: impl Fn(u64, [f64; 3]) -> String) -> String {
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let start = lines.iter().position(|l| l == "$Nodes").unwrap();
+    let num_blocks: usize = lines[start + 1]
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut i = start + 2;
+    for _ in 0..num_blocks {
+        let count: usize = lines[i].split_whitespace().nth(3).unwrap().parse().unwrap();
+        for k in 0..count {
+            let tag: u64 = lines[i + 1 + k].trim().parse().unwrap();
+            let line = &mut lines[i + 1 + count + k];
+            let x: Vec<f64> = line
+                .split_whitespace()
+                .map(|v| v.parse().unwrap())
+                .collect();
+            *line = edit(tag, [x[0], x[1], x[2]]);
+        }
+        i += 1 + 2 * count;
+    }
+    lines.join("\n") + "\n"
+}
+
+/// The error of a mesh file that must be rejected, and its message.
+fn mesh_error(path: &Path) -> (MeshError, String) {
+    let e = read_msh(path).expect_err("the mesh must be rejected");
+    let message = e.to_string();
+    (e, message)
+}
+
+fn run_quiet(case: &Path) -> Result<internodes::run::RunReport, RunError> {
+    solve_case(
+        case,
+        &RunOptions {
+            quiet: true,
+            ..Default::default()
+        },
+    )
+}
+
+/// The error of a case file that must fail; `why` says why it must.
+fn run_error(case: &Path, why: &str) -> RunError {
+    match run_quiet(case) {
+        Ok(_) => panic!("{} should fail: {why}", case.display()),
+        Err(e) => e,
+    }
+}
+
+/// The message of a case that must fail.
+fn case_failure(text: &str) -> String {
+    let (_dir, path) = write_case(text);
+    match run_quiet(&path) {
+        Ok(_) => panic!("the case should fail:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The two bodies of `two_blocks_2d.msh` (or an edit of it at `mesh`), each supported on its own.
+fn two_blocks_case(mesh: &Path, upper: &str, extra: &str) -> String {
+    format!(
+        r#"mesh = "{}"
+output = "out"
+{extra}
+
+[[body]]
+name = "lower"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "lower_base"
+ux = 0.0
+uy = 0.0
+[[body.load]]
+group = "lower_contact"
+traction = [0.0, -1.0]
+
+[[body]]
+name = "{upper}"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "upper_top"
+ux = 0.0
+uy = 0.0
+"#,
+        mesh.display()
+    )
+}
+
+/// The unit square of `square_*.msh`: clamped on `left`, pulled by `traction` on `right`.
+fn square_case(mesh: &str, traction: &str) -> String {
+    format!(
+        r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "square"
+youngs_modulus = 100.0
+poisson_ratio = 0.25
+[[body.dirichlet]]
+group = "left"
+ux = 0.0
+uy = 0.0
+[[body.load]]
+group = "right"
+traction = {traction}
+"#,
+        fixture(mesh).display()
+    )
+}
+
+/// Displacement of every node of `solution.h5` in `dir`, by gmsh node tag.
+fn displacement_by_tag(dir: &Path) -> HashMap<i64, Vec<f64>> {
+    let file = hdf5::File::open(dir.join("solution.h5")).unwrap();
+    let tags: Vec<i64> = file.dataset("mesh/node_tag").unwrap().read_raw().unwrap();
+    let u: Vec<f64> = file
+        .dataset("fields/displacement")
+        .unwrap()
+        .read_raw()
+        .unwrap();
+    let width = u.len() / tags.len();
+    tags.into_iter()
+        .zip(u.chunks(width).map(<[f64]>::to_vec))
+        .collect()
+}
+
+fn exists(dir: &Path, name: &str) -> bool {
+    dir.join(name).exists()
+}
+
+// ---------------------------------------------------------------------------------------------
+// 1. Node tags are read as written
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn shuffled_node_tags_give_the_same_mesh_as_sorted_ones() {
+    // Written by gmsh's Python API (tests/fixtures/shuffled_tags.py): the same nodes and
+    // elements, added in increasing tag order or in a shuffled one.
+    for (sorted, shuffled) in [
+        ("square_sorted.msh", "square_shuffled.msh"),
+        ("square_sorted.msh", "square_shuffled_bin.msh"),
+        ("cube_sorted.msh", "cube_shuffled.msh"),
+    ] {
+        let a = read_fixture(sorted);
+        let b = read_fixture(shuffled);
+        assert_eq!(coords_by_tag(&a), coords_by_tag(&b), "{shuffled}");
+        assert_eq!(cells_by_tag(&a), cells_by_tag(&b), "{shuffled}");
+    }
+}
+
+/// The issue's example: a unit square whose four nodes are written in the order 3, 4, 1, 2
+/// (a dense tag range, so the old reader numbered them 1, 2, 3, 4 by position).
+const SQUARE_3412: &str = r#"$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+3
+1 1 "left"
+1 2 "right"
+2 3 "square"
+$EndPhysicalNames
+$Entities
+0 2 1 0
+1 0 0 0 0 1 0 1 1 0
+2 1 0 0 1 1 0 1 2 0
+1 0 0 0 1 1 0 1 3 0
+$EndEntities
+$Nodes
+1 4 1 4
+2 1 0 4
+3
+4
+1
+2
+1 1 0
+0 1 0
+0 0 0
+1 0 0
+$EndNodes
+$Elements
+3 4 1 4
+1 1 1 1
+1 4 1
+1 2 1 1
+2 2 3
+2 1 2 2
+3 1 2 3
+4 1 3 4
+$EndElements
+"#;
+
+#[test]
+fn the_square_written_in_the_order_3_4_1_2_is_read_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("square_3412.msh");
+    std::fs::write(&path, SQUARE_3412).unwrap();
+    let mesh = read_msh(&path).unwrap();
+    let expected: HashMap<u64, [f64; 3]> = [
+        (1, [0.0, 0.0, 0.0]),
+        (2, [1.0, 0.0, 0.0]),
+        (3, [1.0, 1.0, 0.0]),
+        (4, [0.0, 1.0, 0.0]),
+    ]
+    .into_iter()
+    .collect();
+    assert_eq!(coords_by_tag(&mesh), expected);
+    // The clamped edge is x = 0, the loaded one x = 1 (not swapped by a 180 degree rotation).
+    let body = &mesh.bodies[0];
+    for (group, x) in [("left", 0.0), ("right", 1.0)] {
+        for n in body.group_nodes(group).unwrap() {
+            assert_eq!(body.coords[n][0], x, "{group}");
+        }
+    }
+}
+
+#[test]
+fn a_solve_on_shuffled_node_tags_equals_the_solve_on_sorted_ones() {
+    let solve = |mesh: &str| {
+        let (dir, path) = write_case(&square_case(mesh, "[1.0, 0.5]"));
+        run_quiet(&path).unwrap_or_else(|e| panic!("{mesh}: {e}"));
+        displacement_by_tag(&dir.path().join("out"))
+    };
+    let sorted = solve("square_sorted.msh");
+    for shuffled in ["square_shuffled.msh", "square_shuffled_bin.msh"] {
+        let other = solve(shuffled);
+        assert_eq!(sorted.len(), other.len());
+        for (tag, u) in &sorted {
+            let v = &other[tag];
+            for k in 0..2 {
+                // The same equations in another order: equal to round-off.
+                assert!(
+                    (u[k] - v[k]).abs() <= 1e-12,
+                    "{shuffled} node {tag}: {u:?} {v:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_node_tag_defined_twice_is_an_error_naming_the_tag_and_lines() {
+    // Tag 2 replaces tag 1 in the node list of SQUARE_3412: tag 2 twice, tag 1 missing.
+    let text = SQUARE_3412.replacen("4\n1\n2\n", "4\n2\n2\n", 1);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("twice.msh");
+    std::fs::write(&path, text).unwrap();
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::Syntax { line: 22, .. }), "{message}");
+    assert!(
+        message.contains("node tag 2 is defined twice") && message.contains("first on line 21"),
+        "{message}"
+    );
+}
+
+#[test]
+fn an_entity_defined_twice_is_an_error() {
+    // The right edge's entity line with the left edge's tag: its physical tag would replace
+    // the left edge's.
+    let text = SQUARE_3412.replacen("2 1 0 0 1 1 0 1 2 0", "1 1 0 0 1 1 0 1 2 0", 1);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("entity.msh");
+    std::fs::write(&path, text).unwrap();
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::Syntax { line: 13, .. }), "{message}");
+    assert!(message.contains("defined twice in $Entities"), "{message}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// 2. Corrupt headers are errors, not panics
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn a_physical_names_count_near_2_to_the_64_is_an_error() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        text.replacen(
+            "$PhysicalNames\n4\n",
+            "$PhysicalNames\n18446744073709551615\n",
+            1,
+        )
+    });
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::Syntax { line: 5, .. }), "{message}");
+    assert!(message.contains("18446744073709551615"), "{message}");
+}
+
+#[test]
+fn binary_data_sizes_other_than_8_are_errors() {
+    let binary = std::fs::read(fixture("block_2d_bin.msh")).unwrap();
+    for size in ["4", "2147483648", "99999999999999999999"] {
+        let bytes = [
+            b"$MeshFormat\n4.1 1 ".as_slice(),
+            size.as_bytes(),
+            &binary[b"$MeshFormat\n4.1 1 8".len()..],
+        ]
+        .concat();
+        let e = read_msh_bytes(Path::new("size.msh"), &bytes).expect_err(size);
+        let message = e.to_string();
+        assert!(matches!(e, MeshError::Syntax { line: 2, .. }), "{message}");
+        assert!(message.contains("only 8"), "{message}");
+    }
+}
+
+#[test]
+fn a_nodes_section_announcing_zero_nodes_is_an_error_not_an_overflow() {
+    // numNodes = 0 with tags 1..1: mshio computed numNodes - 1 and overflowed (a panic in debug
+    // builds). The elements then refer to nodes the file does not define.
+    let (_dir, path) = edited_fixture("square_sorted.msh", |text| {
+        let start = text.find("$Nodes").unwrap();
+        let end = text.find("$EndNodes").unwrap();
+        format!(
+            "{}$Nodes\n1 0 1 1\n2 1 0 0\n{}",
+            &text[..start],
+            &text[end..]
+        )
+    });
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::UndefinedNode { .. }), "{message}");
+}
+
+#[test]
+fn node_and_element_counts_beyond_the_file_are_errors() {
+    for (from, to) in [
+        (
+            "$Nodes\n11 490 1 490\n",
+            "$Nodes\n11 18446744073709551615 1 490\n",
+        ),
+        (
+            "$Nodes\n11 490 1 490\n",
+            "$Nodes\n4611686018427387904 490 1 490\n",
+        ),
+        ("$Elements\n", "$Elements\n9223372036854775807 "),
+    ] {
+        let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+            assert!(text.contains(from), "{from}");
+            text.replacen(from, to, 1)
+        });
+        let (e, message) = mesh_error(&path);
+        assert!(matches!(e, MeshError::Syntax { .. }), "{message}");
+    }
+}
+
+/// A small deterministic generator (xorshift), so that the corruptions below are reproducible.
+fn xorshift(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
+#[test]
+fn truncated_and_bit_flipped_meshes_give_errors_or_meshes_never_panics() {
+    // The fuzz target's property on a few thousand reproducible inputs, in every `cargo test`.
+    let mut state = 0x9e37_79b9_7f4a_7c15;
+    for name in [
+        "block_2d_bin.msh",
+        "square_shuffled.msh",
+        "square_shuffled_bin.msh",
+    ] {
+        let bytes = std::fs::read(fixture(name)).unwrap();
+        for cut in (0..bytes.len()).step_by(bytes.len() / 200 + 1) {
+            let _ = read_msh_bytes(Path::new(name), &bytes[..cut]);
+        }
+        // Every single-bit flip of the header (the data size of '4.1 1 8' among them).
+        for at in 0..64 {
+            for bit in 0..8 {
+                let mut flipped = bytes.clone();
+                flipped[at] ^= 1 << bit;
+                let _ = read_msh_bytes(Path::new(name), &flipped);
+            }
+        }
+        for _ in 0..1000 {
+            let mut flipped = bytes.clone();
+            for _ in 0..1 + xorshift(&mut state) % 4 {
+                let at = (xorshift(&mut state) % bytes.len() as u64) as usize;
+                flipped[at] ^= 1 << (xorshift(&mut state) % 8);
+            }
+            if let Err(e) = read_msh_bytes(Path::new(name), &flipped) {
+                assert!(e.to_string().contains(name));
+            }
+        }
+    }
+}
+
+#[test]
+fn info_into_a_closed_pipe_does_not_panic() {
+    // `internodes info m.msh | head -1`: the reader stops early.
+    let mut child = Command::new(BINARY)
+        .args(["info", fixture("two_blocks_3d.msh").to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn exporting_matrices_with_a_dirichlet_point_group_does_not_panic() {
+    let text = two_blocks_case(
+        &fixture("two_blocks_2d.msh"),
+        "upper",
+        "export_matrices = true",
+    )
+    .replacen(
+        "group = \"upper_top\"\nux = 0.0\nuy = 0.0",
+        "group = \"upper_top\"\nuy = 0.0\n[[body.dirichlet]]\ngroup = \"upper_corner\"\nux = 0.0",
+        1,
+    );
+    let (dir, path) = write_case(&text);
+    run_quiet(&path).unwrap();
+    let matrices = dir.path().join("out/matrices");
+    assert!(matrices.join("upper__upper_top_mass.mtx").exists());
+    assert!(!matrices.join("upper__upper_corner_mass.mtx").exists());
+}
+
+// ---------------------------------------------------------------------------------------------
+// 3. The output folder holds one run's complete results, or a failure mark
+// ---------------------------------------------------------------------------------------------
+
+/// Asserts that `out` holds no result file and a failure mark naming `what`.
+fn assert_failed_without_results(out: &Path, what: &str) {
+    for name in internodes::output::RESULT_FILES {
+        assert!(!exists(out, name), "{name} left in {}", out.display());
+    }
+    let mark = std::fs::read_to_string(out.join("FAILED.txt")).expect("FAILED.txt");
+    assert!(mark.contains(what), "{mark}");
+    let leftovers: Vec<_> = std::fs::read_dir(out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".internodes"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn a_failed_run_removes_earlier_results_and_marks_the_folder() {
+    let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let out = dir.path().join("out");
+    run_quiet(&good).unwrap();
+    assert!(exists(&out, "solution.h5") && exists(&out, "summary.json"));
+
+    // The same case, now failing in the solve of its second body.
+    let bad = dir.path().join("bad.toml");
+    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", "").replace(
+        "[[body]]\nname = \"lower\"",
+        "[solver]\nresidual_tolerance = 1e-300\n\n[[body]]\nname = \"lower\"",
+    );
+    std::fs::write(&bad, text).unwrap();
+    let e = run_error(&bad, "the tolerance cannot be met");
+    assert_failed_without_results(&out, &e.to_string());
+
+    // The next successful run removes the mark.
+    run_quiet(&good).unwrap();
+    assert!(exists(&out, "summary.json") && !exists(&out, "FAILED.txt"));
+}
+
+#[test]
+fn runs_remove_only_their_own_files_from_the_output_folder() {
+    // An output folder the user keeps other files in, also inside matrices/.
+    let (dir, good) = write_case(&two_blocks_case(
+        &fixture("two_blocks_2d.msh"),
+        "upper",
+        "export_matrices = true",
+    ));
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("matrices")).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    std::fs::write(out.join("matrices/notes.txt"), "mine").unwrap();
+    run_quiet(&good).unwrap();
+    assert!(exists(&out, "matrices/lower_stiffness.mtx"));
+    let text = std::fs::read_to_string(&good).unwrap();
+    std::fs::write(
+        &good,
+        text.replace("name = \"upper\"", "name = \"nowhere\""),
+    )
+    .unwrap();
+    run_error(&good, "no body 'nowhere'");
+    assert!(!exists(&out, "matrices/lower_stiffness.mtx"));
+    assert!(exists(&out, "notes.txt") && exists(&out, "matrices/notes.txt"));
+}
+
+#[test]
+fn a_case_file_that_does_not_parse_marks_the_folder_it_names() {
+    let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    run_quiet(&good).unwrap();
+    let text = std::fs::read_to_string(&good).unwrap();
+    std::fs::write(&good, text.replace("poisson_ratio", "poison_ratio")).unwrap();
+    let e = run_error(&good, "misspelled key");
+    assert_failed_without_results(&dir.path().join("out"), "poison_ratio");
+    assert!(e.to_string().contains("poison_ratio"));
+}
+
+#[test]
+fn a_run_failing_after_writing_the_solution_leaves_no_result() {
+    // The first run succeeds; the second writes solution.h5 and then fails exporting the
+    // matrices of a body whose name is not a file name (matrices/up/per_stiffness.mtx).
+    let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    run_quiet(&good).unwrap();
+    let mesh = dir.path().join("slash.msh");
+    let text = std::fs::read_to_string(fixture("two_blocks_2d.msh")).unwrap();
+    std::fs::write(&mesh, text.replacen("\"upper\"", "\"up/per\"", 1)).unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        two_blocks_case(&mesh, "up/per", "export_matrices = true"),
+    )
+    .unwrap();
+    let e = run_error(&bad, "matrices/up/ does not exist");
+    assert_failed_without_results(&dir.path().join("out"), &e.to_string());
+}
+
+#[test]
+fn a_contact_case_with_a_bad_extra_body_fails_before_solving() {
+    // The contact bodies are fine, a third [[body]] is not in the mesh: nothing may be solved
+    // or written (the old run solved the contact and left force_displacement.csv).
+    let text = common::half_disc_on_block("half_disc_on_block.msh", "")
+        + "\n[[body]]\nname = \"third\"\nyoungs_modulus = 1.0\npoisson_ratio = 0.3\n";
+    let (dir, path) = write_case(&text);
+    let e = run_error(&path, "no body 'third'");
+    assert!(e.to_string().contains("'third'"), "{e}");
+    assert_failed_without_results(&dir.path().join("out"), "'third'");
+}
+
+#[test]
+fn concurrent_runs_into_one_folder_leave_one_runs_complete_results() {
+    // Two cases that differ in Young's modulus, run together into one folder, ten times.
+    let dir = tempfile::tempdir().unwrap();
+    let cases: Vec<PathBuf> = ["100.0", "400.0"]
+        .iter()
+        .map(|e| {
+            let path = dir.path().join(format!("e{e}.toml"));
+            let text = square_case("square_sorted.msh", "[1.0, 0.0]")
+                .replace("youngs_modulus = 100.0", &format!("youngs_modulus = {e}"))
+                .replace("output = \"out\"", "output = \"shared\"");
+            std::fs::write(&path, text).unwrap();
+            path
+        })
+        .collect();
+    let out = dir.path().join("shared");
+    for _ in 0..10 {
+        std::thread::scope(|s| {
+            for case in &cases {
+                s.spawn(move || run_quiet(case).unwrap());
+            }
+        });
+        // The displacement scales with 1 / E: the HDF5 file and the summary are one run's.
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let e = summary["bodies"][0]["youngs_modulus"].as_f64().unwrap();
+        let u = displacement_by_tag(&out);
+        let largest = u.values().map(|v| v[0].abs()).fold(0.0, f64::max);
+        // E = 100 gives a largest ux of about 1e-2, E = 400 a quarter of it.
+        assert!(
+            (largest * e - 1.0).abs() < 0.5,
+            "E = {e}, largest ux {largest}"
+        );
+        assert!(!exists(&out, "FAILED.txt"));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4. 2D bodies must lie in the xy plane
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn a_2d_mesh_whose_z_varies_is_rejected() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        edit_nodes(&text, |tag, x| {
+            format!("{} {} {}", x[0], x[1], if tag == 7 { 0.1 } else { 0.0 })
+        })
+    });
+    let (_, message) = mesh_error(&path);
+    assert!(
+        message.contains("xy plane") && message.contains("'block'"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_2d_mesh_in_the_xz_plane_is_rejected_as_such() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        edit_nodes(&text, |_, x| format!("{} {} {}", x[0], x[2], x[1]))
+    });
+    let (_, message) = mesh_error(&path);
+    assert!(message.contains("xy plane"), "not 'degenerate': {message}");
+}
+
+#[test]
+fn two_2d_bodies_on_different_planes_are_rejected() {
+    let upper = read_fixture("two_blocks_2d.msh")
+        .body("upper")
+        .unwrap()
+        .node_tags
+        .clone();
+    let (_dir, path) = edited_fixture("two_blocks_2d.msh", |text| {
+        edit_nodes(&text, |tag, x| {
+            let z = if upper.binary_search(&tag).is_ok() {
+                1.0
+            } else {
+                0.0
+            };
+            format!("{} {} {z}", x[0], x[1])
+        })
+    });
+    let (_, message) = mesh_error(&path);
+    assert!(
+        message.contains("xy plane") && message.contains("'upper' z in [1e0, 1e0]"),
+        "{message}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// 5. Case files that are wrong but were accepted
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn a_body_in_two_body_tables_is_an_error() {
+    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "lower", "");
+    let message = case_failure(&text);
+    assert!(
+        message.contains("body 'lower' has two [[body]] tables"),
+        "{message}"
+    );
+}
+
+/// A case on `geo/block_2d.geo` with `parameters` as its `geo_parameters`.
+fn geo_case(geo: &str, parameters: &str) -> String {
+    let geo = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("geo")
+        .join(geo);
+    format!(
+        r#"mesh = "{}"
+geo_parameters = {parameters}
+output = "out"
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+"#,
+        geo.display()
+    )
+}
+
+#[test]
+fn geo_parameters_the_script_does_not_use_are_errors() {
+    let message = case_failure(&geo_case("block_2d.geo", "{ levle = 1 }"));
+    assert!(
+        message.contains("geo_parameters.levle") && message.contains("level"),
+        "{message}"
+    );
+}
+
+#[test]
+fn non_finite_geo_parameters_are_errors() {
+    let message = case_failure(&geo_case("block_2d.geo", "{ level = nan }"));
+    assert!(
+        message.contains("geo_parameters.level") && message.contains("finite"),
+        "{message}"
+    );
+}
+
+#[test]
+fn geo_parameters_beside_a_msh_are_errors() {
+    let text = square_case("square_sorted.msh", "[1.0, 0.0]").replace(
+        "output = \"out\"",
+        "output = \"out\"\ngeo_parameters = { level = 1 }",
+    );
+    let message = case_failure(&text);
+    assert!(
+        message.contains("geo_parameters") && message.contains("not a .geo"),
+        "{message}"
+    );
+}
+
+#[test]
+fn load_steps_beyond_the_bound_are_errors() {
+    let steps = vec!["1.0"; internodes::case::MAX_LOAD_STEPS + 1].join(", ");
+    let text =
+        common::half_disc_on_block("half_disc_on_block.msh", &format!("load_steps = [{steps}]"));
+    let message = case_failure(&text);
+    assert!(
+        message.contains("load_steps") && message.contains("at most 1000"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_3d_geometry_without_a_physical_volume_is_rejected_as_such() {
+    // Drop the volume's physical tag: only the boundary triangles remain in groups.
+    let (_dir, path) = edited_fixture("block_3d.msh", |text| {
+        let start = text.find("$Entities").unwrap();
+        let end = text.find("$EndEntities").unwrap();
+        let mut lines: Vec<String> = text[start..end].lines().map(str::to_string).collect();
+        let counts: Vec<usize> = lines[1]
+            .split_whitespace()
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let first_volume = 2 + counts[0] + counts[1] + counts[2];
+        for line in &mut lines[first_volume..first_volume + counts[3]] {
+            let mut parts: Vec<&str> = line.split_whitespace().collect();
+            let n: usize = parts[7].parse().unwrap();
+            parts.drain(8..8 + n);
+            parts[7] = "0";
+            *line = parts.join(" ");
+        }
+        format!("{}{}\n{}", &text[..start], lines.join("\n"), &text[end..])
+    });
+    let (_, message) = mesh_error(&path);
+    assert!(message.contains("no physical volume"), "{message}");
+}
+
+#[test]
+fn two_physical_groups_with_one_name_are_rejected() {
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        text.replacen("\"block_sides\"", "\"block_top\"", 1)
+    });
+    let (e, message) = mesh_error(&path);
+    assert!(matches!(e, MeshError::Syntax { .. }), "{message}");
+    assert!(
+        message.contains("'block_top' is given to two groups"),
+        "{message}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// 6. Messages name the file, the line or key, and what was expected
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn non_finite_loads_are_errors_naming_the_load() {
+    for load in [
+        "traction = [nan, 0.0]",
+        "pressure = nan",
+        "pressure = inf",
+        "hertz_pressure = { p0 = nan, a = 0.5, center = [0.0, 0.0] }",
+    ] {
+        let text =
+            square_case("square_sorted.msh", "[1.0, 0.0]").replace("traction = [1.0, 0.0]", load);
+        let message = case_failure(&text);
+        assert!(
+            message.contains("body 'square', load on 'right'") && message.contains("finite"),
+            "{load}: {message}"
+        );
+    }
+    let text = square_case("square_sorted.msh", "[1.0, 0.0]").replace(
+        "poisson_ratio = 0.25",
+        "poisson_ratio = 0.25\nbody_force = [0.0, nan]",
+    );
+    let message = case_failure(&text);
+    assert!(
+        message.contains("body_force") && message.contains("finite"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_nan_node_coordinate_is_an_error_naming_the_node_and_line() {
+    let (_dir, path) = edited_fixture("square_sorted.msh", |text| {
+        edit_nodes(&text, |tag, x| {
+            if tag == 13 {
+                format!("{} nan 0", x[0])
+            } else {
+                format!("{} {} {}", x[0], x[1], x[2])
+            }
+        })
+    });
+    let text = std::fs::read_to_string(&path).unwrap();
+    let line = 1 + text.lines().position(|l| l.contains("nan")).unwrap();
+    let (e, message) = mesh_error(&path);
+    assert!(
+        matches!(e, MeshError::Syntax { line: l, .. } if l == line),
+        "{message}"
+    );
+    assert!(
+        message.contains("node 13") && message.contains("non-finite"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_load_on_a_point_group_says_a_boundary_group_is_needed() {
+    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", "")
+        .replace("group = \"lower_contact\"", "group = \"lower_corner\"");
+    let message = case_failure(&text);
+    assert!(
+        message.contains("load on 'lower_corner'")
+            && message.contains("group of points")
+            && message.contains("physical curve"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_bad_section_header_names_its_own_line() {
+    // The $Nodes summary line of block_2d.msh with a letter in its node count.
+    let text = std::fs::read_to_string(fixture("block_2d.msh")).unwrap();
+    let line = 2 + text.lines().position(|l| l == "$Nodes").unwrap();
+    let (_dir, path) = edited_fixture("block_2d.msh", |text| {
+        text.replacen("$Nodes\n11 490 1 490\n", "$Nodes\n11 4x0 1 490\n", 1)
+    });
+    let (e, message) = mesh_error(&path);
+    assert!(
+        matches!(e, MeshError::Syntax { line: l, .. } if l == line),
+        "{message}"
+    );
+    assert!(
+        message.contains("the number of nodes") && message.contains("4x0"),
+        "{message}"
+    );
+}
