@@ -2,14 +2,14 @@
 //!
 //! Body 1 (primary) carries the multiplier `lambda`, the contact traction on it; body 2
 //! (secondary) receives `-R21 lambda`. One solve, in the order of the files:
-//! - [`problem`]: the two bodies, their candidate surfaces ([`surface`]) and the settings;
-//! - [`interface`]: the interface operators, built once over all candidates: rescaled Wendland
-//!   C2 interpolation ([`rbf`]) evaluated at each node's closest point on the other surface
-//!   ([`projection`]), the lumped interface mass, the contact normal and the gaps;
-//! - [`solve`]: the active-set loop (primal-dual active set), each iteration assembling the
-//!   coupled system ([`system`]) and solving it ([`coupled_solver`], [`compliance`]);
-//! - [`checks`]: the active-set update of each iteration and the certificate of the answer,
-//!   checked independently of the loop's operators; [`post`]: fields, forces, Hertz fit.
+//! - `problem.rs`: the two bodies, their candidate surfaces (`surface.rs`) and the settings;
+//! - `interface.rs`: the interface operators, built once over all candidates: rescaled Wendland
+//!   C2 interpolation (`rbf.rs`) evaluated at each node's closest point on the other surface
+//!   (`projection.rs`), the lumped interface mass, the contact normal and the gaps;
+//! - `solve.rs`: the active-set loop (primal-dual active set), each iteration assembling the
+//!   coupled system (`system.rs`) and solving it (`coupled_solver.rs`, `compliance.rs`);
+//! - `checks.rs`: the active-set update of each iteration and the certificate of the answer,
+//!   checked independently of the loop's operators; `post.rs`: fields, forces, Hertz fit.
 //!
 //! Method, signs and known traps: `shared/notes/method.md`.
 

@@ -132,8 +132,8 @@ impl ContactSettings {
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum PrimaryChoice {
     /// The body with the clearly coarser contact surface (spacing near the other body at least
-    /// [`COARSER`] times the other's); between surfaces of similar spacing, the more compliant
-    /// body (contact modulus `E / (1 - nu^2)` at least [`SIMILAR_STIFFNESS`] times lower); between
+    /// `COARSER` times the other's); between surfaces of similar spacing, the more compliant
+    /// body (contact modulus `E / (1 - nu^2)` at least `SIMILAR_STIFFNESS` times lower); between
     /// bodies similar in both, the coarser surface. See [`ContactProblem::new`] for why.
     #[default]
     Auto,
@@ -196,7 +196,7 @@ pub struct ContactProblem<'m> {
 impl<'m> ContactProblem<'m> {
     /// The contact moduli `E / (1 - nu^2)` of the primary and secondary bodies, normalized to
     /// sum to one: the weights of their normals in the contact normal
-    /// ([`super::interface::contact_normal`]).
+    /// (`super::interface::contact_normal`).
     pub fn normal_weights(&self) -> [f64; 2] {
         let modulus = |p: &ElasticProblem| {
             p.material.youngs_modulus() / (1.0 - p.material.poisson_ratio().powi(2))

@@ -1,7 +1,7 @@
 //! The INTERNODES active-set loop: a primal-dual active set method (a semismooth Newton method
 //! on the nodal complementarity conditions; Hüeber and Wohlmuth 2005) over interface operators
-//! built once ([`super::interface`]), with its answer certified by independent checks
-//! ([`super::certificate`]).
+//! built once (`super::interface`), with its answer certified by independent checks
+//! ([`super::checks`]).
 //!
 //! ```text
 //! A <- primary candidates that touch or penetrate in the reference configuration, e <- 0
@@ -19,11 +19,11 @@
 //! At an active node the constraint holds `g_i = 0`, at an inactive one `p_i = 0`, so the test
 //! reads `p_i > 0` on A and `g_i < 0` off it, and `c` drops out; the tolerances make the two
 //! tests robust to round-off. Removal and addition happen in one update, as in the seed's
-//! Algorithm 3 (its improvement over Algorithm 3's one-at-a-time variants). What differs from
+//! Algorithm 3. What differs from
 //! the seed's loop: the operators do not change with A (the seed rebuilds them, with Algorithm
 //! 2, for every active set, so that the discrete problem itself moves from one iteration to the
 //! next), the pressure `p_i = -lambda_i . n_i` tested is the unknown of the system (lumped
-//! interface mass, [`super::surface`]), and the gap is the geometric one.
+//! interface mass, `super::surface`), and the gap is the geometric one.
 //!
 //! An update that would return to an active set seen before first keeps active (pins, for the
 //! rest of the solve) the nodes it removes for tension that had been removed before and came
@@ -71,7 +71,7 @@ const UNSTABLE_GAP_OVER_H: f64 = 1.0;
 pub(super) const SETTLED: f64 = 0.01;
 
 /// Where an active-set loop starts: the active primary candidates (surface indices) and the
-/// gap corrections `e` (one per primary candidate; [`super::interface`]).
+/// gap corrections `e` (one per primary candidate; `super::interface`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ActiveSet {
     pub nodes: BTreeSet<usize>,

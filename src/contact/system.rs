@@ -9,7 +9,7 @@
 //! `K_k`, `f_k` are Dirichlet-constrained (rows and columns of prescribed dofs hold only their
 //! diagonal, and carry no coupling). `lambda` is the traction on body 1 at its active nodes I;
 //! body 2 receives `lambda_2 = -R21 lambda` on its whole candidate surface. `M1`, `M2` are the
-//! lumped interface mass matrices ([`super::surface`]). Tied: one vector multiplier per node and the vector
+//! lumped interface mass matrices (`super::surface`). Tied: one vector multiplier per node and the vector
 //! constraint `u1 - R12 u2 = d`. Frictionless: `lambda = lambda_n n1`, one scalar per node, and
 //! only the normal constraint `n1 . (u1 - R12 u2) = n1 . d`.
 //!
@@ -29,7 +29,7 @@ use crate::elastic::AssembledBody;
 use crate::linalg::mat_vec;
 
 /// The interface operators of one iteration, on the active primary nodes I (built by
-/// [`super::interface::InterfaceOperators::coupling`]).
+/// `super::interface::InterfaceOperators::coupling`).
 pub struct Coupling {
     pub formulation: Formulation,
     /// Body-local node of each active primary node.

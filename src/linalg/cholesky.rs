@@ -15,7 +15,7 @@
 //!   arithmetic, are fixed by that number and threads only pick them up; `tests/threads.rs`
 //!   checks the outcome for 1, 2 and 3 threads.
 //! - **Solves**: faer sequential (`Par::Seq`); many right-hand sides are cut into blocks of at
-//!   most [`RHS_BLOCK`] columns, a partition fixed by their number, solved in parallel.
+//!   most `RHS_BLOCK` columns, a partition fixed by their number, solved in parallel.
 //!
 //! Measured (`benches/threads.rs` and a faer-`Par` variant of it; block_3d and
 //! hemisphere_on_block meshes; fastest of 3 to 10 runs on the shared 2-core machine, taken
@@ -160,7 +160,7 @@ impl Cholesky {
 
     /// Overwrites the columns of `rhs` (n x k, column-major) with the solutions of `K x = rhs`.
     ///
-    /// The columns are cut into the fewest blocks of at most [`RHS_BLOCK`] columns, of equal
+    /// The columns are cut into the fewest blocks of at most `RHS_BLOCK` columns, of equal
     /// width (the last one narrower), solved in parallel, each sequentially. The partition
     /// depends on `num_rhs` only, so every column gets the same arithmetic for any number of
     /// threads.
