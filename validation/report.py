@@ -27,6 +27,11 @@ from compare import Check
 from suite import SuiteResult
 
 
+# The commit the run started from (set by run.py before it writes anything, so that files the run
+# itself writes, such as the regression bands, do not mark the report "-dirty").
+COMMIT: str | None = None
+
+
 def machine() -> dict:
     """Machine and versions, for the report header."""
     def command(*args: str) -> str:
@@ -51,7 +56,7 @@ def machine() -> dict:
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "machine": f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}",
         "os": command("sh", "-c", ". /etc/os-release && echo $PRETTY_NAME"),
-        "commit": command("git", "-C", str(repo), "describe", "--always", "--dirty"),
+        "commit": COMMIT or command("git", "-C", str(repo), "describe", "--always", "--dirty"),
         "rustc": command("rustc", "--version"),
         "dolfinx": dolfinx_version,
         "gmsh": command("gmsh", "--version") or command("sh", "-c", "gmsh --version 2>&1"),

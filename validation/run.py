@@ -212,6 +212,8 @@ def main() -> int:
             print("run.py: the tree has uncommitted changes; commit them first, so that the report "
                   "written to validation/report/ names the code it describes:\n" + dirty, file=sys.stderr)
             return 2
+    report.COMMIT = subprocess.run(["git", "-C", str(REPO), "describe", "--always", "--dirty"],
+                                   capture_output=True, text=True).stdout.strip() or None
     cases = sorted((VALIDATION / "cases").glob("*.toml"))
     if args.cases:
         cases = [VALIDATION / "cases" / f"{name}.toml" for name in args.cases]
