@@ -60,7 +60,7 @@ REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
 from compare import Check  # noqa: E402
-from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing  # noqa: E402
+from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing, json_safe  # noqa: E402
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
@@ -750,19 +750,8 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
     ])
     data = {"levels": list(levels), "quick": quick, "seconds": seconds, "young_modulus": YOUNGS_MODULUS,
             "poisson_ratio": POISSON_RATIO, "E_star": E_STAR, "load_steps": list(LOAD_STEPS),
-            "cases": {c.name: asdict(c) for c in CASES}, "rates": rates, "results": _json_safe(results)}
+            "cases": {c.name: asdict(c) for c in CASES}, "rates": rates, "results": json_safe(results)}
     return SuiteResult("Hertz contact: four cases under refinement", checks, figures, text, data)
-
-
-def _json_safe(value):
-    """Replace NaN / inf by None and int keys by strings, recursively."""
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def main() -> int:

@@ -143,3 +143,20 @@ def surface_spacing(msh: Path, group: str, dim: int, radius: float) -> float:
     if len(near) == 0:
         return float("nan")
     return float(np.linalg.norm(x[near[:, 0]] - x[near[:, 1]], axis=1).mean())
+
+
+def json_safe(value):
+    """Replace NaN / inf by None, keys by strings and numpy scalars by Python ones, recursively."""
+    import math
+
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, np.generic):
+        return json_safe(value.item())
+    return value

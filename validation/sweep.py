@@ -111,7 +111,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing  # noqa: E402
+from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing, json_safe  # noqa: E402
 
 BUILD = VALIDATION / "build" / "sweep"
 RADIUS = 1.0
@@ -728,7 +728,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
                                   f"also as secondary; the radius check uses the primary's active set)", Path(overlay)))
     seconds = time.perf_counter() - start
     text = report_text(cases, checks, records, quick, seconds)
-    data = {"quick": quick, "seconds": seconds, "cases": _json_safe(records)}
+    data = {"quick": quick, "seconds": seconds, "cases": json_safe(records)}
     return SuiteResult("Sweep: the contact solver over the issue's parameter ranges (gate)", checks, figures, text,
                        data)
 
@@ -825,19 +825,6 @@ def plot_summary(cases: list[Case], checks: list[Check], records: dict, path: Pa
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return True
-
-
-def _json_safe(value):
-    """Replace NaN / inf by None, recursively."""
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, np.generic):
-        return _json_safe(value.item())
-    return value
 
 
 def main() -> int:
