@@ -41,6 +41,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A closed pipe on stdout or stderr (`internodes solve case 2>&1 | head -1`) ends the
+    // process as it ends every Unix tool, by SIGPIPE, instead of a panic in `eprintln!` (Rust
+    // ignores SIGPIPE by default and turns the failed write into a panic).
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of a signal before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     // Results must not depend on the number of threads (RAYON_NUM_THREADS). The Cholesky
     // solves guarantee it themselves; faer's sparse LUs (RBF interpolation, the monolithic
     // reference solver) take faer's global setting, whose default splits work by thread count.

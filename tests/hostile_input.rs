@@ -445,6 +445,23 @@ fn info_into_a_closed_pipe_does_not_panic() {
 }
 
 #[test]
+fn solve_into_a_closed_stderr_pipe_does_not_panic() {
+    // `internodes solve case 2>&1 | head -1`: the progress lines meet a closed pipe. A panic
+    // exits with status 101; the process must end by SIGPIPE (or finish) instead.
+    let (_dir, case) =
+        common::write_case(&common::half_disc_on_block("half_disc_on_block.msh", ""));
+    let mut child = Command::new(BINARY)
+        .args(["solve", case.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert_ne!(status.code(), Some(101), "{status:?}");
+}
+
+#[test]
 fn exporting_matrices_with_a_dirichlet_point_group_does_not_panic() {
     let text = two_blocks_case(
         &fixture("two_blocks_2d.msh"),
