@@ -189,8 +189,7 @@ def write_case(size: Size, run: str, steps: tuple[float, ...]) -> Path:
 # ---------------------------------------------------------------------------
 
 LOAD_STEP_LINE = re.compile(r"^load step (\d+)/(\d+): factor (\S+)$")
-ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+) \+\s+(\d+), added\s+(\d+), removed\s+(\d+),"
-                            r".*, ([-+0-9.eE]+) s$")
+ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-(\d+)\s.*; ([-+0-9.eE]+) s \(")
 CHOLESKY_LINE = re.compile(r"^\s+Cholesky of both bodies: ([-+0-9.eE]+) s$")
 
 
@@ -206,8 +205,7 @@ def parse_log(log: Path) -> tuple[float, list[list[dict]]]:
             if not steps:  # a single load step prints no "load step" line
                 steps.append([])
             steps[-1].append({"iteration": int(match[1]), "active_primary": int(match[2]),
-                              "active_secondary": int(match[3]), "added": int(match[4]),
-                              "removed": int(match[5]), "seconds": float(match[6])})
+                              "added": int(match[3]), "removed": int(match[4]), "seconds": float(match[5])})
     if cholesky is None:
         raise RunFailed(f"{log}: no 'Cholesky of both bodies' line (log format changed?)")
     return cholesky, steps
@@ -256,7 +254,7 @@ def run_ours(binary: Path, case: Path, output: Path) -> dict:
         steps.append({"load_factor": record["load_factor"], "status": record["status"],
                       "iterations": its, "seconds": phases[f"contact step {record['step']}"],
                       "compliance_estimate": compliance_estimate(its),
-                      "active_primary": last["active_primary"], "active_secondary": last["active_secondary"],
+                      "active_primary": last["active_primary"],
                       "force": record["force_primary"][-1], "hertz_a": record["hertz_a"]})
     set_up = phases["contact set-up"]
     return usage | {
@@ -409,7 +407,7 @@ def _steps_cell(step: dict) -> str:
 
 def contact_table(sizes: list[dict]) -> list[list[str]]:
     """Our contact solves: one row per size and run."""
-    rows = [["DOFs (sphere + block)", "run", "active nodes (sphere + block)", "set-up: asm + chol + other",
+    rows = [["DOFs (sphere + block)", "run", "active primary nodes", "set-up: asm + chol + other",
              "step 1 (its)", "step 2 (its)", "per iteration: mean / median", "compliance (est.)",
              "contact total", "wall", "peak MB", "status"]]
     for size in sizes:
@@ -423,7 +421,7 @@ def contact_table(sizes: list[dict]) -> list[list[str]]:
             its = all_iterations(r)
             rows.append([
                 f"{sum(r['dofs'].values()):,} ({' + '.join(f'{d:,}' for d in r['dofs'].values())})", label,
-                f"{steps[-1]['active_primary']} + {steps[-1]['active_secondary']}",
+                f"{steps[-1]['active_primary']}",
                 f"{fmt(r['set_up'])} = {fmt(r['assembly'], 2)} + {fmt(r['cholesky'])} + {fmt(r['other_set_up'], 2)}",
                 _steps_cell(steps[0]), _steps_cell(steps[1]) if len(steps) > 1 else "-",
                 f"{fmt(statistics.mean(its))} / {fmt(statistics.median(its))}",
@@ -473,7 +471,7 @@ def iteration_table(sizes: list[dict]) -> list[list[str]]:
                 rest = t[2:]
                 rows.append([f"{3 * size['nodes']:,}", RUNS[run][0].removeprefix("ours, "),
                              f"{k} ({s['load_factor']:g})", s["status"], str(len(t)),
-                             f"{s['active_primary']} + {s['active_secondary']}", fmt(t[0]),
+                             f"{s['active_primary']}", fmt(t[0]),
                              fmt(t[1]) if len(t) > 1 else "-",
                              f"{fmt(statistics.median(rest))} / {fmt(max(rest))}" if rest else "-",
                              fmt(sum(t)), fmt(s["seconds"]), fmt(s["compliance_estimate"]),
