@@ -767,22 +767,7 @@ fn load_steps_beyond_the_bound_are_errors() {
 fn a_3d_geometry_without_a_physical_volume_is_rejected_as_such() {
     // Drop the volume's physical tag: only the boundary triangles remain in groups.
     let (_dir, path) = edited_fixture("block_3d.msh", |text| {
-        let start = text.find("$Entities").unwrap();
-        let end = text.find("$EndEntities").unwrap();
-        let mut lines: Vec<String> = text[start..end].lines().map(str::to_string).collect();
-        let counts: Vec<usize> = lines[1]
-            .split_whitespace()
-            .map(|c| c.parse().unwrap())
-            .collect();
-        let first_volume = 2 + counts[0] + counts[1] + counts[2];
-        for line in &mut lines[first_volume..first_volume + counts[3]] {
-            let mut parts: Vec<&str> = line.split_whitespace().collect();
-            let n: usize = parts[7].parse().unwrap();
-            parts.drain(8..8 + n);
-            parts[7] = "0";
-            *line = parts.join(" ");
-        }
-        format!("{}{}\n{}", &text[..start], lines.join("\n"), &text[end..])
+        common::without_physical_tags(&text, 3)
     });
     let (_, message) = mesh_error(&path);
     assert!(message.contains("no physical volume"), "{message}");

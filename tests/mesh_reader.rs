@@ -287,25 +287,9 @@ fn inverted_cells_are_reported_with_their_element_tag() {
 
 #[test]
 fn a_file_without_bodies_is_rejected() {
+    // Drop the body's physical tag from every surface entity: no cell is in a group then.
     let (_dir, path) = edited_fixture("block_2d.msh", |text| {
-        // Drop the body's physical tag from every surface entity: no cell is in a group then.
-        let start = text.find("$Entities").unwrap();
-        let end = text.find("$EndEntities").unwrap();
-        let mut lines: Vec<String> = text[start..end].lines().map(str::to_string).collect();
-        let counts: Vec<usize> = lines[1]
-            .split_whitespace()
-            .map(|c| c.parse().unwrap())
-            .collect();
-        let first_surface = 2 + counts[0] + counts[1];
-        for line in &mut lines[first_surface..first_surface + counts[2]] {
-            let mut parts: Vec<&str> = line.split_whitespace().collect();
-            // tag, 6 bounding box values, number of physical tags, the tags, ...
-            let n: usize = parts[7].parse().unwrap();
-            parts.drain(8..8 + n);
-            parts[7] = "0";
-            *line = parts.join(" ");
-        }
-        format!("{}{}\n{}", &text[..start], lines.join("\n"), &text[end..])
+        common::without_physical_tags(&text, 2)
     });
     let (e, message) = error_of(&path);
     assert!(matches!(e, MeshError::NoBodies { .. }), "{message}");

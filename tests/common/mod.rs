@@ -29,6 +29,30 @@ pub fn edited_fixture(
     (dir, path)
 }
 
+/// `text` (an ASCII MSH 4.1 file) with the physical tags of every entity of dimension `dim`
+/// removed from `$Entities`: its elements then belong to no physical group.
+pub fn without_physical_tags(text: &str, dim: usize) -> String {
+    let start = text.find("$Entities").expect("an $Entities section");
+    let end = text.find("$EndEntities").expect("an $EndEntities line");
+    let mut lines: Vec<String> = text[start..end].lines().map(str::to_string).collect();
+    let counts: Vec<usize> = lines[1]
+        .split_whitespace()
+        .map(|c| c.parse().unwrap())
+        .collect();
+    // Points, curves, surfaces, volumes, one line each, after the section name and the counts.
+    let first = 2 + counts[..dim].iter().sum::<usize>();
+    for line in &mut lines[first..first + counts[dim]] {
+        let mut parts: Vec<&str> = line.split_whitespace().collect();
+        // tag, 6 bounding box values (3 for points), number of physical tags, the tags, ...
+        let at = if dim == 0 { 4 } else { 7 };
+        let n: usize = parts[at].parse().unwrap();
+        parts.drain(at + 1..at + 1 + n);
+        parts[at] = "0";
+        *line = parts.join(" ");
+    }
+    format!("{}{}\n{}", &text[..start], lines.join("\n"), &text[end..])
+}
+
 /// A case file with `text`, written to a fresh temporary folder (kept alive by the returned
 /// guard; relative output paths land inside it).
 pub fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
