@@ -82,8 +82,13 @@ impl CertificateCheck {
     }
 }
 
-/// Certifies the displacements and interface forces of a solution (module doc).
-pub fn certify(problem: &ContactProblem, solution: &CoupledSolution) -> Certificate {
+/// Certifies the displacements and interface forces of a solution (module doc); also returns
+/// the geometric gaps it measured on the primary and secondary surfaces (the `normal_gap`
+/// output).
+pub fn certify(
+    problem: &ContactProblem,
+    solution: &CoupledSolution,
+) -> (Certificate, [Vec<f64>; 2]) {
     let settings = &problem.settings;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
@@ -92,9 +97,11 @@ pub fn certify(problem: &ContactProblem, solution: &CoupledSolution) -> Certific
         (s2, s1, u2, u1, &solution.contact_force2[..]),
     ];
 
+    let gaps = sides.map(|(own, other, u_own, u_other, _)| {
+        geometric_gaps(own, other, Some(u_own), Some(u_other))
+    });
     let mut penetration = [Worst::default(), Worst::default()];
-    for (worst, &(own, other, u_own, u_other, _)) in penetration.iter_mut().zip(&sides) {
-        let gaps = geometric_gaps(own, other, Some(u_own), Some(u_other));
+    for ((worst, &(own, ..)), gaps) in penetration.iter_mut().zip(&sides).zip(&gaps) {
         for (s, g) in gaps.iter().enumerate() {
             worst.offer(-g / own.spacing[s], own, s);
         }
@@ -156,10 +163,13 @@ pub fn certify(problem: &ContactProblem, solution: &CoupledSolution) -> Certific
             node_tag: None,
         },
     ];
-    Certificate {
-        passed: checks.iter().all(|c| c.passed),
-        checks,
-    }
+    (
+        Certificate {
+            passed: checks.iter().all(|c| c.passed),
+            checks,
+        },
+        gaps,
+    )
 }
 
 /// The largest value seen and its node (0 with no node when nothing is positive).

@@ -2,7 +2,6 @@
 //! stresses), the interface fields of both surfaces, total forces and the Hertz fit.
 
 use super::checks::Certificate;
-use super::interface::geometric_gaps;
 use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
 use super::solve::{ActiveSet, ContactSolver};
 use super::system::{CoupledSolution, Coupling};
@@ -10,7 +9,8 @@ use super::{ContactError, ContactSurface, hertz};
 use crate::elastic::{AssembledBody, ElasticProblem, ElasticSolution, SolveStats, reactions};
 use crate::fem::stress::cell_fields;
 
-/// The solution of the last iterate, with surface fields, forces and the Hertz fit.
+/// The solution of the last iterate, with surface fields (`gaps`: the certificate's geometric
+/// gaps of the primary and secondary surfaces), forces and the Hertz fit.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn finish(
     solver: &ContactSolver,
@@ -18,6 +18,7 @@ pub(super) fn finish(
     status: ContactStatus,
     history: Vec<IterationRecord>,
     certificate: Certificate,
+    gaps: [Vec<f64>; 2],
     coupling: &Coupling,
     solution: CoupledSolution,
     active_set: ActiveSet,
@@ -25,19 +26,11 @@ pub(super) fn finish(
     let problem = solver.problem;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let dim = s1.dim;
-    let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
-    let primary_fields = surface_fields(
-        s1,
-        &solution.contact_force1,
-        geometric_gaps(s1, s2, Some(u1), Some(u2)),
-        |s| active_set.nodes.contains(&s),
-    );
-    let mut secondary_fields = surface_fields(
-        s2,
-        &solution.contact_force2,
-        geometric_gaps(s2, s1, Some(u2), Some(u1)),
-        |_| false,
-    );
+    let [gaps1, gaps2] = gaps;
+    let primary_fields = surface_fields(s1, &solution.contact_force1, gaps1, |s| {
+        active_set.nodes.contains(&s)
+    });
+    let mut secondary_fields = surface_fields(s2, &solution.contact_force2, gaps2, |_| false);
     // The secondary surface has no active set of its own: a node is in contact where it
     // receives a compressive force and touches the primary body to the certified accuracy.
     let touching = problem.settings.secondary_penetration_tolerance;

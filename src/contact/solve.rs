@@ -219,7 +219,7 @@ impl<'a> ContactSolver<'a> {
         }
 
         let (coupling, solution) = last.expect("max_iterations >= 1 is validated");
-        let certificate = certify(problem, &solution);
+        let (certificate, gaps) = certify(problem, &solution);
         let status = match status {
             ContactStatus::Converged if !certificate.passed => ContactStatus::NotCertified,
             ContactStatus::Converged if active.is_empty() => ContactStatus::NoContact,
@@ -235,6 +235,7 @@ impl<'a> ContactSolver<'a> {
             status,
             history,
             certificate,
+            gaps,
             &coupling,
             solution,
             next_start,
