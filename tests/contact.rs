@@ -391,6 +391,35 @@ fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
 }
 
 #[test]
+fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
+    // The stiff block primary, its surface twice coarser than the disc's (R/80), pressed by
+    // 0.001: the contact zone is about 1.6 block spacings across, and the disc sags into the
+    // flat between the block's constrained nodes by about a tenth of the indentation. Every
+    // other check passes (penetration, tension, balance), yet the disc force is about 6% below
+    // the one with the disc's own nodes constrained (the disc primary): that answer must not
+    // be called converged, and the sag must be named.
+    let text = stiff_block("half_disc_on_block_coarse_block.msh", "block")
+        .replace("uy = -0.02", "uy = -0.001");
+    assert!(text.contains("uy = -0.001"), "{text}");
+    let coarse = solve(&text).unwrap();
+    assert_eq!(coarse.status, ContactStatus::NotCertified);
+    let failed: Vec<&str> = coarse
+        .certificate
+        .checks
+        .iter()
+        .filter(|c| !c.passed)
+        .map(|c| c.name)
+        .collect();
+    assert_eq!(failed, ["secondary sag"], "{:?}", coarse.certificate);
+
+    // The premise: constraining the disc's nodes instead changes the force by several percent.
+    let fine = solve(&text.replace("primary = \"block\"", "primary = \"disc\"")).unwrap();
+    let (on_disc_coarse, on_disc_fine) = (coarse.force_secondary[1], fine.force_primary[1]);
+    let change = (on_disc_coarse - on_disc_fine).abs() / on_disc_fine.abs();
+    assert!(change > 0.03, "{on_disc_coarse} against {on_disc_fine}");
+}
+
+#[test]
 fn a_contact_body_needs_a_body_table() {
     let text = two_blocks(
         2,

@@ -15,6 +15,11 @@
 //!   outward normal, not the loop's contact normal); the largest tension over the largest
 //!   pressure of either surface must not exceed `certificate_tension_tolerance`, a bound for
 //!   the undershoot of the RBF transfer of the multiplier to the secondary surface.
+//! - **Secondary sag.** The secondary's largest penetration over the indentation depth (how far
+//!   the surfaces moved into each other over the contact zone) must not exceed `sag_tolerance`:
+//!   the constraint holds the secondary only at the primary's nodes, and a secondary surface
+//!   curved into a coarse flat primary sags between them (`secondary_sag`). The penetration
+//!   check above bounds that sag by the spacing; this one bounds its effect on the answer.
 //! - **Force balance.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
 //!   exceed `imbalance_tolerance`: the transfer `R21` conserves force only to its accuracy.
 //!
@@ -40,7 +45,7 @@ pub struct Certificate {
 #[derive(Debug, Clone, Serialize)]
 pub struct CertificateCheck {
     /// "penetration" and "secondary penetration" (over h), "tension" (over the largest
-    /// pressure), or "imbalance".
+    /// pressure), "secondary sag" (over the indentation depth), or "imbalance".
     pub name: &'static str,
     pub value: f64,
     pub tolerance: f64,
@@ -72,6 +77,8 @@ impl CertificateCheck {
             " h"
         } else if self.name.ends_with("tension") {
             " of the largest pressure"
+        } else if self.name.ends_with("sag") {
+            " of the indentation depth"
         } else {
             ""
         };
@@ -146,6 +153,9 @@ pub fn certify(
         norm(f2)
     };
 
+    let indentation = indentation_depth(s1, s2, &gaps[0], &mean[0]);
+    let secondary_sag = secondary_sag(s2, &gaps[1], indentation, settings);
+
     let [penetration1, penetration2] = penetration;
     let checks = vec![
         penetration1.check("penetration", settings.penetration_tolerance),
@@ -154,6 +164,7 @@ pub fn certify(
             settings.secondary_penetration_tolerance,
         ),
         tension.check("tension", settings.certificate_tension_tolerance),
+        secondary_sag,
         CertificateCheck {
             name: "imbalance",
             value: imbalance,
@@ -170,6 +181,45 @@ pub fn certify(
         },
         gaps,
     )
+}
+
+/// How far the two surfaces moved into each other over the contact zone: the largest change of
+/// the geometric gap, reference to deformed, over the primary nodes that receive a compressive
+/// mean pressure. For a sphere pressed onto a flat it is the gap the rim had to close,
+/// `a^2 / (2R)`, half the approach `delta = a^2 / R`; for a body meshed overlapping, the
+/// overlap undone.
+fn indentation_depth(
+    primary: &ContactSurface,
+    secondary: &ContactSurface,
+    gaps: &[f64],
+    pressure: &[f64],
+) -> f64 {
+    let reference = geometric_gaps(primary, secondary, None, None);
+    (0..primary.len())
+        .filter(|&s| pressure[s] > 0.0)
+        .map(|s| (reference[s] - gaps[s]).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The secondary's largest penetration into the primary over the indentation depth. Only the
+/// transfer holds the secondary nodes: between two constrained primary nodes `h_p` apart, a
+/// secondary surface of curvature `1/R` sags into a flat primary by about `h_p^2 / (8R)`, which
+/// is `(h_p / a)^2 / 4` of the indentation depth `a^2 / (2R)`: the contact is that much softer
+/// than the secondary's own discretization, and the force (`P ~ delta^(3/2)` in 3D) lower by
+/// about 3/4 of it. A figure below the primary's penetration tolerance times the node's
+/// spacing always passes (touching flat surfaces have no indentation and no sag).
+fn secondary_sag(
+    secondary: &ContactSurface,
+    gaps: &[f64],
+    indentation: f64,
+    settings: &super::ContactSettings,
+) -> CertificateCheck {
+    let mut worst = Worst::default();
+    for (s, g) in gaps.iter().enumerate() {
+        let floor = settings.penetration_tolerance * secondary.spacing[s] / settings.sag_tolerance;
+        worst.offer(-g / indentation.max(floor), secondary, s);
+    }
+    worst.check("secondary sag", settings.sag_tolerance)
 }
 
 /// The largest value seen and its node (0 with no node when nothing is positive).

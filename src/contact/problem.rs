@@ -54,6 +54,10 @@ pub struct ContactSettings {
     /// spacings across the contact zone, falling with h), far below the spacing-sized
     /// penetration of a wrong active set.
     pub secondary_penetration_tolerance: f64,
+    /// The certificate's bound on the secondary's penetration over the indentation depth
+    /// (`super::checks`; default 0.03): how much softer than the secondary's own
+    /// discretization the coupling lets the contact be.
+    pub sag_tolerance: f64,
     /// The certificate's bound on the tensile normal force any surface node receives over its
     /// area (along the node's own outward normal), relative to the largest pressure (default
     /// 0.1). The secondary pressure is the RBF transfer `R21 lambda` of the multiplier, which
@@ -79,6 +83,7 @@ impl Default for ContactSettings {
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
             secondary_penetration_tolerance: 0.05,
+            sag_tolerance: 0.03,
             certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
             rbf_radius: 2.0,
@@ -118,6 +123,7 @@ impl ContactSettings {
                 "certificate_tension_tolerance",
                 self.certificate_tension_tolerance,
             ),
+            ("sag_tolerance", self.sag_tolerance),
             ("imbalance_tolerance", self.imbalance_tolerance),
         ] {
             if !(value >= 0.0 && value.is_finite()) {
