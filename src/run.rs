@@ -131,7 +131,7 @@ fn solve_into(
     let mut solved: Vec<SolvedBody> = Vec::new();
     let contact = case.contact_problem(&mesh)?;
     let mut contact_summary = None;
-    if let Some(problem) = &contact {
+    if let Some(problem) = contact {
         say(format!(
             "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
             problem.primary.body.name,
@@ -146,74 +146,9 @@ fn solve_into(
             "primary body '{}' ({}): {}",
             problem.primary.body.name, problem.primary_report.mode, problem.primary_report.reason
         ));
-        // The set-up (assembly, factorizations, interpolation) once, then one active-set loop
-        // per load step, each starting from the previous active set.
-        let contact_error = |source| RunError::Contact {
-            path: case.path.clone(),
-            source,
-        };
-        let phase = Instant::now();
-        let mut contact_solver =
-            ContactSolver::new(problem, &case.solver).map_err(contact_error)?;
-        timings.push(("contact set-up".to_string(), phase.elapsed().as_secs_f64()));
-        let load_steps = case.load_steps();
-        let mut steps = Vec::new();
-        let mut last: Option<ContactSolution> = None;
-        for (k, &factor) in load_steps.iter().enumerate() {
-            if load_steps.len() > 1 {
-                say(format!(
-                    "load step {}/{}: factor {factor}",
-                    k + 1,
-                    load_steps.len()
-                ));
-            }
-            let phase = Instant::now();
-            let start = last.as_ref().map(|s| &s.active_set);
-            let solution = contact_solver.solve(factor, start).map_err(contact_error)?;
-            let seconds = phase.elapsed().as_secs_f64();
-            timings.push((format!("contact step {}", k + 1), seconds));
-            say(format!(
-                "contact status: {}",
-                describe(&solution, problem.settings.formulation)
-            ));
-            steps.push(StepRecord {
-                step: k + 1,
-                load_factor: factor,
-                status: solution.status,
-                iterations: solution.history.len(),
-                force_primary: solution.force_primary[..mesh.dim].to_vec(),
-                force_secondary: solution.force_secondary[..mesh.dim].to_vec(),
-                force_imbalance: solution.force_imbalance,
-                hertz_a: solution.hertz_primary.map(|h| h.a),
-                hertz_p0: solution.hertz_primary.map(|h| h.p0),
-                seconds,
-            });
-            let stop = !matches!(
-                solution.status,
-                ContactStatus::Converged | ContactStatus::NoContact
-            );
-            last = Some(solution);
-            if stop {
-                say("stopping the load steps: this step did not converge".to_string());
-                break;
-            }
-        }
-        let solution = last.expect("at least one load step");
-        let csv = output_dir.join("force_displacement.csv");
-        std::fs::write(&csv, StepRecord::csv(&steps))
-            .map_err(|source| OutputError::Io { path: csv, source })?;
-        // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
-        // Warned even with --quiet, since a file the user expects is missing.
-        let png = output_dir.join("force_displacement.png");
-        let title = format!(
-            "{}: contact force on '{}' against load factor",
-            case_name(&case),
-            problem.primary.body.name
-        );
-        if let Err(e) = write_force_displacement_png(&png, &title, &steps) {
-            eprintln!("warning: {} not written: {e}", png.display());
-        }
-        contact_summary = Some(summarize_contact(problem, &solution, steps));
+        let (problem, solution, steps) =
+            solve_contact_case(problem, &case, &output_dir, &mut timings, &say)?;
+        contact_summary = Some(summarize_contact(&problem, &solution, steps));
         solved.push(SolvedBody {
             name: problem.primary.body.name.clone(),
             solution: solution.primary,
@@ -287,6 +222,151 @@ fn solve_into(
         start.elapsed().as_secs_f64()
     ));
     Ok(summary)
+}
+
+/// The contact solve of a case: every load step with the chosen primary, and, when the primary
+/// was chosen automatically and that solve does not end `converged` (or `no-contact`), every
+/// load step again with the other body as primary. The second answer is kept if it converges;
+/// otherwise the first is, and the summary's reason says what both ended with. A coarse flat
+/// primary under a curved secondary is the usual case: the secondary sags between the
+/// primary's nodes (certificate), which a curved primary does not let happen.
+/// Writes `force_displacement.csv` and `.png` of the kept solve.
+fn solve_contact_case<'m>(
+    problem: ContactProblem<'m>,
+    case: &Case,
+    output_dir: &Path,
+    timings: &mut Vec<(String, f64)>,
+    say: &dyn Fn(String),
+) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), RunError> {
+    let (solution, steps) = solve_load_steps(&problem, case, "", timings, say)?;
+    let (problem, solution, steps) = if problem.primary_report.mode == "auto"
+        && !settled(solution.status)
+    {
+        let first = (problem.primary.body.name.clone(), failure(&solution));
+        let other = problem.with_other_primary();
+        say(format!(
+            "primary = \"auto\": with '{}' as primary the solve ended {}; solving again with '{}' as primary",
+            first.0, first.1, other.primary.body.name
+        ));
+        let retry = solve_load_steps(&other, case, "other primary: ", timings, say);
+        match retry {
+            Ok((second, steps2)) if settled(second.status) => {
+                let other_name = other.primary.body.name.clone();
+                let other = other.with_reason_appended(&format!(
+                    "'{other_name}' carries the multiplier because '{}' as primary ended {}",
+                    first.0, first.1
+                ));
+                (other, second, steps2)
+            }
+            retry => {
+                let second = match retry {
+                    Ok((second, _)) => failure(&second),
+                    Err(e) => format!("with an error ({e})"),
+                };
+                let other_name = other.primary.body.name.clone();
+                let problem = other.with_other_primary().with_reason_appended(&format!(
+                    "kept although it ended {}: '{other_name}' as primary ended {second}",
+                    first.1
+                ));
+                (problem, solution, steps)
+            }
+        }
+    } else {
+        (problem, solution, steps)
+    };
+    let csv = output_dir.join("force_displacement.csv");
+    std::fs::write(&csv, StepRecord::csv(&steps))
+        .map_err(|source| OutputError::Io { path: csv, source })?;
+    // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
+    // Warned even with --quiet, since a file the user expects is missing.
+    let png = output_dir.join("force_displacement.png");
+    let title = format!(
+        "{}: contact force on '{}' against load factor",
+        case_name(case),
+        problem.primary.body.name
+    );
+    if let Err(e) = write_force_displacement_png(&png, &title, &steps) {
+        eprintln!("warning: {} not written: {e}", png.display());
+    }
+    Ok((problem, solution, steps))
+}
+
+/// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
+/// load step, each starting from the previous active set; stops at the first step that does
+/// not converge. `label` prefixes the timing names.
+fn solve_load_steps(
+    problem: &ContactProblem,
+    case: &Case,
+    label: &str,
+    timings: &mut Vec<(String, f64)>,
+    say: &dyn Fn(String),
+) -> Result<(ContactSolution, Vec<StepRecord>), RunError> {
+    let contact_error = |source| RunError::Contact {
+        path: case.path.clone(),
+        source,
+    };
+    let dim = problem.primary_surface.dim;
+    let phase = Instant::now();
+    let mut contact_solver = ContactSolver::new(problem, &case.solver).map_err(contact_error)?;
+    timings.push((
+        format!("{label}contact set-up"),
+        phase.elapsed().as_secs_f64(),
+    ));
+    let load_steps = case.load_steps();
+    let mut steps = Vec::new();
+    let mut last: Option<ContactSolution> = None;
+    for (k, &factor) in load_steps.iter().enumerate() {
+        if load_steps.len() > 1 {
+            say(format!(
+                "load step {}/{}: factor {factor}",
+                k + 1,
+                load_steps.len()
+            ));
+        }
+        let phase = Instant::now();
+        let start = last.as_ref().map(|s| &s.active_set);
+        let solution = contact_solver.solve(factor, start).map_err(contact_error)?;
+        let seconds = phase.elapsed().as_secs_f64();
+        timings.push((format!("{label}contact step {}", k + 1), seconds));
+        say(format!(
+            "contact status: {}",
+            describe(&solution, problem.settings.formulation)
+        ));
+        steps.push(StepRecord {
+            step: k + 1,
+            load_factor: factor,
+            status: solution.status,
+            iterations: solution.history.len(),
+            force_primary: solution.force_primary[..dim].to_vec(),
+            force_secondary: solution.force_secondary[..dim].to_vec(),
+            force_imbalance: solution.force_imbalance,
+            hertz_a: solution.hertz_primary.map(|h| h.a),
+            hertz_p0: solution.hertz_primary.map(|h| h.p0),
+            seconds,
+        });
+        let stop = !settled(solution.status);
+        last = Some(solution);
+        if stop {
+            say("stopping the load steps: this step did not converge".to_string());
+            break;
+        }
+    }
+    Ok((last.expect("at least one load step"), steps))
+}
+
+/// A solve that ended as a contact solution (`converged` or `no-contact`).
+fn settled(status: ContactStatus) -> bool {
+    matches!(status, ContactStatus::Converged | ContactStatus::NoContact)
+}
+
+/// How a solve that did not settle ended, in a few words (for the primary choice's reason).
+fn failure(solution: &ContactSolution) -> String {
+    let status = serde_json::to_value(solution.status).expect("a unit enum serializes");
+    let status = status.as_str().unwrap_or("?").to_string();
+    match solution.status {
+        ContactStatus::NotCertified => format!("{status} ({})", solution.certificate.failures()),
+        _ => status,
+    }
 }
 
 /// The case file's name without its extension (the plot title).

@@ -420,6 +420,30 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
 }
 
 #[test]
+fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {
+    // Equal materials, the block's surface twice coarser than the disc's (R/80), pressed by
+    // 0.003: auto picks the coarser block, whose answer fails the certificate on the disc's
+    // sag; the disc as primary is certified, and that answer is the one kept, with the reason.
+    let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
+        .replace("uy = -0.02", "uy = -0.003");
+    assert!(text.contains("uy = -0.003"), "{text}");
+    let block_first = solve(&text.replace("primary = \"disc\"", "primary = \"block\"")).unwrap();
+    assert_eq!(block_first.status, ContactStatus::NotCertified);
+
+    let (code, summary) = solve_cli(&text.replace("primary = \"disc\"", "primary = \"auto\""));
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(0), "{contact}");
+    assert_eq!(contact["status"], "converged", "{contact}");
+    assert_eq!(contact["primary"], "disc", "{contact}");
+    assert_eq!(contact["primary_choice"]["mode"], "auto");
+    let reason = contact["primary_choice"]["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("'block' as primary ended not-certified (secondary sag"),
+        "{reason}"
+    );
+}
+
+#[test]
 fn a_contact_body_needs_a_body_table() {
     let text = two_blocks(
         2,

@@ -200,6 +200,23 @@ pub struct ContactProblem<'m> {
 }
 
 impl<'m> ContactProblem<'m> {
+    /// The same problem with the roles of the two bodies exchanged (the reason is kept).
+    pub fn with_other_primary(self) -> Self {
+        Self {
+            primary: self.secondary,
+            secondary: self.primary,
+            primary_surface: self.secondary_surface,
+            secondary_surface: self.primary_surface,
+            ..self
+        }
+    }
+
+    /// The same problem, its primary choice's reason extended by `more`.
+    pub fn with_reason_appended(mut self, more: &str) -> Self {
+        self.primary_report.reason = format!("{}; {more}", self.primary_report.reason);
+        self
+    }
+
     /// The contact moduli `E / (1 - nu^2)` of the primary and secondary bodies, normalized to
     /// sum to one: the weights of their normals in the contact normal
     /// (`super::interface::contact_normal`).
