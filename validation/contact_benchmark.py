@@ -18,7 +18,7 @@ other, so that its wall time and peak resident memory (``ru_maxrss`` from
   2. ours, load steps  the same with ``load_steps = [0.5, 1.0]``: half, then the
                        full displacement; the second step starts from the first
                        step's active set and reuses the Cholesky factors and the
-                       cached interface compliance.
+                       cached responses to the multipliers.
      For both, the per-iteration times of every step are read from the run's log
      (``summary.json`` keeps the last step's only), the phases from
      ``summary.json``.
@@ -212,12 +212,12 @@ def parse_log(log: Path) -> tuple[float, list[list[dict]]]:
 
 
 def compliance_estimate(iterations: list[dict]) -> float:
-    """Seconds of a step attributed to new interface-compliance columns (an estimate).
+    """Seconds of a step attributed to new responses to the multipliers (an estimate).
 
     An iteration that reuses every cached column costs about the step's median
     iteration (dense Schur complement, two solves per body, contact checks); the
-    time above that median is counted as compliance solves for the dofs the
-    active set reached for the first time.
+    time above that median is counted as the solves for the nodes that became
+    active for the first time.
     """
     seconds = [i["seconds"] for i in iterations]
     if not seconds:
@@ -532,18 +532,17 @@ def reading(sizes: list[dict]) -> list[str]:
                     "Cholesky factorization is a direct solver's cost (factor work ~ n^2 in 3D with nested "
                     "dissection) where GAMG's is ~ n: once it alone exceeds twice dolfinx's solve, the aim is out "
                     "of reach for this design whatever the loop costs. The compliance solves are one full "
-                    "forward + backward solve with a body's factor per interface dof the active set reaches (three "
-                    "per node and body, with the ring of neighbours the interface mass matrices load), of which "
+                    "forward + backward solve with each body's factor per multiplier (per active primary node, "
+                    "src/contact/compliance.rs), of which "
                     "only the candidate-surface rows are kept; the second iteration pays most of them, because the "
                     "unconstrained first iteration makes every geometrically overlapping node active at once ("
                     + "; ".join(_overshoot(s) for s in done) + "), so columns are computed for more nodes than "
                     "end in contact, and the loop then removes the nodes in tension a rim at a time. The other "
-                    "iteration work is paid at every iteration: mostly the dense Schur complement gathered "
-                    "entry by entry from the cached columns and multiplied out (C G B, dense products of "
-                    "(3 x active nodes)-sized blocks), then four single-right-hand-side solves with the factors "
-                    "(z = K^-1 f and the back-substitution, per body), the interface operators, the Schur LU and "
-                    "the contact checks (this order is from a timed build of one run, see `validation/README.md`); "
-                    "it grows with the iteration count.")
+                    "iteration work is paid at every iteration: the dense Schur complement gathered from the "
+                    "cached responses and multiplied out (s C Y: constraint rows on the read surface dofs times "
+                    "the responses there), its LU, four single-right-hand-side solves with the factors "
+                    "(z = K^-1 f and the back-substitution, per body), the interface operators and the contact "
+                    "checks; it grows with the iteration count.")
     stepped = [s for s in sizes if "step" in ratios(s)]
     if stepped:
         parts = []

@@ -1,29 +1,38 @@
-//! The interface compliance of a body: the block of `K_c^-1` on its candidate-surface dofs,
-//! `G[a, b] = (K_c^-1)[a, b]`, the displacement at dof `a` under a unit load at dof `b`.
+//! The interface response of a body to each multiplier: `Y_k = K_c^-1 b_k`, `b_k` the force
+//! that a unit multiplier `k` puts on the body (its column of the coupling block `B`, without
+//! the system's scaling), kept on the body's candidate-surface dofs.
 //!
-//! An active-set iteration needs `Y = K^-1 B` only where the constraint rows `C` read it, and
-//! both the rows of `B` (the interface forces) and the columns of `C` (the interface
-//! displacements) are candidate-surface dofs, so `C K^-1 B = C G B`. From one iteration or
-//! load step to the next the active set changes by a few nodes: a column of `G` is computed
-//! (one solve with the body's Cholesky factor) the first time a dof is loaded, and kept for
-//! every later iteration and load step. The alternative, `m` solves per iteration for `Y`,
-//! redoes the same solves every time.
+//! An active-set iteration needs `K^-1 B` only where the constraint rows `C` read it, and the
+//! columns of `C` (the interface displacements) are candidate-surface dofs, so the Schur
+//! complement is `D - s C Y` with `Y = [Y_k]` restricted to those dofs. The operators are built
+//! once (`super::interface`), so `b_k` depends only on which primary node (and component, for
+//! tied contact) multiplier `k` belongs to: `Y_k` is computed (one solve with the body's
+//! Cholesky factor) the first time that node is active, and kept for every later iteration and
+//! load step.
+//!
+//! One solve per multiplier, rather than one per loaded dof: the secondary's column `M2 R21 e_k`
+//! loads every secondary node the interpolation reaches, nearly the whole facing surface
+//! (the rows of `R12` and columns of `R21` are dense over it), so a dof-by-dof compliance
+//! needs about `dim` times the facing secondary nodes in solves, against one per active node.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
 use crate::linalg::Cholesky;
 
-/// Columns of `G`, computed on demand. Rows are the candidate-surface dofs of the body.
-pub struct SurfaceCompliance {
-    /// Row of `G` of each body dof (`usize::MAX` off the candidate surface).
+/// Identifies a multiplier across iterations: the primary body node it acts at, and its
+/// component (tied) or `None` (frictionless: one normal multiplier per node).
+pub type MultiplierKey = (usize, Option<usize>);
+
+/// The responses `Y_k` of one body computed so far, on its candidate-surface dofs.
+pub struct SurfaceResponse {
+    /// Row of each body dof in a stored response (`usize::MAX` off the candidate surface).
     row: Vec<usize>,
     /// Body dof of each row.
     surface_dofs: Vec<usize>,
-    /// Column of `G` (all its rows) of each loaded dof.
-    columns: HashMap<usize, Vec<f64>>,
+    responses: HashMap<MultiplierKey, Vec<f64>>,
 }
 
-impl SurfaceCompliance {
+impl SurfaceResponse {
     /// An empty cache for the candidate surface `surface_nodes` (body nodes) of a body with
     /// `num_dofs` dofs, `dim` per node.
     pub fn new(surface_nodes: &[usize], dim: usize, num_dofs: usize) -> Self {
@@ -38,48 +47,46 @@ impl SurfaceCompliance {
         Self {
             row,
             surface_dofs,
-            columns: HashMap::new(),
+            responses: HashMap::new(),
         }
     }
 
-    /// Computes the columns of the `dofs` not known yet, with one multi-right-hand-side solve;
-    /// returns how many were new.
-    ///
-    /// # Panics
-    /// If a dof is off the candidate surface (the coupling only loads surface dofs).
-    pub fn extend(&mut self, factor: &Cholesky, dofs: impl IntoIterator<Item = usize>) -> usize {
-        let missing: BTreeSet<usize> = dofs
-            .into_iter()
-            .filter(|dof| !self.columns.contains_key(dof))
-            .collect();
-        if missing.is_empty() {
-            return 0;
-        }
+    /// Whether the response of `key` is known.
+    pub fn contains(&self, key: &MultiplierKey) -> bool {
+        self.responses.contains_key(key)
+    }
+
+    /// Computes and keeps the responses to the `loads` (each a key and its sparse body force
+    /// `(dof, value)`), with multi-right-hand-side solves; a key already known is skipped.
+    pub fn extend(&mut self, factor: &Cholesky, loads: &[(MultiplierKey, Vec<(usize, f64)>)]) {
         // In chunks, so that the right-hand sides of a large first active set fit in memory.
         const CHUNK: usize = 64;
         let n = self.row.len();
-        let missing: Vec<usize> = missing.into_iter().collect();
+        let missing: Vec<&(MultiplierKey, Vec<(usize, f64)>)> =
+            loads.iter().filter(|(key, _)| !self.contains(key)).collect();
         for chunk in missing.chunks(CHUNK) {
             let mut rhs = vec![0.0; n * chunk.len()];
-            for (k, &dof) in chunk.iter().enumerate() {
-                assert!(
-                    self.row[dof] != usize::MAX,
-                    "dof {dof} is not on the candidate surface"
-                );
-                rhs[k * n + dof] = 1.0;
+            for (j, (_, load)) in chunk.iter().enumerate() {
+                for &(dof, value) in load {
+                    rhs[j * n + dof] += value;
+                }
             }
             factor.solve_in_place(&mut rhs, chunk.len());
-            for (k, &dof) in chunk.iter().enumerate() {
-                let full = &rhs[k * n..(k + 1) * n];
-                let column = self.surface_dofs.iter().map(|&d| full[d]).collect();
-                self.columns.insert(dof, column);
+            for (j, (key, _)) in chunk.iter().enumerate() {
+                let full = &rhs[j * n..(j + 1) * n];
+                let response = self.surface_dofs.iter().map(|&d| full[d]).collect();
+                self.responses.insert(*key, response);
             }
         }
-        missing.len()
     }
 
-    /// `G[a, b]`; the column of `b` must have been computed by [`Self::extend`].
-    pub fn entry(&self, a: usize, b: usize) -> f64 {
-        self.columns[&b][self.row[a]]
+    /// `Y_key[dof]`; the response must have been computed by [`Self::extend`].
+    ///
+    /// # Panics
+    /// If `dof` is off the candidate surface (the constraint rows only read surface dofs).
+    pub fn entry(&self, key: &MultiplierKey, dof: usize) -> f64 {
+        let row = self.row[dof];
+        assert!(row != usize::MAX, "dof {dof} is not on the candidate surface");
+        self.responses[key][row]
     }
 }

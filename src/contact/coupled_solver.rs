@@ -4,12 +4,12 @@
 //!   (sparse Cholesky) for the whole contact solve, and every iteration solves only the
 //!   interface problem by block elimination:
 //!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`.
-//!   `C K^-1 B = C G B` is formed densely from the interface compliance `G` of each body
-//!   ([`super::compliance`]), whose columns are computed once per loaded dof and reused by
-//!   every later iteration and load step; the Schur complement is factored by dense LU with
-//!   partial pivoting (interfaces have hundreds to a few thousand multipliers). Each iteration
-//!   then costs two single-column solves per body, plus one solve per dof the active set
-//!   reaches for the first time.
+//!   `C K^-1 B = s C Y` is formed densely from each body's responses `Y_k` to the
+//!   multipliers ([`super::compliance`]), computed once per multiplier (primary node) and
+//!   reused by every later iteration and load step; the Schur complement is factored by dense
+//!   LU with partial pivoting (interfaces have hundreds to a few thousand multipliers). Each
+//!   iteration then costs two single-column solves per body, plus one solve per body for each
+//!   node that becomes active for the first time.
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
 
@@ -18,7 +18,7 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::compliance::SurfaceCompliance;
+use super::compliance::SurfaceResponse;
 use super::system::CoupledSystem;
 use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
@@ -34,17 +34,17 @@ pub enum CoupledSolver {
     MonolithicLu,
 }
 
-/// The Cholesky factors of both bodies' constrained stiffness matrices, and the interface
-/// compliance columns computed with them so far.
+/// The Cholesky factors of both bodies' constrained stiffness matrices, and the bodies'
+/// responses to the multipliers computed with them so far.
 pub struct BodyFactors {
     factor1: Cholesky,
     factor2: Cholesky,
-    compliance1: SurfaceCompliance,
-    compliance2: SurfaceCompliance,
+    response1: SurfaceResponse,
+    response2: SurfaceResponse,
 }
 
 impl BodyFactors {
-    /// Factors both bodies; the compliance caches cover their candidate surfaces.
+    /// Factors both bodies; the response caches cover their candidate surfaces.
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
@@ -63,8 +63,8 @@ impl BodyFactors {
         Ok(Self {
             factor1: factor1?,
             factor2: factor2?,
-            compliance1: SurfaceCompliance::new(&surface1.nodes, dim, body1.f_c.len()),
-            compliance2: SurfaceCompliance::new(&surface2.nodes, dim, body2.f_c.len()),
+            response1: SurfaceResponse::new(&surface1.nodes, dim, body1.f_c.len()),
+            response2: SurfaceResponse::new(&surface2.nodes, dim, body2.f_c.len()),
         })
     }
 }
@@ -104,68 +104,64 @@ fn solve_schur(
     system: &CoupledSystem,
     factors: &mut BodyFactors,
 ) -> Result<Vec<f64>, ContactError> {
-    let (n1, n2, m) = (system.n1, system.n2, system.m);
-    // The dofs B loads and C reads, per body (sorted, distinct).
-    let split = |dofs: &mut dyn Iterator<Item = usize>| {
-        let (mut first, mut second): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
-        for dof in dofs {
-            if dof < n1 {
-                first.push(dof);
-            } else {
-                second.push(dof - n1);
-            }
-        }
-        for v in [&mut first, &mut second] {
-            v.sort_unstable();
-            v.dedup();
-        }
-        (first, second)
-    };
-    let (loaded1, loaded2) = split(&mut system.b.iter().map(|e| e.0));
-    let (read1, read2) = split(&mut system.c.iter().map(|e| e.1));
+    let (n1, n2, m, s) = (system.n1, system.n2, system.m, system.s);
+    let BodyFactors {
+        factor1,
+        factor2,
+        response1,
+        response2,
+    } = factors;
 
-    // z = K^-1 f.
+    // z = K^-1 f. The bodies are independent: solved side by side.
     let mut z1 = system.f[..n1].to_vec();
     let mut z2 = system.f[n1..].to_vec();
-    // The bodies are independent: solved side by side.
-    let (factor1, factor2) = (&factors.factor1, &factors.factor2);
     rayon::join(
         || factor1.solve_in_place(&mut z1, 1),
         || factor2.solve_in_place(&mut z2, 1),
     );
 
-    // S = D - C G B, and r = g - C z.
-    factors
-        .compliance1
-        .extend(&factors.factor1, loaded1.iter().copied());
-    factors
-        .compliance2
-        .extend(&factors.factor2, loaded2.iter().copied());
-    let position = |dofs: &[usize], dof: usize| dofs.binary_search(&dof).expect("listed dof");
+    // Y_k = K^-1 (B e_k / s) for the multipliers not seen before (`super::compliance`).
+    let mut loads: [Vec<Vec<(usize, f64)>>; 2] = [vec![Vec::new(); m], vec![Vec::new(); m]];
+    for &(row, k, value) in &system.b {
+        let (body, dof) = if row < n1 { (0, row) } else { (1, row - n1) };
+        loads[body][k].push((dof, value / s));
+    }
+    let new = |response: &SurfaceResponse, loads: &mut Vec<Vec<(usize, f64)>>| {
+        (0..m)
+            .filter(|&k| !response.contains(&system.keys[k]))
+            .map(|k| (system.keys[k], std::mem::take(&mut loads[k])))
+            .collect::<Vec<_>>()
+    };
+    let [loads1, loads2] = &mut loads;
+    let (new1, new2) = (new(response1, loads1), new(response2, loads2));
+    rayon::join(
+        || response1.extend(factor1, &new1),
+        || response2.extend(factor2, &new2),
+    );
+
+    // S = D - s C Y, and r = g - C z; C and Y as dense blocks on the dofs C reads.
     let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
-    for (compliance, loaded, read, dofs) in [
-        (&factors.compliance1, &loaded1, &read1, 0..n1),
-        (&factors.compliance2, &loaded2, &read2, n1..n1 + n2),
-    ] {
-        if loaded.is_empty() || read.is_empty() {
+    for (response, dofs) in [(&*response1, 0..n1), (&*response2, n1..n1 + n2)] {
+        let mut read: Vec<usize> = (system.c.iter())
+            .filter(|e| dofs.contains(&e.1))
+            .map(|e| e.1 - dofs.start)
+            .collect();
+        read.sort_unstable();
+        read.dedup();
+        if read.is_empty() || m == 0 {
             continue;
         }
-        let mut b = DMatrix::<f64>::zeros(loaded.len(), m);
-        for &(row, k, value) in &system.b {
-            if dofs.contains(&row) {
-                b[(position(loaded, row - dofs.start), k)] += value;
-            }
-        }
+        let position = |dof: usize| read.binary_search(&dof).expect("listed dof");
         let mut c = DMatrix::<f64>::zeros(m, read.len());
         for &(k, col, value) in &system.c {
             if dofs.contains(&col) {
-                c[(k, position(read, col - dofs.start))] += value;
+                c[(k, position(col - dofs.start))] += value;
             }
         }
-        let g = DMatrix::from_fn(read.len(), loaded.len(), |i, j| {
-            compliance.entry(read[i], loaded[j])
+        let y = DMatrix::from_fn(read.len(), m, |i, k| {
+            response.entry(&system.keys[k], read[i])
         });
-        schur -= c * (g * b);
+        schur -= (c * y) * s;
     }
     let mut r = DVector::from_column_slice(&system.g);
     for &(k, col, value) in &system.c {
@@ -189,8 +185,10 @@ fn solve_schur(
             w2[row - n1] += value * lambda[k];
         }
     }
-    factors.factor1.solve_in_place(&mut w1, 1);
-    factors.factor2.solve_in_place(&mut w2, 1);
+    rayon::join(
+        || factor1.solve_in_place(&mut w1, 1),
+        || factor2.solve_in_place(&mut w2, 1),
+    );
     let mut x: Vec<f64> = z1.iter().zip(&w1).map(|(z, w)| z - w).collect();
     x.extend(z2.iter().zip(&w2).map(|(z, w)| z - w));
     x.extend(lambda.iter());

@@ -24,6 +24,7 @@
 
 use faer::sparse::{SparseColMat, Triplet};
 
+use super::compliance::MultiplierKey;
 use super::{ContactError, Formulation};
 use crate::elastic::AssembledBody;
 use crate::linalg::mat_vec;
@@ -104,6 +105,9 @@ pub struct CoupledSystem {
     pub n2: usize,
     /// Number of multipliers.
     pub m: usize,
+    /// Which primary node (and component) each multiplier belongs to; its column of `B` over
+    /// `s` depends on nothing else (`super::compliance`).
+    pub keys: Vec<MultiplierKey>,
     /// Multiplier scaling: the unknown is `lambda / s`.
     pub s: f64,
     /// Entries `(row < n1 + n2, multiplier, value)` of B.
@@ -137,6 +141,14 @@ impl CoupledSystem {
         }
         let s = if m > 0 { k_scale / m_scale } else { 1.0 };
         let t = k_scale;
+        let keys: Vec<MultiplierKey> = match coupling.formulation {
+            Formulation::Tied => coupling
+                .primary_nodes
+                .iter()
+                .flat_map(|&node| (0..dim).map(move |c| (node, Some(c))))
+                .collect(),
+            Formulation::Frictionless => coupling.primary_nodes.iter().map(|&n| (n, None)).collect(),
+        };
         let dropped: Vec<bool> = (0..m)
             .map(|col| coupling.is_dropped(col, body1, dim))
             .collect();
@@ -191,6 +203,7 @@ impl CoupledSystem {
             n1,
             n2,
             m,
+            keys,
             s,
             b,
             c: c_entries,
