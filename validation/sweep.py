@@ -859,6 +859,11 @@ DECISIONS = """\
 * *Contact zone of internodes*: the primary's active nodes with pressure above 1e-9 of the largest
   (the reference's rule), for the contact radius, the Hertz fit and the symmetry check; the
   secondary's active flags and interpolated pressures reach far outside the zone.
+* *Symmetry plane* (changed after the first 3D R/50 run): the plane where dolfinx puts the interface
+  of the two discrete bodies (each alone on a rigid flat, their approaches adding up to delta at one
+  force), not v = -delta/2: the upper mesh, 1.5 times coarser, makes a stiffer discrete body (4.9%
+  more force than the lower at the same approach on the R/50 mesh). The distances from -delta/2 are
+  in each row's note.
 * *Approach*: set from Hertz (3D) or a measured dolfinx curve (2D) for the intended width; the
   spacings across actually reached are in the table (reference or Hertz a for the measured force).
 """
