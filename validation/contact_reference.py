@@ -564,6 +564,83 @@ def node_table(model: RigidFlatContact, result: dict) -> list[dict]:
 # ---------------------------------------------------------------------------
 
 
+def turned_mesh(msh: Path, dim: int) -> Path:
+    """The mesh turned upside down (``<stem>_turned.msh`` beside it, rewritten when older than the mesh):
+    rotated by 180 degrees about the first horizontal axis (3D: y, z -> -y, -z; 2D: x, y -> -x, -y), so
+    that the lower body of a two-equal mesh points down onto v = 0 like the upper one. A rotation, not a
+    reflection: the cells keep their orientation (a reflected mesh inverts every cell)."""
+    out = msh.with_name(f"{msh.stem}_turned.msh")
+    if out.is_file() and out.stat().st_mtime >= msh.stat().st_mtime:
+        return out
+    negated = (1, 2) if dim == 3 else (0, 1)
+    with _gmsh_model(msh):
+        tags, coords, _ = gmsh.model.mesh.getNodes(includeBoundary=True, returnParametricCoord=False)
+        for k, tag in enumerate(tags):
+            x = list(coords[3 * k:3 * k + 3])
+            for axis in negated:
+                x[axis] = -x[axis]
+            gmsh.model.mesh.setNode(int(tag), x, [])
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(str(out))
+    return out
+
+
+# Approaches of each body alone, as fractions of the pair's delta: each takes about half of it.
+PAIR_FRACTIONS = (0.35, 0.45, 0.5, 0.55, 0.65)
+
+
+def two_body_plane(msh: Path, dim: int, delta: float, bodies: dict, cache: Path, youngs_modulus: float,
+                   poisson_ratio: float) -> dict:
+    """Where two bodies of equal material, pressed together by ``delta``, meet: the plane of their interface.
+
+    ``bodies`` maps "upper" and "lower" to (body, contact surface, support) groups of ``msh``: the upper
+    body's pole down at v = 0, its support moved by -delta; the lower body's pole up at v = 0, its
+    support clamped. Between equal materials the frictionless interface is flat, so each body deforms
+    as on a rigid flat under the same force P. Each is pressed alone onto a rigid flat (the lower one
+    on the mesh turned upside down) at approaches PAIR_FRACTIONS of delta; P solves
+    delta_upper(P) + delta_lower(P) = delta (log-log interpolation of each approach-force curve), and
+    the interface lies at v = -delta_lower(P). With two different meshes the two discrete bodies differ
+    in stiffness, and the plane is not v = -delta/2. Each body's curve is cached in ``cache``.
+    """
+    curves = {}
+    for role in ("upper", "lower"):
+        body, contact, support = bodies[role]
+        source = msh if role == "upper" else turned_mesh(msh, dim)
+        stamp_data = {"mesh": source.name, "mesh_size": msh.stat().st_size, "mesh_mtime": msh.stat().st_mtime,
+                      "delta": delta, "fractions": PAIR_FRACTIONS, "E": youngs_modulus, "nu": poisson_ratio,
+                      "body": body}
+        folder = cache / f"{msh.stem}_{role}_delta{delta:g}"
+        stamp, result = folder / "stamp.json", folder / "contact_reference.json"
+        if stamp.is_file() and result.is_file() and json.loads(stamp.read_text()) == stamp_data:
+            data = json.loads(result.read_text())
+        else:
+            data = run_reference(source, folder, delta=delta, youngs_modulus=youngs_modulus,
+                                 poisson_ratio=poisson_ratio, fractions=PAIR_FRACTIONS, kappas=(),
+                                 groups={"body": body, "contact": contact, "top": support})
+            stamp.write_text(json.dumps(stamp_data))
+        points = sorted((r["delta"], r["force"]) for r in data["force_approach"] if r["force"] > 0)
+        curves[role] = (np.log([d for d, _ in points]), np.log([f for _, f in points]))
+
+    def approach(role: str, force: float) -> float:
+        log_delta, log_force = curves[role]
+        return float(np.exp(np.interp(math.log(force), log_force, log_delta)))
+
+    def excess(force: float) -> float:
+        return approach("upper", force) + approach("lower", force) - delta
+
+    low = max(math.exp(c[1][0]) for c in curves.values())
+    high = min(math.exp(c[1][-1]) for c in curves.values())
+    if not excess(low) < 0 < excess(high):
+        raise ReferenceFailure(f"{msh}: the approach {delta:g} of the pair is not bracketed by the bodies' "
+                               f"rigid-flat curves (forces {low:.4g} to {high:.4g})")
+    for _ in range(100):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if excess(middle) < 0 else (low, middle)
+    force = 0.5 * (low + high)
+    return {"force": force, "delta_upper": approach("upper", force), "delta_lower": approach("lower", force),
+            "plane": -approach("lower", force)}
+
+
 def run_reference(msh: Path, output: Path, delta: float | None = None, youngs_modulus: float = 1000.0,
                   poisson_ratio: float = 0.3, fractions=DEFAULT_FRACTIONS, kappas=DEFAULT_KAPPAS,
                   groups: dict | None = None) -> dict:

@@ -131,7 +131,6 @@ RADIUS_TOLERANCE = 1.0  # spacings
 HERTZ_TOLERANCE = 0.03
 HERTZ_RESOLVED = 5.0  # a_H / h from which the 3% Hertz checks apply
 SYMMETRY_TOLERANCE = 0.01  # spacings
-PAIR_FRACTIONS = (0.35, 0.45, 0.5, 0.55, 0.65)  # of delta: each body's approach is about delta / 2
 MESH_TOLERANCE = 0.25  # relative, on the measured spacings
 RIM_PREMISE = 3.0  # spacings
 OVERLAP_PREMISE = 2.0  # spacings
@@ -614,74 +613,11 @@ def reference(case: Case, msh: Path) -> dict:
     return data
 
 
-def mirrored(msh: Path, dim: int) -> Path:
-    """The mesh with the vertical coordinate negated (``<stem>_mirrored.msh``, written once): the lower
-    body of a two-equal mesh then points down onto the plane v = 0 like the upper one."""
-    out = msh.with_name(f"{msh.stem}_mirrored.msh")
-    if out.is_file() and out.stat().st_mtime >= msh.stat().st_mtime:
-        return out
-    import gmsh
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Verbosity", 1)
-        gmsh.open(str(msh))
-        tags, coords, _ = gmsh.model.mesh.getNodes(includeBoundary=True, returnParametricCoord=False)
-        for k, tag in enumerate(tags):
-            x = list(coords[3 * k:3 * k + 3])
-            x[dim - 1] = -x[dim - 1]
-            gmsh.model.mesh.setNode(int(tag), x, [])
-        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-        gmsh.write(str(out))
-    finally:
-        gmsh.finalize()
-    return out
-
-
 def pair_plane(case: Case, msh: Path) -> dict:
-    """Where the two discrete bodies of a two-equal case meet, from dolfinx (module doc, *Symmetry plane*).
-
-    Each body alone is pressed onto a rigid flat by ``contact_reference`` (the lower one on the mirrored
-    mesh), at approaches PAIR_FRACTIONS of delta; between equal materials the frictionless interface is
-    flat, so each body deforms as on a rigid flat under the same force P. The force solves
-    delta_upper(P) + delta_lower(P) = delta (log-log interpolation of each curve), and the plane is
-    v = -delta_lower(P), the lower support being clamped. Cached in build/sweep/references.
-    """
-    curves = {}
-    for role, (body, contact, support) in case.bodies().items():
-        source = msh if role == "upper" else mirrored(msh, case.dim)
-        stamp_data = {"mesh": source.name, "mesh_stamp": json.loads(msh.with_suffix(".json").read_text()),
-                      "delta": case.delta, "fractions": PAIR_FRACTIONS, "E": YOUNGS_MODULUS, "nu": POISSON_RATIO,
-                      "body": body}
-        folder = BUILD / "references" / f"{msh.stem}_{role}_delta{case.delta:g}"
-        stamp, result = folder / "stamp.json", folder / "contact_reference.json"
-        if stamp.is_file() and result.is_file() and json.loads(stamp.read_text()) == stamp_data:
-            data = json.loads(result.read_text())
-        else:
-            data = contact_reference.run_reference(
-                source, folder, delta=case.delta, youngs_modulus=YOUNGS_MODULUS, poisson_ratio=POISSON_RATIO,
-                fractions=PAIR_FRACTIONS, kappas=(), groups={"body": body, "contact": contact, "top": support})
-            stamp.write_text(json.dumps(stamp_data))
-        points = sorted((r["delta"], r["force"]) for r in data["force_approach"] if r["force"] > 0)
-        curves[role] = (np.log([d for d, _ in points]), np.log([f for _, f in points]))
-
-    def approach(role: str, force: float) -> float:
-        log_delta, log_force = curves[role]
-        return float(np.exp(np.interp(math.log(force), log_force, log_delta)))
-
-    def excess(force: float) -> float:
-        return approach("upper", force) + approach("lower", force) - case.delta
-
-    low = max(math.exp(curves[r][1][0]) for r in curves)
-    high = min(math.exp(curves[r][1][-1]) for r in curves)
-    if not excess(low) < 0 < excess(high):
-        raise RunFailed(f"pair reference: the approach {case.delta:g} is not bracketed by the rigid-flat curves "
-                        f"(forces {low:.4g} to {high:.4g})")
-    for _ in range(100):
-        middle = 0.5 * (low + high)
-        low, high = (middle, high) if excess(middle) < 0 else (low, middle)
-    force = 0.5 * (low + high)
-    return {"force": force, "delta_upper": approach("upper", force), "delta_lower": approach("lower", force),
-            "plane": -approach("lower", force)}
+    """Where the two discrete bodies of a two-equal case meet, from dolfinx (module doc, *Symmetry
+    plane*; ``contact_reference.two_body_plane``), cached in build/sweep/references."""
+    return contact_reference.two_body_plane(msh, case.dim, case.delta, case.bodies(), BUILD / "references",
+                                            YOUNGS_MODULUS, POISSON_RATIO)
 
 
 def rigid_flat_checks(case: Case, msh: Path, output: Path, out_dir: Path, ref: dict, h: dict,
