@@ -444,6 +444,27 @@ fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {
 }
 
 #[test]
+fn a_not_certified_load_step_does_not_stop_the_later_ones() {
+    // The stiff block primary on its twice coarser surface (R/80 disc), pressed by 0.02 in two
+    // steps: at 5% of the load the zone spans about two block spacings and the disc's sag fails
+    // the certificate; the full load resolves the zone and is certified. Both steps run, each
+    // with its own status, and the run ends with the last one's.
+    let text = stiff_block("half_disc_on_block_coarse_block.msh", "block").replace(
+        "primary = \"block\"",
+        "primary = \"block\"\nload_steps = [0.05, 1.0]",
+    );
+    assert!(text.contains("load_steps = [0.05, 1.0]"), "{text}");
+    let (code, summary) = solve_cli(&text);
+    let contact = &summary["contact"];
+    let steps = contact["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 2, "{contact}");
+    assert_eq!(steps[0]["status"], "not-certified", "{contact}");
+    assert_eq!(steps[1]["status"], "converged", "{contact}");
+    assert_eq!(contact["status"], "converged");
+    assert_eq!(code, Some(0));
+}
+
+#[test]
 fn a_contact_body_needs_a_body_table() {
     let text = two_blocks(
         2,

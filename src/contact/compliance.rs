@@ -62,8 +62,10 @@ impl SurfaceResponse {
         // In chunks, so that the right-hand sides of a large first active set fit in memory.
         const CHUNK: usize = 64;
         let n = self.row.len();
-        let missing: Vec<&(MultiplierKey, Vec<(usize, f64)>)> =
-            loads.iter().filter(|(key, _)| !self.contains(key)).collect();
+        let missing: Vec<&(MultiplierKey, Vec<(usize, f64)>)> = loads
+            .iter()
+            .filter(|(key, _)| !self.contains(key))
+            .collect();
         for chunk in missing.chunks(CHUNK) {
             let mut rhs = vec![0.0; n * chunk.len()];
             for (j, (_, load)) in chunk.iter().enumerate() {
@@ -86,7 +88,10 @@ impl SurfaceResponse {
     /// If `dof` is off the candidate surface (the constraint rows only read surface dofs).
     pub fn entry(&self, key: &MultiplierKey, dof: usize) -> f64 {
         let row = self.row[dof];
-        assert!(row != usize::MAX, "dof {dof} is not on the candidate surface");
+        assert!(
+            row != usize::MAX,
+            "dof {dof} is not on the candidate surface"
+        );
         self.responses[key][row]
     }
 }

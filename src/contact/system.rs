@@ -147,7 +147,9 @@ impl CoupledSystem {
                 .iter()
                 .flat_map(|&node| (0..dim).map(move |c| (node, Some(c))))
                 .collect(),
-            Formulation::Frictionless => coupling.primary_nodes.iter().map(|&n| (n, None)).collect(),
+            Formulation::Frictionless => {
+                coupling.primary_nodes.iter().map(|&n| (n, None)).collect()
+            }
         };
         let dropped: Vec<bool> = (0..m)
             .map(|col| coupling.is_dropped(col, body1, dim))
