@@ -296,6 +296,14 @@ fn stiff_block(mesh: &str, primary: &str) -> String {
         )
 }
 
+/// The names of the certificate checks a solution failed.
+fn failed_checks(solution: &ContactSolution) -> Vec<&'static str> {
+    (solution.certificate.checks.iter())
+        .filter(|c| !c.passed)
+        .map(|c| c.name)
+        .collect()
+}
+
 /// Solves `text` on the command line: exit status and summary.json.
 fn solve_cli(text: &str) -> (Option<i32>, serde_json::Value) {
     let (dir, path) = write_case(text);
@@ -403,14 +411,12 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
     assert!(text.contains("uy = -0.001"), "{text}");
     let coarse = solve(&text).unwrap();
     assert_eq!(coarse.status, ContactStatus::NotCertified);
-    let failed: Vec<&str> = coarse
-        .certificate
-        .checks
-        .iter()
-        .filter(|c| !c.passed)
-        .map(|c| c.name)
-        .collect();
-    assert_eq!(failed, ["secondary sag"], "{:?}", coarse.certificate);
+    assert_eq!(
+        failed_checks(&coarse),
+        ["secondary sag"],
+        "{:?}",
+        coarse.certificate
+    );
 
     // The premise: constraining the disc's nodes instead changes the force by several percent.
     let fine = solve(&text.replace("primary = \"block\"", "primary = \"disc\"")).unwrap();
@@ -979,13 +985,7 @@ fn a_contact_zone_of_one_node_is_not_certified_and_says_why() {
     let solution = solve(&text).unwrap();
     assert_eq!(solution.status, ContactStatus::NotCertified);
     assert!(!solution.certificate.passed);
-    let failed: Vec<&str> = solution
-        .certificate
-        .checks
-        .iter()
-        .filter(|c| !c.passed)
-        .map(|c| c.name)
-        .collect();
+    let failed = failed_checks(&solution);
     assert!(!failed.is_empty());
 
     // The command line writes the last iterate, names the failed check, exits with status 1.
