@@ -6,7 +6,6 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use internodes::contact::ContactStatus;
 use internodes::mesh::{MeshSummary, read_msh};
 use internodes::run::{RunOptions, solve_case};
 
@@ -69,16 +68,11 @@ fn main() -> ExitCode {
         )
         .map_err(Into::into)
         .and_then(|report| match report.summary.contact.as_ref() {
-            Some(contact)
-                if !matches!(
-                    contact.status,
-                    ContactStatus::Converged | ContactStatus::NoContact
-                ) =>
-            {
-                let status = serde_json::to_value(contact.status).unwrap_or_default();
+            Some(contact) if !contact.status.is_solution() => {
+                let status = contact.status.name();
                 let failures = contact.certificate.failures();
                 Err(format!(
-                    "the contact solve did not converge: status {status}{} (see {}/summary.json); the last iterate was written for inspection",
+                    "the contact solve did not converge: status \"{status}\"{} (see {}/summary.json); the last iterate was written for inspection",
                     if failures.is_empty() {
                         String::new()
                     } else {

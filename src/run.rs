@@ -240,7 +240,7 @@ fn solve_contact_case<'m>(
 ) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), RunError> {
     let (solution, steps) = solve_load_steps(&problem, case, "", timings, say)?;
     let (problem, solution, steps) = if problem.primary_report.mode == "auto"
-        && !settled(solution.status)
+        && !solution.status.is_solution()
     {
         let first = (problem.primary.body.name.clone(), failure(&solution));
         let other = problem.with_other_primary();
@@ -250,7 +250,7 @@ fn solve_contact_case<'m>(
         ));
         let retry = solve_load_steps(&other, case, "other primary: ", timings, say);
         match retry {
-            Ok((second, steps2)) if settled(second.status) => {
+            Ok((second, steps2)) if second.status.is_solution() => {
                 let other_name = other.primary.body.name.clone();
                 let other = other.with_reason_appended(&format!(
                     "'{other_name}' carries the multiplier because '{}' as primary ended {}",
@@ -348,7 +348,7 @@ fn solve_load_steps(
         // next one (each step is certified on its own: a narrow zone at a small load factor can
         // fail the sag check on a mesh that resolves the final zone); a loop that did not settle
         // is not.
-        let stop = !settled(solution.status) && solution.status != ContactStatus::NotCertified;
+        let stop = !solution.status.is_solution() && solution.status != ContactStatus::NotCertified;
         last = Some(solution);
         if stop {
             say("stopping the load steps: this step's active set did not settle".to_string());
@@ -358,18 +358,12 @@ fn solve_load_steps(
     Ok((last.expect("at least one load step"), steps))
 }
 
-/// A solve that ended as a contact solution (`converged` or `no-contact`).
-fn settled(status: ContactStatus) -> bool {
-    matches!(status, ContactStatus::Converged | ContactStatus::NoContact)
-}
-
 /// How a solve that did not settle ended, in a few words (for the primary choice's reason).
 fn failure(solution: &ContactSolution) -> String {
-    let status = serde_json::to_value(solution.status).expect("a unit enum serializes");
-    let status = status.as_str().unwrap_or("?").to_string();
+    let status = solution.status.name();
     match solution.status {
         ContactStatus::NotCertified => format!("{status} ({})", solution.certificate.failures()),
-        _ => status,
+        _ => status.to_string(),
     }
 }
 

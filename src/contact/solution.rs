@@ -31,6 +31,25 @@ pub enum ContactStatus {
     Cycling,
 }
 
+impl ContactStatus {
+    /// `converged` or `no-contact`: the loop's answer is a contact solution.
+    pub fn is_solution(self) -> bool {
+        matches!(self, Self::Converged | Self::NoContact)
+    }
+
+    /// The status as written in `summary.json` (kebab case).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::NotCertified => "not-certified",
+            Self::NoContact => "no-contact",
+            Self::IterationLimit => "iteration-limit",
+            Self::Unstable => "unstable",
+            Self::Cycling => "cycling",
+        }
+    }
+}
+
 /// Wall-clock seconds of the phases of one iteration.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct PhaseSeconds {
@@ -138,4 +157,24 @@ pub struct ContactSolution {
     pub load_factor: f64,
     /// The active set at the end, from which a next load step starts.
     pub active_set: ActiveSet,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ContactStatus;
+
+    #[test]
+    fn status_names_are_the_summary_json_names() {
+        use ContactStatus::*;
+        for status in [
+            Converged,
+            NotCertified,
+            NoContact,
+            IterationLimit,
+            Unstable,
+            Cycling,
+        ] {
+            assert_eq!(serde_json::to_value(status).unwrap(), status.name());
+        }
+    }
 }

@@ -98,12 +98,11 @@ impl StepRecord {
         text += ",force_imbalance,hertz_a,hertz_p0,seconds\n";
         let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
         for s in steps {
-            let status = serde_json::to_value(s.status).expect("a unit enum serializes");
             text += &format!(
                 "{},{},{},{}",
                 s.step,
                 s.load_factor,
-                status.as_str().unwrap_or(""),
+                s.status.name(),
                 s.iterations
             );
             for f in &s.force_primary {
