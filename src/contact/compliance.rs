@@ -82,16 +82,29 @@ impl SurfaceResponse {
         }
     }
 
-    /// `Y_key[dof]`; the response must have been computed by [`Self::extend`].
+    /// The rows of the stored responses that hold the body dofs `dofs`.
     ///
     /// # Panics
-    /// If `dof` is off the candidate surface (the constraint rows only read surface dofs).
-    pub fn entry(&self, key: &MultiplierKey, dof: usize) -> f64 {
-        let row = self.row[dof];
-        assert!(
-            row != usize::MAX,
-            "dof {dof} is not on the candidate surface"
-        );
-        self.responses[key][row]
+    /// If a dof is off the candidate surface (the constraint rows only read surface dofs).
+    pub fn rows(&self, dofs: &[usize]) -> Vec<usize> {
+        dofs.iter()
+            .map(|&dof| {
+                let row = self.row[dof];
+                assert!(
+                    row != usize::MAX,
+                    "dof {dof} is not on the candidate surface"
+                );
+                row
+            })
+            .collect()
+    }
+
+    /// `Y_key` at the stored rows `rows` (from [`Self::rows`]), into `out`; the response must
+    /// have been computed by [`Self::extend`].
+    pub fn gather(&self, key: &MultiplierKey, rows: &[usize], out: &mut [f64]) {
+        let response = &self.responses[key];
+        for (value, &row) in out.iter_mut().zip(rows) {
+            *value = response[row];
+        }
     }
 }

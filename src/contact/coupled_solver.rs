@@ -158,9 +158,12 @@ fn solve_schur(
                 c[(k, position(col - dofs.start))] += value;
             }
         }
-        let y = DMatrix::from_fn(read.len(), m, |i, k| {
-            response.entry(&system.keys[k], read[i])
-        });
+        // One hash lookup per multiplier, not per entry: this runs every iteration.
+        let rows = response.rows(&read);
+        let mut y = DMatrix::<f64>::zeros(read.len(), m);
+        for (k, key) in system.keys.iter().enumerate() {
+            response.gather(key, &rows, y.column_mut(k).as_mut_slice());
+        }
         schur -= (c * y) * s;
     }
     let mut r = DVector::from_column_slice(&system.g);
