@@ -402,10 +402,11 @@ fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
 fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
     // The stiff block primary, its surface twice coarser than the disc's (R/80), pressed by
     // 0.001: the contact zone is about 1.6 block spacings across, and the disc sags into the
-    // flat between the block's constrained nodes by about a tenth of the indentation. Every
-    // other check passes (penetration, tension, balance), yet the disc force is about 6% below
-    // the one with the disc's own nodes constrained (the disc primary): that answer must not
-    // be called converged, and the sag must be named.
+    // flat between the block's constrained nodes by about a tenth of the indentation. The
+    // penetration, tension and balance checks pass, yet the disc force is about 6% below the
+    // one with the disc's own nodes constrained (the disc primary): that answer must not be
+    // called converged, and the sag must be named. (One block node carries the whole zone, so
+    // the resolution check fails too.)
     let text = stiff_block("half_disc_on_block_coarse_block.msh", "block")
         .replace("uy = -0.02", "uy = -0.001");
     assert!(text.contains("uy = -0.001"), "{text}");
@@ -413,7 +414,7 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
     assert_eq!(coarse.status, ContactStatus::NotCertified);
     assert_eq!(
         failed_checks(&coarse),
-        ["secondary sag"],
+        ["secondary sag", "resolution"],
         "{:?}",
         coarse.certificate
     );
@@ -424,6 +425,42 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
     let change = (on_disc_coarse - on_disc_fine).abs() / on_disc_fine.abs();
     assert!(change > 0.03, "{on_disc_coarse} against {on_disc_fine}");
 }
+
+#[test]
+fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
+    // A mesh made without geo/ (validation/foreign_meshes.py: OpenCASCADE, the pole not a
+    // node, each body refined by its distance to the other): the disc at R/30, the stiff block
+    // 2.5 times coarser and primary, pressed by 0.003. One block node carries the whole zone;
+    // penetration, tension, sag and balance all pass, yet the force on the disc is more than
+    // 1% off dolfinx's rigid flat on the same disc mesh. It must not be called converged, and
+    // the resolution must be named, at that block node.
+    let text = stiff_block("foreign_disc_on_coarse_block.msh", "block")
+        .replace("uy = -0.02", "uy = -0.003");
+    assert!(text.contains("uy = -0.003"), "{text}");
+    let solution = solve(&text).unwrap();
+    let error = solution.force_secondary[1] / FOREIGN_RIGID_FLAT_FORCE_2D - 1.0;
+    assert!(
+        error.abs() > 0.01,
+        "the premise: force {error:+.4} off dolfinx"
+    );
+    assert_eq!(solution.status, ContactStatus::NotCertified);
+    assert_eq!(
+        failed_checks(&solution),
+        ["resolution"],
+        "{:?}",
+        solution.certificate
+    );
+    let resolution = (solution.certificate.checks.iter())
+        .find(|c| c.name == "resolution")
+        .unwrap();
+    assert_eq!(resolution.body.as_deref(), Some("block"));
+    assert!(resolution.value.is_infinite(), "{resolution:?}");
+}
+
+/// The half-disc of `tests/fixtures/foreign_disc_on_coarse_block.msh` pressed by 0.003 onto a
+/// rigid flat: contact force per unit length computed by dolfinx (PETSc VI solver, exact
+/// node-to-plane constraint) on the same disc mesh, by `validation/foreign_meshes.py`.
+const FOREIGN_RIGID_FLAT_FORCE_2D: f64 = 1.3839070125526174;
 
 #[test]
 fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {

@@ -134,7 +134,7 @@ SYMMETRY_TOLERANCE = 0.01  # spacings
 MESH_TOLERANCE = 0.25  # relative, on the measured spacings
 RIM_PREMISE = 3.0  # spacings
 OVERLAP_PREMISE = 2.0  # spacings
-CERTIFICATE_CHECKS = ("penetration", "secondary penetration", "tension", "secondary sag", "imbalance")
+CERTIFICATE_CHECKS = ("penetration", "secondary penetration", "tension", "secondary sag", "resolution", "imbalance")
 
 # The half-disc on a rigid flat (dolfinx, R/160, E 1000, nu 0.3): approach delta -> half-width a_fit.
 RIGID_FLAT_2D = ((0.001, 0.0203), (0.002, 0.0311), (0.004, 0.0456), (0.008, 0.0685), (0.012, 0.0870),

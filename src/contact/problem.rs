@@ -65,6 +65,9 @@ pub struct ContactSettings {
     /// (measured up to 0.067 on the 3D hemisphere meshes); a wrong active set leaves tensions
     /// of the order of the peak pressure.
     pub certificate_tension_tolerance: f64,
+    /// The certificate's lower bound on the contact zone's width, in primary spacings
+    /// (`super::checks`; default 1.5: three primary nodes across a 2D zone, about seven in 3D).
+    pub min_zone_width: f64,
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
@@ -84,6 +87,7 @@ impl Default for ContactSettings {
             tension_tolerance: 1e-8,
             secondary_penetration_tolerance: 0.05,
             sag_tolerance: 0.03,
+            min_zone_width: 1.5,
             certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
             rbf_radius: 2.0,
@@ -110,6 +114,13 @@ impl ContactSettings {
                 "rbf_radius",
                 "a finite number > 1 (units of the nearest-node distance)",
                 self.rbf_radius,
+            );
+        }
+        if !(self.min_zone_width > 0.0 && self.min_zone_width.is_finite()) {
+            return error(
+                "min_zone_width",
+                "a finite number > 0 (primary spacings)",
+                self.min_zone_width,
             );
         }
         for (name, value) in [
