@@ -312,6 +312,11 @@ fn solve_load_steps(
         format!("{label}contact set-up"),
         phase.elapsed().as_secs_f64(),
     ));
+    let transfer = problem.transfer();
+    say(format!(
+        "{label}force on '{}': {} transfer ({})",
+        problem.secondary.body.name, transfer.transfer, transfer.reason
+    ));
     let load_steps = case.load_steps();
     let mut steps = Vec::new();
     let mut last: Option<ContactSolution> = None;
@@ -557,6 +562,7 @@ fn summarize_contact(
         primary: problem.primary.body.name.clone(),
         secondary: problem.secondary.body.name.clone(),
         primary_choice: problem.primary_report.clone(),
+        transfer: problem.transfer(),
         certificate: solution.certificate.clone(),
         settings: problem.settings,
         force_primary: solution.force_primary[..dim].to_vec(),

@@ -20,10 +20,11 @@
 //!   the constraint holds the secondary only at the primary's nodes, and a secondary surface
 //!   curved into a coarse flat primary sags between them (`secondary_sag`). The penetration
 //!   check above bounds that sag by the spacing; this one bounds its effect on the answer.
-//! - **Resolution.** The contact zone must be at least `min_zone_width` primary spacings wide
-//!   ([`zone_resolution`]): with one or two primary nodes across it, the multiplier has too few
-//!   values to carry the pressure profile, and the force is undetermined to the certificate's
-//!   accuracy although every other check can pass (a stiff, coarse primary under a small zone).
+//! - **Resolution.** The contact zone must be at least `min_zone_width` spacings wide on both
+//!   surfaces ([`zone_resolution`]): with one or two nodes of either body across it, the
+//!   pressure profile has too few values, and the force is undetermined to the certificate's
+//!   accuracy although every other check can pass (a stiff, coarse primary under a small zone;
+//!   a coarse compliant secondary under a fine primary).
 //! - **Force balance.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
 //!   exceed `imbalance_tolerance`: the transfer `R21` conserves force only to its accuracy.
 //!
@@ -84,7 +85,7 @@ impl CertificateCheck {
         } else if self.name.ends_with("sag") {
             " of the indentation depth"
         } else if self.name == "resolution" {
-            " (primary spacing over the contact zone's width, whose rim is)"
+            " (spacing over the contact zone's width, whose rim is)"
         } else {
             ""
         };
@@ -162,7 +163,13 @@ pub fn certify(
     let indentation = indentation_depth(s1, s2, &gaps[0], &mean[0]);
     let secondary_sag = secondary_sag(s2, &gaps[1], indentation, settings);
 
-    let resolution = zone_resolution(s1, &mean[0], settings.min_zone_width);
+    let resolution = zone_resolution(
+        [s1, s2],
+        &mean,
+        &gaps,
+        settings.secondary_penetration_tolerance,
+        settings.min_zone_width,
+    );
     let [penetration1, penetration2] = penetration;
     let checks = vec![
         penetration1.check("penetration", settings.penetration_tolerance),
@@ -230,36 +237,46 @@ fn secondary_sag(
     worst.check("secondary sag", settings.sag_tolerance)
 }
 
-/// The primary spacing over the contact zone's width, against `1 / min_width`. The zone is the
-/// primary nodes with a compressive mean pressure; its width is twice the largest distance of
-/// one of them from their centroid (2a for a Hertz zone), its spacing their mean distance to
-/// the nearest surface node. One node in contact gives a width of zero and an infinite figure;
-/// no node in contact gives 0 (nothing to resolve).
-fn zone_resolution(primary: &ContactSurface, pressure: &[f64], min_width: f64) -> CertificateCheck {
-    let zone: Vec<usize> = (0..primary.len()).filter(|&s| pressure[s] > 0.0).collect();
+/// The spacing over the contact zone's width on either surface (the larger), against
+/// `1 / min_width`. A surface's zone is its nodes in contact: a compressive mean pressure and a
+/// geometric gap within `touching` spacings (the secondary penetration tolerance: the
+/// secondary's nodes are held only through the transfer, which loads a ring of nodes around
+/// the zone that do not touch). Its width is twice the largest distance of one of them from
+/// their centroid (2a for a Hertz zone), its spacing their mean distance to the nearest surface
+/// node. One node in contact gives a width of zero and an infinite figure; none gives 0
+/// (nothing to resolve).
+fn zone_resolution(
+    surfaces: [&ContactSurface; 2],
+    pressures: &[Vec<f64>],
+    gaps: &[Vec<f64>; 2],
+    touching: f64,
+    min_width: f64,
+) -> CertificateCheck {
     let mut check = Worst::default();
-    if !zone.is_empty() {
+    for ((surface, pressure), gaps) in surfaces.into_iter().zip(pressures).zip(gaps) {
+        let zone: Vec<usize> = (0..surface.len())
+            .filter(|&s| pressure[s] > 0.0 && gaps[s].abs() <= touching * surface.spacing[s])
+            .collect();
+        if zone.is_empty() {
+            continue;
+        }
         let n = zone.len() as f64;
         let centroid: [f64; 3] =
-            std::array::from_fn(|c| zone.iter().map(|&s| primary.coords[s][c]).sum::<f64>() / n);
-        let (rim, radius) = zone
+            std::array::from_fn(|c| zone.iter().map(|&s| surface.coords[s][c]).sum::<f64>() / n);
+        let distance = |s: usize| {
+            let x = surface.coords[s];
+            (0..3)
+                .map(|c| (x[c] - centroid[c]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let rim = zone
             .iter()
-            .map(|&s| {
-                let x = primary.coords[s];
-                (
-                    s,
-                    (0..3)
-                        .map(|c| (x[c] - centroid[c]).powi(2))
-                        .sum::<f64>()
-                        .sqrt(),
-                )
-            })
-            .fold(
-                (zone[0], 0.0),
-                |best, next| if next.1 > best.1 { next } else { best },
-            );
-        let spacing = zone.iter().map(|&s| primary.spacing[s]).sum::<f64>() / n;
-        check.offer(spacing / (2.0 * radius), primary, rim);
+            .copied()
+            .max_by(|&a, &b| distance(a).total_cmp(&distance(b)));
+        let rim = rim.expect("the zone is not empty");
+        let spacing = zone.iter().map(|&s| surface.spacing[s]).sum::<f64>() / n;
+        check.offer(spacing / (2.0 * distance(rim)), surface, rim);
     }
     check.check("resolution", 1.0 / min_width)
 }

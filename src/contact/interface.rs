@@ -30,8 +30,9 @@
 //! it, not on the RBF reconstruction of that surface.
 //!
 //! **Lumped interface mass.** Node `s` stands for its area `A_s` ([`ContactSurface`]): the
-//! multiplier `lambda_i` exerts `-A_i lambda_i` on body 1 and `+A2_j (R21 lambda)_j` on body
-//! 2, which balance to the interpolation's accuracy.
+//! multiplier `lambda_i` exerts `-A_i lambda_i` on body 1 and, on body 2, either
+//! `+A2_j (R21 lambda)_j` (interpolation, which balances to the interpolation's accuracy) or
+//! `+(R12^T A1 lambda)_j` (conservative, which balances exactly; [`super::Transfer`]).
 
 use std::collections::HashMap;
 
@@ -59,6 +60,9 @@ pub struct InterfaceOperators {
     rows12: HashMap<usize, Vec<(usize, f64)>>,
     /// Column of `R21` of each primary candidate used so far: `(secondary surface index, weight)`.
     columns21: HashMap<usize, Vec<(usize, f64)>>,
+    /// The secondary's force is `-R12^T M1 lambda` rather than `-M2 R21 lambda`
+    /// ([`super::Transfer`]).
+    conservative: bool,
 }
 
 impl InterfaceOperators {
@@ -70,6 +74,7 @@ impl InterfaceOperators {
         secondary: &ContactSurface,
         radius: f64,
         weights: [f64; 2],
+        conservative: bool,
     ) -> Result<Self, ContactError> {
         let [w1, w2] = weights;
         let (on_secondary, facing) = projections(primary, secondary, [w1, w2])?;
@@ -101,6 +106,7 @@ impl InterfaceOperators {
             reference_gaps,
             rows12: HashMap::new(),
             columns21: HashMap::new(),
+            conservative,
         })
     }
 
@@ -121,8 +127,10 @@ impl InterfaceOperators {
             .collect();
         self.rows12
             .extend(missing.iter().copied().zip(self.r12.rows(&missing)));
-        self.columns21
-            .extend(missing.iter().copied().zip(self.r21.columns(&missing)));
+        if !self.conservative {
+            self.columns21
+                .extend(missing.iter().copied().zip(self.r21.columns(&missing)));
+        }
         let to_body2 = |entries: &[(usize, f64)], weight: &dyn Fn(usize, f64) -> f64| {
             entries
                 .iter()
@@ -140,12 +148,17 @@ impl InterfaceOperators {
                 .collect(),
             loads2: active
                 .iter()
-                .map(|i| {
-                    let column: Vec<(usize, f64)> = self.columns21[i]
-                        .iter()
-                        .map(|&(t, w)| (self.receiving[t], w))
-                        .collect();
-                    to_body2(&column, &|j, w| secondary.nodal_area[j] * w)
+                .map(|&i| {
+                    if self.conservative {
+                        // Row i of R12 times A1_i: column i of R12^T M1.
+                        to_body2(&self.rows12[&i], &|_, w| primary.nodal_area[i] * w)
+                    } else {
+                        let column: Vec<(usize, f64)> = self.columns21[&i]
+                            .iter()
+                            .map(|&(t, w)| (self.receiving[t], w))
+                            .collect();
+                        to_body2(&column, &|j, w| secondary.nodal_area[j] * w)
+                    }
                 })
                 .collect(),
             // Only the normal part is a gap: the tied constraint would otherwise impose the

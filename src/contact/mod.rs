@@ -32,7 +32,7 @@ pub use checks::{Certificate, CertificateCheck};
 pub use coupled_solver::CoupledSolver;
 pub use problem::{
     ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,
-    SettingsError,
+    SettingsError, Transfer, TransferReport,
 };
 pub use solution::{
     ContactSolution, ContactStatus, HertzFit, IterationRecord, PhaseSeconds, SurfaceFields,

@@ -19,6 +19,32 @@ pub enum Formulation {
     Tied,
 }
 
+/// How the multiplier's force reaches the secondary body (README, "The force on the
+/// secondary").
+///
+/// - `Interpolation` (INTERNODES, the seed's system): the secondary receives the traction
+///   interpolated at its own nodes, `lambda_2 = -R21 lambda`, integrated by its interface mass:
+///   nodal forces `-M2 R21 lambda`. A secondary coarser than the primary samples a field finer
+///   than itself there, and the total force no longer balances `M1 lambda` (the imbalance grows
+///   as the contact zone spans fewer secondary spacings).
+/// - `Conservative`: the secondary receives the primary's nodal forces distributed by the
+///   transpose of the displacement interpolation, `-R12^T M1 lambda` (the mortar method's
+///   transfer). The rows of `R12` sum to one, so the forces on the two bodies balance exactly,
+///   and the coupling is the transpose of the constraint: the system is the Lagrange
+///   multiplier form of `u1 - R12 u2 = d`. Onto a secondary finer than the primary it leaves the
+///   secondary nodes between the projections of primary nodes unloaded, which is why
+///   INTERNODES interpolates there.
+/// - `Auto` (default): conservative when the secondary's contact surface is coarser than the
+///   primary's near the other body ([`contact_zone_spacing`]), interpolation otherwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Transfer {
+    #[default]
+    Auto,
+    Interpolation,
+    Conservative,
+}
+
 /// A setting outside its range.
 #[derive(Debug, Error, PartialEq)]
 #[error("{name} must be {expected}, got {value}")]
@@ -35,6 +61,8 @@ pub struct SettingsError {
 pub struct ContactSettings {
     /// Default: frictionless.
     pub formulation: Formulation,
+    /// How the multiplier's force reaches the secondary (default: auto, [`Transfer`]).
+    pub transfer: Transfer,
     /// How each iteration's linear system is solved (default: Schur complement on Cholesky
     /// factors computed once).
     pub solver: CoupledSolver,
@@ -65,8 +93,8 @@ pub struct ContactSettings {
     /// (measured up to 0.067 on the 3D hemisphere meshes); a wrong active set leaves tensions
     /// of the order of the peak pressure.
     pub certificate_tension_tolerance: f64,
-    /// The certificate's lower bound on the contact zone's width, in primary spacings
-    /// (`super::checks`; default 1.5: three primary nodes across a 2D zone, about seven in 3D).
+    /// The certificate's lower bound on the contact zone's width, in spacings of either
+    /// surface (`super::checks`; default 1.5: three nodes across a 2D zone, about seven in 3D).
     pub min_zone_width: f64,
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
@@ -81,6 +109,7 @@ impl Default for ContactSettings {
     fn default() -> Self {
         Self {
             formulation: Formulation::default(),
+            transfer: Transfer::default(),
             solver: CoupledSolver::default(),
             max_iterations: 50,
             penetration_tolerance: 1e-3,
@@ -119,7 +148,7 @@ impl ContactSettings {
         if !(self.min_zone_width > 0.0 && self.min_zone_width.is_finite()) {
             return error(
                 "min_zone_width",
-                "a finite number > 0 (primary spacings)",
+                "a finite number > 0 (spacings)",
                 self.min_zone_width,
             );
         }
@@ -148,10 +177,9 @@ impl ContactSettings {
 /// Which body carries the multiplier: `"auto"` (default) or a body's name.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum PrimaryChoice {
-    /// The body with the clearly coarser contact surface (spacing near the other body at least
-    /// `COARSER` times the other's); between surfaces of similar spacing, the more compliant
-    /// body (contact modulus `E / (1 - nu^2)` at least `SIMILAR_STIFFNESS` times lower); between
-    /// bodies similar in both, the coarser surface. See [`ContactProblem::new`] for why.
+    /// The more compliant body (contact modulus `E / (1 - nu^2)` at least `SIMILAR_STIFFNESS`
+    /// times lower); between bodies of similar stiffness, the finer contact surface. See
+    /// [`ContactProblem::new`] for why.
     #[default]
     Auto,
     Body(String),
@@ -168,6 +196,14 @@ impl<'de> Deserialize<'de> for PrimaryChoice {
     }
 }
 
+/// How the secondary's force is computed, and why (printed, and in the summary).
+#[derive(Debug, Clone, Serialize)]
+pub struct TransferReport {
+    /// "interpolation" or "conservative".
+    pub transfer: &'static str,
+    pub reason: String,
+}
+
 /// Which body was made primary, and why (printed, and in the summary).
 #[derive(Debug, Clone, Serialize)]
 pub struct PrimaryReport {
@@ -175,10 +211,6 @@ pub struct PrimaryReport {
     pub mode: &'static str,
     pub reason: String,
 }
-
-/// A contact surface whose spacing near the other body ([`contact_zone_spacing`]) is at least
-/// this many times the other's is "clearly coarser" for [`PrimaryChoice::Auto`].
-pub const COARSER: f64 = 1.5;
 
 /// Contact moduli within this ratio are "similar stiffness" for [`PrimaryChoice::Auto`].
 pub const SIMILAR_STIFFNESS: f64 = 2.0;
@@ -228,6 +260,38 @@ impl<'m> ContactProblem<'m> {
         self
     }
 
+    /// The transfer of the multiplier's force to the secondary that `settings.transfer` asks
+    /// for ([`Transfer`]; auto compares the two surfaces' spacings near each other).
+    pub fn transfer(&self) -> TransferReport {
+        let (primary, secondary) = (&self.primary_surface, &self.secondary_surface);
+        match self.settings.transfer {
+            Transfer::Interpolation => TransferReport {
+                transfer: "interpolation",
+                reason: "named in the case file".into(),
+            },
+            Transfer::Conservative => TransferReport {
+                transfer: "conservative",
+                reason: "named in the case file".into(),
+            },
+            Transfer::Auto => {
+                let spacing1 = contact_zone_spacing(primary, secondary);
+                let spacing2 = contact_zone_spacing(secondary, primary);
+                let (transfer, relation) = if spacing2 > spacing1 {
+                    ("conservative", "coarser")
+                } else {
+                    ("interpolation", "not coarser")
+                };
+                TransferReport {
+                    transfer,
+                    reason: format!(
+                        "the secondary surface is {relation} than the primary near the contact \
+                         (spacing {spacing2:.3e} against {spacing1:.3e})"
+                    ),
+                }
+            }
+        }
+    }
+
     /// The contact moduli `E / (1 - nu^2)` of the primary and secondary bodies, normalized to
     /// sum to one: the weights of their normals in the contact normal
     /// (`super::interface::contact_normal`).
@@ -242,20 +306,20 @@ impl<'m> ContactProblem<'m> {
     /// The problem of two bodies with the primary chosen by `choice`. An explicit choice must
     /// name one of the two bodies (`Err` gives the names).
     ///
-    /// Why the coarser surface: the secondary's contact force is the multiplier sampled at the
-    /// secondary nodes (`R21 lambda`); a secondary coarser than the primary samples a field
-    /// finer than itself, and the forces on the two bodies no longer balance. Measured on the
-    /// half-disc (R/80) and hemisphere (R/33) on a block of equal stiffness meshed 0.5 and 2
-    /// times as fine: with the coarser surface primary, `|F1 + F2| / |F1|` was 0.05% to 0.16%;
-    /// with the finer one, 2.8% to 19%. A multiplier mesh coarser than the mesh it constrains
-    /// is also the classical inf-sup-stable choice.
+    /// Why the compliant body: the multiplier is controlled through the secondary's
+    /// interpolated response `R12 K2^-1 (transfer)`, of rank at most the secondary's node count;
+    /// on a nearly rigid primary, multiplier modes are left that nothing controls (the
+    /// half-disc at R/500 on a block 1e4 times stiffer, the block primary:
+    /// [`super::ContactStatus::Unstable`]), and a curved secondary sags between the constrained
+    /// nodes of a coarse flat primary (the certificate's sag check). On the compliant body
+    /// `K1^-1` controls every mode.
     ///
-    /// Why the compliant body between similar spacings: the multiplier is controlled through
-    /// the secondary's interpolated response `R12 K2^-1 M2 R21`, of rank at most the
-    /// secondary's node count; on a nearly rigid primary as finely meshed as the secondary,
-    /// multiplier modes are left that nothing controls (the half-disc at R/500 on a block 1e4
-    /// times stiffer, the block primary: [`super::ContactStatus::Unstable`]). On the compliant
-    /// body `K1^-1` controls every mode.
+    /// Why the finer surface between similar bodies: the constraint holds the primary's nodes,
+    /// so the finer surface is the one held everywhere (nothing sags between its nodes), and the
+    /// coarser secondary receives the conservative transfer ([`Transfer`]), which balances the
+    /// forces exactly. (The secondary sampling the multiplier at its own nodes, `R21`, is what
+    /// made a finer primary unbalance them.) It is the mortar method's rule: the finer side
+    /// carries the multiplier.
     pub fn new(
         sides: [ContactSide<'m>; 2],
         choice: &PrimaryChoice,
@@ -300,35 +364,25 @@ impl<'m> ContactProblem<'m> {
             PrimaryChoice::Auto => {
                 let spacing = finest(&sides[1]) / finest(&sides[0]);
                 let stiffness = modulus(&sides[1]) / modulus(&sides[0]);
-                let (first, reason) = if !(1.0 / COARSER..COARSER).contains(&spacing) {
-                    let first = usize::from(spacing > 1.0);
-                    (
-                        first,
-                        format!(
-                            "the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
-                            finest(&sides[first]),
-                            finest(&sides[1 - first]),
-                            name(&sides[1 - first])
-                        ),
-                    )
-                } else if !(1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS).contains(&stiffness) {
+                let (first, reason) = if !(1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS)
+                    .contains(&stiffness)
+                {
                     let first = usize::from(stiffness < 1.0);
                     (
                         first,
                         format!(
-                            "similar spacing (ratio {:.2}); the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
-                            spacing.max(1.0 / spacing),
+                            "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
                             modulus(&sides[first]),
                             modulus(&sides[1 - first]),
                             name(&sides[1 - first])
                         ),
                     )
                 } else {
-                    let first = usize::from(spacing > 1.0);
+                    let first = usize::from(spacing < 1.0);
                     (
                         first,
                         format!(
-                            "similar stiffness (ratio {:.2}) and spacing; the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
+                            "similar stiffness (ratio {:.2}); the finer contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
                             stiffness.max(1.0 / stiffness),
                             finest(&sides[first]),
                             finest(&sides[1 - first]),

@@ -122,6 +122,7 @@ impl<'a> ContactSolver<'a> {
             s2,
             problem.settings.rbf_radius,
             problem.normal_weights(),
+            problem.transfer().transfer == "conservative",
         )?;
         Ok(Self {
             problem,

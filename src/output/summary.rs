@@ -8,6 +8,7 @@ use serde::Serialize;
 use super::OutputError;
 use crate::contact::{
     Certificate, ContactSettings, ContactStatus, HertzFit, IterationRecord, PrimaryReport,
+    TransferReport,
 };
 use crate::elastic::SolveStats;
 
@@ -49,6 +50,8 @@ pub struct ContactSummary {
     pub secondary: String,
     /// Which body carries the multiplier, chosen how and why.
     pub primary_choice: PrimaryReport,
+    /// How the secondary's contact force is computed, and why.
+    pub transfer: TransferReport,
     /// The independent checks of the answer of the last load step.
     pub certificate: Certificate,
     pub settings: ContactSettings,
