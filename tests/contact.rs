@@ -454,7 +454,10 @@ fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
         .find(|c| c.name == "resolution")
         .unwrap();
     assert_eq!(resolution.body.as_deref(), Some("block"));
-    assert!(resolution.value.is_infinite(), "{resolution:?}");
+    assert!(
+        resolution.value >= 1000.0,
+        "a zone of one node: {resolution:?}"
+    );
 }
 
 /// The half-disc of `tests/fixtures/foreign_disc_on_coarse_block.msh` pressed by 0.003 onto a
@@ -501,33 +504,26 @@ fn a_coarser_secondary_receives_the_conservative_transfer() {
 const COARSE_BLOCK_RIGID_FLAT_FORCE_2D_AT_0_004: f64 = 1.829546778705095;
 
 #[test]
-fn auto_tries_the_other_primary_when_its_first_choice_does_not_converge() {
+fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {
     // Equal materials, the block's surface twice coarser than the disc's (R/80), pressed by
-    // 0.01, at most 5 iterations: auto picks the finer disc, whose loop needs 7; the block as
-    // primary settles in 4 and is certified, and that answer is the one kept, with the reason.
+    // 0.004: auto picks the coarser block, whose answer fails the certificate on the disc's
+    // sag (its force is 2% below the disc primary's); the disc as primary is certified, and
+    // that answer is the one kept, with the reason.
     let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
-        .replace("uy = -0.02", "uy = -0.01")
-        .replace(
-            "primary = \"disc\"",
-            "primary = \"auto\"\nmax_iterations = 5",
-        );
-    assert!(
-        text.contains("uy = -0.01") && text.contains("max_iterations = 5"),
-        "{text}"
-    );
-    let disc_first = solve(&text.replace("primary = \"auto\"", "primary = \"disc\"")).unwrap();
-    assert_eq!(disc_first.status, ContactStatus::IterationLimit);
+        .replace("uy = -0.02", "uy = -0.004");
+    assert!(text.contains("uy = -0.004"), "{text}");
+    let block_first = solve(&text.replace("primary = \"disc\"", "primary = \"block\"")).unwrap();
+    assert_eq!(block_first.status, ContactStatus::NotCertified);
 
-    let (code, summary) = solve_cli(&text);
+    let (code, summary) = solve_cli(&text.replace("primary = \"disc\"", "primary = \"auto\""));
     let contact = &summary["contact"];
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["status"], "converged", "{contact}");
-    assert_eq!(contact["primary"], "block", "{contact}");
+    assert_eq!(contact["primary"], "disc", "{contact}");
     assert_eq!(contact["primary_choice"]["mode"], "auto");
     let reason = contact["primary_choice"]["reason"].as_str().unwrap();
-    assert!(reason.contains("the finer contact surface"), "{reason}");
     assert!(
-        reason.contains("'disc' as primary ended iteration-limit"),
+        reason.contains("'block' as primary ended not-certified (secondary sag"),
         "{reason}"
     );
 }
