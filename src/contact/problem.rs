@@ -319,14 +319,12 @@ impl<'m> ContactProblem<'m> {
     /// nodes of a coarse flat primary (the certificate's sag check). On the compliant body
     /// `K1^-1` controls every mode.
     ///
-    /// Why the coarser surface between similar bodies: a fine primary pressed against a
-    /// coarse secondary takes the shape of the secondary's facets, and its pressure oscillates
-    /// between the secondary's nodes (two equal hemispheres at R/50, the upper 1.5 times
-    /// coarser: with the finer primary and the conservative transfer the fitted peak pressure
-    /// was 6.5% above Hertz, with the coarser primary within 3%). A multiplier mesh coarser
-    /// than the mesh it constrains is also the classical inf-sup-stable choice. The finer
-    /// secondary then receives the interpolated traction (`R21`), which balances the forces to
-    /// the interpolation's accuracy. The price is the sag of a curved secondary between the
+    /// Why the coarser surface between similar bodies: a multiplier mesh coarser than the mesh
+    /// it constrains is the classical inf-sup-stable choice, and the finer secondary receives
+    /// the interpolated traction (`R21`), which balances the forces to the interpolation's
+    /// accuracy. The mortar rule (the finer side primary, the conservative transfer to the
+    /// coarser one) measured worse on two equal hemispheres meshed 1.5 times apart (README,
+    /// "Choosing the primary body"). The price is the sag of a curved secondary between the
     /// nodes of a coarse flat primary, which the certificate measures; the retry with the
     /// other primary (`crate::run`) answers it.
     pub fn new(
