@@ -225,8 +225,9 @@ fn solve_into(
 }
 
 /// The contact solve of a case: every load step with the chosen primary, and, when the primary
-/// was chosen automatically and that solve does not end `converged` (or `no-contact`), every
-/// load step again with the other body as primary. The second answer is kept if it converges;
+/// was chosen automatically between bodies of similar stiffness
+/// ([`crate::contact::PrimaryReport::other_may_retry`]) and that solve does not end `converged`
+/// (or `no-contact`), every load step again with the other body as primary. The second answer is kept if it converges;
 /// otherwise the first is, and the summary's reason says what both ended with. A coarse flat
 /// primary under a curved secondary is the usual case: the secondary sags between the
 /// primary's nodes (certificate), which a curved primary does not let happen.
@@ -239,7 +240,7 @@ fn solve_contact_case<'m>(
     say: &dyn Fn(String),
 ) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), RunError> {
     let (solution, steps) = solve_load_steps(&problem, case, "", timings, say)?;
-    let (problem, solution, steps) = if problem.primary_report.mode == "auto"
+    let (problem, solution, steps) = if problem.primary_report.other_may_retry
         && !solution.status.is_solution()
     {
         let first = (problem.primary.body.name.clone(), failure(&solution));

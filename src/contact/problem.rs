@@ -215,6 +215,13 @@ pub struct PrimaryReport {
     /// "auto" or "explicit".
     pub mode: &'static str,
     pub reason: String,
+    /// Whether the other body may carry the multiplier when this choice does not end
+    /// `converged`: auto between bodies of similar stiffness. Between a compliant and a stiff
+    /// body the stiff primary is the unstable choice (`ContactProblem::new`), and a retry with
+    /// it turned uncertified answers into certified wrong ones (README, "Choosing the primary
+    /// body").
+    #[serde(skip)]
+    pub other_may_retry: bool,
 }
 
 /// Contact moduli within this ratio are "similar stiffness" for [`PrimaryChoice::Auto`].
@@ -365,15 +372,15 @@ impl<'m> ContactProblem<'m> {
                     PrimaryReport {
                         mode: "explicit",
                         reason: "named in the case file".into(),
+                        other_may_retry: false,
                     },
                 )
             }
             PrimaryChoice::Auto => {
                 let spacing = finest(&sides[1]) / finest(&sides[0]);
                 let stiffness = modulus(&sides[1]) / modulus(&sides[0]);
-                let (first, reason) = if !(1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS)
-                    .contains(&stiffness)
-                {
+                let similar = (1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS).contains(&stiffness);
+                let (first, reason) = if !similar {
                     let first = usize::from(stiffness < 1.0);
                     (
                         first,
@@ -402,6 +409,7 @@ impl<'m> ContactProblem<'m> {
                     PrimaryReport {
                         mode: "auto",
                         reason,
+                        other_may_retry: similar,
                     },
                 )
             }
