@@ -458,6 +458,19 @@ fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
         resolution.value >= 1000.0,
         "a zone of one node: {resolution:?}"
     );
+
+    // Auto makes the compliant disc primary, whose three nodes in contact resolve the zone
+    // (the coarse stiff block, nearly rigid, need not):
+    // certified, and dolfinx's force to 1%.
+    let auto = solve(&text.replace("primary = \"block\"", "primary = \"auto\"")).unwrap();
+    assert_eq!(
+        auto.status,
+        ContactStatus::Converged,
+        "{:?}",
+        auto.certificate
+    );
+    let error = auto.force_primary[1].abs() / FOREIGN_RIGID_FLAT_FORCE_2D - 1.0;
+    assert!(error.abs() <= 0.01, "auto: force {error:+.4} off dolfinx");
 }
 
 /// The half-disc of `tests/fixtures/foreign_disc_on_coarse_block.msh` pressed by 0.003 onto a
