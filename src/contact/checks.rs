@@ -255,8 +255,9 @@ const COMPLIANT_SHARE: f64 = 0.1;
 /// geometric gap within `touching` spacings (the secondary penetration tolerance: the
 /// secondary's nodes are held only through the transfer, which loads a ring of nodes around
 /// the zone that do not touch). Its width is twice the largest distance of one of them from
-/// their centroid (2a for a Hertz zone), its spacing their mean [`area_spacing`]. One node in contact has no width: its figure is capped at 1000 (JSON has no
-/// infinity). No node in contact gives 0 (nothing to resolve).
+/// their centroid (2a for a Hertz zone), its spacing their mean [`area_spacing`]. One node in
+/// contact has no width: its figure is capped at 1000 (JSON has no infinity). No node in
+/// contact gives 0 (nothing to resolve).
 fn zone_resolution(
     surfaces: [(&ContactSurface, Option<f64>); 2],
     pressures: &[Vec<f64>],
