@@ -8,7 +8,7 @@ use thiserror::Error;
 use crate::case::{Case, CaseError};
 use crate::contact::{
     ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus, Formulation,
-    SurfaceFields,
+    SurfaceFields, primary_agreement,
 };
 use crate::elastic::{ElasticSolution, SolveError, solve};
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
@@ -275,6 +275,18 @@ fn solve_contact_case<'m>(
     } else {
         (problem, solution, steps)
     };
+    let (problem, solution, steps) =
+        if problem.primary_report.check_other && solution.status.is_solution() {
+            let (problem, solution) =
+                check_against_other_primary(problem, solution, case, timings, say)?;
+            let mut steps = steps;
+            if let Some(last) = steps.last_mut() {
+                last.status = solution.status;
+            }
+            (problem, solution, steps)
+        } else {
+            (problem, solution, steps)
+        };
     let csv = output_dir.join("force_displacement.csv");
     std::fs::write(&csv, StepRecord::csv(&steps))
         .map_err(|source| OutputError::Io { path: csv, source })?;
@@ -290,6 +302,48 @@ fn solve_contact_case<'m>(
         eprintln!("warning: {} not written: {e}", png.display());
     }
     Ok((problem, solution, steps))
+}
+
+/// An explicit primary that `primary = "auto"` would not choose
+/// ([`crate::contact::PrimaryReport::check_other`]): every load step again with the other body
+/// as primary, and the certificate's `primary agreement` check on the last step's forces. The
+/// answer kept is the one with the primary the case file names.
+fn check_against_other_primary<'m>(
+    problem: ContactProblem<'m>,
+    mut solution: ContactSolution,
+    case: &Case,
+    timings: &mut Vec<(String, f64)>,
+    say: &dyn Fn(String),
+) -> Result<(ContactProblem<'m>, ContactSolution), RunError> {
+    let (tolerance, formulation) = (
+        problem.settings.primary_agreement_tolerance,
+        problem.settings.formulation,
+    );
+    let other = problem.with_other_primary();
+    let other_name = other.primary.body.name.clone();
+    say(format!(
+        "checking the answer: solving again with '{other_name}' as primary"
+    ));
+    let reference = match solve_load_steps(&other, case, "check with other primary: ", timings, say)
+    {
+        // The force the other primary's multiplier puts on this solve's primary body.
+        Ok((check, _)) if check.status == ContactStatus::Converged => {
+            Ok(check.force_primary.map(|f| -f))
+        }
+        Ok((check, _)) => Err(failure(&check)),
+        Err(e) => Err(format!("with an error ({e})")),
+    };
+    let check = primary_agreement(solution.force_primary, reference, &other_name, tolerance);
+    say(format!(
+        "check with '{other_name}' as primary: {}",
+        check.describe()
+    ));
+    solution.certify_further(check);
+    say(format!(
+        "contact status: {}",
+        describe(&solution, formulation)
+    ));
+    Ok((other.with_other_primary(), solution))
 }
 
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per

@@ -355,6 +355,72 @@ fn a_stiff_primary_as_fine_as_the_other_is_right_or_says_why() {
     }
 }
 
+#[test]
+fn an_explicit_stiff_primary_is_checked_against_the_compliant_primary() {
+    // A mesh made without `geo/`: a hemisphere (R/25) on a block 1e4 times stiffer meshed twice
+    // finer, pressed by 0.004, the block primary by hand. The loop's certificate passes every
+    // check (penetration, tension, sag, resolution, balance) with the force 3% below dolfinx's
+    // rigid flat on the same hemisphere mesh: a certified wrong answer, unless the answer is
+    // compared with the one the hemisphere gives as primary, as `internodes solve` does for a
+    // primary that "auto" would not choose.
+    let text = format!(
+        r#"mesh = "{}"
+output = "out"
+
+[contact]
+bodies = ["sphere", "block"]
+surfaces = ["sphere_contact", "block_contact"]
+primary = "block"
+
+[[body]]
+name = "sphere"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "sphere_top"
+ux = 0.0
+uy = 0.0
+uz = -0.004
+
+[[body]]
+name = "block"
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+uz = 0.0
+"#,
+        common::fixture("foreign_hemisphere_on_fine_block.msh").display()
+    );
+    let loop_only = solve(&text).unwrap();
+    let error = loop_only.force_secondary[2] / FOREIGN_RIGID_FLAT_FORCE_3D - 1.0;
+    assert!(
+        loop_only.status == ContactStatus::Converged && error < -0.02,
+        "the premise: the loop's certificate passes a force {error:+.4} off dolfinx ({:?})",
+        loop_only.status
+    );
+
+    let (code, summary) = solve_cli(&text);
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(1), "{contact}");
+    assert_eq!(contact["status"], "not-certified", "{contact}");
+    assert_eq!(contact["primary"], "block", "{contact}");
+    let reason = contact["primary_choice"]["reason"].as_str().unwrap();
+    assert!(reason.contains("would choose 'sphere'"), "{reason}");
+    let failed: Vec<&str> = (contact["certificate"]["checks"].as_array().unwrap().iter())
+        .filter(|c| c["passed"] == false)
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(failed, ["primary agreement"], "{contact}");
+}
+
+/// The hemisphere of `tests/fixtures/foreign_hemisphere_on_fine_block.msh` pressed by 0.004
+/// onto a rigid flat: contact force computed by dolfinx (PETSc VI solver, exact node-to-plane
+/// constraint) on the same hemisphere mesh, by `validation/foreign_meshes.py`.
+const FOREIGN_RIGID_FLAT_FORCE_3D: f64 = 0.4213517106868755;
+
 /// The half-disc of `tests/fixtures/half_disc_on_block_coarse_block.msh` pressed by 0.02 onto
 /// a rigid flat: contact force per unit length computed by dolfinx (PETSc VI solver, exact
 /// node-to-plane constraint) on the same disc mesh, by `validation/rigid_flat.py`.
@@ -393,8 +459,23 @@ fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
     );
     let imbalance = contact["force_imbalance"].as_f64().unwrap();
     assert!(imbalance <= 0.01, "imbalance {imbalance}");
+    // "auto" would make the disc primary: the answer was compared with that one.
+    let checks = contact["certificate"]["checks"].as_array().unwrap();
+    let agreement = (checks.iter())
+        .find(|c| c["name"] == "primary agreement")
+        .unwrap_or_else(|| panic!("no primary agreement check: {contact}"));
+    assert_eq!(agreement["passed"], true, "{agreement}");
+    assert!(
+        agreement["note"]
+            .as_str()
+            .unwrap()
+            .contains("'disc' as primary"),
+        "{agreement}"
+    );
     eprintln!(
-        "stiff block primary, 2D: force {error:+.4} against dolfinx, imbalance {imbalance:.2e}"
+        "stiff block primary, 2D: force {error:+.4} against dolfinx, imbalance {imbalance:.2e}, \
+         {:.2e} from the disc primary's force",
+        agreement["value"].as_f64().unwrap()
     );
 }
 

@@ -358,7 +358,7 @@ def run(binary: Path, m: Mesh, approach: float, primaries: tuple[str, ...]) -> l
     rows = []
     for primary in primaries:
         output = BUILD / "runs" / f"{stem}_{primary}"
-        case = output.with_suffix(".toml")
+        case = output.parent / f"{output.name}.toml"
         case.parent.mkdir(parents=True, exist_ok=True)
         case.write_text(case_text(m, msh, primary, approach, output))
         done = subprocess.run([str(binary), "solve", str(case), "--quiet"], capture_output=True, text=True)

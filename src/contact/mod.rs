@@ -28,7 +28,7 @@ mod solve;
 mod surface;
 pub mod system;
 
-pub use checks::{Certificate, CertificateCheck};
+pub use checks::{Certificate, CertificateCheck, primary_agreement};
 pub use coupled_solver::CoupledSolver;
 pub use problem::{
     ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,

@@ -102,6 +102,10 @@ pub struct ContactSettings {
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
+    /// The certificate's bound on the relative difference between the contact force and the
+    /// one found with the other body as primary (default 0.01), checked only when the primary
+    /// is one "auto" would not choose ([`PrimaryReport::check_other`]).
+    pub primary_agreement_tolerance: f64,
     /// Support radius of each node's RBF in the transfer operators, in units of the distance
     /// to its nearest node (default 2, the radius seed Algorithm 1 starts from; see
     /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
@@ -123,6 +127,7 @@ impl Default for ContactSettings {
             secondary_min_zone_width: 2.5,
             certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
+            primary_agreement_tolerance: 0.01,
             rbf_radius: 2.0,
         }
     }
@@ -170,6 +175,10 @@ impl ContactSettings {
             ),
             ("sag_tolerance", self.sag_tolerance),
             ("imbalance_tolerance", self.imbalance_tolerance),
+            (
+                "primary_agreement_tolerance",
+                self.primary_agreement_tolerance,
+            ),
         ] {
             if !(value >= 0.0 && value.is_finite()) {
                 return error(name, "a finite number >= 0", value);
@@ -222,6 +231,12 @@ pub struct PrimaryReport {
     /// body").
     #[serde(skip)]
     pub other_may_retry: bool,
+    /// Whether the answer must agree with the one the other body gives as primary: an
+    /// explicit choice that "auto" would not make. Such a primary passed every check of the
+    /// certificate with a force 3% off (a stiff block twice finer than an R/25 hemisphere, 3D),
+    /// so its certificate gets a `primary agreement` check (`crate::run`).
+    #[serde(skip)]
+    pub check_other: bool,
 }
 
 /// Contact moduli within this ratio are "similar stiffness" for [`PrimaryChoice::Auto`].
@@ -347,14 +362,35 @@ impl<'m> ContactProblem<'m> {
             contact_zone_spacing(&sides[0].1, &sides[1].1),
             contact_zone_spacing(&sides[1].1, &sides[0].1),
         ];
-        let finest = |side: &ContactSide| {
-            if std::ptr::eq(side, &sides[0]) {
-                spacing_near[0]
-            } else {
-                spacing_near[1]
-            }
-        };
         let name = |side: &ContactSide| side.0.body.name.clone();
+        // What "auto" chooses (module doc of `PrimaryChoice::Auto`); an explicit choice is
+        // compared with it.
+        let stiffness = modulus(&sides[1]) / modulus(&sides[0]);
+        let similar = (1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS).contains(&stiffness);
+        let (auto_first, auto_reason) = if !similar {
+            let first = usize::from(stiffness < 1.0);
+            (
+                first,
+                format!(
+                    "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
+                    modulus(&sides[first]),
+                    modulus(&sides[1 - first]),
+                    name(&sides[1 - first])
+                ),
+            )
+        } else {
+            let first = usize::from(spacing_near[1] > spacing_near[0]);
+            (
+                first,
+                format!(
+                    "similar stiffness (ratio {:.2}); the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
+                    stiffness.max(1.0 / stiffness),
+                    spacing_near[first],
+                    spacing_near[1 - first],
+                    name(&sides[1 - first])
+                ),
+            )
+        };
         let (first, report) = match choice {
             PrimaryChoice::Body(body) => {
                 let first = sides
@@ -367,52 +403,36 @@ impl<'m> ContactProblem<'m> {
                             name(&sides[1])
                         )
                     })?;
-                (
-                    first,
-                    PrimaryReport {
-                        mode: "explicit",
-                        reason: "named in the case file".into(),
-                        other_may_retry: false,
-                    },
-                )
-            }
-            PrimaryChoice::Auto => {
-                let spacing = finest(&sides[1]) / finest(&sides[0]);
-                let stiffness = modulus(&sides[1]) / modulus(&sides[0]);
-                let similar = (1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS).contains(&stiffness);
-                let (first, reason) = if !similar {
-                    let first = usize::from(stiffness < 1.0);
-                    (
-                        first,
-                        format!(
-                            "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
-                            modulus(&sides[first]),
-                            modulus(&sides[1 - first]),
-                            name(&sides[1 - first])
-                        ),
+                let check_other = first != auto_first;
+                let reason = if check_other {
+                    format!(
+                        "named in the case file; \"auto\" would choose '{}' ({auto_reason}), so \
+                         the answer is checked against the one with '{}' as primary",
+                        name(&sides[auto_first]),
+                        name(&sides[auto_first])
                     )
                 } else {
-                    let first = usize::from(spacing > 1.0);
-                    (
-                        first,
-                        format!(
-                            "similar stiffness (ratio {:.2}); the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
-                            stiffness.max(1.0 / stiffness),
-                            finest(&sides[first]),
-                            finest(&sides[1 - first]),
-                            name(&sides[1 - first])
-                        ),
-                    )
+                    format!("named in the case file (as \"auto\" would: {auto_reason})")
                 };
                 (
                     first,
                     PrimaryReport {
-                        mode: "auto",
+                        mode: "explicit",
                         reason,
-                        other_may_retry: similar,
+                        other_may_retry: false,
+                        check_other,
                     },
                 )
             }
+            PrimaryChoice::Auto => (
+                auto_first,
+                PrimaryReport {
+                    mode: "auto",
+                    reason: auto_reason,
+                    other_may_retry: similar,
+                    check_other: false,
+                },
+            ),
         };
         let [a, b] = sides;
         let ((primary, primary_surface), (secondary, secondary_surface)) =

@@ -159,6 +159,17 @@ pub struct ContactSolution {
     pub active_set: ActiveSet,
 }
 
+impl ContactSolution {
+    /// Adds a check made after the loop (e.g. [`super::checks::primary_agreement`]) to the
+    /// certificate; a failed one makes a `converged` answer `not-certified`.
+    pub fn certify_further(&mut self, check: super::CertificateCheck) {
+        if !check.passed && self.status.is_solution() {
+            self.status = ContactStatus::NotCertified;
+        }
+        self.certificate.push(check);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::ContactStatus;
