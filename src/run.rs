@@ -304,8 +304,8 @@ fn solve_contact_case<'m>(
     Ok((problem, solution, steps))
 }
 
-/// An explicit primary that `primary = "auto"` would not choose
-/// ([`crate::contact::PrimaryReport::check_other`]): every load step again with the other body
+/// An explicit primary much stiffer than the other body, which `primary = "auto"` would not
+/// choose ([`crate::contact::PrimaryReport::check_other`]): every load step again with the other body
 /// as primary, and the certificate's `primary agreement` check on the last step's forces. The
 /// answer kept is the one with the primary the case file names.
 fn check_against_other_primary<'m>(

@@ -34,7 +34,8 @@
 //!   by construction, so with it this check guards the assembly, not the transfer; what then
 //!   bounds a coarse secondary is the resolution check.
 //!
-//! - **Primary agreement** (only when the primary is one `primary = "auto"` would not choose):
+//! - **Primary agreement** (only for a primary named in the case file and at least twice
+//!   stiffer than the other body, a choice `primary = "auto"` avoids):
 //!   the contact force must agree with the one found with the other body as primary, within
 //!   `primary_agreement_tolerance` ([`primary_agreement`]). Another multiplier space is an
 //!   independent discretization of the same problem; a stiff block primary twice finer than a
