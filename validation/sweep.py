@@ -41,8 +41,9 @@ before any run and none is set from a result):
 
 * ``status``: the solve ended "converged" (0) or not (1). Tolerance 0.
 * ``certificate``: the solver's certificate (summary.json contact.certificate) passed, with its
-  penetration, tension and imbalance checks all present; figure the largest value / tolerance over
-  its checks (tolerance 1). A missing certificate, a missing check, or a "passed" flag that
+  penetration, tension, sag, resolution and imbalance checks all present (and the primary
+  agreement where the solver made it: a stiff primary named by hand); figure the largest value /
+  tolerance over its checks (tolerance 1). A missing certificate, a missing check, or a "passed" flag that
   contradicts the figures is a failed row (figure NaN, the note says which), never a pass.
 * ``primary``: an explicit primary was honoured (summary.json primary == the asked body,
   primary_choice.mode "explicit"); "auto" was reported as "auto" (its reason is in the note).
@@ -521,8 +522,11 @@ def certificate_check(case: Case, contact: dict) -> Check:
     checks = cert.get("checks") if isinstance(cert.get("checks"), list) else []
     by_name = {c.get("name"): c for c in checks if isinstance(c, dict)}
     missing = [n for n in CERTIFICATE_CHECKS if n not in by_name]
+    # Checks made only in some runs (the primary agreement of a stiff primary named by hand)
+    # count as well when present.
+    names = list(CERTIFICATE_CHECKS) + [n for n in by_name if n not in CERTIFICATE_CHECKS]
     ratios, parts = [], []
-    for name in CERTIFICATE_CHECKS:
+    for name in names:
         c = by_name.get(name)
         if c is None:
             continue
@@ -539,7 +543,7 @@ def certificate_check(case: Case, contact: dict) -> Check:
     note = "; ".join(parts)
     if missing:
         return Check("certificate", case.name, math.nan, 1.0, f"certificate lacks {', '.join(missing)}; {note}")
-    flags = cert.get("passed") is True and all(by_name[n].get("passed") is True for n in CERTIFICATE_CHECKS)
+    flags = cert.get("passed") is True and all(by_name[n].get("passed") is True for n in names)
     if flags != (worst <= 1.0):
         return Check("certificate", case.name, math.nan, 1.0,
                      f"certificate passed = {cert.get('passed')} contradicts its figures; {note}")
