@@ -240,7 +240,7 @@ fn solve_contact_case<'m>(
     say: &dyn Fn(String),
 ) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), RunError> {
     let (solution, steps) = solve_load_steps(&problem, case, "", timings, say)?;
-    let (problem, solution, steps) = if problem.primary_report.other_may_retry
+    let (problem, solution, mut steps) = if problem.primary_report.other_may_retry
         && !solution.status.is_solution()
     {
         let first = (problem.primary.body.name.clone(), failure(&solution));
@@ -275,18 +275,16 @@ fn solve_contact_case<'m>(
     } else {
         (problem, solution, steps)
     };
-    let (problem, solution, steps) =
-        if problem.primary_report.check_other && solution.status.is_solution() {
-            let (problem, solution) =
-                check_against_other_primary(problem, solution, case, timings, say)?;
-            let mut steps = steps;
-            if let Some(last) = steps.last_mut() {
-                last.status = solution.status;
-            }
-            (problem, solution, steps)
-        } else {
-            (problem, solution, steps)
-        };
+    let (problem, solution) = if problem.primary_report.check_other && solution.status.is_solution()
+    {
+        check_against_other_primary(problem, solution, case, timings, say)?
+    } else {
+        (problem, solution)
+    };
+    // The last step's status is the answer's, checks made after the loop included.
+    if let Some(last) = steps.last_mut() {
+        last.status = solution.status;
+    }
     let csv = output_dir.join("force_displacement.csv");
     std::fs::write(&csv, StepRecord::csv(&steps))
         .map_err(|source| OutputError::Io { path: csv, source })?;
@@ -370,7 +368,9 @@ fn solve_load_steps(
     let transfer = problem.transfer();
     say(format!(
         "{label}force on '{}': {} transfer ({})",
-        problem.secondary.body.name, transfer.transfer, transfer.reason
+        problem.secondary.body.name,
+        serde_json::to_value(transfer.transfer).expect("a unit enum serializes"),
+        transfer.reason
     ));
     let load_steps = case.load_steps();
     let mut steps = Vec::new();

@@ -213,8 +213,8 @@ impl<'de> Deserialize<'de> for PrimaryChoice {
 /// How the secondary's force is computed, and why (printed, and in the summary).
 #[derive(Debug, Clone, Serialize)]
 pub struct TransferReport {
-    /// "interpolation" or "conservative".
-    pub transfer: &'static str,
+    /// `Interpolation` or `Conservative` (never `Auto`: the choice made).
+    pub transfer: Transfer,
     pub reason: String,
 }
 
@@ -268,16 +268,21 @@ pub struct ContactProblem<'m> {
     pub secondary_surface: ContactSurface,
     pub settings: ContactSettings,
     pub primary_report: PrimaryReport,
+    /// [`contact_zone_spacing`] of the primary and secondary surfaces, measured once: the
+    /// primary choice and the transfer choice both read them.
+    contact_spacing: [f64; 2],
 }
 
 impl<'m> ContactProblem<'m> {
     /// The same problem with the roles of the two bodies exchanged (the reason is kept).
     pub fn with_other_primary(self) -> Self {
+        let [primary, secondary] = self.contact_spacing;
         Self {
             primary: self.secondary,
             secondary: self.primary,
             primary_surface: self.secondary_surface,
             secondary_surface: self.primary_surface,
+            contact_spacing: [secondary, primary],
             ..self
         }
     }
@@ -291,23 +296,17 @@ impl<'m> ContactProblem<'m> {
     /// The transfer of the multiplier's force to the secondary that `settings.transfer` asks
     /// for ([`Transfer`]; auto compares the two surfaces' spacings near each other).
     pub fn transfer(&self) -> TransferReport {
-        let (primary, secondary) = (&self.primary_surface, &self.secondary_surface);
         match self.settings.transfer {
-            Transfer::Interpolation => TransferReport {
-                transfer: "interpolation",
-                reason: "named in the case file".into(),
-            },
-            Transfer::Conservative => TransferReport {
-                transfer: "conservative",
+            named @ (Transfer::Interpolation | Transfer::Conservative) => TransferReport {
+                transfer: named,
                 reason: "named in the case file".into(),
             },
             Transfer::Auto => {
-                let spacing1 = contact_zone_spacing(primary, secondary);
-                let spacing2 = contact_zone_spacing(secondary, primary);
+                let [spacing1, spacing2] = self.contact_spacing;
                 let (transfer, relation) = if spacing2 > spacing1 {
-                    ("conservative", "coarser")
+                    (Transfer::Conservative, "coarser")
                 } else {
-                    ("interpolation", "not coarser")
+                    (Transfer::Interpolation, "not coarser")
                 };
                 TransferReport {
                     transfer,
@@ -448,6 +447,7 @@ impl<'m> ContactProblem<'m> {
             secondary_surface,
             settings,
             primary_report: report,
+            contact_spacing: [spacing_near[first], spacing_near[1 - first]],
         })
     }
 }

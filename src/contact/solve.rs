@@ -44,7 +44,7 @@ use super::coupled_solver::{self, BodyFactors, CoupledSolver};
 use super::interface::{InterfaceOperators, geometric_gaps};
 use super::solution::{ContactSolution, ContactStatus, PhaseSeconds};
 use super::system::{CoupledSolution, CoupledSystem, Coupling};
-use super::{ContactError, ContactProblem, post};
+use super::{ContactError, ContactProblem, Transfer, post};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 
 /// Solves a two-body contact problem at its full load.
@@ -122,7 +122,7 @@ impl<'a> ContactSolver<'a> {
             s2,
             problem.settings.rbf_radius,
             problem.normal_weights(),
-            problem.transfer().transfer == "conservative",
+            problem.transfer().transfer == Transfer::Conservative,
         )?;
         Ok(Self {
             problem,
