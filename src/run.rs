@@ -7,8 +7,8 @@ use thiserror::Error;
 
 use crate::case::{Case, CaseError};
 use crate::contact::{
-    ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus, Formulation,
-    SurfaceFields, primary_agreement,
+    ContactError, ContactProblem, ContactRun, ContactSolution, StepRecord, SurfaceFields,
+    solve_contact,
 };
 use crate::elastic::{ElasticSolution, SolveError, solve};
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
@@ -16,7 +16,7 @@ use crate::mesh::BodyMesh;
 use crate::mesh::{Mesh, MeshError, mesh_geo, read_msh, read_msh_bytes};
 use crate::output::{
     BodyFields, BodySummary, CaseSummary, ContactSummary, GENERATED_MESH, OutputError,
-    ResultFolder, StepRecord, mark_failed_folder, write_force_displacement_png,
+    ResultFolder, force_displacement_csv, mark_failed_folder, write_force_displacement_png,
     write_matrix_market, write_xdmf,
 };
 
@@ -146,8 +146,12 @@ fn solve_into(
             "primary body '{}' ({}): {}",
             problem.primary.body.name, problem.primary_report.mode, problem.primary_report.reason
         ));
-        let (problem, solution, steps) =
-            solve_contact_case(problem, &case, &output_dir, &mut timings, &say)?;
+        let ContactRun {
+            problem,
+            solution,
+            steps,
+            ..
+        } = solve_contact_case(problem, &case, &output_dir, &mut timings)?;
         contact_summary = Some(summarize_contact(&problem, &solution, steps));
         solved.push(SolvedBody {
             name: problem.primary.body.name.clone(),
@@ -224,69 +228,23 @@ fn solve_into(
     Ok(summary)
 }
 
-/// The contact solve of a case: every load step with the chosen primary, and, when the primary
-/// was chosen automatically between bodies of similar stiffness
-/// ([`crate::contact::PrimaryReport::other_may_retry`]) and that solve does not end `converged`
-/// (or `no-contact`), every load step again with the other body as primary. The second answer is kept if it converges;
-/// otherwise the first is, and the summary's reason says what both ended with. A coarse flat
-/// primary under a curved secondary is the usual case: the secondary sags between the
-/// primary's nodes (certificate), which a curved primary does not let happen.
-/// Writes `force_displacement.csv` and `.png` of the kept solve.
+/// The contact solve of a case ([`solve_contact`]: its load steps, and the other primary's
+/// solve when the first choice may be wrong), and its `force_displacement.csv` and `.png`.
 fn solve_contact_case<'m>(
     problem: ContactProblem<'m>,
     case: &Case,
     output_dir: &Path,
     timings: &mut Vec<(String, f64)>,
-    say: &dyn Fn(String),
-) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), RunError> {
-    let (solution, steps) = solve_load_steps(&problem, case, "", timings, say)?;
-    let (problem, solution, mut steps) = if problem.primary_report.other_may_retry
-        && !solution.status.is_solution()
-    {
-        let first = (problem.primary.body.name.clone(), failure(&solution));
-        let other = problem.with_other_primary();
-        say(format!(
-            "primary = \"auto\": with '{}' as primary the solve ended {}; solving again with '{}' as primary",
-            first.0, first.1, other.primary.body.name
-        ));
-        let retry = solve_load_steps(&other, case, "other primary: ", timings, say);
-        match retry {
-            Ok((second, steps2)) if second.status.is_solution() => {
-                let other_name = other.primary.body.name.clone();
-                let other = other.with_reason_appended(&format!(
-                    "'{other_name}' carries the multiplier because '{}' as primary ended {}",
-                    first.0, first.1
-                ));
-                (other, second, steps2)
-            }
-            retry => {
-                let second = match retry {
-                    Ok((second, _)) => failure(&second),
-                    Err(e) => format!("with an error ({e})"),
-                };
-                let other_name = other.primary.body.name.clone();
-                let problem = other.with_other_primary().with_reason_appended(&format!(
-                    "kept although it ended {}: '{other_name}' as primary ended {second}",
-                    first.1
-                ));
-                (problem, solution, steps)
-            }
+) -> Result<ContactRun<'m>, RunError> {
+    let run = solve_contact(problem, &case.solver, &case.load_steps()).map_err(|source| {
+        RunError::Contact {
+            path: case.path.clone(),
+            source,
         }
-    } else {
-        (problem, solution, steps)
-    };
-    let (problem, solution) = if problem.primary_report.check_other && solution.status.is_solution()
-    {
-        check_against_other_primary(problem, solution, case, timings, say)?
-    } else {
-        (problem, solution)
-    };
-    // The last step's status is the answer's, checks made after the loop included.
-    if let Some(last) = steps.last_mut() {
-        last.status = solution.status;
-    }
+    })?;
+    timings.extend(run.timings.iter().cloned());
     let csv = output_dir.join("force_displacement.csv");
-    std::fs::write(&csv, StepRecord::csv(&steps))
+    std::fs::write(&csv, force_displacement_csv(&run.steps))
         .map_err(|source| OutputError::Io { path: csv, source })?;
     // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
     // Warned even with --quiet, since a file the user expects is missing.
@@ -294,137 +252,12 @@ fn solve_contact_case<'m>(
     let title = format!(
         "{}: contact force on '{}' against load factor",
         case_name(case),
-        problem.primary.body.name
+        run.problem.primary.body.name
     );
-    if let Err(e) = write_force_displacement_png(&png, &title, &steps) {
+    if let Err(e) = write_force_displacement_png(&png, &title, &run.steps) {
         eprintln!("warning: {} not written: {e}", png.display());
     }
-    Ok((problem, solution, steps))
-}
-
-/// An explicit primary much stiffer than the other body, which `primary = "auto"` would not
-/// choose ([`crate::contact::PrimaryReport::check_other`]): every load step again with the other body
-/// as primary, and the certificate's `primary agreement` check on the last step's forces. The
-/// answer kept is the one with the primary the case file names.
-fn check_against_other_primary<'m>(
-    problem: ContactProblem<'m>,
-    mut solution: ContactSolution,
-    case: &Case,
-    timings: &mut Vec<(String, f64)>,
-    say: &dyn Fn(String),
-) -> Result<(ContactProblem<'m>, ContactSolution), RunError> {
-    let (tolerance, formulation) = (
-        problem.settings.primary_agreement_tolerance,
-        problem.settings.formulation,
-    );
-    let other = problem.with_other_primary();
-    let other_name = other.primary.body.name.clone();
-    say(format!(
-        "checking the answer: solving again with '{other_name}' as primary"
-    ));
-    let reference = match solve_load_steps(&other, case, "check with other primary: ", timings, say)
-    {
-        // The force the other primary's multiplier puts on this solve's primary body.
-        Ok((check, _)) if check.status == ContactStatus::Converged => {
-            Ok(check.force_primary.map(|f| -f))
-        }
-        Ok((check, _)) => Err(failure(&check)),
-        Err(e) => Err(format!("with an error ({e})")),
-    };
-    let check = primary_agreement(solution.force_primary, reference, &other_name, tolerance);
-    say(format!(
-        "check with '{other_name}' as primary: {}",
-        check.describe()
-    ));
-    solution.certify_further(check);
-    say(format!(
-        "contact status: {}",
-        describe(&solution, formulation)
-    ));
-    Ok((other.with_other_primary(), solution))
-}
-
-/// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
-/// load step, each starting from the previous active set; stops at the first step whose loop
-/// does not settle (`not-certified` steps go on). `label` prefixes the timing names.
-fn solve_load_steps(
-    problem: &ContactProblem,
-    case: &Case,
-    label: &str,
-    timings: &mut Vec<(String, f64)>,
-    say: &dyn Fn(String),
-) -> Result<(ContactSolution, Vec<StepRecord>), RunError> {
-    let contact_error = |source| RunError::Contact {
-        path: case.path.clone(),
-        source,
-    };
-    let dim = problem.primary_surface.dim;
-    let phase = Instant::now();
-    let mut contact_solver = ContactSolver::new(problem, &case.solver).map_err(contact_error)?;
-    timings.push((
-        format!("{label}contact set-up"),
-        phase.elapsed().as_secs_f64(),
-    ));
-    let transfer = problem.transfer();
-    say(format!(
-        "{label}force on '{}': {} transfer ({})",
-        problem.secondary.body.name,
-        serde_json::to_value(transfer.transfer).expect("a unit enum serializes"),
-        transfer.reason
-    ));
-    let load_steps = case.load_steps();
-    let mut steps = Vec::new();
-    let mut last: Option<ContactSolution> = None;
-    for (k, &factor) in load_steps.iter().enumerate() {
-        if load_steps.len() > 1 {
-            say(format!(
-                "load step {}/{}: factor {factor}",
-                k + 1,
-                load_steps.len()
-            ));
-        }
-        let phase = Instant::now();
-        let start = last.as_ref().map(|s| &s.active_set);
-        let solution = contact_solver.solve(factor, start).map_err(contact_error)?;
-        let seconds = phase.elapsed().as_secs_f64();
-        timings.push((format!("{label}contact step {}", k + 1), seconds));
-        say(format!(
-            "contact status: {}",
-            describe(&solution, problem.settings.formulation)
-        ));
-        steps.push(StepRecord {
-            step: k + 1,
-            load_factor: factor,
-            status: solution.status,
-            iterations: solution.history.len(),
-            force_primary: solution.force_primary[..dim].to_vec(),
-            force_secondary: solution.force_secondary[..dim].to_vec(),
-            force_imbalance: solution.force_imbalance,
-            hertz_a: solution.hertz_primary.map(|h| h.a),
-            hertz_p0: solution.hertz_primary.map(|h| h.p0),
-            seconds,
-        });
-        // A step whose active set settled but failed its certificate is a valid start for the
-        // next one (each step is certified on its own: a narrow zone at a small load factor can
-        // fail the sag check on a mesh that resolves the final zone); a loop that did not settle
-        // is not.
-        let stop = !solution.status.is_solution() && solution.status != ContactStatus::NotCertified;
-        last = Some(solution);
-        if stop {
-            say("stopping the load steps: this step's active set did not settle".to_string());
-            break;
-        }
-    }
-    Ok((last.expect("at least one load step"), steps))
-}
-
-/// How a solve that did not settle ended, in a few words (for the primary choice's reason).
-fn failure(solution: &ContactSolution) -> String {
-    let status = solution.status.name();
-    match solution.status {
-        ContactStatus::NotCertified => format!("{status} ({})", solution.certificate.failures()),
-        _ => status.to_string(),
-    }
+    Ok(run)
 }
 
 /// The case file's name without its extension (the plot title).
@@ -549,61 +382,6 @@ struct SolvedBody {
     name: String,
     solution: ElasticSolution,
     surface: Option<SurfaceFields>,
-}
-
-/// How the contact solve ended, with its certificate.
-fn describe(solution: &ContactSolution, formulation: Formulation) -> String {
-    let iterations = solution.history.len();
-    let certificate = solution
-        .certificate
-        .checks
-        .iter()
-        .map(|c| c.describe())
-        .collect::<Vec<_>>()
-        .join("; ");
-    let outcome = match solution.status {
-        ContactStatus::Converged => format!(
-            "converged in {iterations} iterations; contact force {:.6e}{}{}",
-            norm(&solution.force_primary),
-            solution.hertz_primary.map_or(String::new(), |h| format!(
-                ", Hertz fit a = {:.6e}, p0 = {:.6e}",
-                h.a, h.p0
-            )),
-            if formulation == Formulation::Tied {
-                format!(
-                    ", largest tangential traction {:.3e}",
-                    solution.max_tangential_traction
-                )
-            } else {
-                String::new()
-            }
-        ),
-        ContactStatus::NoContact => {
-            "no contact: the bodies do not touch; each body was solved alone".to_string()
-        }
-        ContactStatus::NotCertified => format!(
-            "NOT converged: the active set settled in {iterations} iterations but the certificate failed: {}",
-            solution.certificate.failures()
-        ),
-        ContactStatus::IterationLimit => {
-            format!("NOT converged: the iteration cap ({iterations}) was reached")
-        }
-        ContactStatus::Unstable => format!(
-            "NOT converged: at iteration {iterations} an active node is {:.1e} spacings off the other body's surface: the interpolated constraint does not control the geometry, typically a primary much stiffer than the secondary with as fine a contact surface (inf-sup); use primary = \"auto\"",
-            solution
-                .history
-                .last()
-                .map_or(f64::NAN, |r| r.max_gap_error_over_h)
-        ),
-        ContactStatus::Cycling => format!(
-            "NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"
-        ),
-    };
-    format!("{outcome}\n  certificate: {certificate}")
-}
-
-fn norm(f: &[f64; 3]) -> f64 {
-    (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()
 }
 
 fn summarize_contact(

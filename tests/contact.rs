@@ -5,14 +5,18 @@ mod common;
 
 use common::{fixture, run_solve, write_case};
 use internodes::case::{Case, CaseError};
-use internodes::contact::{ContactSolution, ContactStatus, ContactSurface, solve_contact};
+use internodes::contact::{
+    ContactSolution, ContactSolver, ContactStatus, ContactSurface, solve_contact,
+};
 use internodes::elastic::SolverSettings;
 use internodes::fem::assembly::assemble_surface_mass;
 use internodes::linalg::mat_vec;
 use internodes::mesh::read_msh;
 
-/// Solves the `[contact]` of a case given as TOML text.
-fn solve(text: &str) -> Result<ContactSolution, String> {
+/// Solves the `[contact]` of a case given as TOML text with the library's [`solve_contact`]
+/// (its load steps, the retry and the agreement check included); `loop_only` runs one
+/// active-set loop at the full load instead.
+fn solve_with(text: &str, loop_only: bool) -> Result<ContactSolution, String> {
     let (_dir, path) = write_case(text);
     let case = Case::load(&path).map_err(|e| e.to_string())?;
     let mesh = read_msh(&case.mesh).map_err(|e| e.to_string())?;
@@ -24,7 +28,16 @@ fn solve(text: &str) -> Result<ContactSolution, String> {
         verbose: false,
         ..case.solver
     };
-    solve_contact(&problem, &settings).map_err(|e| e.to_string())
+    if loop_only {
+        let mut solver = ContactSolver::new(&problem, &settings).map_err(|e| e.to_string())?;
+        return solver.solve(1.0, None).map_err(|e| e.to_string());
+    }
+    let run = solve_contact(problem, &settings, &case.load_steps()).map_err(|e| e.to_string())?;
+    Ok(run.solution)
+}
+
+fn solve(text: &str) -> Result<ContactSolution, String> {
+    solve_with(text, false)
 }
 
 /// Two stacked unit blocks with non-matching meshes, compressed by `delta` through the top of
@@ -394,13 +407,17 @@ uz = 0.0
 "#,
         common::fixture("foreign_hemisphere_on_fine_block.msh").display()
     );
-    let loop_only = solve(&text).unwrap();
+    let loop_only = solve_with(&text, true).unwrap();
     let error = loop_only.force_secondary[2] / FOREIGN_RIGID_FLAT_FORCE_3D - 1.0;
     assert!(
         loop_only.status == ContactStatus::Converged && error < -0.02,
         "the premise: the loop's certificate passes a force {error:+.4} off dolfinx ({:?})",
         loop_only.status
     );
+    // A library caller gets the check too.
+    let library = solve(&text).unwrap();
+    assert_eq!(library.status, ContactStatus::NotCertified);
+    assert_eq!(failed_checks(&library), ["primary agreement"]);
 
     let (code, summary) = solve_cli(&text);
     let contact = &summary["contact"];
@@ -1191,7 +1208,7 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
         verbose: false,
         ..case.solver
     };
-    let mut solver = internodes::contact::ContactSolver::new(&problem, &settings).unwrap();
+    let mut solver = ContactSolver::new(&problem, &settings).unwrap();
     let half = solver.solve(0.5, None).unwrap();
     let full = solver.solve(1.0, Some(&half.active_set)).unwrap();
     let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -1242,4 +1259,18 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
         rows[0].starts_with("step,load_factor,status,iterations,contact_force_x,contact_force_y")
     );
     assert!(rows[2].starts_with("2,1,converged,"), "{csv}");
+}
+
+#[test]
+fn a_library_caller_without_load_factors_gets_an_error() {
+    let (_dir, path) = write_case(&half_disc_on_block(""));
+    let case = Case::load(&path).unwrap();
+    let mesh = read_msh(&case.mesh).unwrap();
+    for factors in [vec![], vec![0.5, f64::NAN]] {
+        let problem = case.contact_problem(&mesh).unwrap().unwrap();
+        let error = solve_contact(problem, &case.solver, &factors)
+            .err()
+            .unwrap_or_else(|| panic!("{factors:?} accepted"));
+        assert!(error.to_string().contains("load factors"), "{error}");
+    }
 }

@@ -9,7 +9,9 @@
 //! - `solve.rs`: the active-set loop (primal-dual active set), each iteration assembling the
 //!   coupled system (`system.rs`) and solving it (`coupled_solver.rs`, `compliance.rs`);
 //! - `checks.rs`: the active-set update of each iteration and the certificate of the answer,
-//!   checked independently of the loop's operators; `post.rs`: fields, forces, Hertz fit.
+//!   checked independently of the loop's operators; `post.rs`: fields, forces, Hertz fit;
+//! - `driver.rs`: [`solve_contact`], the solve a caller asks for: the load steps, and a second
+//!   solve with the other body as primary when the first choice may be the wrong one.
 //!
 //! Method, signs and known traps: `shared/notes/method.md`.
 
@@ -17,6 +19,7 @@ mod boundary;
 mod checks;
 mod compliance;
 mod coupled_solver;
+mod driver;
 mod hertz;
 mod interface;
 mod post;
@@ -28,8 +31,9 @@ mod solve;
 mod surface;
 pub mod system;
 
-pub use checks::{Certificate, CertificateCheck, primary_agreement};
+pub use checks::{Certificate, CertificateCheck};
 pub use coupled_solver::CoupledSolver;
+pub use driver::{ContactRun, StepRecord, solve_contact};
 pub use problem::{
     ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,
     SettingsError, Transfer, TransferReport,
@@ -37,7 +41,7 @@ pub use problem::{
 pub use solution::{
     ContactSolution, ContactStatus, HertzFit, IterationRecord, PhaseSeconds, SurfaceFields,
 };
-pub use solve::{ActiveSet, ContactSolver, solve_contact};
+pub use solve::{ActiveSet, ContactSolver};
 pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;
@@ -48,6 +52,8 @@ use crate::elastic::ProblemError;
 /// [`ContactStatus`], not an error).
 #[derive(Debug, Error)]
 pub enum ContactError {
+    #[error("load factors: expected a non-empty list of finite numbers, got {0:?}")]
+    LoadFactors(Vec<f64>),
     #[error("contact settings: {0}")]
     Settings(#[from] SettingsError),
     #[error(transparent)]

@@ -235,7 +235,7 @@ pub struct PrimaryReport {
     /// explicit primary at least `SIMILAR_STIFFNESS` times stiffer than the other body, the
     /// choice "auto" avoids as unstable. Such a primary passed every check of the certificate
     /// with a force 3% off (a stiff block twice finer than an R/25 hemisphere, 3D), so its
-    /// certificate gets a `primary agreement` check (`crate::run`).
+    /// certificate gets a `primary agreement` check (`super::driver`).
     #[serde(skip)]
     pub check_other: bool,
 }
@@ -348,7 +348,7 @@ impl<'m> ContactProblem<'m> {
     /// coarser one) measured worse on two equal hemispheres meshed 1.5 times apart (README,
     /// "Choosing the primary body"). The price is the sag of a curved secondary between the
     /// nodes of a coarse flat primary, which the certificate measures; the retry with the
-    /// other primary (`crate::run`) answers it.
+    /// other primary (`super::driver`) answers it.
     pub fn new(
         sides: [ContactSide<'m>; 2],
         choice: &PrimaryChoice,

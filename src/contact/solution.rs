@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use super::Formulation;
 use super::checks::Certificate;
 use super::solve::ActiveSet;
 use crate::elastic::ElasticSolution;
@@ -160,7 +161,64 @@ pub struct ContactSolution {
 }
 
 impl ContactSolution {
-    /// Adds a check made after the loop (e.g. [`super::checks::primary_agreement`]) to the
+    /// How the solve ended, with its certificate (the progress output).
+    pub fn describe(&self, formulation: Formulation) -> String {
+        let iterations = self.history.len();
+        let certificate = (self.certificate.checks.iter())
+            .map(|c| c.describe())
+            .collect::<Vec<_>>()
+            .join("; ");
+        let outcome = match self.status {
+            ContactStatus::Converged => format!(
+                "converged in {iterations} iterations; contact force {:.6e}{}{}",
+                norm(&self.force_primary),
+                self.hertz_primary.map_or(String::new(), |h| format!(
+                    ", Hertz fit a = {:.6e}, p0 = {:.6e}",
+                    h.a, h.p0
+                )),
+                if formulation == Formulation::Tied {
+                    format!(
+                        ", largest tangential traction {:.3e}",
+                        self.max_tangential_traction
+                    )
+                } else {
+                    String::new()
+                }
+            ),
+            ContactStatus::NoContact => {
+                "no contact: the bodies do not touch; each body was solved alone".to_string()
+            }
+            ContactStatus::NotCertified => format!(
+                "NOT converged: the active set settled in {iterations} iterations but the certificate failed: {}",
+                self.certificate.failures()
+            ),
+            ContactStatus::IterationLimit => {
+                format!("NOT converged: the iteration cap ({iterations}) was reached")
+            }
+            ContactStatus::Unstable => format!(
+                "NOT converged: at iteration {iterations} an active node is {:.1e} spacings off the other body's surface: the interpolated constraint does not control the geometry, typically a primary much stiffer than the secondary with as fine a contact surface (inf-sup); use primary = \"auto\"",
+                self.history
+                    .last()
+                    .map_or(f64::NAN, |r| r.max_gap_error_over_h)
+            ),
+            ContactStatus::Cycling => format!(
+                "NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"
+            ),
+        };
+        format!("{outcome}\n  certificate: {certificate}")
+    }
+
+    /// How the solve ended, in a few words (for the primary choice's reason): the status, and
+    /// the failed checks of a `not-certified` one.
+    pub fn ending(&self) -> String {
+        let status = self.status.name();
+        match self.status {
+            ContactStatus::NotCertified => format!("{status} ({})", self.certificate.failures()),
+            _ => status.to_string(),
+        }
+    }
+
+    /// Adds a check made after the loop (e.g. `super::checks::primary_agreement`) to the
     /// certificate; a failed one makes a `converged` answer `not-certified`.
     pub fn certify_further(&mut self, check: super::CertificateCheck) {
         if !check.passed && self.status.is_solution() {
@@ -168,6 +226,10 @@ impl ContactSolution {
         }
         self.certificate.push(check);
     }
+}
+
+fn norm(f: &[f64; 3]) -> f64 {
+    (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()
 }
 
 #[cfg(test)]

@@ -47,14 +47,6 @@ use super::system::{CoupledSolution, CoupledSystem, Coupling};
 use super::{ContactError, ContactProblem, Transfer, post};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 
-/// Solves a two-body contact problem at its full load.
-pub fn solve_contact(
-    problem: &ContactProblem,
-    solver: &SolverSettings,
-) -> Result<ContactSolution, ContactError> {
-    ContactSolver::new(problem, solver)?.solve(1.0, None)
-}
-
 /// An active node this many spacings off the other surface after a solve means the constraint
 /// no longer controls the geometry ([`ContactStatus::Unstable`]). On converging cases the active
 /// nodes stay within a fraction of a spacing of the other surface (the gap correction is an

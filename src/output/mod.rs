@@ -10,7 +10,7 @@ mod xdmf;
 pub use folder::{FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, mark_failed_folder};
 pub use matrix_market::write_matrix_market;
 pub use plot::{PlotError, write_force_displacement_png};
-pub use summary::{BodySummary, CaseSummary, ContactSummary, StepRecord};
+pub use summary::{BodySummary, CaseSummary, ContactSummary, force_displacement_csv};
 pub use xdmf::{BodyFields, write_xdmf};
 
 use std::path::PathBuf;

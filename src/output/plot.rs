@@ -13,7 +13,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 use thiserror::Error;
 
-use super::StepRecord;
+use crate::contact::StepRecord;
 
 /// The font used when `INTERNODES_PLOT_FONT` is not set (Debian package `fonts-dejavu-core`).
 const DEFAULT_PLOT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";

@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::OutputError;
 use crate::contact::{
     Certificate, ContactSettings, ContactStatus, HertzFit, IterationRecord, PrimaryReport,
-    TransferReport,
+    StepRecord, TransferReport,
 };
 use crate::elastic::SolveStats;
 
@@ -73,54 +73,36 @@ pub struct ContactSummary {
     pub steps: Vec<StepRecord>,
 }
 
-/// How one load step ended.
-#[derive(Debug, Clone, Serialize)]
-pub struct StepRecord {
-    pub step: usize,
-    pub load_factor: f64,
-    pub status: ContactStatus,
-    pub iterations: usize,
-    /// Total contact force on each body (the CSV has the primary's).
-    pub force_primary: Vec<f64>,
-    pub force_secondary: Vec<f64>,
-    pub force_imbalance: f64,
-    pub hertz_a: Option<f64>,
-    pub hertz_p0: Option<f64>,
-    pub seconds: f64,
-}
-
-impl StepRecord {
-    /// The steps as CSV: one header line, one row per step.
-    pub fn csv(steps: &[StepRecord]) -> String {
-        let dim = steps.first().map_or(0, |s| s.force_primary.len());
-        let axes = ["x", "y", "z"];
-        let mut text = String::from("step,load_factor,status,iterations");
-        for axis in &axes[..dim] {
-            text += &format!(",contact_force_{axis}");
-        }
-        text += ",force_imbalance,hertz_a,hertz_p0,seconds\n";
-        let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
-        for s in steps {
-            text += &format!(
-                "{},{},{},{}",
-                s.step,
-                s.load_factor,
-                s.status.name(),
-                s.iterations
-            );
-            for f in &s.force_primary {
-                text += &format!(",{f:.10e}");
-            }
-            text += &format!(
-                ",{:.3e},{},{},{:.3}\n",
-                s.force_imbalance,
-                optional(s.hertz_a),
-                optional(s.hertz_p0),
-                s.seconds
-            );
-        }
-        text
+/// The load steps as `force_displacement.csv`: one header line, one row per step.
+pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
+    let dim = steps.first().map_or(0, |s| s.force_primary.len());
+    let axes = ["x", "y", "z"];
+    let mut text = String::from("step,load_factor,status,iterations");
+    for axis in &axes[..dim] {
+        text += &format!(",contact_force_{axis}");
     }
+    text += ",force_imbalance,hertz_a,hertz_p0,seconds\n";
+    let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
+    for s in steps {
+        text += &format!(
+            "{},{},{},{}",
+            s.step,
+            s.load_factor,
+            s.status.name(),
+            s.iterations
+        );
+        for f in &s.force_primary {
+            text += &format!(",{f:.10e}");
+        }
+        text += &format!(
+            ",{:.3e},{},{},{:.3}\n",
+            s.force_imbalance,
+            optional(s.hertz_a),
+            optional(s.hertz_p0),
+            s.seconds
+        );
+    }
+    text
 }
 
 impl CaseSummary {

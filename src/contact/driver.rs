@@ -1,0 +1,262 @@
+//! The contact solve a caller asks for: from a problem and its load factors to a certified
+//! answer, whichever primary carries it.
+//!
+//! ```text
+//! 1. every load step with the chosen primary (one set-up, one active-set loop per step)
+//! 2. if "auto" chose between bodies of similar stiffness and the answer is not a solution:
+//!      every load step with the other primary; keep its answer if that one is
+//! 3. if the primary was named and is much stiffer than the other body:
+//!      every load step with the other primary; certify that the two contact forces agree
+//! ```
+//!
+//! Step 2 answers the sag of a curved secondary between the nodes of a coarse flat primary
+//! ([`PrimaryReport::other_may_retry`]); step 3 the stiff primary that passes every check of
+//! the loop's certificate with a wrong force ([`PrimaryReport::check_other`]). Both live here,
+//! not in the command line, so that every caller of [`solve_contact`] gets the same answer.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::checks::primary_agreement;
+use super::{ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus};
+use crate::elastic::SolverSettings;
+
+/// How one load step ended.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepRecord {
+    pub step: usize,
+    pub load_factor: f64,
+    pub status: ContactStatus,
+    pub iterations: usize,
+    /// Total contact force on each body (the CSV has the primary's).
+    pub force_primary: Vec<f64>,
+    pub force_secondary: Vec<f64>,
+    pub force_imbalance: f64,
+    pub hertz_a: Option<f64>,
+    pub hertz_p0: Option<f64>,
+    pub seconds: f64,
+}
+
+/// A finished contact solve.
+pub struct ContactRun<'m> {
+    /// The problem of the answer: its primary is the body that carries the multiplier (the
+    /// other one after a retry), and its report says why.
+    pub problem: ContactProblem<'m>,
+    /// The last load step's answer; its status and certificate include the checks made after
+    /// the loop.
+    pub solution: ContactSolution,
+    /// One record per load step of the answer's primary.
+    pub steps: Vec<StepRecord>,
+    /// Seconds of each set-up and load step, named in order (the checking solves prefixed).
+    pub timings: Vec<(String, f64)>,
+}
+
+/// Solves `problem` at each of `load_factors` in turn (each step starting from the previous
+/// active set), with the retry and the agreement check of the module doc. Progress goes to
+/// standard error when `solver.verbose`.
+pub fn solve_contact<'m>(
+    problem: ContactProblem<'m>,
+    solver: &SolverSettings,
+    load_factors: &[f64],
+) -> Result<ContactRun<'m>, ContactError> {
+    if load_factors.is_empty() || !load_factors.iter().all(|f| f.is_finite()) {
+        return Err(ContactError::LoadFactors(load_factors.to_vec()));
+    }
+    let mut log = Log {
+        verbose: solver.verbose,
+        timings: Vec::new(),
+    };
+    // 1. The chosen primary.
+    let (solution, steps) = solve_load_steps(&problem, solver, load_factors, "", &mut log)?;
+    // 2. The other primary, when auto's choice between similar bodies did not settle.
+    let (problem, solution, mut steps) =
+        if problem.primary_report.other_may_retry && !solution.status.is_solution() {
+            retry_with_other_primary(problem, solution, steps, solver, load_factors, &mut log)
+        } else {
+            (problem, solution, steps)
+        };
+    // 3. The other primary's force, when a stiff primary was named.
+    let (problem, solution) = if problem.primary_report.check_other && solution.status.is_solution()
+    {
+        check_against_other_primary(problem, solution, solver, load_factors, &mut log)
+    } else {
+        (problem, solution)
+    };
+    // The last step's status is the answer's, checks made after the loop included.
+    if let Some(last) = steps.last_mut() {
+        last.status = solution.status;
+    }
+    Ok(ContactRun {
+        problem,
+        solution,
+        steps,
+        timings: log.timings,
+    })
+}
+
+/// Every load step again with the other body as primary. Its answer is kept if it is a
+/// solution; otherwise the first one is, and the reason says what both ended with.
+fn retry_with_other_primary<'m>(
+    problem: ContactProblem<'m>,
+    solution: ContactSolution,
+    steps: Vec<StepRecord>,
+    solver: &SolverSettings,
+    load_factors: &[f64],
+    log: &mut Log,
+) -> (ContactProblem<'m>, ContactSolution, Vec<StepRecord>) {
+    let (first, first_ended) = (problem.primary.body.name.clone(), solution.ending());
+    let other = problem.with_other_primary();
+    let other_name = other.primary.body.name.clone();
+    log.say(format!(
+        "primary = \"auto\": with '{first}' as primary the solve ended {first_ended}; solving \
+         again with '{other_name}' as primary"
+    ));
+    match solve_load_steps(&other, solver, load_factors, "other primary: ", log) {
+        Ok((second, second_steps)) if second.status.is_solution() => (
+            other.with_reason_appended(&format!(
+                "'{other_name}' carries the multiplier because '{first}' as primary ended \
+                 {first_ended}"
+            )),
+            second,
+            second_steps,
+        ),
+        retry => {
+            let second_ended = match retry {
+                Ok((second, _)) => second.ending(),
+                Err(e) => format!("with an error ({e})"),
+            };
+            let problem = other.with_other_primary().with_reason_appended(&format!(
+                "kept although it ended {first_ended}: '{other_name}' as primary ended \
+                 {second_ended}"
+            ));
+            (problem, solution, steps)
+        }
+    }
+}
+
+/// Every load step again with the other body as primary, and the certificate's `primary
+/// agreement` check on the last step's forces. The answer kept is the named primary's.
+fn check_against_other_primary<'m>(
+    problem: ContactProblem<'m>,
+    mut solution: ContactSolution,
+    solver: &SolverSettings,
+    load_factors: &[f64],
+    log: &mut Log,
+) -> (ContactProblem<'m>, ContactSolution) {
+    let (tolerance, formulation) = (
+        problem.settings.primary_agreement_tolerance,
+        problem.settings.formulation,
+    );
+    let other = problem.with_other_primary();
+    let other_name = other.primary.body.name.clone();
+    log.say(format!(
+        "checking the answer: solving again with '{other_name}' as primary"
+    ));
+    let label = "check with other primary: ";
+    let reference = match solve_load_steps(&other, solver, load_factors, label, log) {
+        // The force the other primary's multiplier puts on this solve's primary body.
+        Ok((check, _)) if check.status == ContactStatus::Converged => {
+            Ok(check.force_primary.map(|f| -f))
+        }
+        Ok((check, _)) => Err(check.ending()),
+        Err(e) => Err(format!("with an error ({e})")),
+    };
+    let check = primary_agreement(solution.force_primary, reference, &other_name, tolerance);
+    log.say(format!(
+        "check with '{other_name}' as primary: {}",
+        check.describe()
+    ));
+    solution.certify_further(check);
+    log.say(format!(
+        "contact status: {}",
+        solution.describe(formulation)
+    ));
+    (other.with_other_primary(), solution)
+}
+
+/// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
+/// load step, each starting from the previous active set; stops at the first step whose loop
+/// does not settle (`not-certified` steps go on). `label` prefixes the timing names.
+fn solve_load_steps(
+    problem: &ContactProblem,
+    solver: &SolverSettings,
+    load_factors: &[f64],
+    label: &str,
+    log: &mut Log,
+) -> Result<(ContactSolution, Vec<StepRecord>), ContactError> {
+    let dim = problem.primary_surface.dim;
+    let phase = Instant::now();
+    let mut contact_solver = ContactSolver::new(problem, solver)?;
+    log.time(format!("{label}contact set-up"), phase);
+    let transfer = problem.transfer();
+    log.say(format!(
+        "{label}force on '{}': {} transfer ({})",
+        problem.secondary.body.name,
+        serde_json::to_value(transfer.transfer).expect("a unit enum serializes"),
+        transfer.reason
+    ));
+    let mut steps = Vec::new();
+    let mut last: Option<ContactSolution> = None;
+    for (k, &factor) in load_factors.iter().enumerate() {
+        if load_factors.len() > 1 {
+            log.say(format!(
+                "load step {}/{}: factor {factor}",
+                k + 1,
+                load_factors.len()
+            ));
+        }
+        let phase = Instant::now();
+        let start = last.as_ref().map(|s| &s.active_set);
+        let solution = contact_solver.solve(factor, start)?;
+        let seconds = log.time(format!("{label}contact step {}", k + 1), phase);
+        log.say(format!(
+            "contact status: {}",
+            solution.describe(problem.settings.formulation)
+        ));
+        steps.push(StepRecord {
+            step: k + 1,
+            load_factor: factor,
+            status: solution.status,
+            iterations: solution.history.len(),
+            force_primary: solution.force_primary[..dim].to_vec(),
+            force_secondary: solution.force_secondary[..dim].to_vec(),
+            force_imbalance: solution.force_imbalance,
+            hertz_a: solution.hertz_primary.map(|h| h.a),
+            hertz_p0: solution.hertz_primary.map(|h| h.p0),
+            seconds,
+        });
+        // A step whose active set settled but failed its certificate is a valid start for the
+        // next one (each step is certified on its own: a narrow zone at a small load factor can
+        // fail the sag check on a mesh that resolves the final zone); a loop that did not settle
+        // is not.
+        let stop = !solution.status.is_solution() && solution.status != ContactStatus::NotCertified;
+        last = Some(solution);
+        if stop {
+            log.say("stopping the load steps: this step's active set did not settle");
+            break;
+        }
+    }
+    Ok((last.expect("solve_contact checks the load factors"), steps))
+}
+
+/// Progress messages (when verbose) and phase timings of a solve.
+struct Log {
+    verbose: bool,
+    timings: Vec<(String, f64)>,
+}
+
+impl Log {
+    fn say(&self, message: impl AsRef<str>) {
+        if self.verbose {
+            eprintln!("{}", message.as_ref());
+        }
+    }
+
+    /// Records the seconds since `start` under `name`, and returns them.
+    fn time(&mut self, name: String, start: Instant) -> f64 {
+        let seconds = start.elapsed().as_secs_f64();
+        self.timings.push((name, seconds));
+        seconds
+    }
+}
