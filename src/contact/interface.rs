@@ -47,8 +47,10 @@ pub struct InterfaceOperators {
     /// From the secondary candidates to the projections of the primary candidates.
     r12: Interpolation,
     /// From the primary candidates to the projections of the secondary candidates that face
-    /// the primary surface, `receiving` (surface indices).
-    r21: Interpolation,
+    /// the primary surface, `receiving` (surface indices). Not built for the conservative
+    /// transfer, which does not use it: a secondary node outside every primary support is then
+    /// loaded through `R12^T`, and is no error.
+    r21: Option<Interpolation>,
     receiving: Vec<usize>,
     /// Whether each primary candidate faces the secondary surface (only those can be active).
     pub facing: Vec<bool>,
@@ -60,9 +62,6 @@ pub struct InterfaceOperators {
     rows12: HashMap<usize, Vec<(usize, f64)>>,
     /// Column of `R21` of each primary candidate used so far: `(secondary surface index, weight)`.
     columns21: HashMap<usize, Vec<(usize, f64)>>,
-    /// The secondary's force is `-R12^T M1 lambda` rather than `-M2 R21 lambda`
-    /// ([`super::Transfer`]).
-    conservative: bool,
 }
 
 impl InterfaceOperators {
@@ -83,9 +82,12 @@ impl InterfaceOperators {
         let r12 = covering_interpolation(secondary, radius, &r12_targets, primary, |t| t)?;
         // Only the secondary nodes that face the primary surface receive its traction.
         let receiving: Vec<usize> = (0..secondary.len()).filter(|&j| facing2[j]).collect();
-        let r21_targets: Vec<[f64; 3]> = receiving.iter().map(|&j| on_primary[j].point).collect();
-        let r21 =
-            covering_interpolation(primary, radius, &r21_targets, secondary, |t| receiving[t])?;
+        let r21 = if conservative {
+            None
+        } else {
+            let targets: Vec<[f64; 3]> = receiving.iter().map(|&j| on_primary[j].point).collect();
+            Some(covering_interpolation(primary, radius, &targets, secondary, |t| receiving[t])?)
+        };
         let n2_flat: Vec<f64> = secondary.normals.iter().flatten().copied().collect();
         let n2_at_1 = r12.apply(&n2_flat, 3);
         let normals: Vec<[f64; 3]> = (0..primary.len())
@@ -106,7 +108,6 @@ impl InterfaceOperators {
             reference_gaps,
             rows12: HashMap::new(),
             columns21: HashMap::new(),
-            conservative,
         })
     }
 
@@ -127,9 +128,9 @@ impl InterfaceOperators {
             .collect();
         self.rows12
             .extend(missing.iter().copied().zip(self.r12.rows(&missing)));
-        if !self.conservative {
+        if let Some(r21) = &self.r21 {
             self.columns21
-                .extend(missing.iter().copied().zip(self.r21.columns(&missing)));
+                .extend(missing.iter().copied().zip(r21.columns(&missing)));
         }
         let to_body2 = |entries: &[(usize, f64)], weight: &dyn Fn(usize, f64) -> f64| {
             entries
@@ -149,8 +150,9 @@ impl InterfaceOperators {
             loads2: active
                 .iter()
                 .map(|&i| {
-                    if self.conservative {
-                        // Row i of R12 times A1_i: column i of R12^T M1.
+                    if self.r21.is_none() {
+                        // The conservative transfer, `-R12^T M1 lambda` ([`super::Transfer`]):
+                        // row i of R12 times A1_i is column i of R12^T M1.
                         to_body2(&self.rows12[&i], &|_, w| primary.nodal_area[i] * w)
                     } else {
                         let column: Vec<(usize, f64)> = self.columns21[&i]
