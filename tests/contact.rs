@@ -376,7 +376,37 @@ fn an_explicit_stiff_primary_is_checked_against_the_compliant_primary() {
     // rigid flat on the same hemisphere mesh: a certified wrong answer, unless the answer is
     // compared with the one the hemisphere gives as primary, as `internodes solve` does for a
     // primary that "auto" would not choose.
-    let text = format!(
+    let text = foreign_stiff_block_primary();
+    let loop_only = solve_with(&text, true).unwrap();
+    let error = loop_only.force_secondary[2] / FOREIGN_RIGID_FLAT_FORCE_3D - 1.0;
+    assert!(
+        loop_only.status == ContactStatus::Converged && error < -0.02,
+        "the premise: the loop's certificate passes a force {error:+.4} off dolfinx ({:?})",
+        loop_only.status
+    );
+    // A library caller gets the check too.
+    let library = solve(&text).unwrap();
+    assert_eq!(library.status, ContactStatus::NotCertified);
+    assert_eq!(failed_checks(&library), ["primary agreement"]);
+
+    let (code, summary) = solve_cli(&text);
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(1), "{contact}");
+    assert_eq!(contact["status"], "not-certified", "{contact}");
+    assert_eq!(contact["primary"], "block", "{contact}");
+    let reason = contact["primary_choice"]["reason"].as_str().unwrap();
+    assert!(reason.contains("would choose 'sphere'"), "{reason}");
+    let failed: Vec<&str> = (contact["certificate"]["checks"].as_array().unwrap().iter())
+        .filter(|c| c["passed"] == false)
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(failed, ["primary agreement"], "{contact}");
+}
+
+/// The hemisphere of `foreign_hemisphere_on_fine_block.msh` (R/25, E = 1000) pressed by 0.004
+/// onto the block 1e4 times stiffer and twice finer, the block primary by hand.
+fn foreign_stiff_block_primary() -> String {
+    format!(
         r#"mesh = "{}"
 output = "out"
 
@@ -406,37 +436,76 @@ uy = 0.0
 uz = 0.0
 "#,
         common::fixture("foreign_hemisphere_on_fine_block.msh").display()
-    );
-    let loop_only = solve_with(&text, true).unwrap();
-    let error = loop_only.force_secondary[2] / FOREIGN_RIGID_FLAT_FORCE_3D - 1.0;
-    assert!(
-        loop_only.status == ContactStatus::Converged && error < -0.02,
-        "the premise: the loop's certificate passes a force {error:+.4} off dolfinx ({:?})",
-        loop_only.status
-    );
-    // A library caller gets the check too.
-    let library = solve(&text).unwrap();
-    assert_eq!(library.status, ContactStatus::NotCertified);
-    assert_eq!(failed_checks(&library), ["primary agreement"]);
-
-    let (code, summary) = solve_cli(&text);
-    let contact = &summary["contact"];
-    assert_eq!(code, Some(1), "{contact}");
-    assert_eq!(contact["status"], "not-certified", "{contact}");
-    assert_eq!(contact["primary"], "block", "{contact}");
-    let reason = contact["primary_choice"]["reason"].as_str().unwrap();
-    assert!(reason.contains("would choose 'sphere'"), "{reason}");
-    let failed: Vec<&str> = (contact["certificate"]["checks"].as_array().unwrap().iter())
-        .filter(|c| c["passed"] == false)
-        .map(|c| c["name"].as_str().unwrap())
-        .collect();
-    assert_eq!(failed, ["primary agreement"], "{contact}");
+    )
 }
 
 /// The hemisphere of `tests/fixtures/foreign_hemisphere_on_fine_block.msh` pressed by 0.004
 /// onto a rigid flat: contact force computed by dolfinx (PETSc VI solver, exact node-to-plane
 /// constraint) on the same hemisphere mesh, by `validation/foreign_meshes.py`.
 const FOREIGN_RIGID_FLAT_FORCE_3D: f64 = 0.4213517106868755;
+
+/// The same at the approaches 0.001, 0.002, 0.003 (`run_reference(..., delta=0.004)`, its
+/// default fractions 0.25, 0.5, 0.75).
+const FOREIGN_RIGID_FLAT_FORCES_3D: [f64; 3] = [
+    0.043539357158780406,
+    0.16472739076094023,
+    0.2930395507239048,
+];
+
+#[test]
+fn every_load_step_of_an_explicit_stiff_primary_is_checked() {
+    // The force-displacement curve is an answer too: stepped to 0.004 in four steps, the stiff
+    // block primary's loop certifies steps whose force is more than 1% off dolfinx; each step's
+    // record must then say not-certified, and why.
+    let factors = [0.25, 0.5, 0.75, 1.0];
+    let text = foreign_stiff_block_primary();
+    let (_dir, path) = write_case(&text);
+    let case = Case::load(&path).unwrap();
+    let mesh = read_msh(&case.mesh).unwrap();
+    let settings = SolverSettings {
+        verbose: false,
+        ..case.solver
+    };
+    let references: Vec<f64> = FOREIGN_RIGID_FLAT_FORCES_3D
+        .into_iter()
+        .chain([FOREIGN_RIGID_FLAT_FORCE_3D])
+        .collect();
+    let error = |force_on_sphere: f64, k: usize| force_on_sphere / references[k] - 1.0;
+
+    let problem = case.contact_problem(&mesh).unwrap().unwrap();
+    let mut solver = ContactSolver::new(&problem, &settings).unwrap();
+    let mut start = None;
+    let mut certified_wrong = 0;
+    for (k, factor) in factors.into_iter().enumerate() {
+        let step = solver.solve(factor, start.as_ref()).unwrap();
+        let e = error(step.force_secondary[2], k);
+        certified_wrong += usize::from(step.status == ContactStatus::Converged && e.abs() > 0.01);
+        start = Some(step.active_set);
+    }
+    assert!(
+        certified_wrong >= 2,
+        "the premise: the loop alone certifies steps more than 1% off dolfinx"
+    );
+
+    let problem = case.contact_problem(&mesh).unwrap().unwrap();
+    let run = solve_contact(problem, &settings, &factors).unwrap();
+    assert_eq!(run.steps.len(), factors.len());
+    for (k, step) in run.steps.iter().enumerate() {
+        let e = error(step.force_secondary[2], k);
+        if e.abs() > 0.01 {
+            assert_eq!(
+                step.status,
+                ContactStatus::NotCertified,
+                "step {k}: {e:+.4}"
+            );
+            assert!(
+                step.failed_checks.contains(&"primary agreement"),
+                "step {k}: {:?}",
+                step.failed_checks
+            );
+        }
+    }
+}
 
 /// The half-disc of `tests/fixtures/half_disc_on_block_coarse_block.msh` pressed by 0.02 onto
 /// a rigid flat: contact force per unit length computed by dolfinx (PETSc VI solver, exact

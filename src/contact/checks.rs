@@ -84,6 +84,14 @@ impl Certificate {
         self.checks.push(check);
     }
 
+    /// The names of the failed checks.
+    pub fn failed(&self) -> Vec<&'static str> {
+        (self.checks.iter())
+            .filter(|c| !c.passed)
+            .map(|c| c.name)
+            .collect()
+    }
+
     /// The failed checks in one line, e.g. for a status message.
     pub fn failures(&self) -> String {
         self.checks

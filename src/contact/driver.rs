@@ -19,7 +19,9 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::checks::primary_agreement;
-use super::{ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus};
+use super::{
+    CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus,
+};
 use crate::elastic::SolverSettings;
 
 /// How one load step ended.
@@ -36,6 +38,32 @@ pub struct StepRecord {
     pub hertz_a: Option<f64>,
     pub hertz_p0: Option<f64>,
     pub seconds: f64,
+    /// The names of the certificate checks this step failed (`not-certified`).
+    pub failed_checks: Vec<&'static str>,
+}
+
+impl StepRecord {
+    /// Adds a check made after the loop: a failed one makes a `converged` step
+    /// `not-certified`.
+    fn certify_further(&mut self, check: &CertificateCheck) {
+        if !check.passed {
+            if self.status.is_solution() {
+                self.status = ContactStatus::NotCertified;
+            }
+            self.failed_checks.push(check.name);
+        }
+    }
+
+    /// How the step ended, in a few words: the status, and the failed checks of a
+    /// `not-certified` one.
+    fn ending(&self) -> String {
+        match self.status {
+            ContactStatus::NotCertified => {
+                format!("{} ({})", self.status.name(), self.failed_checks.join(", "))
+            }
+            status => status.name().to_string(),
+        }
+    }
 }
 
 /// A finished contact solve.
@@ -76,16 +104,24 @@ pub fn solve_contact<'m>(
         } else {
             (problem, solution, steps)
         };
-    // 3. The other primary's force, when a stiff primary was named.
-    let (problem, solution) = if problem.primary_report.check_other && solution.status.is_solution()
-    {
-        check_against_other_primary(problem, solution, solver, load_factors, &mut log)
-    } else {
-        (problem, solution)
-    };
-    // The last step's status is the answer's, checks made after the loop included.
+    // 3. The other primary's forces, when a stiff primary was named.
+    let (problem, solution) =
+        if problem.primary_report.check_other && steps.iter().any(|s| s.status.is_solution()) {
+            check_against_other_primary(
+                problem,
+                solution,
+                &mut steps,
+                solver,
+                load_factors,
+                &mut log,
+            )
+        } else {
+            (problem, solution)
+        };
+    // The last step's record is the answer's, checks made after the loop included.
     if let Some(last) = steps.last_mut() {
         last.status = solution.status;
+        last.failed_checks = solution.certificate.failed();
     }
     Ok(ContactRun {
         problem,
@@ -135,11 +171,13 @@ fn retry_with_other_primary<'m>(
     }
 }
 
-/// Every load step again with the other body as primary, and the certificate's `primary
-/// agreement` check on the last step's forces. The answer kept is the named primary's.
+/// Every load step again with the other body as primary, and the `primary agreement` check
+/// of each step's force: in the last step's certificate, and in every step's record (the
+/// force-displacement curve is an answer too). The answer kept is the named primary's.
 fn check_against_other_primary<'m>(
     problem: ContactProblem<'m>,
     mut solution: ContactSolution,
+    steps: &mut [StepRecord],
     solver: &SolverSettings,
     load_factors: &[f64],
     log: &mut Log,
@@ -154,14 +192,33 @@ fn check_against_other_primary<'m>(
         "checking the answer: solving again with '{other_name}' as primary"
     ));
     let label = "check with other primary: ";
-    let reference = match solve_load_steps(&other, solver, load_factors, label, log) {
+    let (reference, other_steps) = match solve_load_steps(&other, solver, load_factors, label, log)
+    {
         // The force the other primary's multiplier puts on this solve's primary body.
-        Ok((check, _)) if check.status == ContactStatus::Converged => {
-            Ok(check.force_primary.map(|f| -f))
+        Ok((check, other_steps)) if check.status == ContactStatus::Converged => {
+            (Ok(check.force_primary.map(|f| -f)), other_steps)
         }
-        Ok((check, _)) => Err(check.ending()),
-        Err(e) => Err(format!("with an error ({e})")),
+        Ok((check, other_steps)) => (Err(check.ending()), other_steps),
+        Err(e) => (Err(format!("with an error ({e})")), Vec::new()),
     };
+    // The earlier steps, each against the other primary's step at the same load factor.
+    let earlier = steps.len().saturating_sub(1);
+    for (k, step) in steps[..earlier].iter_mut().enumerate() {
+        let other_step = match other_steps.get(k) {
+            Some(o) if o.status == ContactStatus::Converged => Ok(std::array::from_fn(|c| {
+                -o.force_primary.get(c).unwrap_or(&0.0)
+            })),
+            Some(o) => Err(o.ending()),
+            None => Err("before this load step (its load steps stopped)".to_string()),
+        };
+        let force = std::array::from_fn(|c| *step.force_primary.get(c).unwrap_or(&0.0));
+        step.certify_further(&primary_agreement(
+            force,
+            other_step,
+            &other_name,
+            tolerance,
+        ));
+    }
     let check = primary_agreement(solution.force_primary, reference, &other_name, tolerance);
     log.say(format!(
         "check with '{other_name}' as primary: {}",
@@ -225,6 +282,7 @@ fn solve_load_steps(
             hertz_a: solution.hertz_primary.map(|h| h.a),
             hertz_p0: solution.hertz_primary.map(|h| h.p0),
             seconds,
+            failed_checks: solution.certificate.failed(),
         });
         // A step whose active set settled but failed its certificate is a valid start for the
         // next one (each step is certified on its own: a narrow zone at a small load factor can

@@ -86,7 +86,13 @@ impl InterfaceOperators {
             None
         } else {
             let targets: Vec<[f64; 3]> = receiving.iter().map(|&j| on_primary[j].point).collect();
-            Some(covering_interpolation(primary, radius, &targets, secondary, |t| receiving[t])?)
+            Some(covering_interpolation(
+                primary,
+                radius,
+                &targets,
+                secondary,
+                |t| receiving[t],
+            )?)
         };
         let n2_flat: Vec<f64> = secondary.normals.iter().flatten().copied().collect();
         let n2_at_1 = r12.apply(&n2_flat, 3);

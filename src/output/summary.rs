@@ -81,7 +81,7 @@ pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
     for axis in &axes[..dim] {
         text += &format!(",contact_force_{axis}");
     }
-    text += ",force_imbalance,hertz_a,hertz_p0,seconds\n";
+    text += ",force_imbalance,hertz_a,hertz_p0,seconds,failed_checks\n";
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
     for s in steps {
         text += &format!(
@@ -95,11 +95,12 @@ pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
             text += &format!(",{f:.10e}");
         }
         text += &format!(
-            ",{:.3e},{},{},{:.3}\n",
+            ",{:.3e},{},{},{:.3},{}\n",
             s.force_imbalance,
             optional(s.hertz_a),
             optional(s.hertz_p0),
-            s.seconds
+            s.seconds,
+            s.failed_checks.join(";")
         );
     }
     text
