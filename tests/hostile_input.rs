@@ -632,6 +632,108 @@ fn concurrent_runs_into_one_folder_leave_one_runs_complete_results() {
     }
 }
 
+/// A folder holding `two_blocks_2d.msh` as `mesh` and the case `case` reading it, with the output
+/// folder set to the folder itself (`output = "."`).
+fn case_beside_its_outputs(mesh: &str, case: &str) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh_path = dir.path().join(mesh);
+    std::fs::copy(fixture("two_blocks_2d.msh"), &mesh_path).unwrap();
+    let text =
+        two_blocks_case(Path::new(mesh), "upper", "").replace("output = \"out\"", "output = \".\"");
+    let case_path = dir.path().join(case);
+    std::fs::write(&case_path, text).unwrap();
+    (dir, mesh_path, case_path)
+}
+
+#[test]
+fn an_input_mesh_named_mesh_msh_in_the_output_folder_is_never_removed() {
+    let original = std::fs::read(fixture("two_blocks_2d.msh")).unwrap();
+    let (dir, mesh, case) = case_beside_its_outputs("mesh.msh", "case.toml");
+    run_quiet(&case).unwrap();
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        original,
+        "the input mesh was changed"
+    );
+    assert!(exists(dir.path(), "summary.json"));
+
+    // --output naming the mesh's folder, and a second run over the first one's results.
+    solve_case(
+        &case,
+        &RunOptions {
+            output: Some(dir.path().to_owned()),
+            quiet: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        original,
+        "--output removed the input mesh"
+    );
+
+    // A case file that does not parse marks the folder, and the mesh stays.
+    let text = std::fs::read_to_string(&case).unwrap();
+    std::fs::write(&case, text.replace("youngs_modulus", "young_modulus")).unwrap();
+    run_error(&case, "misspelled key");
+    assert_failed_without_results(dir.path(), "young_modulus");
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        original,
+        "a failed run removed the input mesh"
+    );
+}
+
+#[test]
+fn an_output_folder_holding_an_input_under_a_result_name_is_refused() {
+    // The mesh saved as summary.json beside the case, output = ".": the run would replace it.
+    let original = std::fs::read(fixture("two_blocks_2d.msh")).unwrap();
+    let (dir, mesh, case) = case_beside_its_outputs("summary.json", "case.toml");
+    let message = run_error(&case, "the mesh has a result's name").to_string();
+    assert!(
+        message.contains("summary.json")
+            && message.contains("`output` key")
+            && message.contains("case.toml"),
+        "{message}"
+    );
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        original,
+        "the input mesh was changed"
+    );
+    assert!(!exists(dir.path(), "FAILED.txt") && !exists(dir.path(), "solution.h5"));
+
+    // --output is named as such.
+    let with_option = solve_case(
+        &case,
+        &RunOptions {
+            output: Some(dir.path().to_owned()),
+            quiet: true,
+            ..Default::default()
+        },
+    );
+    let Err(e) = with_option.map(|_| ()) else {
+        panic!("--output holds the mesh under a result name");
+    };
+    let e = e.to_string();
+    assert!(e.contains("--output") && e.contains("summary.json"), "{e}");
+
+    // A case file named like the failure mark, that does not parse, is not overwritten by it.
+    let (dir, _, case) = case_beside_its_outputs("lower.msh", "FAILED.txt");
+    let broken = std::fs::read_to_string(&case)
+        .unwrap()
+        .replace("youngs_modulus", "young_modulus");
+    std::fs::write(&case, &broken).unwrap();
+    run_error(&case, "misspelled key");
+    assert_eq!(
+        std::fs::read_to_string(&case).unwrap(),
+        broken,
+        "the case file was overwritten"
+    );
+    assert!(exists(dir.path(), "lower.msh"));
+}
+
 // ---------------------------------------------------------------------------------------------
 // 4. 2D bodies must lie in the xy plane
 // ---------------------------------------------------------------------------------------------

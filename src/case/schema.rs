@@ -172,6 +172,12 @@ impl Case {
         Ok(case)
     }
 
+    /// Whether the run meshes a `.geo` with gmsh (into `mesh.msh` in the output folder) rather
+    /// than reading a `.msh`.
+    pub fn generates_mesh(&self) -> bool {
+        self.mesh.extension().is_some_and(|e| e == "geo")
+    }
+
     /// The output folder a case file names, read from its raw TOML: where a run whose case
     /// does not parse as a whole can still mark its failure.
     pub fn output_folder_of(path: &Path) -> Option<PathBuf> {
@@ -206,7 +212,7 @@ impl Case {
         if self.geo_parameters.is_empty() {
             return Ok(());
         }
-        if self.mesh.extension().is_none_or(|e| e != "geo") {
+        if !self.generates_mesh() {
             return Err(self.invalid(
                 "geo_parameters",
                 format!(

@@ -9,7 +9,13 @@
 //! The staging folder's name carries the process id and a counter, so concurrent runs never
 //! write into each other's files, and a lock file makes each commit (or failure mark) whole:
 //! the run that finishes last owns the folder, with all of its files.
+//!
+//! A run never removes or replaces its own input: `mesh.msh` is ours only when the run meshes a
+//! `.geo` (a `.msh` case may well read a `mesh.msh` that lies in its output folder), and an
+//! output folder that holds the case file or the mesh under a result file's name is refused
+//! before anything is removed ([`check_inputs`]).
 
+use std::ffi::OsStr;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -59,14 +65,24 @@ pub struct ResultFolder {
 }
 
 impl ResultFolder {
-    /// Creates `dir` if needed, removes earlier results (and mesh) and creates the staging
-    /// folder.
-    pub fn create(dir: &Path) -> Result<Self, OutputError> {
+    /// Creates `dir` if needed, removes earlier results (and the generated mesh, when this
+    /// run generates one) and creates the staging folder. `inputs` are the files the run reads
+    /// (case file, mesh): if one of them lies in `dir` under a name the run would remove or
+    /// replace, nothing is touched and the error names it and `origin` (where `dir` was set).
+    pub fn create(
+        dir: &Path,
+        origin: &str,
+        inputs: &[&Path],
+        generates_mesh: bool,
+    ) -> Result<Self, OutputError> {
+        check_inputs(dir, origin, inputs, generates_mesh)?;
         create_dir(dir)?;
         {
             let _lock = CommitLock::acquire(dir)?;
             remove_results(dir)?;
-            remove_file(&dir.join(GENERATED_MESH))?;
+            if generates_mesh {
+                remove_file(&dir.join(GENERATED_MESH))?;
+            }
         }
         let run = RUNS.fetch_add(1, Ordering::Relaxed);
         let staging = dir.join(format!("{STAGING_PREFIX}{}-{run}", std::process::id()));
@@ -129,17 +145,79 @@ impl ResultFolder {
 }
 
 /// Marks `dir` as holding the failure of a run that stopped before it had a
-/// [`ResultFolder`] (a case file that does not parse): earlier results and mesh are removed
-/// and [`FAILURE_MARK`] written. Nothing is done if `dir` does not exist.
-pub fn mark_failed_folder(dir: &Path, command: &str, error: &dyn std::error::Error) {
+/// [`ResultFolder`] (a case file that does not parse): earlier results are removed and
+/// [`FAILURE_MARK`] written. `mesh.msh` stays: whether this run would have generated it is not
+/// known, and it may be the mesh the case reads. Nothing is done if `dir` does not exist, or if
+/// it holds `case_file` under a result file's name (said on stderr).
+pub fn mark_failed_folder(
+    dir: &Path,
+    origin: &str,
+    case_file: &Path,
+    command: &str,
+    error: &dyn std::error::Error,
+) {
     if !dir.is_dir() {
         return;
     }
-    let marked = remove_file(&dir.join(GENERATED_MESH))
+    let marked = check_inputs(dir, origin, &[case_file], false)
         .and_then(|()| mark_failed(dir, None, command, error));
     if let Err(e) = marked {
         eprintln!("warning: {e}");
     }
+}
+
+/// Refuses an output folder `dir` that holds one of the run's `inputs` under a name the run
+/// removes or replaces: a result file, the failure mark, an `.mtx` file in `matrices/`, or
+/// `mesh.msh` when the run generates the mesh. Paths are compared after resolving symbolic
+/// links and `..`, so `output = "."` beside the inputs is caught; a folder that does not exist
+/// yet holds nothing.
+pub fn check_inputs(
+    dir: &Path,
+    origin: &str,
+    inputs: &[&Path],
+    generates_mesh: bool,
+) -> Result<(), OutputError> {
+    let Ok(dir_resolved) = dir.canonicalize() else {
+        return Ok(());
+    };
+    let mut names: Vec<&str> = RESULT_FILES.to_vec();
+    names.push(FAILURE_MARK);
+    if generates_mesh {
+        names.push(GENERATED_MESH);
+    }
+    for &input in inputs {
+        let (Some(folder), Some(name)) = (resolved_folder(input), input.file_name()) else {
+            continue;
+        };
+        let clash = if folder == dir_resolved {
+            names
+                .iter()
+                .find(|&&n| OsStr::new(n) == name)
+                .map(|n| n.to_string())
+        } else if folder == dir_resolved.join(MATRICES)
+            && Path::new(name).extension() == Some(OsStr::new("mtx"))
+        {
+            Some(format!("{MATRICES}/{}", name.to_string_lossy()))
+        } else {
+            None
+        };
+        if let Some(name) = clash {
+            return Err(OutputError::InputInOutput {
+                dir: dir.to_owned(),
+                origin: origin.to_owned(),
+                input: input.to_owned(),
+                name,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The folder that holds `path`, with symbolic links and `..` resolved (`None` if it does not
+/// exist).
+fn resolved_folder(path: &Path) -> Option<PathBuf> {
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    parent.unwrap_or(Path::new(".")).canonicalize().ok()
 }
 
 fn mark_failed(

@@ -26,6 +26,18 @@ pub enum OutputError {
     },
     #[error("cannot write HDF5 file {path}: {source}")]
     Hdf5 { path: PathBuf, source: hdf5::Error },
+    #[error(
+        "the output folder {dir} ({origin}) holds the input {input} under the name '{name}', \
+         which a run removes or replaces; set another output folder or rename the input"
+    )]
+    InputInOutput {
+        dir: PathBuf,
+        /// Where the folder was set: the case file's `output` key or `--output`.
+        origin: String,
+        input: PathBuf,
+        /// The result name it has.
+        name: String,
+    },
     #[error("cannot write {path}: {source}")]
     Json {
         path: PathBuf,
