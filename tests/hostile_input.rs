@@ -974,3 +974,91 @@ fn a_bad_section_header_names_its_own_line() {
         "{message}"
     );
 }
+
+/// A case on `glued_blocks_{dim}d.msh` (`lower` below `upper`, their union, the `interface`
+/// between them): `body` clamped on `lower_base`, `load` on `interface`.
+fn glued_case(dim: usize, body: &str, load: &str) -> String {
+    let clamp = if dim == 2 {
+        "ux = 0.0\nuy = 0.0"
+    } else {
+        "ux = 0.0\nuy = 0.0\nuz = 0.0"
+    };
+    format!(
+        r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "{body}"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "lower_base"
+{clamp}
+[[body.load]]
+group = "interface"
+{load}
+"#,
+        fixture(&format!("glued_blocks_{dim}d.msh")).display()
+    )
+}
+
+#[test]
+fn a_pressure_on_a_group_inside_the_body_is_an_error_in_2d_and_3d() {
+    // The interface of the two blocks lies inside their union: its facets are shared by two
+    // cells, and the run once succeeded with zero reaction.
+    for dim in [2, 3] {
+        for load in [
+            "pressure = 1.0".to_string(),
+            format!(
+                "hertz_pressure = {{ p0 = 1.0, a = 0.5, center = {} }}",
+                if dim == 2 {
+                    "[0.5, 0.0]"
+                } else {
+                    "[0.5, 0.5, 0.0]"
+                }
+            ),
+        ] {
+            let message = case_failure(&glued_case(dim, "union", &load));
+            assert!(
+                message.contains("load on 'interface'")
+                    && message.contains("inside the body")
+                    && message.contains("two cells of 'union'")
+                    && message.contains("a pressure needs a boundary group"),
+                "{dim}D, {load}: {message}"
+            );
+        }
+    }
+}
+
+/// The force in the direction `dim - 1` on `lower_base` of the run of `text`.
+fn base_reaction(text: &str, dim: usize) -> f64 {
+    let (_dir, path) = write_case(text);
+    let report = run_quiet(&path).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    report.summary.bodies[0].reactions["lower_base"][dim - 1]
+}
+
+#[test]
+fn a_pressure_on_the_interface_of_two_bodies_loads_each_as_a_boundary() {
+    // The same interface is a boundary of `lower` alone (one cell per facet): a unit pressure on
+    // its unit length (2D) or area (3D) is balanced by the clamped base, to round-off.
+    for dim in [2, 3] {
+        let reaction = base_reaction(&glued_case(dim, "lower", "pressure = 1.0"), dim);
+        assert!((reaction - 1.0).abs() < 1e-10, "{dim}D: {reaction}");
+    }
+}
+
+#[test]
+fn a_traction_on_a_group_inside_the_body_is_a_line_or_surface_force() {
+    // A traction vector does not depend on the side: inside the union it is a force of 2 per
+    // unit length (area) over the unit interface, balanced by the base.
+    for dim in [2, 3] {
+        let traction = if dim == 2 {
+            "[0.0, 2.0]"
+        } else {
+            "[0.0, 0.0, 2.0]"
+        };
+        let text = glued_case(dim, "union", &format!("traction = {traction}"));
+        let reaction = base_reaction(&text, dim);
+        assert!((reaction + 2.0).abs() < 1e-10, "{dim}D: {reaction}");
+    }
+}

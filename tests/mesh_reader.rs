@@ -99,6 +99,40 @@ fn two_dimensional_and_three_dimensional_contact_geometries_read() {
     );
 }
 
+#[test]
+fn facets_between_two_cells_of_a_body_are_told_from_its_boundary() {
+    // The interface of the glued blocks is a boundary of `lower` and of `upper` (one cell of
+    // each), and lies inside `union` (every facet between a cell of each half).
+    for (name, dim) in [("glued_blocks_2d.msh", 2), ("glued_blocks_3d.msh", 3)] {
+        let mesh = read_fixture(name);
+        for body in ["lower", "upper"] {
+            let group = mesh
+                .body(body)
+                .unwrap()
+                .boundary_group("interface")
+                .unwrap();
+            assert!(
+                group.is_boundary(),
+                "{name}, {body}: {:?}",
+                group.interior_facets
+            );
+        }
+        let union = mesh.body("union").unwrap();
+        let interface = union.boundary_group("interface").unwrap();
+        assert_eq!(
+            interface.interior_facets.len(),
+            interface.num_facets(dim),
+            "{name}"
+        );
+        for outer in ["lower_base", "upper_top"] {
+            assert!(
+                union.boundary_group(outer).unwrap().is_boundary(),
+                "{name}, {outer}"
+            );
+        }
+    }
+}
+
 fn error_of(path: &std::path::Path) -> (MeshError, String) {
     let e = read_msh(path).expect_err("the file is bad");
     let message = e.to_string();

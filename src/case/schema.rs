@@ -377,6 +377,32 @@ impl Case {
                     ),
                 ));
             }
+            // A pressure pushes along the outward normal of each facet's cell; a facet between
+            // two cells has two, and the pushes of the facets of an embedded line or surface
+            // cancel (the run once succeeded with zero reaction). A traction vector does not
+            // depend on the side: inside the body it is a line (surface) force, and stays.
+            if l.traction.is_none()
+                && let Some(group) = body.boundary_group(&l.group)
+                && !group.is_boundary()
+            {
+                return Err(self.invalid(
+                    context(&what),
+                    format!(
+                        "'{}' lies inside the body: {} of its facets (gmsh element {}{}) are \
+                         shared by two cells of '{}', where a pressure has no outward side; a \
+                         pressure needs a boundary group, whose facets lie on one cell only",
+                        l.group,
+                        group.interior_facets.len(),
+                        group.interior_facets[0],
+                        if group.interior_facets.len() > 1 {
+                            " and others"
+                        } else {
+                            ""
+                        },
+                        spec.name
+                    ),
+                ));
+            }
             let load = match (&l.traction, l.pressure, &l.hertz_pressure) {
                 (Some(t), None, None) => SurfaceLoad::Traction(vector(t, &what)?),
                 (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(finite(

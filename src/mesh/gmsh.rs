@@ -272,6 +272,11 @@ impl FileContents {
             }
         }
         let mut found: Vec<(usize, Vec<usize>, usize)> = Vec::new();
+        // A facet that is a face of a second cell lies inside the body (gmsh `Line In Surface`,
+        // `Surface In Volume`, or the interface of two volumes in one body): it keeps its first
+        // cell, and its element tag is recorded so that a pressure on it can be refused.
+        let mut taken = vec![false; facets.element_tags.len()];
+        let mut interior: Vec<(usize, u64)> = Vec::new();
         if !wanted.is_empty() {
             for c in 0..body.num_cells() {
                 let cell = body.cell(c);
@@ -282,7 +287,12 @@ impl FileContents {
                         .collect();
                     let mut key = face.clone();
                     key.sort_unstable();
-                    if let Some(f) = wanted.remove(&key) {
+                    let Some(&f) = wanted.get(&key) else {
+                        continue;
+                    };
+                    if std::mem::replace(&mut taken[f], true) {
+                        interior.push((f, facets.element_tags[f]));
+                    } else {
                         orient_outward(&body.coords, &mut face, cell[opposite], dim);
                         found.push((f, face, c));
                     }
@@ -291,10 +301,12 @@ impl FileContents {
         }
         // Keep the file's facet order so that results are reproducible.
         found.sort_unstable_by_key(|(f, _, _)| *f);
+        interior.sort_unstable();
         FacetGroup {
             physical_tag: tag,
             facets: found.iter().flat_map(|(_, face, _)| face.clone()).collect(),
             facet_cells: found.iter().map(|(_, _, c)| *c).collect(),
+            interior_facets: interior.into_iter().map(|(_, tag)| tag).collect(),
         }
     }
 }

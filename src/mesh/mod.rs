@@ -77,6 +77,10 @@ pub struct FacetGroup {
     pub facets: Vec<usize>,
     /// The body cell each facet belongs to.
     pub facet_cells: Vec<usize>,
+    /// gmsh element tags of the facets that are faces of two cells of the body, in the file's
+    /// order: such a group lies (in part) inside the body, where a pressure has no outward side.
+    /// Empty for a boundary group.
+    pub interior_facets: Vec<u64>,
 }
 
 impl BodyMesh {
@@ -146,6 +150,11 @@ impl FacetGroup {
 
     pub fn num_facets(&self, dim: Dim) -> usize {
         self.facets.len() / dim
+    }
+
+    /// Whether every facet lies on one cell of the body only (none is inside it).
+    pub fn is_boundary(&self) -> bool {
+        self.interior_facets.is_empty()
     }
 
     /// The distinct local nodes of the group, sorted.

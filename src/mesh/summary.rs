@@ -42,7 +42,7 @@ impl fmt::Display for MeshSummary<'_> {
                 writeln!(f, "  points '{}': {} nodes", name, nodes.len())?;
             }
             for (name, group) in &body.boundary_groups {
-                writeln!(
+                write!(
                     f,
                     "  boundary '{}': {} {}, {} nodes",
                     name,
@@ -50,6 +50,16 @@ impl fmt::Display for MeshSummary<'_> {
                     facet,
                     group.nodes().len()
                 )?;
+                if group.is_boundary() {
+                    writeln!(f)?;
+                } else {
+                    // A pressure on it is refused: say so where the groups are listed.
+                    writeln!(
+                        f,
+                        " ({} of them inside the body, between two cells)",
+                        group.interior_facets.len()
+                    )?;
+                }
             }
         }
         Ok(())
