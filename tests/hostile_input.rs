@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::{edited_fixture, fixture, read_fixture, write_case};
-use internodes::mesh::{Mesh, MeshError, read_msh, read_msh_bytes};
+use internodes::mesh::{Mesh, MeshError, MeshSummary, read_msh, read_msh_bytes};
 use internodes::run::{RunError, RunOptions, solve_case};
 
 const BINARY: &str = env!("CARGO_BIN_EXE_internodes");
@@ -1061,4 +1061,52 @@ fn a_traction_on_a_group_inside_the_body_is_a_line_or_surface_force() {
         let reaction = base_reaction(&text, dim);
         assert!((reaction + 2.0).abs() < 1e-10, "{dim}D: {reaction}");
     }
+}
+
+/// A case on `unnamed_groups_2d.msh`: the body '1' clamped on `clamped`, pulled down by its
+/// weight.
+fn unnamed_groups_case(clamped: &str) -> String {
+    format!(
+        r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "1"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+body_force = [0.0, -1.0]
+[[body.dirichlet]]
+group = "{clamped}"
+ux = 0.0
+uy = 0.0
+"#,
+        fixture("unnamed_groups_2d.msh").display()
+    )
+}
+
+#[test]
+fn a_name_shared_by_unnamed_groups_of_two_dimensions_is_an_ambiguous_reference() {
+    // Physical Curve(1) and Physical Point(1) have no names: both go by '1'.
+    let message = case_failure(&unnamed_groups_case("1"));
+    assert!(
+        message.contains("group '1'")
+            && message.contains("ambiguous")
+            && message.contains("dimension 0 tag 1 (unnamed)")
+            && message.contains("dimension 1 tag 1 (unnamed)")
+            && message.contains("unnamed_groups_2d.msh"),
+        "{message}"
+    );
+    // 'info' says so where it lists the groups.
+    let info = MeshSummary(&read_fixture("unnamed_groups_2d.msh")).to_string();
+    assert!(
+        info.contains("dim 0  tag    1  1  (no name: goes by its tag)  (ambiguous in a case file: also dim 1 tag 1)"),
+        "{info}"
+    );
+
+    // The unnamed curve 2 is the only group called '2': the weight of the unit square hangs on
+    // it, to round-off.
+    let (_dir, path) = write_case(&unnamed_groups_case("2"));
+    let report = run_quiet(&path).unwrap();
+    let reaction = report.summary.bodies[0].reactions["2"][1];
+    assert!((reaction - 1.0).abs() < 1e-10, "{reaction}");
 }

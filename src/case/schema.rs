@@ -281,10 +281,48 @@ impl Case {
     /// any body is an error before anything is solved or written.
     pub fn check_bodies(&self, mesh: &Mesh) -> Result<(), CaseError> {
         for spec in &self.bodies {
+            let groups = spec.dirichlet.iter().map(|d| &d.group);
+            for group in groups.chain(spec.loads.iter().map(|l| &l.group)) {
+                self.check_unambiguous(mesh, &format!("body '{}'", spec.name), group)?;
+            }
             let body = self.body_mesh(mesh, spec)?;
             self.elastic_problem(body, spec)?;
         }
+        if let Some(contact) = &self.contact {
+            for group in &contact.surfaces {
+                self.check_unambiguous(mesh, "[contact] surfaces", group)?;
+            }
+        }
         Ok(())
+    }
+
+    /// Unnamed physical groups go by their tag, so an unnamed Physical Curve(1) and Physical
+    /// Point(1) are both '1': a case naming '1' would silently get one of them.
+    fn check_unambiguous(&self, mesh: &Mesh, context: &str, group: &str) -> Result<(), CaseError> {
+        let groups = mesh.groups_below_bodies(group);
+        if groups.len() < 2 {
+            return Ok(());
+        }
+        let listed: Vec<String> = groups
+            .iter()
+            .map(|g| {
+                format!(
+                    "dimension {} tag {}{}",
+                    g.dim,
+                    g.tag,
+                    if g.named { "" } else { " (unnamed)" }
+                )
+            })
+            .collect();
+        Err(self.invalid(
+            format!("{context}, group '{group}'"),
+            format!(
+                "'{group}' is ambiguous in {}: it names the physical groups {}; give them \
+                 distinct names in the .geo (e.g. Physical Curve(\"base\") = {{...}})",
+                mesh.path.display(),
+                listed.join(" and ")
+            ),
+        ))
     }
 
     fn invalid(&self, context: impl Into<String>, message: impl Into<String>) -> CaseError {

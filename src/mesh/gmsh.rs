@@ -57,6 +57,7 @@ pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             dim: d,
             tag,
             name: name_of(d, tag),
+            named: physical_names.contains_key(&(d, tag)),
         })
         .collect();
     for (&(d, tag), name) in &physical_names {
@@ -65,6 +66,7 @@ pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                 dim: d,
                 tag,
                 name: name.clone(),
+                named: true,
             });
         }
     }

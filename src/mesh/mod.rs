@@ -45,7 +45,11 @@ pub struct Mesh {
 pub struct PhysicalGroup {
     pub dim: Dim,
     pub tag: i32,
+    /// Its name in `$PhysicalNames`, or its tag written out when it has none.
     pub name: String,
+    /// Whether `$PhysicalNames` names it. An unnamed group goes by its tag, which groups of
+    /// other dimensions may share.
+    pub named: bool,
 }
 
 /// One body: P1 simplices, numbered locally.
@@ -169,6 +173,16 @@ impl FacetGroup {
 impl Mesh {
     pub fn body(&self, name: &str) -> Option<&BodyMesh> {
         self.bodies.iter().find(|b| b.name == name)
+    }
+
+    /// The boundary and point groups (dimension below the bodies') called `name`: more than one
+    /// when unnamed groups of two dimensions go by the same tag, and a case file naming it is
+    /// ambiguous.
+    pub fn groups_below_bodies(&self, name: &str) -> Vec<&PhysicalGroup> {
+        self.physical_groups
+            .iter()
+            .filter(|g| g.dim < self.dim && g.name == name)
+            .collect()
     }
 
     /// The physical group called `name`, if the file declares one.

@@ -18,7 +18,27 @@ impl fmt::Display for MeshSummary<'_> {
         writeln!(f, "{} ({}D, P1)", mesh.path.display(), mesh.dim)?;
         writeln!(f, "physical groups:")?;
         for g in &mesh.physical_groups {
-            writeln!(f, "  dim {}  tag {:>4}  {}", g.dim, g.tag, g.name)?;
+            write!(f, "  dim {}  tag {:>4}  {}", g.dim, g.tag, g.name)?;
+            if !g.named {
+                write!(f, "  (no name: goes by its tag)")?;
+            }
+            // Which group a case file means by this name cannot be told: say so here.
+            if g.dim < mesh.dim {
+                let others: Vec<String> = mesh
+                    .groups_below_bodies(&g.name)
+                    .iter()
+                    .filter(|o| (o.dim, o.tag) != (g.dim, g.tag))
+                    .map(|o| format!("dim {} tag {}", o.dim, o.tag))
+                    .collect();
+                if !others.is_empty() {
+                    write!(
+                        f,
+                        "  (ambiguous in a case file: also {})",
+                        others.join(", ")
+                    )?;
+                }
+            }
+            writeln!(f)?;
         }
         for body in &mesh.bodies {
             let (lo, hi) = body.bounding_box();
