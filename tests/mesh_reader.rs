@@ -328,3 +328,16 @@ fn a_file_without_bodies_is_rejected() {
     let (e, message) = error_of(&path);
     assert!(matches!(e, MeshError::NoBodies { .. }), "{message}");
 }
+
+#[test]
+fn a_partitioned_mesh_is_rejected_as_such_with_the_fix() {
+    // gmsh -part 2 puts the elements on partition entities: the file once read as having no
+    // physical groups at all.
+    let (_, message) = error_of(&fixture("block_2d_partitioned.msh"));
+    assert!(
+        message.contains("block_2d_partitioned.msh:25:")
+            && message.contains("partitioned")
+            && message.contains("without -part"),
+        "{message}"
+    );
+}

@@ -86,6 +86,14 @@ pub enum MeshError {
          a 3D body is a named physical volume (Physical Volume(\"name\") = {{...}} in the .geo)"
     )]
     NoPhysicalVolume { path: PathBuf, volumes: u64 },
+    #[error(
+        "{path}:{line}: the mesh is partitioned ($PartitionedEntities, written by gmsh -part N or \
+         Mesh.NbPartitions > 0), which internodes does not read: its elements lie on partition \
+         entities outside the physical groups. Save it unpartitioned: mesh again without -part \
+         (Mesh.NbPartitions = 0); files split per partition (Mesh.PartitionSplitMeshFiles) are \
+         partitioned too"
+    )]
+    Partitioned { path: PathBuf, line: usize },
     #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
     EmptyBody { path: PathBuf, body: String },
 }

@@ -96,6 +96,14 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshContents, MeshError>
             "Entities" => entities(&mut cursor, &mut contents)?,
             "Nodes" => contents.nodes = nodes(&mut cursor)?,
             "Elements" => contents.element_blocks = elements(&mut cursor)?,
+            // Its elements would be skipped as belonging to no physical group, and the file
+            // rejected as holding no body: say why instead.
+            "PartitionedEntities" => {
+                return Err(MeshError::Partitioned {
+                    path: path.to_owned(),
+                    line: cursor.line_at(start),
+                });
+            }
             _ => {
                 cursor.skip_section(start, &name)?;
                 continue;
