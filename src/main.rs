@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use internodes::mesh::{MeshSummary, read_msh};
+use internodes::output::unsaid_causes;
 use internodes::run::{RunOptions, solve_case};
 
 #[derive(Parser)]
@@ -92,10 +93,8 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            let mut source = e.source();
-            while let Some(cause) = source {
+            for cause in unsaid_causes(&*e) {
                 eprintln!("  caused by: {cause}");
-                source = cause.source();
             }
             ExitCode::FAILURE
         }

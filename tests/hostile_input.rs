@@ -1110,3 +1110,29 @@ fn a_name_shared_by_unnamed_groups_of_two_dimensions_is_an_ambiguous_reference()
     let reaction = report.summary.bodies[0].reactions["2"][1];
     assert!((reaction - 1.0).abs() < 1e-10, "{reaction}");
 }
+
+#[test]
+fn an_error_and_its_causes_are_printed_once() {
+    // The case error quotes the mesh error, which quotes the I/O error: each once on stderr and
+    // in the failure mark (every cause used to be printed again under its own message).
+    let (dir, case) = write_case(&square_case("square_sorted.msh", "[1.0, 0.0]").replace(
+        &fixture("square_sorted.msh").display().to_string(),
+        "missing.msh",
+    ));
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    let output = Command::new(BINARY)
+        .args(["solve", case.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let mark = std::fs::read_to_string(dir.path().join("out/FAILED.txt")).unwrap();
+    for text in [stderr.as_ref(), mark.as_str()] {
+        assert_eq!(text.matches("cannot read mesh file").count(), 1, "{text}");
+        assert_eq!(
+            text.matches("No such file or directory").count(),
+            1,
+            "{text}"
+        );
+        assert!(!text.contains("caused by"), "{text}");
+    }
+}

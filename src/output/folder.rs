@@ -246,12 +246,29 @@ fn failure_text(command: &str, error: &dyn std::error::Error) -> String {
          runs were removed.\ncommand: {command}\ntime: {}\nerror: {error}\n",
         utc(seconds)
     );
-    let mut source = error.source();
-    while let Some(cause) = source {
+    for cause in unsaid_causes(error) {
         let _ = writeln!(text, "  caused by: {cause}");
-        source = cause.source();
     }
     text
+}
+
+/// The messages of the causes (sources) of `error` that the messages before them do not already
+/// hold. Most of our errors write their source into their own message (`case file c.toml:
+/// m.msh: ...`), so printing every source repeats the same sentence; a source that adds
+/// something (an I/O error under a message that does not quote it) is kept.
+pub fn unsaid_causes(error: &dyn std::error::Error) -> Vec<String> {
+    let mut said = error.to_string();
+    let mut causes = Vec::new();
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let text = cause.to_string();
+        if !said.contains(&text) {
+            said.push_str(&text);
+            causes.push(text);
+        }
+        source = cause.source();
+    }
+    causes
 }
 
 /// `seconds` since 1970 as a UTC date and time (the civil-from-days algorithm of H. Hinnant's

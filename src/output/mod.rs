@@ -7,7 +7,9 @@ mod plot;
 mod summary;
 mod xdmf;
 
-pub use folder::{FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, mark_failed_folder};
+pub use folder::{
+    FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, mark_failed_folder, unsaid_causes,
+};
 pub use matrix_market::write_matrix_market;
 pub use plot::{PlotError, write_force_displacement_png};
 pub use summary::{BodySummary, CaseSummary, ContactSummary, force_displacement_csv};
