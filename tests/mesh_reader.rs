@@ -244,6 +244,8 @@ fn second_order_elements_are_unsupported() {
         message.contains("Qua4") && message.contains("triangles"),
         "{message}"
     );
+    // The group is named as the case file names it (the error once gave its tag list, '[1]').
+    assert!(message.contains("physical group 'block'"), "{message}");
 }
 
 /// Moves node `tag` of an ASCII fixture to `x`.

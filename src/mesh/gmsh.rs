@@ -41,7 +41,7 @@ pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         .iter()
         .map(|n| ((n.dim, n.tag), n.name.clone()))
         .collect();
-    let file = FileContents::new(path, msh)?;
+    let file = FileContents::new(path, msh, &physical_names)?;
 
     let dim = file.dim;
     let name_of = |d: Dim, tag: i32| -> String {
@@ -136,7 +136,12 @@ struct FileContents {
 }
 
 impl FileContents {
-    fn new(path: &Path, msh: MshContents) -> Result<Self, MeshError> {
+    /// `names` are the `$PhysicalNames`, to name the groups of unsupported elements.
+    fn new(
+        path: &Path,
+        msh: MshContents,
+        names: &BTreeMap<(Dim, i32), String>,
+    ) -> Result<Self, MeshError> {
         let physical_tags = &msh.entity_groups;
         let blocks = &msh.element_blocks;
         let in_group =
@@ -185,8 +190,15 @@ impl FileContents {
                     path: path.to_owned(),
                     element_type: element_type_name(block.element_type),
                     location: format!(
-                        "entity {} of dimension {} (physical group {:?})",
-                        block.entity_tag, d, tags
+                        "entity {} of dimension {} (physical group {})",
+                        block.entity_tag,
+                        d,
+                        tags.iter()
+                            .map(|&t| names
+                                .get(&(d, t))
+                                .map_or_else(|| format!("{t} (unnamed)"), |n| format!("'{n}'")))
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     ),
                     expected: if dim == 2 {
                         "3-node triangles with 2-node boundary lines"
