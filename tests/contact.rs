@@ -1343,3 +1343,48 @@ fn a_library_caller_without_load_factors_gets_an_error() {
         assert!(error.to_string().contains("load factors"), "{error}");
     }
 }
+
+#[test]
+fn a_body_slid_sideways_is_paired_where_it_touches() {
+    // Frictionless contact between equally stiff bodies: the half-disc pressed by 0.02 and
+    // pushed sideways by 0.1 (four spacings) onto the flat block must carry the force it carries
+    // pressed straight down: sliding over a flat changes where the block is loaded, not how
+    // much. Paired where the contact began, the block received its reaction four spacings from
+    // where the disc touched it and the run was certified 3.1% high.
+    let straight = common::half_disc_on_block("half_disc_on_block.msh", "");
+    let slid = straight.replace("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02");
+    assert!(slid.contains("ux = 0.1"), "{slid}");
+    let (straight, slid) = (solve(&straight).unwrap(), solve(&slid).unwrap());
+    assert_eq!(straight.status, ContactStatus::Converged);
+    assert_eq!(slid.status, ContactStatus::Converged);
+    let ratio = slid.force_primary[1] / straight.force_primary[1];
+    assert!((ratio - 1.0).abs() < 0.005, "force ratio {ratio}");
+    let seen = (slid.history.iter()).fold(0.0f64, |m, r| m.max(r.pairing_drift_over_h));
+    assert!(seen > 1.0, "the slide was not seen: {seen} h");
+
+    // Where each body is loaded, from the output fields: the pressure-weighted centre of the
+    // disc's displaced nodes and of the block's nodes.
+    let mesh = read_msh(&fixture("half_disc_on_block.msh")).unwrap();
+    let centre = |fields: &internodes::contact::SurfaceFields, body: &str, u: &[f64]| {
+        let coords = &mesh.body(body).unwrap().coords;
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (s, &node) in fields.nodes.iter().enumerate() {
+            let p = fields.mean_pressure[s].max(0.0);
+            sum += p * (coords[node][0] + u[2 * node]);
+            weight += p;
+        }
+        sum / weight
+    };
+    let disc = centre(&slid.primary_fields, "disc", &slid.primary.displacement);
+    let block = centre(
+        &slid.secondary_fields,
+        "block",
+        &slid.secondary.displacement,
+    );
+    eprintln!("slid by 0.1: force ratio {ratio:.5}, centres: disc {disc:.4}, block {block:.4}");
+    assert!((disc - 0.1).abs() < 0.025, "disc loaded about x = {disc}");
+    assert!(
+        (block - disc).abs() < 0.005,
+        "block loaded about x = {block}, disc {disc}"
+    );
+}

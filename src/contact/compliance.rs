@@ -4,11 +4,11 @@
 //!
 //! An active-set iteration needs `K^-1 B` only where the constraint rows `C` read it, and the
 //! columns of `C` (the interface displacements) are candidate-surface dofs, so the Schur
-//! complement is `D - s C Y` with `Y = [Y_k]` restricted to those dofs. The operators are built
-//! once (`super::interface`), so `b_k` depends only on which primary node (and component, for
-//! tied contact) multiplier `k` belongs to: `Y_k` is computed (one solve with the body's
-//! Cholesky factor) the first time that node is active, and kept for every later iteration and
-//! load step.
+//! complement is `D - s C Y` with `Y = [Y_k]` restricted to those dofs. While the operators
+//! stay as built (`super::interface`), `b_k` depends only on which primary node (and
+//! component, for tied contact) multiplier `k` belongs to: `Y_k` is computed (one solve with
+//! the body's Cholesky factor) the first time that node is active, and kept for every later
+//! iteration and load step, until the operators are paired again.
 //!
 //! One solve per multiplier, rather than one per loaded dof: the secondary's column `M2 R21 e_k`
 //! loads every secondary node the interpolation reaches, nearly the whole facing surface
@@ -49,6 +49,11 @@ impl SurfaceResponse {
             surface_dofs,
             responses: HashMap::new(),
         }
+    }
+
+    /// Forgets every response: the interface operators they were computed with changed.
+    pub fn clear(&mut self) {
+        self.responses.clear();
     }
 
     /// Whether the response of `key` is known.

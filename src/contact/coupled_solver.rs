@@ -69,6 +69,14 @@ impl BodyFactors {
     }
 }
 
+impl BodyFactors {
+    /// Forgets the bodies' responses to the multipliers: the interface operators changed.
+    pub fn forget_responses(&mut self) {
+        self.response1.clear();
+        self.response2.clear();
+    }
+}
+
 /// Solves the coupled system; returns `x = [u1; u2; lambda / s]`.
 pub fn solve(
     system: &CoupledSystem,

@@ -99,6 +99,10 @@ pub struct ContactSettings {
     /// The same bound in secondary spacings, unless the secondary is nearly rigid (default
     /// 2.5: four nodes across a 2D zone).
     pub secondary_min_zone_width: f64,
+    /// The certificate's bound on the distance between the centres of the normal contact
+    /// forces on the two bodies, over the primary's spacing (`super::checks`; default 0.25):
+    /// equal and opposite forces must also act at the same place.
+    pub force_centre_tolerance: f64,
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
@@ -127,6 +131,7 @@ impl Default for ContactSettings {
             secondary_min_zone_width: 2.5,
             certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
+            force_centre_tolerance: 0.25,
             primary_agreement_tolerance: 0.01,
             rbf_radius: 2.0,
         }
@@ -175,6 +180,7 @@ impl ContactSettings {
             ),
             ("sag_tolerance", self.sag_tolerance),
             ("imbalance_tolerance", self.imbalance_tolerance),
+            ("force_centre_tolerance", self.force_centre_tolerance),
             (
                 "primary_agreement_tolerance",
                 self.primary_agreement_tolerance,

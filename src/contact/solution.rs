@@ -81,6 +81,9 @@ pub struct IterationRecord {
     /// Largest |geometric gap| of an active node over its h: how far the active nodes are
     /// from the other body's discrete surface.
     pub max_gap_error_over_h: f64,
+    /// Largest distance an active node's paired point on the secondary has slid since the
+    /// interface operators were built, over its spacing (they are paired again beyond 0.05).
+    pub pairing_drift_over_h: f64,
     pub relative_residual: f64,
     pub seconds: PhaseSeconds,
 }
@@ -90,7 +93,7 @@ impl IterationRecord {
     pub fn line(&self) -> String {
         let t = &self.seconds;
         format!(
-            "  iteration {:>3}: active {:>5}, +{:<4} -{:<4} penetration {:.1e} h, tension {:.1e} p_max, active gap {:.1e} h; {:.3} s (operators {:.3}, solve {:.3}, search {:.3})",
+            "  iteration {:>3}: active {:>5}, +{:<4} -{:<4} penetration {:.1e} h, tension {:.1e} p_max, active gap {:.1e} h, slid {:.1e} h; {:.3} s (operators {:.3}, solve {:.3}, search {:.3})",
             self.iteration,
             self.active,
             self.added,
@@ -98,6 +101,7 @@ impl IterationRecord {
             self.max_penetration_over_h,
             self.max_tension_over_p,
             self.max_gap_error_over_h,
+            self.pairing_drift_over_h,
             t.operators + t.solve + t.search + t.checks,
             t.operators,
             t.solve,

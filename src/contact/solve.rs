@@ -8,11 +8,20 @@
 //! repeat
 //!   1. coupling of A: rows of R12, columns of M2 R21, lumped M1, gaps d + e   (fixed operators)
 //!   2. solve the coupled system for u1, u2, lambda
-//!   3. gaps of every candidate: geometric g (closest point, deformed) and linearized g_lin
+//!   3. gaps of every candidate: geometric g (closest point, deformed) and linearized g_lin;
+//!      the slide s of the surfaces over each other (mean tangential u1 - R12 u2 over A)
 //!   4. A' <- {i in A : p_i >= -tol_t p_max}  +  {i not in A : g_i < -tol_p h_i};  e <- g - g_lin
+//!   5. if A' = A, settled, and s moved more than 0.05 h from the operators' pairing:
+//!      pair the operators again for s (each node moved by s), e <- g - g_lin, A' <- A
 //! until A' = A and every active node lies on the other surface (|g_i| <= 0.01 tol_p h_i)
-//! certify: geometric penetration, tension and force balance, measured independently
+//! certify: geometric penetration, tension, force balance and where the forces act, measured
+//! independently
 //! ```
+//!
+//! Step 5 is what lets the bodies slide: the operators pair each node with the point of the
+//! other surface it faces, and a body pushed sideways touches the other elsewhere than where it
+//! started. The operators change only when the active set has settled, so each pairing is a
+//! fixed complementarity problem for the update of step 4.
 //!
 //! Step 4 is the primal-dual active set update for the nodal complementarity function
 //! `C_i = p_i - max(0, p_i - c g_i)`, `c = E*/h`: a node is active next when `p_i - c g_i > 0`.
@@ -44,7 +53,7 @@ use super::coupled_solver::{self, BodyFactors, CoupledSolver};
 use super::interface::{InterfaceOperators, geometric_gaps};
 use super::solution::{ContactSolution, ContactStatus, PhaseSeconds};
 use super::system::{CoupledSolution, CoupledSystem, Coupling};
-use super::{ContactError, ContactProblem, Transfer, post};
+use super::{ContactError, ContactProblem, ContactSurface, Transfer, post};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 
 /// An active node this many spacings off the other surface after a solve means the constraint
@@ -54,6 +63,27 @@ use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 /// whole overlap, on the 3D R/200 hemisphere); the stiff half-disc primary at R/500 was 1.3 to
 /// 1.8 h off at its second solve, and further off at every solve after.
 const UNSTABLE_GAP_OVER_H: f64 = 1.0;
+
+/// When the surfaces have slid ([`InterfaceOperators::slide`]) this many spacings of the
+/// active nodes away from the pairing of the operators, they are paired again once the active
+/// set settles.
+const REPAIR_DRIFT_OVER_H: f64 = 0.05;
+
+/// How far the slide `now` is from the operators' `slid`, over the smallest spacing of the
+/// `active` primary nodes.
+fn pairing_drift(
+    slid: &[f64; 3],
+    now: &[f64; 3],
+    primary: &ContactSurface,
+    active: &[usize],
+) -> f64 {
+    let h = (active.iter().map(|&i| primary.spacing[i])).fold(f64::INFINITY, f64::min);
+    let distance = (0..3)
+        .map(|k| (now[k] - slid[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    if h.is_finite() { distance / h } else { 0.0 }
+}
 
 /// The active nodes count as lying on the other surface when their geometric gaps are within
 /// this fraction of the penetration tolerance. The gap corrections contract by about ten per
@@ -82,7 +112,22 @@ pub struct ContactSolver<'a> {
     pub(super) stats1: SolveStats,
     pub(super) stats2: SolveStats,
     factors: Option<BodyFactors>,
+    /// Paired for the slide of the last solve; a solve without a start pairs them again
+    /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
+}
+
+/// The interface operators of `problem`, paired with the primary surface slid by `slid` over
+/// the secondary ([`InterfaceOperators::slide`]).
+fn pair(problem: &ContactProblem, slid: [f64; 3]) -> Result<InterfaceOperators, ContactError> {
+    InterfaceOperators::new(
+        &problem.primary_surface,
+        &problem.secondary_surface,
+        problem.settings.rbf_radius,
+        problem.normal_weights(),
+        problem.transfer().transfer == Transfer::Conservative,
+        slid,
+    )
 }
 
 impl<'a> ContactSolver<'a> {
@@ -109,13 +154,7 @@ impl<'a> ContactSolver<'a> {
             }
             CoupledSolver::MonolithicLu => None,
         };
-        let operators = InterfaceOperators::new(
-            s1,
-            s2,
-            problem.settings.rbf_radius,
-            problem.normal_weights(),
-            problem.transfer().transfer == Transfer::Conservative,
-        )?;
+        let operators = pair(problem, [0.0; 3])?;
         Ok(Self {
             problem,
             solver: *solver,
@@ -155,6 +194,9 @@ impl<'a> ContactSolver<'a> {
         let problem = self.problem;
         let settings = &problem.settings;
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        if start.is_none() && self.operators.slid != [0.0; 3] {
+            self.pair_again([0.0; 3])?;
+        }
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
         let (mut active, mut corrections) = (start.nodes, start.corrections);
         let mut safeguard = Safeguard::default();
@@ -174,12 +216,15 @@ impl<'a> ContactSolver<'a> {
             let solution = timed(&mut seconds.solve, || {
                 self.coupled_solve(&coupling, load_factor)
             })?;
-            // 3. Gaps of every primary candidate: geometric (the search) and linearized.
+            // 3. Gaps of every primary candidate: geometric (the search) and linearized; how far
+            //    the active nodes' pairing has slid.
             let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
-            let (gaps, linear) = timed(&mut seconds.search, || {
+            let (gaps, linear, slid) = timed(&mut seconds.search, || {
                 let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                (gaps, self.operators.linearized_gaps(s1, s2, u1, u2))
+                let slid = self.operators.slide(s1, s2, u1, u2, &nodes);
+                (gaps, self.operators.linearized_gaps(s1, s2, u1, u2), slid)
             });
+            let drift = pairing_drift(&self.operators.slid, &slid, s1, &nodes);
             // 4. The primal-dual active set update, and the gap corrections.
             let update = timed(&mut seconds.checks, || {
                 let (traction, normals) = (&solution.traction, &coupling.normals);
@@ -195,14 +240,28 @@ impl<'a> ContactSolver<'a> {
                 )
             });
             corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
-            let record = update.record(iteration, solution.relative_residual, seconds);
+            // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
+            //    settled on a pairing the surfaces have slid away from is paired again where
+            //    they touch, and solved again.
+            let step = match safeguard.next(&active, &update) {
+                Step::Stop(ContactStatus::Converged) if drift > REPAIR_DRIFT_OVER_H => {
+                    timed(&mut seconds.operators, || self.pair_again(slid))?;
+                    let linear =
+                        (self.operators).linearized_gaps(s1, s2, &solution.u1, &solution.u2);
+                    corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
+                    safeguard = Safeguard::default();
+                    Step::Solve(active.clone())
+                }
+                step => step,
+            };
+            let residual = solution.relative_residual;
+            let record = update.record(iteration, residual, drift, seconds);
             if self.solver.verbose {
                 eprintln!("{}", record.line());
             }
             history.push(record);
             last = Some((coupling, solution));
-            // 5. Stop, or go on with the next set (safeguarded against repeats).
-            match safeguard.next(&active, &update) {
+            match step {
                 Step::Solve(next) => active = next,
                 Step::Stop(end) => {
                     status = end;
@@ -237,6 +296,16 @@ impl<'a> ContactSolver<'a> {
 }
 
 impl ContactSolver<'_> {
+    /// Builds the interface operators again, paired with the primary surface slid by `slid`;
+    /// the bodies' responses computed with the old ones are forgotten.
+    fn pair_again(&mut self, slid: [f64; 3]) -> Result<(), ContactError> {
+        self.operators = pair(self.problem, slid)?;
+        if let Some(factors) = self.factors.as_mut() {
+            factors.forget_responses();
+        }
+        Ok(())
+    }
+
     /// The coupled system of `coupling`, solved and checked by its relative residual.
     fn coupled_solve(
         &mut self,

@@ -149,6 +149,17 @@ impl ContactSurface {
         -normal_force / self.nodal_area[s]
     }
 
+    /// The reference position of the point with `barycentric` coordinates on facet `facet`: the
+    /// material point a projection onto the displaced surface found.
+    pub fn reference_point(&self, facet: usize, barycentric: &[f64; 3]) -> [f64; 3] {
+        let corners = &self.facets[self.dim * facet..self.dim * (facet + 1)];
+        std::array::from_fn(|k| {
+            (corners.iter().zip(barycentric))
+                .map(|(&s, b)| b * self.coords[s][k])
+                .sum()
+        })
+    }
+
     /// The surface's facets at its nodes' positions displaced by `u` (body dofs; `None`: the
     /// reference positions), indexed for closest-point projection.
     pub fn index(&self, u: Option<&[f64]>) -> SurfaceIndex {
