@@ -41,7 +41,7 @@ before any run and none is set from a result):
 
 * ``status``: the solve ended "converged" (0) or not (1). Tolerance 0.
 * ``certificate``: the solver's certificate (summary.json contact.certificate) passed, with its
-  penetration, tension, sag, resolution and imbalance checks all present (and the primary
+  penetration, tension, sag, resolution, force centre and imbalance checks all present (and the primary
   agreement where the solver made it: a stiff primary named by hand); figure the largest value /
   tolerance over its checks (tolerance 1). A missing certificate, a missing check, or a "passed" flag that
   contradicts the figures is a failed row (figure NaN, the note says which), never a pass.
@@ -135,7 +135,8 @@ SYMMETRY_TOLERANCE = 0.01  # spacings
 MESH_TOLERANCE = 0.25  # relative, on the measured spacings
 RIM_PREMISE = 3.0  # spacings
 OVERLAP_PREMISE = 2.0  # spacings
-CERTIFICATE_CHECKS = ("penetration", "secondary penetration", "tension", "secondary sag", "resolution", "imbalance")
+CERTIFICATE_CHECKS = ("penetration", "secondary penetration", "tension", "secondary sag", "resolution",
+                      "force centre", "imbalance")
 
 # The half-disc on a rigid flat (dolfinx, R/160, E 1000, nu 0.3): approach delta -> half-width a_fit.
 RIGID_FLAT_2D = ((0.001, 0.0203), (0.002, 0.0311), (0.004, 0.0456), (0.008, 0.0685), (0.012, 0.0870),
@@ -789,7 +790,7 @@ DECISIONS = """\
   displacement (the overlap alone); the 3D one half overlapping, half imposed. Rigid-flat cases are
   pressed only: the reference needs the body above the flat on the same mesh.
 * *Certificate*: read from summary.json; a missing certificate, a missing check (penetration,
-  secondary penetration, tension, secondary sag, resolution, imbalance) or a "passed" flag
+  secondary penetration, tension, secondary sag, resolution, force centre, imbalance) or a "passed" flag
   contradicting the figures fails the row.
 * *Supported*: two cases the issue lists among those that must certify (two equal hemispheres at
   R/33; the 3D zone 3 spacings across, until the conservative transfer) or that it lets name a
