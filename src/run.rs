@@ -136,6 +136,9 @@ fn solve_into(
         phase.elapsed().as_secs_f64()
     ));
     case.check_bodies(&mesh)?;
+    if options.export_matrices || case.export_matrices {
+        case.check_export_names(&mesh)?;
+    }
 
     // 3. One elastic solve per body.
     let mut solved: Vec<SolvedBody> = Vec::new();

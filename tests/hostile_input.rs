@@ -566,19 +566,22 @@ fn a_case_file_that_does_not_parse_marks_the_folder_it_names() {
 #[test]
 fn a_run_failing_after_writing_the_solution_leaves_no_result() {
     // The first run succeeds; the second writes solution.h5 and then fails exporting the
-    // matrices of a body whose name is not a file name (matrices/up/per_stiffness.mtx).
+    // matrices of a body whose name is too long for a file name (250 bytes and
+    // `_stiffness.mtx` exceed the 255 of Linux file systems).
     let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
     run_quiet(&good).unwrap();
-    let mesh = dir.path().join("slash.msh");
+    let long = "u".repeat(250);
+    let mesh = dir.path().join("long.msh");
     let text = std::fs::read_to_string(fixture("two_blocks_2d.msh")).unwrap();
-    std::fs::write(&mesh, text.replacen("\"upper\"", "\"up/per\"", 1)).unwrap();
+    std::fs::write(&mesh, text.replacen("\"upper\"", &format!("\"{long}\""), 1)).unwrap();
     let bad = dir.path().join("bad.toml");
     std::fs::write(
         &bad,
-        two_blocks_case(&mesh, "up/per", "export_matrices = true"),
+        two_blocks_case(&mesh, &long, "export_matrices = true"),
     )
     .unwrap();
-    let e = run_error(&bad, "matrices/up/ does not exist");
+    let e = run_error(&bad, "the file name is too long");
+    assert!(e.to_string().contains("_stiffness.mtx"), "{e}");
     assert_failed_without_results(&dir.path().join("out"), &e.to_string());
 }
 
@@ -1135,4 +1138,45 @@ fn an_error_and_its_causes_are_printed_once() {
         );
         assert!(!text.contains("caused by"), "{text}");
     }
+}
+
+#[test]
+fn names_with_a_slash_are_refused_before_solving_when_matrices_are_exported() {
+    // Body and group names go into matrices/<body>_stiffness.mtx and
+    // matrices/<body>__<group>_mass.mtx: 'up/per' once failed after the solve, and a group
+    // '../../base' would write outside the output folder.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(fixture("two_blocks_2d.msh")).unwrap();
+    let body_mesh = dir.path().join("body.msh");
+    std::fs::write(&body_mesh, text.replacen("\"upper\"", "\"up/per\"", 1)).unwrap();
+    let message = case_failure(&two_blocks_case(
+        &body_mesh,
+        "up/per",
+        "export_matrices = true",
+    ));
+    assert!(
+        message.contains("body 'up/per', export_matrices")
+            && message.contains("matrices/up/per_stiffness.mtx")
+            && message.contains("rename"),
+        "{message}"
+    );
+
+    let group_mesh = dir.path().join("group.msh");
+    std::fs::write(
+        &group_mesh,
+        text.replacen("\"lower_base\"", "\"../../base\"", 1),
+    )
+    .unwrap();
+    let with_group = |extra: &str| {
+        two_blocks_case(&group_mesh, "upper", extra)
+            .replace("group = \"lower_base\"", "group = \"../../base\"")
+    };
+    let message = case_failure(&with_group("export_matrices = true"));
+    assert!(
+        message.contains("group '../../base'") && message.contains("lower__../../base_mass.mtx"),
+        "{message}"
+    );
+    // Without the export the names are fine: the solution files do not use them as paths.
+    let (_dir, path) = write_case(&with_group(""));
+    run_quiet(&path).unwrap();
 }

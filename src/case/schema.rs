@@ -296,6 +296,41 @@ impl Case {
         Ok(())
     }
 
+    /// With `export_matrices`, body and boundary group names go into the file names
+    /// `matrices/<body>_stiffness.mtx` and `matrices/<body>__<group>_mass.mtx`: a `/` (or `\`)
+    /// there names a folder, or one outside the output folder (`../..`), so the export would
+    /// fail after the solve or write where it must not. Checked before anything is solved.
+    pub fn check_export_names(&self, mesh: &Mesh) -> Result<(), CaseError> {
+        let bad = |name: &str| name.contains(['/', '\\']);
+        for spec in &self.bodies {
+            let body = self.body_mesh(mesh, spec)?;
+            let groups = spec.dirichlet.iter().map(|d| &d.group);
+            let mut groups = groups.chain(spec.loads.iter().map(|l| &l.group));
+            let (what, file) = if bad(&spec.name) {
+                (
+                    "its name".to_string(),
+                    format!("{}_stiffness.mtx", spec.name),
+                )
+            } else if let Some(group) = groups.find(|g| bad(g) && body.boundary_group(g).is_some())
+            {
+                (
+                    format!("the name of group '{group}'"),
+                    format!("{}__{group}_mass.mtx", spec.name),
+                )
+            } else {
+                continue;
+            };
+            return Err(self.invalid(
+                format!("body '{}', export_matrices", spec.name),
+                format!(
+                    "{what} goes into the file name matrices/{file}, where a '/' or '\\' would \
+                     name a folder; rename the physical group or do not export the matrices"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Unnamed physical groups go by their tag, so an unnamed Physical Curve(1) and Physical
     /// Point(1) are both '1': a case naming '1' would silently get one of them.
     fn check_unambiguous(&self, mesh: &Mesh, context: &str, group: &str) -> Result<(), CaseError> {
