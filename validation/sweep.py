@@ -85,6 +85,12 @@ before any run and none is set from a result):
   more force than the lower at the same approach. The plane is taken from dolfinx instead
   (``pair_plane``: each body alone on a rigid flat, the plane where their approaches add up to
   delta at one force); the distances from -delta/2 are in the note of the row.
+* slid (``slide`` > 0: the curved body's support also pushed sideways by ``slide`` spacings, its
+  refined region widened by as much): ``slide: force``, |P / P_straight - 1| <= 1% (the tolerance of
+  the force everywhere), P_straight the force of its straight twin, the same mesh pushed straight
+  down. Over a flat, frictionless sliding moves where the block is loaded, not how much (the twin
+  is judged against Hertz like every case); the Hertz fit on the block is centred where the body
+  was pushed to.
 * quick-subset premises (``make test`` must contain them; computed from the mesh and the dolfinx
   reference, not from internodes): ``premise: rim gap / h`` (rim case: the reference's outermost
   contact node starts more than 3 curved-body spacings from the flat; figure 3 h / that gap,
@@ -162,6 +168,7 @@ class Case:
     premise: str = ""  # "rim" | "overlap" | "stiff-fine": what this case stands for in the quick subset
     timeout: float = 600.0  # seconds for the solve
     mesh_overrides: tuple = ()  # (geo parameter, value) pairs replacing the defaults of ``geo``
+    slide: float = 0.0  # spacings the curved body's support is also pushed sideways (x)
     why: str = ""
     # False: outside the supported range (README, "Contact"): the solve must then either be right
     # (converged, certified, every accuracy check met) or end with a status other than
@@ -210,6 +217,11 @@ class Case:
         return self.delta + self.gap
 
     @property
+    def lateral(self) -> float:
+        """Sideways displacement imposed on the curved body's support (x)."""
+        return self.slide * self.h
+
+    @property
     def roles(self) -> tuple[str, str]:
         """(the role h_c refers to, the other one): curved / block, or lower / upper."""
         return ("lower", "upper") if self.two_equal else ("curved", "block")
@@ -226,7 +238,8 @@ class Case:
     def geo(self) -> tuple[str, dict]:
         """geo script and its -setnumber parameters (mesh sizes in the module doc)."""
         a, h = self.a_target, self.h
-        r_c = round(max(1.3 * a, a + 3 * h, a + 2 * h * self.block_ratio), 3)
+        # A slid case keeps its contact zone inside the refined region of the block.
+        r_c = round(max(1.3 * a, a + 3 * h, a + 2 * h * self.block_ratio) + self.lateral, 3)
         if self.dim == 2:
             sizes = {"h_c": round(h, 6), "r_c": r_c, "h_far": 0.25, "d_far": 1.5}
         else:
@@ -247,9 +260,10 @@ class Case:
         role = "h_upper / h_lower" if self.two_equal else "block ratio"
         how = {"imposed": "imposed", "overlap": f"meshed overlap {-self.gap / self.h:.2g} h alone",
                "both": f"half meshed overlap ({-self.gap / self.h:.2g} h), half imposed"}[self.approach_by]
+        slid = f", slid sideways by {self.slide:g} h" if self.slide else ""
         return (f"{self.dim}D {self.kind}, h = R/{self.spacing}, ~{self.across:g} h across "
                 f"(a = {self.a_target:.4g}), delta = {self.delta:g} ({how}), E ratio {self.e_ratio:g}, "
-                f"primary {self.primary}, {role} {self.block_ratio:g}")
+                f"primary {self.primary}, {role} {self.block_ratio:g}{slid}")
 
 
 # The covering set. Columns: name, dim, kind, N, spacings across, E ratio, primary, block ratio, approach.
@@ -303,6 +317,13 @@ CASES = (
              "(explicit) with only 5 of its spacings across; must not end converged unless right"),
     Case("3d-two-equal-R50", 3, "two-equal", 50, 10, 1.0, "auto", block_ratio=TWO_EQUAL_RATIO,
          why="two equal hemispheres, different meshes; auto choice"),
+    Case("2d-hertz-R80-slid", 2, "hertz", 80, 16, 1.0, "auto", slide=8, quick=True,
+         why="pushed sideways by 8 spacings as well as down, equal materials: the surfaces are paired "
+             "where they touch (before, the block's reaction stayed where the contact began and the force "
+             "was certified 6% high); against Hertz and its straight twin"),
+    Case("3d-hertz-R33-E10-slid", 3, "hertz", 33, 7, 10.0, "auto", slide=4,
+         why="3D, pushed sideways by 4 spacings as well as down, E ratio 10; against Hertz and its "
+             "straight twin"),
 )
 
 
@@ -330,13 +351,15 @@ def primary_body(case: Case) -> str:
     return "auto" if case.primary == "auto" else case.bodies()[case.primary][0]
 
 
-def case_text(case: Case, msh: Path, output: Path) -> str:
-    """The TOML case: the curved (upper) body's support pushed down by ``imposed``, the other clamped."""
+def case_text(case: Case, msh: Path, output: Path, lateral: float | None = None) -> str:
+    """The TOML case: the curved (upper) body's support pushed down by ``imposed`` and sideways by
+    ``lateral`` (default the case's), the other clamped."""
+    lateral = case.lateral if lateral is None else lateral
     roles = case.bodies()
     (moving, moving_surface, moving_support), (fixed, fixed_surface, fixed_support) = roles.values()
     contact = contact_table((moving, fixed), (moving_surface, fixed_surface), primary_body(case))
     zero = ["ux = 0.0", "uy = 0.0", "uz = 0.0"][: case.dim]
-    push = zero[:-1] + [f"{'uz' if case.dim == 3 else 'uy'} = {-case.imposed!r}"]
+    push = [f"ux = {lateral!r}"] + zero[1:-1] + [f"{'uz' if case.dim == 3 else 'uy'} = {-case.imposed!r}"]
     e_fixed = YOUNGS_MODULUS * (1.0 if case.two_equal else case.e_ratio)
     text = f"# {case.name}: {case.parameters_text()} (written by validation/sweep.py)\n"
     text += f"mesh = {json.dumps(str(msh))}\noutput = {json.dumps(str(output))}\n\n{contact}"
@@ -347,19 +370,19 @@ def case_text(case: Case, msh: Path, output: Path) -> str:
     return text
 
 
-def solve(binary: Path, case: Case, msh: Path) -> tuple[Path, dict]:
+def solve(binary: Path, case: Case, msh: Path, straight: bool = False) -> tuple[Path, dict]:
     """Write the case and run internodes; returns (output folder, run record).
 
     An unconverged contact status exits 1 but writes its last iterate: that is a result whose
     status row fails, not a crash. No output at all is a RunFailed with the end of the log.
     """
-    folder = BUILD / case.name
+    folder = BUILD / (case.name + ("-straight" if straight else ""))
     folder.mkdir(parents=True, exist_ok=True)
     output = folder / "internodes"
     for stale in ("summary.json", "solution.h5"):
         (output / stale).unlink(missing_ok=True)
     toml = folder / "case.toml"
-    toml.write_text(case_text(case, msh, output))
+    toml.write_text(case_text(case, msh, output, 0.0 if straight else None))
     start = time.perf_counter()
     try:
         result = subprocess.run([str(binary), "solve", str(toml), "--output", str(output)], capture_output=True,
@@ -437,10 +460,12 @@ def vertical_force(out: dict, body: str, dim: int) -> float:
     return abs(float(out["contact"][key][dim - 1]))
 
 
-def hertz_fit(out: dict, body: str, dim: int) -> dict | None:
-    """Ellipse fit of the mean pressure over ``body``'s active nodes with p > 0 (r from the axis)."""
+def hertz_fit(out: dict, body: str, dim: int, axis: float = 0.0) -> dict | None:
+    """Ellipse fit of the mean pressure over ``body``'s active nodes with p > 0 (r from the axis,
+    at x = ``axis``)."""
     on = loaded(out, body, "contact_mean_pressure")
-    r = np.linalg.norm(out["geometry"][on][:, : dim - 1], axis=1)
+    lateral = out["geometry"][on][:, : dim - 1] - np.array([axis] + [0.0] * (dim - 2))
+    r = np.linalg.norm(lateral, axis=1)
     fit = contact_reference.ellipse_fit(r, out["contact_mean_pressure"][on])
     return fit and {"a": fit["a"], "p0": fit["p0"], "nodes": int(on.sum())}
 
@@ -584,7 +609,9 @@ def hertz_checks(case: Case, out: dict, h: dict) -> tuple[list[Check], dict]:
     role = next(r for r, (b, _, _) in case.bodies().items() if b == primary)
     force = vertical_force(out, primary, case.dim)
     theory = hertz(case, force)
-    fit = hertz_fit(out, primary, case.dim)
+    # Slid: the curved body's nodes move with it, the block's contact zone is centred where it
+    # was pushed to.
+    fit = hertz_fit(out, primary, case.dim, case.lateral if role in ("block", "lower") else 0.0)
     h_fit = h[role]
     resolved = theory["a"] / h_fit >= HERTZ_RESOLVED
     tol_a = HERTZ_TOLERANCE if resolved else h_fit / theory["a"]
@@ -726,11 +753,32 @@ def run_case(binary: Path, case: Case, out_dir: Path) -> tuple[list[Check], dict
                                   f"{half['distance'] / h_fine:.3g} h, mean {half['mean'] / h_fine:+.3g} h"))
         checks += more
         record |= data
+        if case.slide:
+            more, data = slide_checks(binary, case, msh, out)
+            checks += more
+            record |= data
     except (RunFailed, contact_reference.ReferenceFailure, OSError, KeyError, ValueError, TypeError,
             json.JSONDecodeError) as error:
         checks.append(Check("run", case.name, math.nan, 0.0, f"{type(error).__name__}: {error}"))
         record["error"] = f"{type(error).__name__}: {error}"
     return checks, record
+
+
+def slide_checks(binary: Path, case: Case, msh: Path, out: dict) -> tuple[list[Check], dict]:
+    """A slid case against its straight twin (same mesh, pushed straight down): over a flat,
+    frictionless sliding moves where the block is loaded, not how much, so the two forces on the
+    curved body agree (the twin is itself judged against Hertz by the case without a slide)."""
+    output, _ = solve(binary, case, msh, straight=True)
+    twin = read_output(output)
+    curved = case.bodies()["curved"][0]
+    if twin["contact"].get("status") != "converged":
+        return [Check("slide: force", case.name, math.nan, FORCE_TOLERANCE,
+                      f"the straight twin ended {twin['contact'].get('status')}")], {}
+    force, straight = vertical_force(out, curved, case.dim), vertical_force(twin, curved, case.dim)
+    error = abs(force / straight - 1)
+    return [Check("slide: force", case.name, error, FORCE_TOLERANCE,
+                  f"P = {force:.6g} slid by {case.lateral:.4g} ({case.slide:g} h), {straight:.6g} pushed "
+                  f"straight down on the same mesh")], {"slide": {"force": force, "straight": straight}}
 
 
 def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None = None) -> SuiteResult:
