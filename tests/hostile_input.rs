@@ -1180,3 +1180,48 @@ fn names_with_a_slash_are_refused_before_solving_when_matrices_are_exported() {
     let (_dir, path) = write_case(&with_group(""));
     run_quiet(&path).unwrap();
 }
+
+#[test]
+fn a_curve_of_a_3d_body_named_as_a_boundary_group_is_an_error_saying_so() {
+    // The reader keeps no edges of a 3D mesh, so 'base_edge' was reported as missing from the
+    // body, though `info` lists it.
+    let clamped = |group: &str| {
+        format!(
+            r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "{group}"
+ux = 0.0
+uy = 0.0
+uz = 0.0
+[[body.load]]
+group = "block_top"
+pressure = 1.0
+"#,
+            fixture("cube_edge_group.msh").display()
+        )
+    };
+    let message = case_failure(&clamped("base_edge"));
+    assert!(
+        message.contains("group 'base_edge'")
+            && message.contains("is a physical curve of")
+            && message.contains("a curve of a 3D body, which is not a boundary group")
+            && message.contains("physical surfaces"),
+        "{message}"
+    );
+    let message = case_failure(&clamped("block"));
+    assert!(
+        message.contains("'block' is a physical volume") && message.contains("a body"),
+        "{message}"
+    );
+    // The base itself is a boundary group: a unit pressure on the unit top is carried by it.
+    let (_dir, path) = write_case(&clamped("block_base"));
+    let report = run_quiet(&path).unwrap();
+    let reaction = report.summary.bodies[0].reactions["block_base"][2];
+    assert!((reaction - 1.0).abs() < 1e-10, "{reaction}");
+}

@@ -281,11 +281,13 @@ impl Case {
     /// any body is an error before anything is solved or written.
     pub fn check_bodies(&self, mesh: &Mesh) -> Result<(), CaseError> {
         for spec in &self.bodies {
+            let body = self.body_mesh(mesh, spec)?;
             let groups = spec.dirichlet.iter().map(|d| &d.group);
             for group in groups.chain(spec.loads.iter().map(|l| &l.group)) {
-                self.check_unambiguous(mesh, &format!("body '{}'", spec.name), group)?;
+                let context = format!("body '{}'", spec.name);
+                self.check_unambiguous(mesh, &context, group)?;
+                self.check_group_dimension(mesh, body, &context, group)?;
             }
-            let body = self.body_mesh(mesh, spec)?;
             self.elastic_problem(body, spec)?;
         }
         if let Some(contact) = &self.contact {
@@ -329,6 +331,48 @@ impl Case {
             ));
         }
         Ok(())
+    }
+
+    /// A group that is not on the body but is a physical group of another dimension than
+    /// boundary groups and points (a curve of a 3D mesh, whose edges the reader does not keep, or
+    /// a body) would be reported as missing: say what it is and what is needed instead.
+    fn check_group_dimension(
+        &self,
+        mesh: &Mesh,
+        body: &BodyMesh,
+        context: &str,
+        group: &str,
+    ) -> Result<(), CaseError> {
+        if body.group_nodes(group).is_some() {
+            return Ok(());
+        }
+        let kind = ["point", "curve", "surface", "volume"];
+        let Some(found) = mesh
+            .physical_groups
+            .iter()
+            .find(|g| g.name == group && g.dim != 0 && g.dim + 1 != mesh.dim)
+        else {
+            return Ok(());
+        };
+        let what = if found.dim == mesh.dim {
+            "a body, not a boundary group".to_string()
+        } else {
+            format!(
+                "a {} of a {}D body, which is not a boundary group",
+                kind[found.dim], mesh.dim
+            )
+        };
+        Err(self.invalid(
+            format!("{context}, group '{group}'"),
+            format!(
+                "'{group}' is a physical {} of {}: {what}; Dirichlet conditions and loads act on \
+                 boundary groups, the physical {}s on the body's boundary (Dirichlet conditions \
+                 also on physical points)",
+                kind[found.dim],
+                mesh.path.display(),
+                kind[mesh.dim - 1]
+            ),
+        ))
     }
 
     /// Unnamed physical groups go by their tag, so an unnamed Physical Curve(1) and Physical
