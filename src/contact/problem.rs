@@ -100,8 +100,8 @@ pub struct ContactSettings {
     /// 2.5: four nodes across a 2D zone).
     pub secondary_min_zone_width: f64,
     /// The certificate's bound on the distance between the centres of the normal contact
-    /// forces on the two bodies, over the primary's spacing (`super::checks`; default 0.25):
-    /// equal and opposite forces must also act at the same place.
+    /// forces on the two bodies, over the coarser surface's spacing where they are loaded
+    /// (`super::checks`; default 1): equal and opposite forces must also act at the same place.
     pub force_centre_tolerance: f64,
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
@@ -131,7 +131,7 @@ impl Default for ContactSettings {
             secondary_min_zone_width: 2.5,
             certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
-            force_centre_tolerance: 0.25,
+            force_centre_tolerance: 1.0,
             primary_agreement_tolerance: 0.01,
             rbf_radius: 2.0,
         }
