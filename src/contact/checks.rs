@@ -322,12 +322,12 @@ fn force_centres(sides: &[Side; 2], mean: &[Vec<f64>]) -> ForceCentres {
             spacing = spacing.max(loaded.sum::<f64>() / magnitude);
         }
         (total > 0.0).then(|| {
-            std::array::from_fn(|c| {
-                (0..own.len())
-                    .map(|s| force(s) * own.deformed(u_own, s)[c])
-                    .sum::<f64>()
-                    / total
-            })
+            let mut moment = [0.0; 3];
+            for s in 0..own.len() {
+                let (f, x) = (force(s), own.deformed(u_own, s));
+                (0..3).for_each(|k| moment[k] += f * x[k]);
+            }
+            moment.map(|m| m / total)
         })
     });
     ForceCentres { centres, spacing }

@@ -125,40 +125,23 @@ impl InterfaceOperators {
         })
     }
 
-    /// How far the primary surface has slid over the secondary for the displacements `u1`,
-    /// `u2` (body dofs): the area-weighted mean over the `active` primary nodes (surface
-    /// indices, whose rows of `R12` are built) of the tangential part of `u1_i - (R12 u2)_i`.
-    /// Only the mean, the zone's rigid slide: the tangential strain of the surfaces (the
-    /// Poisson expansion of a body pressed onto another) is of the order of the strains the
-    /// linear theory neglects, and pairing the nodes where that strain moved them unbalanced
-    /// the interpolation transfer by 2% on a half-disc (its multiplier is a traction per unit
-    /// reference area).
+    /// How far the primary surface has slid over the secondary: the area-weighted mean over
+    /// the `active` primary nodes (surface indices) of the tangential part of their jumps
+    /// ([`Self::jumps`]). Only the mean, the zone's rigid slide: the tangential strain of the
+    /// surfaces (the Poisson expansion of a body pressed onto another) is of the order of the
+    /// strains the linear theory neglects, and pairing the nodes where that strain moved them
+    /// unbalanced the interpolation transfer by 2% on a half-disc (its multiplier is a traction
+    /// per unit reference area).
     pub fn slide(
         &self,
         primary: &ContactSurface,
-        secondary: &ContactSurface,
-        u1: &[f64],
-        u2: &[f64],
+        jumps: &[[f64; 3]],
         active: &[usize],
     ) -> [f64; 3] {
-        let dim = primary.dim;
-        let displacement = |u: &[f64], node: usize| -> [f64; 3] {
-            std::array::from_fn(|k| if k < dim { u[dim * node + k] } else { 0.0 })
-        };
         let (mut sum, mut area) = ([0.0; 3], 0.0);
         for &i in active {
-            let Some(row) = self.rows12.get(&i) else {
-                continue;
-            };
-            let u1_i = displacement(u1, primary.nodes[i]);
-            let mut jump = u1_i;
-            for &(j, w) in row {
-                let u2_j = displacement(u2, secondary.nodes[j]);
-                (0..3).for_each(|k| jump[k] -= w * u2_j[k]);
-            }
-            let n = self.normals[i];
+            let (jump, n, a) = (jumps[i], self.normals[i], primary.nodal_area[i]);
             let along: f64 = (0..3).map(|k| jump[k] * n[k]).sum();
-            let a = primary.nodal_area[i];
             (0..3).for_each(|k| sum[k] += a * (jump[k] - along * n[k]));
             area += a;
         }
@@ -233,15 +216,15 @@ impl InterfaceOperators {
         }
     }
 
-    /// The linearized gap of every primary candidate, `g_i(u) = d_i - n_i . (u1_i - (R12
-    /// u2)_i)`, for the bodies' displacements `u1`, `u2` (body dofs).
-    pub fn linearized_gaps(
+    /// The displacement jump `u1_i - (R12 u2)_i` of every primary candidate, for the bodies'
+    /// displacements `u1`, `u2` (body dofs): what the linearized gaps and the slide read.
+    pub fn jumps(
         &self,
         primary: &ContactSurface,
         secondary: &ContactSurface,
         u1: &[f64],
         u2: &[f64],
-    ) -> Vec<f64> {
+    ) -> Vec<[f64; 3]> {
         let dim = primary.dim;
         let u2_flat: Vec<f64> = secondary
             .nodes
@@ -252,11 +235,19 @@ impl InterfaceOperators {
         (0..primary.len())
             .map(|i| {
                 let node = primary.nodes[i];
-                let jump: f64 = (0..dim)
-                    .map(|k| self.normals[i][k] * (u1[dim * node + k] - u2_at_1[3 * i + k]))
-                    .sum();
-                self.reference_gaps[i] - jump
+                std::array::from_fn(|k| {
+                    let u1_k = if k < dim { u1[dim * node + k] } else { 0.0 };
+                    u1_k - u2_at_1[3 * i + k]
+                })
             })
+            .collect()
+    }
+
+    /// The linearized gap of every primary candidate, `g_i(u) = d_i - n_i . (u1_i - (R12
+    /// u2)_i)`, from its jump ([`Self::jumps`]).
+    pub fn linearized_gaps(&self, jumps: &[[f64; 3]]) -> Vec<f64> {
+        (jumps.iter().zip(&self.normals).zip(&self.reference_gaps))
+            .map(|((jump, n), d)| d - (0..3).map(|k| n[k] * jump[k]).sum::<f64>())
             .collect()
     }
 }

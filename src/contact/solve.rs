@@ -221,8 +221,9 @@ impl<'a> ContactSolver<'a> {
             let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
             let (gaps, linear, slid) = timed(&mut seconds.search, || {
                 let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                let slid = self.operators.slide(s1, s2, u1, u2, &nodes);
-                (gaps, self.operators.linearized_gaps(s1, s2, u1, u2), slid)
+                let jumps = self.operators.jumps(s1, s2, u1, u2);
+                let slid = self.operators.slide(s1, &jumps, &nodes);
+                (gaps, self.operators.linearized_gaps(&jumps), slid)
             });
             let drift = pairing_drift(&self.operators.slid, &slid, s1, &nodes);
             // 4. The primal-dual active set update, and the gap corrections.
@@ -246,8 +247,8 @@ impl<'a> ContactSolver<'a> {
             let step = match safeguard.next(&active, &update) {
                 Step::Stop(ContactStatus::Converged) if drift > REPAIR_DRIFT_OVER_H => {
                     timed(&mut seconds.operators, || self.pair_again(slid))?;
-                    let linear =
-                        (self.operators).linearized_gaps(s1, s2, &solution.u1, &solution.u2);
+                    let jumps = (self.operators).jumps(s1, s2, &solution.u1, &solution.u2);
+                    let linear = self.operators.linearized_gaps(&jumps);
                     corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
                     safeguard = Safeguard::default();
                     Step::Solve(active.clone())
