@@ -393,7 +393,9 @@ impl Safeguard {
                 return Step::Stop(ContactStatus::Converged);
             }
             let error = update.max_gap_error_over_h;
-            let contracted = self.last_error.is_none_or(|last| error <= CONTRACTION * last);
+            let contracted = self
+                .last_error
+                .is_none_or(|last| error <= CONTRACTION * last);
             self.slow = if contracted { 0 } else { self.slow + 1 };
             self.last_error = Some(error);
             return if self.slow >= STALLED_AFTER {
@@ -434,4 +436,93 @@ fn timed<T>(slot: &mut f64, f: impl FnOnce() -> T) -> T {
     let value = f();
     *slot += clock.elapsed().as_secs_f64();
     value
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An update that keeps `active` as it is, with the active nodes' gap error `error` (over
+    /// h), settled or not.
+    fn unchanged(active: &BTreeSet<usize>, error: f64, settled: bool) -> Update {
+        Update {
+            next: active.clone(),
+            tension: Vec::new(),
+            penetrating: Vec::new(),
+            settled,
+            active: active.len(),
+            max_gap_error_over_h: error,
+        }
+    }
+
+    fn status(step: Step) -> Option<ContactStatus> {
+        match step {
+            Step::Stop(status) => Some(status),
+            Step::Solve(_) => None,
+        }
+    }
+
+    #[test]
+    fn a_gap_error_that_stops_contracting_ends_stalled() {
+        let active: BTreeSet<usize> = [1, 2, 3].into();
+        let mut safeguard = Safeguard::default();
+        // The first solve of a set has nothing to compare with; then 0.9 and 0.95 of the last.
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1e-2, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 9e-3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 8.5e-3, false))),
+            Some(ContactStatus::Stalled)
+        );
+    }
+
+    #[test]
+    fn a_contracting_gap_error_goes_on_until_it_settles() {
+        let active: BTreeSet<usize> = [1, 2].into();
+        let mut safeguard = Safeguard::default();
+        for error in [1e-1, 4e-2, 1e-3, 1e-6] {
+            assert_eq!(
+                status(safeguard.next(&active, &unchanged(&active, error, false))),
+                None
+            );
+        }
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1e-9, true))),
+            Some(ContactStatus::Converged)
+        );
+    }
+
+    #[test]
+    fn a_slow_iteration_on_a_new_active_set_starts_the_count_again() {
+        let (first, second): (BTreeSet<usize>, BTreeSet<usize>) = ([1, 2].into(), [1, 2, 3].into());
+        let mut safeguard = Safeguard::default();
+        assert_eq!(
+            status(safeguard.next(&first, &unchanged(&first, 1e-2, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&first, &unchanged(&first, 9e-3, false))),
+            None
+        );
+        let mut grow = unchanged(&first, 9e-3, false);
+        grow.next = second.clone();
+        assert_eq!(status(safeguard.next(&first, &grow)), None);
+        assert_eq!(
+            status(safeguard.next(&second, &unchanged(&second, 8e-3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&second, &unchanged(&second, 7.9e-3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&second, &unchanged(&second, 7.8e-3, false))),
+            Some(ContactStatus::Stalled)
+        );
+    }
 }
