@@ -717,12 +717,17 @@ pub(super) struct Update {
     pub(super) next: BTreeSet<usize>,
     /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
     pub(super) tension: Vec<(usize, f64)>,
-    /// Inactive nodes facing the other surface with `g_i < -tol_p h_i`, with their penetration
-    /// over `h_i` (a penetrating node that does not face the other candidate surface is left
-    /// to the certificate, which names it).
+    /// Inactive nodes with `g_i < -tol_p h_i`, with their penetration over `h_i`: every
+    /// primary candidate, as the certificate's penetration check measures them. (Only the nodes
+    /// that faced the other surface in the reference configuration were once tested, and a
+    /// block node under a punch's corner, whose line along the contact normal meets the punch's
+    /// side, was left penetrating by 1% of a spacing for the certificate to refuse.)
     pub(super) penetrating: Vec<(usize, f64)>,
     /// Every active node lies on the other surface: `|g_i| <= SETTLED tol_p h_i`.
     pub(super) settled: bool,
+    /// Every active node lies on the other surface within the penetration tolerance,
+    /// `|g_i| <= tol_p h_i`: the complementarity residual passes.
+    pub(super) within_tolerance: bool,
     pub(super) active: usize,
     pub(super) max_gap_error_over_h: f64,
 }
@@ -734,7 +739,6 @@ impl Update {
         traction: &[[f64; 3]],
         normals: &[[f64; 3]],
         [gaps, held]: [&[f64]; 2],
-        facing: &[bool],
         pinned: &HashSet<usize>,
     ) -> Self {
         let settings = &problem.settings;
@@ -753,7 +757,7 @@ impl Update {
             .collect();
         let is_active: HashSet<usize> = active.iter().copied().collect();
         let penetrating: Vec<(usize, f64)> = (0..s1.len())
-            .filter(|&i| facing[i] && !is_active.contains(&i))
+            .filter(|&i| !is_active.contains(&i))
             .map(|i| (i, -gaps[i] / s1.spacing[i]))
             .filter(|&(_, over_h)| over_h > settings.penetration_tolerance)
             .collect();
@@ -769,6 +773,7 @@ impl Update {
         Self {
             next,
             settled: max_gap_error_over_h <= super::solve::SETTLED * settings.penetration_tolerance,
+            within_tolerance: max_gap_error_over_h <= settings.penetration_tolerance,
             tension,
             penetrating,
             active: active.len(),
