@@ -585,6 +585,24 @@ def turned_mesh(msh: Path, dim: int) -> Path:
     return out
 
 
+def lifted_mesh(msh: Path, dim: int, shift: float) -> Path:
+    """The mesh moved up by ``shift`` along the vertical axis (``<stem>_lifted<shift>.msh`` beside it,
+    rewritten when older than the mesh): the curved body of a mesh made overlapping (geo ``gap < 0``),
+    lifted by -gap, is the same discrete body with its pole on the flat, which the reference needs."""
+    out = msh.with_name(f"{msh.stem}_lifted{shift:g}.msh")
+    if out.is_file() and out.stat().st_mtime >= msh.stat().st_mtime:
+        return out
+    with _gmsh_model(msh):
+        tags, coords, _ = gmsh.model.mesh.getNodes(includeBoundary=True, returnParametricCoord=False)
+        for k, tag in enumerate(tags):
+            x = list(coords[3 * k:3 * k + 3])
+            x[dim - 1] += shift
+            gmsh.model.mesh.setNode(int(tag), x, [])
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(str(out))
+    return out
+
+
 # Approaches of each body alone, as fractions of the pair's delta: each takes about half of it.
 PAIR_FRACTIONS = (0.35, 0.45, 0.5, 0.55, 0.65)
 
