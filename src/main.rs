@@ -40,6 +40,12 @@ enum Command {
     },
 }
 
+/// Exit status of a solve whose contact problem was not solved (a status other than
+/// `converged` or `no-contact`).
+const EXIT_NOT_SOLVED: u8 = 2;
+/// Exit status of a solve whose contact problem was solved but whose accuracy report failed.
+const EXIT_INACCURATE: u8 = 3;
+
 fn main() -> ExitCode {
     // A closed pipe on stdout or stderr (`internodes solve case 2>&1 | head -1`) ends the
     // process as it ends every Unix tool, by SIGPIPE, instead of a panic in `eprintln!` (Rust
@@ -53,7 +59,7 @@ fn main() -> ExitCode {
     // solves guarantee it themselves; faer's sparse LUs (RBF interpolation, the monolithic
     // reference solver) take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
-    let result: Result<(), Box<dyn Error>> = match Cli::parse().command {
+    let result: Result<u8, Box<dyn Error>> = match Cli::parse().command {
         Command::Solve {
             case,
             output,
@@ -68,29 +74,35 @@ fn main() -> ExitCode {
             },
         )
         .map_err(Into::into)
-        .and_then(|report| match report.summary.contact.as_ref() {
-            Some(contact) if !contact.status.is_solution() => {
-                let status = contact.status.name();
-                let failures = contact.certificate.failures();
-                Err(format!(
-                    "the contact solve did not converge: status \"{status}\"{} (see {}/summary.json); the last iterate was written for inspection",
-                    if failures.is_empty() {
-                        String::new()
-                    } else {
-                        format!(", certificate failed: {failures}")
-                    },
-                    report.output_dir.display()
-                )
-                .into())
+        .map(|report| {
+            let folder = report.output_dir.display();
+            match report.summary.contact.as_ref() {
+                Some(contact) if !contact.status.is_solution() => {
+                    let failed = failures(&contact.solved.checks);
+                    eprintln!(
+                        "error: the contact problem was not solved: status \"{}\"{} (see {folder}/summary.json); the last iterate was written for inspection",
+                        contact.status.name(),
+                        if failed.is_empty() { String::new() } else { format!(", failed: {failed}") },
+                    );
+                    EXIT_NOT_SOLVED
+                }
+                Some(contact) if !contact.accuracy.passed => {
+                    eprintln!(
+                        "error: the contact problem was solved, but its accuracy report failed: {} (see {folder}/summary.json)",
+                        failures(&contact.accuracy.indicators)
+                    );
+                    EXIT_INACCURATE
+                }
+                _ => 0,
             }
-            _ => Ok(()),
         }),
         Command::Info { mesh } => read_msh(&mesh)
             .map_err(Into::into)
-            .and_then(|m| print_stdout(&MeshSummary(&m).to_string())),
+            .and_then(|m| print_stdout(&MeshSummary(&m).to_string()))
+            .map(|()| 0),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => ExitCode::from(code),
         Err(e) => {
             eprintln!("error: {e}");
             for cause in unsaid_causes(&*e) {
@@ -99,6 +111,14 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The failed checks among `checks`, in one line.
+fn failures(checks: &[internodes::contact::CertificateCheck]) -> String {
+    (checks.iter().filter(|c| !c.passed))
+        .map(|c| c.describe())
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// Writes `text` to stdout. A reader that stops early (`internodes info m.msh | head`) closes

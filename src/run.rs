@@ -403,13 +403,15 @@ fn summarize_contact(
     steps: Vec<StepRecord>,
 ) -> ContactSummary {
     let dim = problem.primary_surface.dim;
+    let (solved, accuracy) = ContactSummary::checks(&solution.certificate);
     ContactSummary {
         status: solution.status,
         primary: problem.primary.body.name.clone(),
         secondary: problem.secondary.body.name.clone(),
         primary_choice: problem.primary_report.clone(),
         transfer: problem.transfer(),
-        certificate: solution.certificate.clone(),
+        solved,
+        accuracy,
         settings: problem.settings,
         force_primary: solution.force_primary[..dim].to_vec(),
         force_secondary: solution.force_secondary[..dim].to_vec(),

@@ -49,23 +49,100 @@ use serde::Serialize;
 use std::collections::{BTreeSet, HashSet};
 
 use super::interface::geometric_gaps;
+use super::linearization::gap_rows;
 use super::solution::{IterationRecord, PhaseSeconds};
 use super::system::CoupledSolution;
-use super::{ContactProblem, ContactSurface};
+use super::{ContactProblem, ContactSurface, Formulation};
 
-/// The checks of one contact answer.
-#[derive(Debug, Clone, Serialize)]
+/// What a check measures. The first five are residuals of the discrete contact problem: they
+/// decide whether it is solved (the status, [`contact_status`]). The others are accuracy
+/// indicators: they say whether the solved problem's answer can be trusted (the accuracy
+/// report), and never change the status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum CheckKind {
+    /// Primal feasibility: no primary node inside the other body (over its spacing).
+    #[serde(rename = "penetration")]
+    Penetration,
+    /// Primal feasibility of the secondary's nodes, which only the transfer holds.
+    #[serde(rename = "secondary penetration")]
+    SecondaryPenetration,
+    /// Dual feasibility: no surface node of either body pulled (over the largest pressure).
+    #[serde(rename = "tension")]
+    Tension,
+    /// Complementarity: every active node on the other surface (over its spacing).
+    #[serde(rename = "complementarity")]
+    Complementarity,
+    /// Equilibrium of the interface: the contact forces on the two bodies balance.
+    #[serde(rename = "equilibrium")]
+    Equilibrium,
+    /// The secondary's sag between constrained primary nodes, over the indentation depth.
+    #[serde(rename = "secondary sag")]
+    SecondarySag,
+    /// The contact zone's width in spacings, against the minimum.
+    #[serde(rename = "resolution")]
+    Resolution,
+    /// Where the two bodies' contact forces act, over the coarser spacing.
+    #[serde(rename = "force centre")]
+    ForceCentre,
+    /// The contact force against the other primary's.
+    #[serde(rename = "primary agreement")]
+    PrimaryAgreement,
+}
+
+impl CheckKind {
+    /// The name in `summary.json` and in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Penetration => "penetration",
+            Self::SecondaryPenetration => "secondary penetration",
+            Self::Tension => "tension",
+            Self::Complementarity => "complementarity",
+            Self::Equilibrium => "equilibrium",
+            Self::SecondarySag => "secondary sag",
+            Self::Resolution => "resolution",
+            Self::ForceCentre => "force centre",
+            Self::PrimaryAgreement => "primary agreement",
+        }
+    }
+
+    /// A residual of the discrete problem (the status), not an accuracy indicator.
+    pub fn is_residual(self) -> bool {
+        matches!(
+            self,
+            Self::Penetration
+                | Self::SecondaryPenetration
+                | Self::Tension
+                | Self::Complementarity
+                | Self::Equilibrium
+        )
+    }
+
+    /// The unit of the figure, for messages.
+    fn unit(self) -> &'static str {
+        match self {
+            Self::Penetration | Self::SecondaryPenetration | Self::Complementarity => " h",
+            Self::Tension => " of the largest pressure",
+            Self::SecondarySag => " of the indentation depth",
+            Self::ForceCentre => {
+                " of the coarser spacing (between the two bodies' centres of normal force)"
+            }
+            Self::Resolution => " (spacing over the contact zone's width, over the minimum's, rim)",
+            Self::PrimaryAgreement | Self::Equilibrium => " of the force",
+        }
+    }
+}
+
+/// The checks of one contact answer: the residuals of the discrete problem and the accuracy
+/// indicators ([`CheckKind`]).
+#[derive(Debug, Clone)]
 pub struct Certificate {
-    pub passed: bool,
     pub checks: Vec<CertificateCheck>,
 }
 
 /// One check: its figure against its tolerance, and where the worst value is.
 #[derive(Debug, Clone, Serialize)]
 pub struct CertificateCheck {
-    /// "penetration" and "secondary penetration" (over h), "tension" (over the largest
-    /// pressure), "secondary sag" (over the indentation depth), or "imbalance".
-    pub name: &'static str,
+    pub name: CheckKind,
     pub value: f64,
     pub tolerance: f64,
     pub passed: bool,
@@ -80,12 +157,31 @@ pub struct CertificateCheck {
 impl Certificate {
     /// Adds a check made outside [`certify`] (e.g. [`primary_agreement`]).
     pub fn push(&mut self, check: CertificateCheck) {
-        self.passed &= check.passed;
         self.checks.push(check);
     }
 
-    /// The names of the failed checks.
-    pub fn failed(&self) -> Vec<&'static str> {
+    /// Every residual check passed: the discrete problem is solved.
+    pub fn solved(&self) -> bool {
+        self.residuals().all(|c| c.passed)
+    }
+
+    /// Every accuracy indicator passed.
+    pub fn accurate(&self) -> bool {
+        self.indicators().all(|c| c.passed)
+    }
+
+    /// The residual checks.
+    pub fn residuals(&self) -> impl Iterator<Item = &CertificateCheck> {
+        self.checks.iter().filter(|c| c.name.is_residual())
+    }
+
+    /// The accuracy indicators.
+    pub fn indicators(&self) -> impl Iterator<Item = &CertificateCheck> {
+        self.checks.iter().filter(|c| !c.name.is_residual())
+    }
+
+    /// The kinds of the failed checks.
+    pub fn failed(&self) -> Vec<CheckKind> {
         (self.checks.iter())
             .filter(|c| !c.passed)
             .map(|c| c.name)
@@ -103,34 +199,39 @@ impl Certificate {
     }
 }
 
+/// How the loop's ending and the residual checks make the status: the one place that decides
+/// it. A loop that stopped converged has solved the discrete problem only if every residual,
+/// measured independently of the loop's operators, is within its tolerance; an empty active
+/// set is then no contact. The accuracy indicators play no part.
+pub fn contact_status(
+    loop_end: super::ContactStatus,
+    certificate: &Certificate,
+    active_is_empty: bool,
+) -> super::ContactStatus {
+    use super::ContactStatus::{Converged, NoContact, NotSolved};
+    match loop_end {
+        Converged if !certificate.solved() => NotSolved,
+        Converged if active_is_empty => NoContact,
+        other => other,
+    }
+}
+
 impl CertificateCheck {
     pub fn describe(&self) -> String {
         let at = match (&self.body, self.node_tag) {
             (Some(body), Some(tag)) => format!(" at node {tag} of '{body}'"),
             _ => String::new(),
         };
-        let unit = if self.name.ends_with("penetration") {
-            " h"
-        } else if self.name.ends_with("tension") {
-            " of the largest pressure"
-        } else if self.name.ends_with("sag") {
-            " of the indentation depth"
-        } else if self.name == "force centre" {
-            " of the coarser spacing (between the two bodies' centres of normal force)"
-        } else if self.name == "resolution" {
-            " (spacing over the contact zone's width, over the minimum's, rim)"
-        } else if self.name == "primary agreement" {
-            " of the force"
-        } else {
-            ""
-        };
+        let unit = self.name.unit();
         let note = self
             .note
             .as_ref()
             .map_or(String::new(), |note| format!(": {note}"));
         format!(
             "{} {:.3e}{unit}{at} (tolerance {:.1e}){note}",
-            self.name, self.value, self.tolerance
+            self.name.name(),
+            self.value,
+            self.tolerance
         )
     }
 }
@@ -141,6 +242,7 @@ impl CertificateCheck {
 pub fn certify(
     problem: &ContactProblem,
     solution: &CoupledSolution,
+    active: &[usize],
 ) -> (Certificate, [Vec<f64>; 2]) {
     let settings = &problem.settings;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
@@ -212,19 +314,31 @@ pub fn certify(
         settings.secondary_penetration_tolerance,
     );
     let centres = force_centres(&sides, &mean);
+    // Complementarity: the gap each active node's constraint holds, measured again at the
+    // answer (frictionless: the gap of its linearization, `super::linearization`, which is the
+    // geometric gap wherever the node faces the inside of a secondary facet; tied: the
+    // geometric gap).
+    let held: Vec<f64> = match settings.formulation {
+        Formulation::Frictionless => (gap_rows(s1, s2, Some(u1), Some(u2)).into_iter())
+            .map(|row| row.gap)
+            .collect(),
+        Formulation::Tied => gaps[0].clone(),
+    };
+    let mut complementarity = Worst::default();
+    for &i in active {
+        complementarity.offer(held[i].abs() / s1.spacing[i], s1, i);
+    }
     let [penetration1, penetration2] = penetration;
     let checks = vec![
-        penetration1.check("penetration", settings.penetration_tolerance),
+        penetration1.check(CheckKind::Penetration, settings.penetration_tolerance),
         penetration2.check(
-            "secondary penetration",
+            CheckKind::SecondaryPenetration,
             settings.secondary_penetration_tolerance,
         ),
-        tension.check("tension", settings.certificate_tension_tolerance),
-        secondary_sag,
-        resolution,
-        centres.check(settings.force_centre_tolerance),
+        tension.check(CheckKind::Tension, settings.certificate_tension_tolerance),
+        complementarity.check(CheckKind::Complementarity, settings.penetration_tolerance),
         CertificateCheck {
-            name: "imbalance",
+            name: CheckKind::Equilibrium,
             value: imbalance,
             tolerance: settings.imbalance_tolerance,
             passed: imbalance <= settings.imbalance_tolerance,
@@ -232,14 +346,11 @@ pub fn certify(
             node_tag: None,
             note: None,
         },
+        secondary_sag,
+        resolution,
+        centres.check(settings.force_centre_tolerance),
     ];
-    (
-        Certificate {
-            passed: checks.iter().all(|c| c.passed),
-            checks,
-        },
-        gaps,
-    )
+    (Certificate { checks }, gaps)
 }
 
 /// The primary agreement check: `|F - F_other| / |F_other|`, `F` the total contact force on
@@ -281,7 +392,7 @@ pub fn primary_agreement(
         ),
     };
     CertificateCheck {
-        name: "primary agreement",
+        name: CheckKind::PrimaryAgreement,
         value,
         tolerance,
         passed: value <= tolerance,
@@ -352,7 +463,7 @@ impl ForceCentres {
             _ => 0.0,
         };
         CertificateCheck {
-            name: "force centre",
+            name: CheckKind::ForceCentre,
             value,
             tolerance,
             passed: value <= tolerance,
@@ -412,7 +523,7 @@ fn secondary_sag(
         let floor = settings.penetration_tolerance * secondary.spacing[s] / settings.sag_tolerance;
         worst.offer(-g / indentation.max(floor), secondary, s);
     }
-    worst.check("secondary sag", settings.sag_tolerance)
+    worst.check(CheckKind::SecondarySag, settings.sag_tolerance)
 }
 
 /// A secondary body whose share of the two bodies' compliance (`1 / E*`) is below this is
@@ -462,7 +573,7 @@ fn zone_resolution(
         let width = (2.0 * distance(rim)).max(spacing / 1000.0);
         check.offer(min_width * spacing / width, surface, rim);
     }
-    check.check("resolution", 1.0)
+    check.check(CheckKind::Resolution, 1.0)
 }
 
 /// The edge length of a regular mesh whose nodes stand for node `s`'s area: the area itself in
@@ -494,7 +605,7 @@ impl Worst {
         }
     }
 
-    fn check(self, name: &'static str, tolerance: f64) -> CertificateCheck {
+    fn check(self, name: CheckKind, tolerance: f64) -> CertificateCheck {
         let (body, node_tag) = self.node.map_or((None, None), |(b, t)| (Some(b), Some(t)));
         CertificateCheck {
             name,
@@ -529,7 +640,7 @@ impl Update {
         active: &[usize],
         traction: &[[f64; 3]],
         normals: &[[f64; 3]],
-        gaps: &[f64],
+        [gaps, held]: [&[f64]; 2],
         facing: &[bool],
         pinned: &HashSet<usize>,
     ) -> Self {
@@ -555,7 +666,7 @@ impl Update {
             .collect();
         let max_gap_error_over_h = active
             .iter()
-            .map(|&i| gaps[i].abs() / s1.spacing[i])
+            .map(|&i| held[i].abs() / s1.spacing[i])
             .fold(0.0, f64::max);
         let mut next: BTreeSet<usize> = active.iter().copied().collect();
         for (i, _) in &tension {

@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::checks::primary_agreement;
+use super::checks::{CheckKind, primary_agreement};
 use super::{
     CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus,
 };
@@ -38,30 +38,35 @@ pub struct StepRecord {
     pub hertz_a: Option<f64>,
     pub hertz_p0: Option<f64>,
     pub seconds: f64,
-    /// The names of the certificate checks this step failed (`not-certified`).
-    pub failed_checks: Vec<&'static str>,
+    /// Whether the step's accuracy report passed.
+    pub accurate: bool,
+    /// The checks this step failed: residuals (`not-solved`) and accuracy indicators.
+    pub failed_checks: Vec<CheckKind>,
 }
 
 impl StepRecord {
-    /// Adds a check made after the loop: a failed one makes a `converged` step
-    /// `not-certified`.
+    /// Adds an accuracy indicator computed after the loop.
     fn certify_further(&mut self, check: &CertificateCheck) {
         if !check.passed {
-            if self.status.is_solution() {
-                self.status = ContactStatus::NotCertified;
-            }
+            self.accurate = false;
             self.failed_checks.push(check.name);
         }
     }
 
-    /// How the step ended, in a few words: the status, and the failed checks of a
-    /// `not-certified` one.
+    /// Whether the step's answer is one to rely on: solved, and accurate.
+    fn is_trusted(&self) -> bool {
+        self.status.is_solution() && self.accurate
+    }
+
+    /// How the step ended, in a few words: the status, and the failed checks.
     fn ending(&self) -> String {
-        match self.status {
-            ContactStatus::NotCertified => {
-                format!("{} ({})", self.status.name(), self.failed_checks.join(", "))
-            }
-            status => status.name().to_string(),
+        let failed: Vec<&str> = self.failed_checks.iter().map(|c| c.name()).collect();
+        if failed.is_empty() {
+            self.status.name().to_string()
+        } else if self.status.is_solution() {
+            format!("{}, accuracy report failed ({})", self.status.name(), failed.join(", "))
+        } else {
+            format!("{} ({})", self.status.name(), failed.join(", "))
         }
     }
 }
@@ -99,7 +104,7 @@ pub fn solve_contact<'m>(
     let (solution, steps) = solve_load_steps(&problem, solver, load_factors, "", &mut log)?;
     // 2. The other primary, when auto's choice between similar bodies did not settle.
     let (problem, solution, mut steps) =
-        if problem.primary_report.other_may_retry && !solution.status.is_solution() {
+        if problem.primary_report.other_may_retry && !solution.is_trusted() {
             retry_with_other_primary(problem, solution, steps, solver, load_factors, &mut log)
         } else {
             (problem, solution, steps)
@@ -121,6 +126,7 @@ pub fn solve_contact<'m>(
     // The last step's record is the answer's, checks made after the loop included.
     if let Some(last) = steps.last_mut() {
         last.status = solution.status;
+        last.accurate = solution.certificate.accurate();
         last.failed_checks = solution.certificate.failed();
     }
     Ok(ContactRun {
@@ -149,7 +155,7 @@ fn retry_with_other_primary<'m>(
          again with '{other_name}' as primary"
     ));
     match solve_load_steps(&other, solver, load_factors, "other primary: ", log) {
-        Ok((second, second_steps)) if second.status.is_solution() => (
+        Ok((second, second_steps)) if second.is_trusted() => (
             other.with_reason_appended(&format!(
                 "'{other_name}' carries the multiplier because '{first}' as primary ended \
                  {first_ended}"
@@ -195,7 +201,7 @@ fn check_against_other_primary<'m>(
     let (reference, other_steps) = match solve_load_steps(&other, solver, load_factors, label, log)
     {
         // The force the other primary's multiplier puts on this solve's primary body.
-        Ok((check, other_steps)) if check.status == ContactStatus::Converged => {
+        Ok((check, other_steps)) if check.status == ContactStatus::Converged && check.is_trusted() => {
             (Ok(check.force_primary.map(|f| -f)), other_steps)
         }
         Ok((check, other_steps)) => (Err(check.ending()), other_steps),
@@ -205,7 +211,7 @@ fn check_against_other_primary<'m>(
     let earlier = steps.len().saturating_sub(1);
     for (k, step) in steps[..earlier].iter_mut().enumerate() {
         let other_step = match other_steps.get(k) {
-            Some(o) if o.status == ContactStatus::Converged => Ok(std::array::from_fn(|c| {
+            Some(o) if o.status == ContactStatus::Converged && o.is_trusted() => Ok(std::array::from_fn(|c| {
                 -o.force_primary.get(c).unwrap_or(&0.0)
             })),
             Some(o) => Err(o.ending()),
@@ -282,13 +288,14 @@ fn solve_load_steps(
             hertz_a: solution.hertz_primary.map(|h| h.a),
             hertz_p0: solution.hertz_primary.map(|h| h.p0),
             seconds,
+            accurate: solution.certificate.accurate(),
             failed_checks: solution.certificate.failed(),
         });
-        // A step whose active set settled but failed its certificate is a valid start for the
-        // next one (each step is certified on its own: a narrow zone at a small load factor can
+        // A step whose active set settled is a valid start for the next one, whatever its
+        // checks say (each step is checked on its own: a narrow zone at a small load factor can
         // fail the sag check on a mesh that resolves the final zone); a loop that did not settle
         // is not.
-        let stop = !solution.status.is_solution() && solution.status != ContactStatus::NotCertified;
+        let stop = !solution.status.is_solution() && solution.status != ContactStatus::NotSolved;
         last = Some(solution);
         if stop {
             log.say("stopping the load steps: this step's active set did not settle");

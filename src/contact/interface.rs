@@ -37,6 +37,7 @@
 
 use std::collections::HashMap;
 
+use super::linearization::GapRow;
 use super::rbf::{Interpolation, interpolation_radii};
 use super::system::Coupling;
 use super::{ContactError, ContactSurface, Formulation};
@@ -152,15 +153,15 @@ impl InterfaceOperators {
         }
     }
 
-    /// The coupling of the active primary candidates `active` (surface indices), each held at
-    /// the gap correction `corrections[i]` (module doc: the constraint is `g_i(u) + e_i = 0`).
+    /// The coupling of the active primary candidates `active` (surface indices) under
+    /// `constraint`: the traction columns of the transfers, and the constraint rows.
     pub fn coupling(
         &mut self,
         primary: &ContactSurface,
         secondary: &ContactSurface,
         formulation: Formulation,
         active: &[usize],
-        corrections: &[f64],
+        constraint: Constraint,
     ) -> Coupling {
         let missing: Vec<usize> = active
             .iter()
@@ -179,40 +180,61 @@ impl InterfaceOperators {
                 .map(|&(j, w)| (secondary.nodes[j], weight(j, w)))
                 .collect()
         };
+        let loads2 = active
+            .iter()
+            .map(|&i| {
+                if self.r21.is_none() {
+                    // The conservative transfer, `-R12^T M1 lambda` ([`super::Transfer`]):
+                    // row i of R12 times A1_i is column i of R12^T M1.
+                    to_body2(&self.rows12[&i], &|_, w| primary.nodal_area[i] * w)
+                } else {
+                    let column: Vec<(usize, f64)> = self.columns21[&i]
+                        .iter()
+                        .map(|&(t, w)| (self.receiving[t], w))
+                        .collect();
+                    to_body2(&column, &|j, w| secondary.nodal_area[j] * w)
+                }
+            })
+            .collect();
+        let (rows, constraint_normals, gaps) = match constraint {
+            Constraint::Interpolated { corrections } => (
+                active
+                    .iter()
+                    .map(|i| to_body2(&self.rows12[i], &|_, w| w))
+                    .collect(),
+                active.iter().map(|&i| self.normals[i]).collect(),
+                // Only the normal part is a gap: the tied constraint would otherwise impose
+                // the tangential offset between x_i and p_i (nonzero off a flat) as a
+                // spurious jump.
+                active
+                    .iter()
+                    .map(|&i| {
+                        let g = self.reference_gaps[i] + corrections[i];
+                        self.normals[i].map(|n| g * n)
+                    })
+                    .collect(),
+            ),
+            Constraint::Geometric { rows } => (
+                active
+                    .iter()
+                    .map(|&i| to_body2(&rows[i].corners, &|_, b| b))
+                    .collect(),
+                active.iter().map(|&i| rows[i].normal).collect(),
+                active
+                    .iter()
+                    .map(|&i| rows[i].normal.map(|n| rows[i].target * n))
+                    .collect(),
+            ),
+        };
         Coupling {
             formulation,
             primary_nodes: active.iter().map(|&i| primary.nodes[i]).collect(),
             normals: active.iter().map(|&i| self.normals[i]).collect(),
+            constraint_normals,
             areas1: active.iter().map(|&i| primary.nodal_area[i]).collect(),
-            r12: active
-                .iter()
-                .map(|i| to_body2(&self.rows12[i], &|_, w| w))
-                .collect(),
-            loads2: active
-                .iter()
-                .map(|&i| {
-                    if self.r21.is_none() {
-                        // The conservative transfer, `-R12^T M1 lambda` ([`super::Transfer`]):
-                        // row i of R12 times A1_i is column i of R12^T M1.
-                        to_body2(&self.rows12[&i], &|_, w| primary.nodal_area[i] * w)
-                    } else {
-                        let column: Vec<(usize, f64)> = self.columns21[&i]
-                            .iter()
-                            .map(|&(t, w)| (self.receiving[t], w))
-                            .collect();
-                        to_body2(&column, &|j, w| secondary.nodal_area[j] * w)
-                    }
-                })
-                .collect(),
-            // Only the normal part is a gap: the tied constraint would otherwise impose the
-            // tangential offset between x_i and p_i (nonzero off a flat) as a spurious jump.
-            gaps: active
-                .iter()
-                .map(|&i| {
-                    let g = self.reference_gaps[i] + corrections[i];
-                    self.normals[i].map(|n| g * n)
-                })
-                .collect(),
+            r12: rows,
+            loads2,
+            gaps,
         }
     }
 
@@ -250,6 +272,17 @@ impl InterfaceOperators {
             .map(|((jump, n), d)| d - (0..3).map(|k| n[k] * jump[k]).sum::<f64>())
             .collect()
     }
+}
+
+/// The constraint rows of an iteration.
+#[derive(Clone, Copy)]
+pub enum Constraint<'a> {
+    /// Tied contact: the rows of `R12`, `u1_i - (R12 u2)_i = (d_i + e_i) n_i`, with the gap
+    /// correction `e` of the last iterate (module doc).
+    Interpolated { corrections: &'a [f64] },
+    /// Frictionless contact: the geometric gap linearized at the last iterate, one row per
+    /// primary candidate ([`super::linearization`]).
+    Geometric { rows: &'a [GapRow] },
 }
 
 /// The contact normal at a node: `(w_own n_own - w_other n_other) / |...|`, its outward normal

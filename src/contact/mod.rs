@@ -22,6 +22,7 @@ mod coupled_solver;
 mod driver;
 mod hertz;
 mod interface;
+mod linearization;
 mod post;
 mod problem;
 pub mod projection;
@@ -31,7 +32,7 @@ mod solve;
 mod surface;
 pub mod system;
 
-pub use checks::{Certificate, CertificateCheck};
+pub use checks::{Certificate, CertificateCheck, CheckKind};
 pub use coupled_solver::CoupledSolver;
 pub use driver::{ContactRun, StepRecord, solve_contact};
 pub use problem::{

@@ -1,7 +1,7 @@
 //! Post-processing of the last iterate: each body's solution (reactions, cell strains and
 //! stresses), the interface fields of both surfaces, total forces and the Hertz fit.
 
-use super::checks::Certificate;
+use super::checks::{Certificate, CheckKind};
 use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
 use super::solve::{ActiveSet, ContactSolver};
 use super::system::{CoupledSolution, Coupling};
@@ -54,7 +54,7 @@ pub(super) fn finish(
     let force_imbalance = certificate
         .checks
         .iter()
-        .find(|c| c.name == "imbalance")
+        .find(|c| c.name == CheckKind::Equilibrium)
         .map_or(f64::NAN, |c| c.value);
     let hertz_primary = hertz::fit(s1, &primary_fields);
     // Tangential with respect to the contact normal the constraint used: zero for

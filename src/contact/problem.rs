@@ -54,6 +54,9 @@ pub struct SettingsError {
     pub value: f64,
 }
 
+/// The largest `max_iterations` accepted.
+const MAX_ITERATIONS_CAP: usize = 1000;
+
 /// Settings of the active-set loop and its certificate; every field has a documented default,
 /// and [`ContactSettings::validate`] checks them all (the solver calls it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -148,8 +151,14 @@ impl ContactSettings {
                 value,
             })
         };
-        if self.max_iterations == 0 {
-            return error("max_iterations", "at least 1", 0.0);
+        // The loop ends by itself within a few iterations of a repeat or a stall
+        // (`super::solve`); a cap beyond this only postpones a status that is already due.
+        if !(1..=MAX_ITERATIONS_CAP).contains(&self.max_iterations) {
+            return error(
+                "max_iterations",
+                "between 1 and 1000",
+                self.max_iterations as f64,
+            );
         }
         // A support that does not reach the nearest node interpolates nothing.
         if !(self.rbf_radius > 1.0 && self.rbf_radius.is_finite()) {

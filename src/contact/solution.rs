@@ -12,14 +12,16 @@ use crate::elastic::ElasticSolution;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ContactStatus {
-    /// The active set settled and the certificate passed: no node of either surface penetrates
-    /// the other body or receives a tensile force beyond the tolerances, and the contact forces
-    /// balance.
+    /// The discrete contact problem is solved: the active set settled and every residual,
+    /// measured independently of the loop, is within its tolerance: no node of either surface
+    /// penetrates the other body or receives a tensile force, every active node lies on the
+    /// other surface, and the contact forces balance. Whether the answer is accurate is the
+    /// accuracy report's question ([`super::Certificate::accurate`]), not the status's.
     Converged,
-    /// The active set settled but the certificate failed (it says which check, where, and by
-    /// how much): not a contact solution.
-    NotCertified,
-    /// The active set settled empty and the certificate passed: the bodies do not touch.
+    /// The active set settled but a residual check failed (it says which, where, and by how
+    /// much): the discrete problem is not solved.
+    NotSolved,
+    /// The active set settled empty and every residual check passed: the bodies do not touch.
     NoContact,
     /// The iteration cap was reached.
     IterationLimit,
@@ -30,6 +32,10 @@ pub enum ContactStatus {
     Unstable,
     /// An active set seen before came back: the loop would repeat forever.
     Cycling,
+    /// On an unchanged active set, the active nodes' distance to the other surface stopped
+    /// shrinking (by half per iteration, twice in a row): the linearized constraint no longer
+    /// converges to the geometric one, and iterating on would not end.
+    Stalled,
 }
 
 impl ContactStatus {
@@ -42,11 +48,12 @@ impl ContactStatus {
     pub fn name(self) -> &'static str {
         match self {
             Self::Converged => "converged",
-            Self::NotCertified => "not-certified",
+            Self::NotSolved => "not-solved",
             Self::NoContact => "no-contact",
             Self::IterationLimit => "iteration-limit",
             Self::Unstable => "unstable",
             Self::Cycling => "cycling",
+            Self::Stalled => "stalled",
         }
     }
 }
@@ -192,8 +199,8 @@ impl ContactSolution {
             ContactStatus::NoContact => {
                 "no contact: the bodies do not touch; each body was solved alone".to_string()
             }
-            ContactStatus::NotCertified => format!(
-                "NOT converged: the active set settled in {iterations} iterations but the certificate failed: {}",
+            ContactStatus::NotSolved => format!(
+                "NOT solved: the active set settled in {iterations} iterations but a residual check failed: {}",
                 self.certificate.failures()
             ),
             ContactStatus::IterationLimit => {
@@ -208,26 +215,45 @@ impl ContactSolution {
             ContactStatus::Cycling => format!(
                 "NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"
             ),
+            ContactStatus::Stalled => format!(
+                "NOT converged: on an unchanged active set the active nodes' distance to the other surface stopped shrinking ({:.1e} spacings at iteration {iterations})",
+                self.history
+                    .last()
+                    .map_or(f64::NAN, |r| r.max_gap_error_over_h)
+            ),
         };
-        format!("{outcome}\n  certificate: {certificate}")
+        let accuracy = if self.certificate.accurate() {
+            "passed".to_string()
+        } else {
+            format!("FAILED: {}", self.certificate.indicators().filter(|c| !c.passed).map(|c| c.describe()).collect::<Vec<_>>().join("; "))
+        };
+        format!("{outcome}\n  checks: {certificate}\n  accuracy report: {accuracy}")
     }
 
     /// How the solve ended, in a few words (for the primary choice's reason): the status, and
-    /// the failed checks of a `not-certified` one.
+    /// the failed checks of a `not-solved` one or of a failed accuracy report.
     pub fn ending(&self) -> String {
         let status = self.status.name();
+        let failures = self.certificate.failures();
         match self.status {
-            ContactStatus::NotCertified => format!("{status} ({})", self.certificate.failures()),
+            ContactStatus::NotSolved => format!("{status} ({failures})"),
+            _ if self.status.is_solution() && !failures.is_empty() => {
+                format!("{status}, accuracy report failed ({failures})")
+            }
             _ => status.to_string(),
         }
     }
 
-    /// Adds a check made after the loop (e.g. `super::checks::primary_agreement`) to the
-    /// certificate; a failed one makes a `converged` answer `not-certified`.
+    /// Whether this is an answer to rely on: the problem solved (or no contact) and the
+    /// accuracy report passed.
+    pub fn is_trusted(&self) -> bool {
+        self.status.is_solution() && self.certificate.accurate()
+    }
+
+    /// Adds an accuracy indicator computed after the loop (e.g.
+    /// `super::checks::primary_agreement`) to the report.
     pub fn certify_further(&mut self, check: super::CertificateCheck) {
-        if !check.passed && self.status.is_solution() {
-            self.status = ContactStatus::NotCertified;
-        }
+        debug_assert!(!check.name.is_residual());
         self.certificate.push(check);
     }
 }
@@ -245,11 +271,12 @@ mod tests {
         use ContactStatus::*;
         for status in [
             Converged,
-            NotCertified,
+            NotSolved,
             NoContact,
             IterationLimit,
             Unstable,
             Cycling,
+            Stalled,
         ] {
             assert_eq!(serde_json::to_value(status).unwrap(), status.name());
         }

@@ -48,12 +48,13 @@
 use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
 
-use super::checks::{Update, certify};
+use super::checks::{Update, certify, contact_status};
 use super::coupled_solver::{self, BodyFactors, CoupledSolver};
-use super::interface::{InterfaceOperators, geometric_gaps};
+use super::interface::{Constraint, InterfaceOperators, geometric_gaps};
+use super::linearization::{GapRow, gap_rows};
 use super::solution::{ContactSolution, ContactStatus, PhaseSeconds};
 use super::system::{CoupledSolution, CoupledSystem, Coupling};
-use super::{ContactError, ContactProblem, ContactSurface, Transfer, post};
+use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer, post};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 
 /// An active node this many spacings off the other surface after a solve means the constraint
@@ -93,10 +94,13 @@ fn pairing_drift(
 pub(super) const SETTLED: f64 = 0.01;
 
 /// Where an active-set loop starts: the active primary candidates (surface indices) and the
-/// gap corrections `e` (one per primary candidate; `super::interface`).
+/// linearization point of their constraints: the gap rows of every primary candidate
+/// (frictionless, [`super::linearization`]) or the gap corrections `e` (tied,
+/// `super::interface`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ActiveSet {
     pub nodes: BTreeSet<usize>,
+    pub rows: Vec<GapRow>,
     pub corrections: Vec<f64>,
 }
 
@@ -167,8 +171,8 @@ impl<'a> ContactSolver<'a> {
         })
     }
 
-    /// The primary candidates that touch or penetrate in the reference configuration, with no
-    /// gap correction.
+    /// The primary candidates that touch or penetrate in the reference configuration, with
+    /// their constraints linearized there.
     pub fn initial_active_set(&self) -> ActiveSet {
         let (s1, s2) = (
             &self.problem.primary_surface,
@@ -180,6 +184,7 @@ impl<'a> ContactSolver<'a> {
             nodes: (0..s1.len())
                 .filter(|&i| self.operators.facing[i] && gaps[i] < tol * s1.spacing[i])
                 .collect(),
+            rows: gap_rows(s1, s2, None, None),
             corrections: vec![0.0; s1.len()],
         }
     }
@@ -198,7 +203,7 @@ impl<'a> ContactSolver<'a> {
             self.pair_again([0.0; 3])?;
         }
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
-        let (mut active, mut corrections) = (start.nodes, start.corrections);
+        let (mut active, mut rows, mut corrections) = (start.nodes, start.rows, start.corrections);
         let mut safeguard = Safeguard::default();
         let mut history = Vec::new();
         let mut status = ContactStatus::IterationLimit;
@@ -210,21 +215,33 @@ impl<'a> ContactSolver<'a> {
             let nodes: Vec<usize> = active.iter().copied().collect();
             let coupling = timed(&mut seconds.operators, || {
                 let formulation = settings.formulation;
-                (self.operators).coupling(s1, s2, formulation, &nodes, &corrections)
+                let constraint = match formulation {
+                    Formulation::Frictionless => Constraint::Geometric { rows: &rows },
+                    Formulation::Tied => Constraint::Interpolated {
+                        corrections: &corrections,
+                    },
+                };
+                (self.operators).coupling(s1, s2, formulation, &nodes, constraint)
             });
             // 2. The coupled solve, checked by its residual.
             let solution = timed(&mut seconds.solve, || {
                 self.coupled_solve(&coupling, load_factor)
             })?;
-            // 3. Gaps of every primary candidate: geometric (the search) and linearized; how far
-            //    the active nodes' pairing has slid.
+            // 3. Gaps of every primary candidate: geometric (the search), and the constraints
+            //    linearized at this iterate; how far the active nodes' pairing has slid.
             let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
             let (gaps, linear, slid) = timed(&mut seconds.search, || {
                 let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
+                rows = gap_rows(s1, s2, Some(u1), Some(u2));
                 let jumps = self.operators.jumps(s1, s2, u1, u2);
                 let slid = self.operators.slide(s1, &jumps, &nodes);
                 (gaps, self.operators.linearized_gaps(&jumps), slid)
             });
+            // The gap each active node's constraint holds: the gap of its linearization.
+            let held: Vec<f64> = match settings.formulation {
+                Formulation::Frictionless => rows.iter().map(|r| r.gap).collect(),
+                Formulation::Tied => gaps.clone(),
+            };
             let drift = pairing_drift(&self.operators.slid, &slid, s1, &nodes);
             // 4. The primal-dual active set update, and the gap corrections.
             let update = timed(&mut seconds.checks, || {
@@ -235,12 +252,14 @@ impl<'a> ContactSolver<'a> {
                     &nodes,
                     traction,
                     normals,
-                    &gaps,
+                    [&gaps, &held],
                     facing,
                     &safeguard.pinned,
                 )
             });
-            corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
+            if settings.formulation == Formulation::Tied {
+                corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
+            }
             // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
             //    settled on a pairing the surfaces have slid away from is paired again where
             //    they touch, and solved again.
@@ -272,14 +291,12 @@ impl<'a> ContactSolver<'a> {
         }
 
         let (coupling, solution) = last.expect("max_iterations >= 1 is validated");
-        let (certificate, gaps) = certify(problem, &solution);
-        let status = match status {
-            ContactStatus::Converged if !certificate.passed => ContactStatus::NotCertified,
-            ContactStatus::Converged if active.is_empty() => ContactStatus::NoContact,
-            other => other,
-        };
+        let nodes: Vec<usize> = active.iter().copied().collect();
+        let (certificate, gaps) = certify(problem, &solution, &nodes);
+        let status = contact_status(status, &certificate, active.is_empty());
         let next_start = ActiveSet {
             nodes: active,
+            rows,
             corrections,
         };
         post::finish(
@@ -342,7 +359,23 @@ struct Safeguard {
     released: HashSet<usize>,
     readded: HashSet<usize>,
     pinned: HashSet<usize>,
+    /// The active nodes' gap error of the last iteration, if it solved the same active set.
+    last_error: Option<f64>,
+    /// How many iterations in a row on one active set failed to contract the gap error.
+    slow: usize,
 }
+
+/// On an unchanged active set the linearized constraint must shrink the active nodes' gap
+/// error (`Update::max_gap_error_over_h`) by at least this factor per iteration: Newton's
+/// method on the gap ([`super::linearization`]) does far better (quadratic, exact in one step
+/// on a flat), the tied fixed-point correction by about ten. An iteration that does not is
+/// outside the regime where the iteration converges for a reason: [`STALLED_AFTER`] such
+/// iterations in a row end the loop as [`ContactStatus::Stalled`], instead of running to the
+/// iteration cap.
+const CONTRACTION: f64 = 0.5;
+
+/// See [`CONTRACTION`].
+const STALLED_AFTER: usize = 2;
 
 impl Safeguard {
     fn next(&mut self, active: &BTreeSet<usize>, update: &Update) -> Step {
@@ -356,12 +389,20 @@ impl Safeguard {
             return Step::Stop(ContactStatus::Unstable);
         }
         if update.next == *active {
-            return if update.settled {
-                Step::Stop(ContactStatus::Converged)
+            if update.settled {
+                return Step::Stop(ContactStatus::Converged);
+            }
+            let error = update.max_gap_error_over_h;
+            let contracted = self.last_error.is_none_or(|last| error <= CONTRACTION * last);
+            self.slow = if contracted { 0 } else { self.slow + 1 };
+            self.last_error = Some(error);
+            return if self.slow >= STALLED_AFTER {
+                Step::Stop(ContactStatus::Stalled)
             } else {
                 Step::Solve(active.clone())
             };
         }
+        (self.last_error, self.slow) = (None, 0);
         self.seen.insert(active.clone());
         let mut next = update.next.clone();
         if self.seen.contains(&next) {

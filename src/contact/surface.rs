@@ -149,6 +149,12 @@ impl ContactSurface {
         -normal_force / self.nodal_area[s]
     }
 
+    /// The corners of facet `facet` (surface node indices), in the order of the barycentric
+    /// coordinates of a [`super::projection::Projection`] onto it.
+    pub fn facet_nodes(&self, facet: usize) -> &[usize] {
+        &self.facets[self.dim * facet..self.dim * (facet + 1)]
+    }
+
     /// The reference position of the point with `barycentric` coordinates on facet `facet`: the
     /// material point a projection onto the displaced surface found.
     pub fn reference_point(&self, facet: usize, barycentric: &[f64; 3]) -> [f64; 3] {

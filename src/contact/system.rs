@@ -35,11 +35,16 @@ pub struct Coupling {
     pub formulation: Formulation,
     /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
-    /// Contact normal at each active node (pointing out of body 1).
+    /// Contact normal at each active node (pointing out of body 1): the direction of the
+    /// frictionless traction `lambda_n n`.
     pub normals: Vec<[f64; 3]>,
+    /// Direction of each frictionless constraint row (pointing out of body 1): the gradient of
+    /// the gap it holds (`super::linearization`). Unused by tied contact.
+    pub constraint_normals: Vec<[f64; 3]>,
     /// Lumped interface mass of each active node: its area `A_i`.
     pub areas1: Vec<f64>,
-    /// Row of `R12` of each active node: `(secondary body node, weight)`.
+    /// Constraint row of each active node: `(secondary body node, weight)`, a row of `R12`
+    /// (tied) or the P1 weights of the secondary facet it projects onto (frictionless).
     pub r12: Vec<Vec<(usize, f64)>>,
     /// Column of `M2 R21` of each active node: `(secondary body node, A2_j R21[j, i])`, the
     /// force a unit traction at node `i` puts on body 2's nodes (with the sign of `lambda_2 =
@@ -80,6 +85,16 @@ impl Coupling {
                     .constraints
                     .is_fixed(dim * self.primary_nodes[col] + c)
             }),
+        }
+    }
+
+    /// Row `(multiplier, component)` coefficients of the constraint of node `b`: tied
+    /// `u1(b, c) - ...` is its own row; frictionless `n_b[c] (u1(b, c) - ...)`, `n_b` the
+    /// constraint's direction.
+    fn constraint_terms(&self, b: usize, c: usize, dim: usize) -> (usize, f64) {
+        match self.formulation {
+            Formulation::Tied => (dim * b + c, 1.0),
+            Formulation::Frictionless => (b, self.constraint_normals[b][c]),
         }
     }
 
@@ -183,7 +198,7 @@ impl CoupledSystem {
         let d: Vec<f64> = dropped.iter().map(|&x| if x { t } else { 0.0 }).collect();
         for (a, &node) in coupling.primary_nodes.iter().enumerate() {
             for c in 0..dim {
-                let (row, weight) = coupling.multiplier_terms(a, c, dim);
+                let (row, weight) = coupling.constraint_terms(a, c, dim);
                 if dropped[row] || weight == 0.0 {
                     continue;
                 }

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::OutputError;
 use crate::contact::{
-    Certificate, ContactSettings, ContactStatus, HertzFit, IterationRecord, PrimaryReport,
+    Certificate, CertificateCheck, ContactSettings, ContactStatus, HertzFit, IterationRecord, PrimaryReport,
     StepRecord, TransferReport,
 };
 use crate::elastic::SolveStats;
@@ -52,8 +52,10 @@ pub struct ContactSummary {
     pub primary_choice: PrimaryReport,
     /// How the secondary's contact force is computed, and why.
     pub transfer: TransferReport,
-    /// The independent checks of the answer of the last load step.
-    pub certificate: Certificate,
+    /// Whether the last load step's discrete problem is solved: its residual checks.
+    pub solved: SolvedChecks,
+    /// Whether the last load step's answer can be trusted: its accuracy indicators.
+    pub accuracy: AccuracyReport,
     pub settings: ContactSettings,
     /// Total contact force on each body, and `|F1 + F2| / |F1|`.
     pub force_primary: Vec<f64>,
@@ -71,6 +73,37 @@ pub struct ContactSummary {
     pub iterations: Vec<IterationRecord>,
     /// One record per load step (also written as `force_displacement.csv`).
     pub steps: Vec<StepRecord>,
+}
+
+/// The residual checks of the discrete problem (`status` is `converged` only if all passed).
+#[derive(Debug, Serialize)]
+pub struct SolvedChecks {
+    pub passed: bool,
+    pub checks: Vec<CertificateCheck>,
+}
+
+/// The accuracy indicators of the answer (a failure leaves the status as it is, and makes the
+/// run exit with status 3).
+#[derive(Debug, Serialize)]
+pub struct AccuracyReport {
+    pub passed: bool,
+    pub indicators: Vec<CertificateCheck>,
+}
+
+impl ContactSummary {
+    /// The two parts of a certificate.
+    pub fn checks(certificate: &Certificate) -> (SolvedChecks, AccuracyReport) {
+        (
+            SolvedChecks {
+                passed: certificate.solved(),
+                checks: certificate.residuals().cloned().collect(),
+            },
+            AccuracyReport {
+                passed: certificate.accurate(),
+                indicators: certificate.indicators().cloned().collect(),
+            },
+        )
+    }
 }
 
 /// The load steps as `force_displacement.csv`: one header line, one row per step.
@@ -100,7 +133,9 @@ pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
             optional(s.hertz_a),
             optional(s.hertz_p0),
             s.seconds,
-            s.failed_checks.join(";")
+            (s.failed_checks.iter().map(|c| c.name()))
+                .collect::<Vec<_>>()
+                .join(";")
         );
     }
     text
