@@ -171,38 +171,19 @@ SOLVED_CHECKS = ("penetration", "secondary penetration", "tension", "complementa
 # Accuracy indicators (contact.accuracy.indicators) present in every contact run; "primary agreement"
 # is added by the solver when it makes that second solve, and is then judged like the others.
 ACCURACY_INDICATORS = ("secondary sag", "resolution", "force centre")
-# The single certificate written before the split, read only until the split solver is merged:
-# its checks fall into the two reports (the force balance "imbalance" is the equilibrium check).
-_LEGACY_SOLVED = {"penetration": "penetration", "secondary penetration": "secondary penetration",
-                  "tension": "tension", "imbalance": "equilibrium"}
-_LEGACY_ACCURACY = ("secondary sag", "resolution", "force centre", "primary agreement")
 
 
-def solver_reports(contact: dict) -> tuple[dict | None, dict | None, tuple[str, ...]]:
-    """(solved, accuracy, residual checks required) from a summary.json contact object.
-
-    ``solved`` is {"passed", "checks": [...]}, ``accuracy`` {"passed", "tolerance", "indicators":
-    [...]}; either is None when absent. A summary with the older single ``certificate`` is split
-    into the same two reports (its checks renamed as above; it has no complementarity check, so
-    the required residual checks are then those it had)."""
-    if "solved" in contact or "accuracy" in contact:
-        solved = contact.get("solved") if isinstance(contact.get("solved"), dict) else None
-        accuracy = contact.get("accuracy") if isinstance(contact.get("accuracy"), dict) else None
-        return solved, accuracy, SOLVED_CHECKS
-    cert = contact.get("certificate")
-    if not isinstance(cert, dict):
-        return None, None, SOLVED_CHECKS
-    checks = [c for c in cert.get("checks", []) if isinstance(c, dict)]
-    solved = [dict(c, name=_LEGACY_SOLVED[c.get("name")]) for c in checks if c.get("name") in _LEGACY_SOLVED]
-    indicators = [c for c in checks if c.get("name") in _LEGACY_ACCURACY]
-    return ({"passed": all(c.get("passed") is True for c in solved), "checks": solved},
-            {"passed": all(c.get("passed") is True for c in indicators), "tolerance": None,
-             "indicators": indicators}, tuple(_LEGACY_SOLVED.values()))
+def solver_reports(contact: dict) -> tuple[dict | None, dict | None]:
+    """(solved, accuracy) of a summary.json contact object: ``solved`` is {"passed", "checks": [...]},
+    ``accuracy`` {"passed", "indicators": [...]}; either is None when absent (a failed row)."""
+    solved = contact.get("solved")
+    accuracy = contact.get("accuracy")
+    return (solved if isinstance(solved, dict) else None, accuracy if isinstance(accuracy, dict) else None)
 
 
 def failed_report_names(contact: dict) -> list[str]:
     """Names of the failed residual checks and accuracy indicators (for tables)."""
-    solved, accuracy, _ = solver_reports(contact)
+    solved, accuracy = solver_reports(contact)
     return ([c.get("name") for c in (solved or {}).get("checks", []) if c.get("passed") is not True]
             + [c.get("name") for c in (accuracy or {}).get("indicators", []) if c.get("passed") is not True])
 
@@ -210,7 +191,7 @@ def failed_report_names(contact: dict) -> list[str]:
 def vouched(contact: dict) -> bool:
     """The solver vouches for its answer: converged (or no contact) and its accuracy report passed
     (CLI exit code 0)."""
-    _, accuracy, _ = solver_reports(contact)
+    _, accuracy = solver_reports(contact)
     return contact.get("status") in ("converged", "no-contact") and bool(accuracy and accuracy.get("passed") is True)
 
 
@@ -219,8 +200,8 @@ def report_rows(case: str, contact: dict, accuracy_required: tuple[str, ...] = A
     passed, its flags consistent with its figures; figure the largest value / tolerance over the
     entries (tolerance 1). A missing report or entry, or a "passed" flag that contradicts the
     figures, is a failed row (figure NaN, the note says which), never a pass."""
-    solved, accuracy, required = solver_reports(contact)
-    return [_report_row("solved", case, solved, "checks", required),
+    solved, accuracy = solver_reports(contact)
+    return [_report_row("solved", case, solved, "checks", SOLVED_CHECKS),
             _report_row("accuracy", case, accuracy, "indicators", accuracy_required)]
 
 

@@ -553,11 +553,11 @@ def named_failure_check(case: Case, contact: dict) -> Check:
     cycling, stalled, iteration-limit; not-solved with a failed residual check), or it converged and
     its accuracy report names a failed indicator (figure 0 when so)."""
     status = contact.get("status")
-    solved, accuracy, _ = solver_reports(contact)
+    solved, accuracy = solver_reports(contact)
     failed = [c for c in (solved or {}).get("checks", []) if isinstance(c, dict) and c.get("passed") is False]
     inaccurate = [c for c in (accuracy or {}).get("indicators", []) if isinstance(c, dict) and c.get("passed") is False]
     named = (status in ("unstable", "cycling", "stalled", "iteration-limit")
-             or (status in ("not-solved", "not-certified") and bool(failed or inaccurate))
+             or (status == "not-solved" and bool(failed))
              or (status in ("converged", "no-contact") and bool(inaccurate)))
     note = f"{status}; " + "; ".join(f"{c.get('name')} {c.get('value'):.3g} > {c.get('tolerance'):.3g}"
                                      for c in failed + inaccurate)
@@ -887,8 +887,8 @@ DECISIONS = """\
   name the reason: a failure status, or a failed accuracy indicator.
 * *Supported*: two cases the issue lists among those that must certify (two equal hemispheres at
   R/33; the 3D zone 3 spacings across, until the conservative transfer) or that it lets name a
-  reason (the stiff 2D primary as fine as the disc) ended `not-certified` on the secondary sag
-  since that check was added (sag 11%, 4.0%, 3.2% of the indentation against 3%); they are judged
+  reason (the stiff 2D primary as fine as the disc) failed the secondary sag check since it was
+  added (sag 11%, 4.0%, 3.2% of the indentation against 3%); they are judged
   as unsupported cases (right, or a named status), and two equal hemispheres at R/50 (the coarser
   one primary with 7 of its spacings across) is the supported 3D two-equal case. The 3D zone 3
   spacings across now converges with the sphere primary and the conservative transfer to the
