@@ -208,7 +208,12 @@ class ContactSolution:
 class RigidFlatContact:
     """The body in dolfinx, with K, the top-face dofs and the contact-surface data (set up once)."""
 
-    def __init__(self, body: BodyMesh, contact: str, top: str, youngs_modulus: float, poisson_ratio: float):
+    def __init__(self, body: BodyMesh, contact: str, top: str, youngs_modulus: float, poisson_ratio: float,
+                 obstacle=None):
+        """``obstacle``: None for the flat x_v = 0; else a function of the contact nodes' lateral
+        coordinates (k, dim - 1) giving the height s of a rigid obstacle's surface below each of them
+        (-inf where there is none): the constraint is then x_v + u_v >= s (the gap measured
+        vertically, at the node's reference lateral position: small sliding)."""
         self.body, self.contact_group, self.top_group = body, contact, top
         self.E, self.nu = youngs_modulus, poisson_ratio
         d = self.dim = body.dim
@@ -229,7 +234,12 @@ class RigidFlatContact:
         self.top_dofs = self._dofs(self.top_nodes, range(d))
         self.contact_dofs = self._dofs(self.contact_nodes, [self.v])
         self.height = body.x[self.contact_nodes, self.v]
-        if (self.height < -1e-14).any():
+        if obstacle is not None:
+            lateral = [c for c in range(d) if c != self.v]
+            self.height = self.height - np.asarray(obstacle(body.x[self.contact_nodes][:, lateral]), float)
+        # nodes with no obstacle below them carry no constraint (an infinite gap)
+        self.bounded = np.isfinite(self.height)
+        if (self.height[self.bounded] < -1e-14).any():
             raise ReferenceFailure(f"{body.path}: contact-surface nodes below the plane x_v = 0 (initial overlap)")
         self.K_bc = self.K.copy()
         self.K_bc.zeroRowsColumns(self.top_dofs.astype(np.int32), diag=1.0)
@@ -354,7 +364,7 @@ class RigidFlatContact:
         lower, upper = x.duplicate(), x.duplicate()
         lower.set(PETSc.NINFINITY)
         upper.set(PETSc.INFINITY)
-        lower.array[self.contact_dofs] = -self.height
+        lower.array[self.contact_dofs] = np.where(self.bounded, -self.height, PETSc.NINFINITY)
         snes = self._snes("vinewtonrsls")
         F = x.duplicate()
         snes.setFunction(self._residual(g), F)
@@ -419,10 +429,11 @@ class RigidFlatContact:
         """
         free = np.ones(s.reaction.shape, bool)
         free[self.top_nodes] = False
-        free[self.contact_nodes, self.v] = False
-        force = max(s.reaction[self.contact_nodes, self.v].sum(), 1e-300)
-        gap = self.height + s.u[self.contact_nodes, self.v]
-        rv = s.reaction[self.contact_nodes, self.v]
+        bounded = self.contact_nodes[self.bounded]
+        free[bounded, self.v] = False
+        force = max(s.reaction[bounded, self.v].sum(), 1e-300)
+        gap = self.height[self.bounded] + s.u[bounded, self.v]
+        rv = s.reaction[bounded, self.v]
         figures = {
             "stationarity": float(abs(s.reaction[free]).max() / force),
             "penetration": float(max(0.0, -gap.min()) / s.delta),
@@ -579,6 +590,24 @@ def turned_mesh(msh: Path, dim: int) -> Path:
             x = list(coords[3 * k:3 * k + 3])
             for axis in negated:
                 x[axis] = -x[axis]
+            gmsh.model.mesh.setNode(int(tag), x, [])
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(str(out))
+    return out
+
+
+def lifted_mesh(msh: Path, dim: int, shift: float) -> Path:
+    """The mesh moved up by ``shift`` along the vertical axis (``<stem>_lifted<shift>.msh`` beside it,
+    rewritten when older than the mesh): the curved body of a mesh made overlapping (geo ``gap < 0``),
+    lifted by -gap, is the same discrete body with its pole on the flat, which the reference needs."""
+    out = msh.with_name(f"{msh.stem}_lifted{shift:g}.msh")
+    if out.is_file() and out.stat().st_mtime >= msh.stat().st_mtime:
+        return out
+    with _gmsh_model(msh):
+        tags, coords, _ = gmsh.model.mesh.getNodes(includeBoundary=True, returnParametricCoord=False)
+        for k, tag in enumerate(tags):
+            x = list(coords[3 * k:3 * k + 3])
+            x[dim - 1] += shift
             gmsh.model.mesh.setNode(int(tag), x, [])
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
         gmsh.write(str(out))

@@ -160,3 +160,79 @@ def json_safe(value):
     if isinstance(value, np.generic):
         return json_safe(value.item())
     return value
+
+
+# ---------------------------------------------------------------------------
+# The solver's two reports in summary.json (contact.solved, contact.accuracy)
+# ---------------------------------------------------------------------------
+
+# Residual checks of the discrete problem (contact.solved.checks): all present in every contact run.
+SOLVED_CHECKS = ("penetration", "secondary penetration", "tension", "complementarity", "equilibrium")
+# Accuracy indicators (contact.accuracy.indicators) present in every contact run; "primary agreement"
+# is added by the solver when it makes that second solve, and is then judged like the others.
+ACCURACY_INDICATORS = ("secondary sag", "resolution", "force centre")
+
+
+def solver_reports(contact: dict) -> tuple[dict | None, dict | None]:
+    """(solved, accuracy) of a summary.json contact object: ``solved`` is {"passed", "checks": [...]},
+    ``accuracy`` {"passed", "indicators": [...]}; either is None when absent (a failed row)."""
+    solved = contact.get("solved")
+    accuracy = contact.get("accuracy")
+    return (solved if isinstance(solved, dict) else None, accuracy if isinstance(accuracy, dict) else None)
+
+
+def failed_report_names(contact: dict) -> list[str]:
+    """Names of the failed residual checks and accuracy indicators (for tables)."""
+    solved, accuracy = solver_reports(contact)
+    return ([c.get("name") for c in (solved or {}).get("checks", []) if c.get("passed") is not True]
+            + [c.get("name") for c in (accuracy or {}).get("indicators", []) if c.get("passed") is not True])
+
+
+def vouched(contact: dict) -> bool:
+    """The solver vouches for its answer: converged (or no contact) and its accuracy report passed
+    (CLI exit code 0)."""
+    _, accuracy = solver_reports(contact)
+    return contact.get("status") in ("converged", "no-contact") and bool(accuracy and accuracy.get("passed") is True)
+
+
+def report_rows(case: str, contact: dict, accuracy_required: tuple[str, ...] = ACCURACY_INDICATORS) -> list[Check]:
+    """Two rows, ``solved`` and ``accuracy``: each report present, every named entry present and
+    passed, its flags consistent with its figures; figure the largest value / tolerance over the
+    entries (tolerance 1). A missing report or entry, or a "passed" flag that contradicts the
+    figures, is a failed row (figure NaN, the note says which), never a pass."""
+    solved, accuracy = solver_reports(contact)
+    return [_report_row("solved", case, solved, "checks", SOLVED_CHECKS),
+            _report_row("accuracy", case, accuracy, "indicators", accuracy_required)]
+
+
+def _report_row(kind: str, case: str, report: dict | None, key: str, required: tuple[str, ...]) -> Check:
+    import math
+
+    if report is None:
+        return Check(kind, case, math.nan, 1.0, f"summary.json contact.{kind} missing")
+    entries = report.get(key) if isinstance(report.get(key), list) else []
+    by_name = {c.get("name"): c for c in entries if isinstance(c, dict)}
+    missing = [n for n in required if n not in by_name]
+    names = list(required) + [n for n in by_name if n not in required]
+    ratios, parts = [], []
+    for name in names:
+        c = by_name.get(name)
+        if c is None:
+            continue
+        try:
+            value, tolerance = float(c["value"]), float(c["tolerance"])
+        except (KeyError, TypeError, ValueError):
+            missing.append(f"{name} (no value / tolerance)")
+            continue
+        ratio = value / tolerance if tolerance > 0 else math.inf
+        ratios.append(ratio)
+        where = f" at {c.get('body')} node {c.get('node_tag')}" if c.get("node_tag") is not None else ""
+        parts.append(f"{name} {value:.3g} / {tolerance:.3g}{where}{'' if c.get('passed') is True else ' FAILED'}")
+    worst = max(ratios, default=math.nan)
+    note = "; ".join(parts)
+    if missing:
+        return Check(kind, case, math.nan, 1.0, f"{kind} report lacks {', '.join(missing)}; {note}")
+    flags = report.get("passed") is True and all(by_name[n].get("passed") is True for n in names)
+    if flags != (worst <= 1.0):
+        return Check(kind, case, math.nan, 1.0, f"{kind}.passed = {report.get('passed')} contradicts its figures; {note}")
+    return Check(kind, case, worst, 1.0, note)
