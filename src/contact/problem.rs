@@ -314,7 +314,7 @@ impl<'m> ContactProblem<'m> {
     }
 
     /// Whether the secondary body is nearly rigid: its share of the two bodies' compliance
-    /// (`1 / E'`) is below [`COMPLIANT_SHARE`].
+    /// (`1 / E'`) is below `COMPLIANT_SHARE`.
     pub fn secondary_is_nearly_rigid(&self) -> bool {
         self.normal_weights()[0] < COMPLIANT_SHARE
     }
