@@ -756,11 +756,19 @@ impl Update {
             .map(|(t, n)| -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]))
             .collect();
         let p_max = pressure.iter().copied().fold(0.0, f64::max);
+        // Tension is measured against the largest pressure; with no node in compression
+        // (bodies pulled apart) against the largest tension, so the worst node's is 1, not
+        // p / f64::MIN_POSITIVE, which overflowed to inf (`null` in summary.json).
+        let scale = if p_max > 0.0 {
+            p_max
+        } else {
+            -pressure.iter().copied().fold(0.0, f64::min)
+        };
         let tension: Vec<(usize, f64)> = active
             .iter()
             .zip(&pressure)
             .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
-            .map(|(&i, &p)| (i, -p / p_max.max(f64::MIN_POSITIVE)))
+            .map(|(&i, &p)| (i, -p / scale))
             .collect();
         let is_active: HashSet<usize> = active.iter().copied().collect();
         let penetrating: Vec<(usize, f64)> = (0..s1.len())
