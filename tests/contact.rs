@@ -1553,6 +1553,26 @@ fn a_contact_zone_of_one_node_is_not_trusted_and_says_why() {
 }
 
 #[test]
+fn no_setting_switches_the_resolution_check_off() {
+    // The zone of the resolution check once counted the nodes within
+    // `secondary_penetration_tolerance` spacings of the other surface, so that a stricter
+    // tolerance could empty it and pass the check. The zone no longer depends on any setting:
+    // whatever this one, a one-node zone is named.
+    for tolerance in ["1e-6", "0.05", "0.5"] {
+        let extra = format!("secondary_penetration_tolerance = {tolerance}");
+        let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, &extra);
+        assert!(text.contains(&extra), "{text}");
+        let solution = solve(&text).unwrap();
+        assert!(!solution.is_trusted(), "{tolerance}: {}", solution.ending());
+        assert!(
+            failed_checks(&solution).contains(&"resolution"),
+            "{tolerance}: {:?}",
+            failed_checks(&solution)
+        );
+    }
+}
+
+#[test]
 fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     // Stepping 0.5 -> 1 from the previous active set (one set-up, one factorization) must give,
     // at each step, what an independent solve at that load factor gives.
