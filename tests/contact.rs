@@ -1012,29 +1012,15 @@ fn flat_blocks_clamped_at_both_ends_match_their_union() {
                 &format!("group = \"upper_top\"\n{vertical} = -0.01\n{lateral}"),
             )
         };
-        let union = {
-            let mesh_path = fixture(&format!("glued_blocks_{dim}d.msh"));
-            let text = format!(
-                "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"union\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n{lateral}\n[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = -0.01\n{lateral}\n",
-                mesh_path.display()
-            );
-            let (_dir, path) = write_case(&text);
-            let case = Case::load(&path).unwrap();
-            let mesh = read_msh(&mesh_path).unwrap();
-            let problem = case
-                .elastic_problem(mesh.body("union").unwrap(), &case.bodies[0])
-                .unwrap();
-            let settings = SolverSettings {
-                verbose: false,
-                ..SolverSettings::default()
-            };
-            let solution = internodes::elastic::solve(&problem, &settings).unwrap();
-            let (_, base) = (solution.reactions.iter())
-                .find(|(group, _)| group == "lower_base")
-                .unwrap()
-                .clone();
-            base[dim - 1].abs()
-        };
+        let union = one_body_reaction(
+            &format!("glued_blocks_{dim}d.msh"),
+            "union",
+            &format!(
+                "[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n{lateral}\n[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = -0.01\n{lateral}\n"
+            ),
+            "lower_base",
+        )[dim - 1]
+            .abs();
         for primary in ["upper", "lower", "auto"] {
             let text = clamp(two_blocks(dim, "frictionless", "", ""))
                 .replace("primary = \"upper\"", &format!("primary = \"{primary}\""));
@@ -1107,37 +1093,51 @@ group = "block_base"
     )
 }
 
-/// The vertical force on the block of `flat_punch_{dim}d.msh` alone, its base clamped and the
-/// punch's footprint `block_under_punch` pushed down by `delta` and free to slide: the rigid
-/// frictionless punch on the same block mesh, by the elastic solver.
-fn footprint_force(dim: usize, delta: f64) -> f64 {
-    let vertical = if dim == 2 { "uy" } else { "uz" };
-    let base = if dim == 2 {
-        "ux = 0.0\nuy = 0.0"
-    } else {
-        "ux = 0.0\nuy = 0.0\nuz = 0.0"
-    };
-    let mesh_path = fixture(&format!("flat_punch_{dim}d.msh"));
+/// The reaction on `group` of body `body` of the fixture `mesh` solved alone (E = 1000,
+/// nu = 0.3) with the Dirichlet conditions `conditions` (TOML `[[body.dirichlet]]` tables).
+fn one_body_reaction(mesh: &str, body: &str, conditions: &str, group: &str) -> Vec<f64> {
+    let mesh_path = fixture(mesh);
     let text = format!(
-        "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"block\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n[[body.dirichlet]]\ngroup = \"block_base\"\n{base}\n[[body.dirichlet]]\ngroup = \"block_under_punch\"\n{vertical} = {}\n",
-        mesh_path.display(),
-        -delta
+        "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"{body}\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n{conditions}",
+        mesh_path.display()
     );
     let (_dir, path) = write_case(&text);
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&mesh_path).unwrap();
     let problem = case
-        .elastic_problem(mesh.body("block").unwrap(), &case.bodies[0])
+        .elastic_problem(mesh.body(body).unwrap(), &case.bodies[0])
         .unwrap();
     let settings = SolverSettings {
         verbose: false,
         ..SolverSettings::default()
     };
     let solution = internodes::elastic::solve(&problem, &settings).unwrap();
-    let (_, reaction) = (solution.reactions.iter())
-        .find(|(group, _)| group == "block_under_punch")
+    (solution.reactions.iter())
+        .find(|(name, _)| name == group)
         .unwrap()
-        .clone();
+        .1
+        .clone()
+}
+
+/// The vertical force on the block of `flat_punch_{dim}d.msh` alone, its base clamped and the
+/// punch's footprint `block_under_punch` pushed down by `delta` and free to slide: the rigid
+/// frictionless punch on the same block mesh, by the elastic solver.
+fn footprint_force(dim: usize, delta: f64) -> f64 {
+    let (vertical, base) = if dim == 2 {
+        ("uy", "ux = 0.0\nuy = 0.0")
+    } else {
+        ("uz", "ux = 0.0\nuy = 0.0\nuz = 0.0")
+    };
+    let conditions = format!(
+        "[[body.dirichlet]]\ngroup = \"block_base\"\n{base}\n[[body.dirichlet]]\ngroup = \"block_under_punch\"\n{vertical} = {}\n",
+        -delta
+    );
+    let reaction = one_body_reaction(
+        &format!("flat_punch_{dim}d.msh"),
+        "block",
+        &conditions,
+        "block_under_punch",
+    );
     reaction[dim - 1].abs()
 }
 

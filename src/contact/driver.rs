@@ -119,34 +119,24 @@ pub fn solve_contact<'m>(
     // 3. The other primary's forces, when a stiff primary was named; 4. auto's transfer's,
     //    when another transfer was named.
     let any_solved = steps.iter().any(|s| s.status.is_solution());
-    let (problem, solution) = if problem.primary_report.check_other && any_solved {
-        let other = Alternative::OtherPrimary;
-        check_against(
-            problem,
-            other,
-            solution,
-            &mut steps,
-            solver,
-            load_factors,
-            &mut log,
-        )
-    } else {
-        (problem, solution)
-    };
-    let (problem, solution) = if problem.transfer_differs_from_auto() && any_solved {
-        let auto = Alternative::AutoTransfer;
-        check_against(
-            problem,
-            auto,
-            solution,
-            &mut steps,
-            solver,
-            load_factors,
-            &mut log,
-        )
-    } else {
-        (problem, solution)
-    };
+    let (mut problem, mut solution) = (problem, solution);
+    for alternative in [Alternative::OtherPrimary, Alternative::AutoTransfer] {
+        let due = match alternative {
+            Alternative::OtherPrimary => problem.primary_report.check_other,
+            Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
+        };
+        if due && any_solved {
+            (problem, solution) = check_against(
+                problem,
+                alternative,
+                solution,
+                &mut steps,
+                solver,
+                load_factors,
+                &mut log,
+            );
+        }
+    }
     // The last step's record is the answer's, checks made after the loop included.
     if let Some(last) = steps.last_mut() {
         last.status = solution.status;
