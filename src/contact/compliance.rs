@@ -1,26 +1,31 @@
-//! The interface response of a body to each multiplier: `Y_k = K_c^-1 b_k`, `b_k` the force
-//! that a unit multiplier `k` puts on the body (its column of the coupling block `B`, without
-//! the system's scaling), kept on the body's candidate-surface dofs.
+//! The interface response of a body to a unit traction: `Y_(i,c) = K_c^-1 b_(i,c)`, `b_(i,c)`
+//! the force that a unit traction of component `c` at active primary node `i` puts on the body
+//! (through the lumped mass on body 1, the transfer on body 2, without the system's scaling),
+//! kept on the body's candidate-surface dofs. A multiplier's response is their combination:
+//! tied, one component; frictionless, `sum_c n_c Y_(i,c)` along its normal `n`.
 //!
 //! An active-set iteration needs `K^-1 B` only where the constraint rows `C` read it, and the
 //! columns of `C` (the interface displacements) are candidate-surface dofs, so the Schur
 //! complement is `D - s C Y` with `Y = [Y_k]` restricted to those dofs. While the operators
-//! stay as built (`super::interface`), `b_k` depends only on which primary node (and
-//! component, for tied contact) multiplier `k` belongs to: `Y_k` is computed (one solve with
-//! the body's Cholesky factor) the first time that node is active, and kept for every later
-//! iteration and load step, until the operators are paired again.
+//! stay as built (`super::interface`), `b_(i,c)` depends only on the node and the component:
+//! it is computed (one solve with the body's Cholesky factor per component) the first time
+//! the node is active, and kept for every later iteration and load step, until the operators
+//! are paired again. Per component, not per multiplier: the frictionless traction acts along
+//! the normal of the secondary facet the node is held on (`super::linearization`), which
+//! turns with the displacement from one iteration to the next; the price is `dim` solves per
+//! node instead of one.
 //!
-//! One solve per multiplier, rather than one per loaded dof: the secondary's column `M2 R21 e_k`
-//! loads every secondary node the interpolation reaches, nearly the whole facing surface
-//! (the rows of `R12` and columns of `R21` are dense over it), so a dof-by-dof compliance
-//! needs about `dim` times the facing secondary nodes in solves, against one per active node.
+//! One solve per node and component, rather than one per loaded dof: the secondary's column
+//! `M2 R21 e_k` loads every secondary node the interpolation reaches, nearly the whole facing
+//! surface (the rows of `R12` and columns of `R21` are dense over it), so a dof-by-dof
+//! compliance needs about `dim` times the facing secondary nodes in solves.
 
 use std::collections::HashMap;
 
 use crate::linalg::Cholesky;
 
-/// Identifies a multiplier across iterations: the primary body node it acts at, and its
-/// component (tied) or `None` (frictionless: one normal multiplier per node).
+/// Identifies a unit traction across iterations: the primary body node it acts at, and its
+/// component (always `Some`; `super::system::CoupledSystem::columns` combines them).
 pub type MultiplierKey = (usize, Option<usize>);
 
 /// The responses `Y_k` of one body computed so far, on its candidate-surface dofs.
