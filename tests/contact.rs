@@ -394,7 +394,10 @@ fn an_explicit_stiff_primary_is_right_or_named() {
     if library.is_trusted() {
         assert!(error.abs() <= 0.01, "trusted, but {error:+.4} off dolfinx");
     }
-    eprintln!("stiff block primary by hand: {} ({error:+.4})", library.ending());
+    eprintln!(
+        "stiff block primary by hand: {} ({error:+.4})",
+        library.ending()
+    );
 
     let (code, summary) = solve_cli(&text);
     let contact = &summary["contact"];
@@ -491,7 +494,10 @@ fn every_load_step_of_an_explicit_stiff_primary_is_right_or_named() {
             !trusted || e.abs() <= 0.01,
             "step {k}: trusted, {e:+.4} off dolfinx"
         );
-        assert_eq!(trusted, step.failed_checks.is_empty() && step.status.is_solution());
+        assert_eq!(
+            trusted,
+            step.failed_checks.is_empty() && step.status.is_solution()
+        );
     }
 }
 
@@ -554,14 +560,16 @@ fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
 }
 
 #[test]
-fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
+fn a_coarse_flat_primary_under_a_narrow_zone_is_not_trusted() {
     // The stiff block primary, its surface twice coarser than the disc's (R/80), pressed by
     // 0.001: the contact zone is about 1.6 block spacings across, and the disc sags into the
-    // flat between the block's constrained nodes by about a tenth of the indentation. The
-    // penetration, tension and balance checks pass, yet the disc force is about 6% below the
-    // one with the disc's own nodes constrained (the disc primary): that answer must not be
-    // called converged, and the sag must be named. (One block node carries the whole zone, so
-    // the resolution check fails too.)
+    // flat beside the block's one constrained node by about a tenth of the indentation. Every
+    // residual passes (the discrete problem is solved), yet the disc force is about 6% below
+    // the one with the disc's own nodes constrained (the disc primary): the accuracy report
+    // must fail, and say why: one block node carries the zone (resolution), and the force
+    // differs from the other primary's (primary agreement). With no block facet between two
+    // constrained nodes there is no sag to measure: the disc's penetration is at the zone's
+    // rim, whose place the resolution bounds.
     let text = stiff_block("half_disc_on_block_coarse_block.msh", "block")
         .replace("uy = -0.02", "uy = -0.001");
     assert!(text.contains("uy = -0.001"), "{text}");
@@ -570,7 +578,7 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_certified_for_sag() {
     assert!(!coarse.is_trusted());
     assert_eq!(
         failed_checks(&coarse),
-        ["secondary sag", "resolution", "primary agreement"],
+        ["resolution", "primary agreement"],
         "{:?}",
         coarse.certificate
     );
@@ -659,8 +667,9 @@ fn a_coarser_secondary_receives_the_conservative_transfer() {
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["status"], "converged", "{contact}");
     assert_eq!(contact["transfer"]["transfer"], "conservative", "{contact}");
+    // The block is both coarser and nearly rigid; the second reason is tested first.
     let reason = contact["transfer"]["reason"].as_str().unwrap();
-    assert!(reason.contains("coarser"), "{reason}");
+    assert!(reason.contains("nearly rigid"), "{reason}");
     let force = contact["force_primary"][1].as_f64().unwrap();
     let error = force / COARSE_BLOCK_RIGID_FLAT_FORCE_2D_AT_0_004 - 1.0;
     assert!(
@@ -693,7 +702,8 @@ fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {
     assert_eq!(contact["primary_choice"]["mode"], "auto");
     let reason = contact["primary_choice"]["reason"].as_str().unwrap();
     assert!(
-        reason.contains("'block' as primary ended converged, accuracy report failed (secondary sag"),
+        reason
+            .contains("'block' as primary ended converged, accuracy report failed (secondary sag"),
         "{reason}"
     );
 }
@@ -977,6 +987,222 @@ fn tied_conforming_blocks_give_the_solution_of_their_union() {
 }
 
 #[test]
+fn flat_blocks_clamped_at_both_ends_match_their_union() {
+    // Two equal blocks on non-matching meshes, the base of the lower one clamped, the top of
+    // the upper one clamped and pressed down by 0.01, the sides free: each block bulges, and
+    // the contact zone ends at the blocks' corners. Mirror-symmetric about the interface, the
+    // frictionless answer is the union's (the interface carries no shear by symmetry), here
+    // solved as one body on a conforming mesh of the same geometry. With the RBF constraint
+    // rows and their gap correction, the 2D case ran to the iteration cap (the correction
+    // doubling every iteration) and the 3D one ended cycling; the linearized geometric gap is
+    // exact on a flat: one iteration, then the stop test.
+    for dim in [2, 3] {
+        let (vertical, lateral) = if dim == 2 {
+            ("uy", "ux = 0.0")
+        } else {
+            ("uz", "ux = 0.0\nuy = 0.0")
+        };
+        let clamp = |text: String| {
+            text.replace(
+                &format!("group = \"lower_base\"\n{vertical} = 0.0"),
+                &format!("group = \"lower_base\"\n{vertical} = 0.0\n{lateral}"),
+            )
+            .replace(
+                &format!("group = \"upper_top\"\n{vertical} = -0.01"),
+                &format!("group = \"upper_top\"\n{vertical} = -0.01\n{lateral}"),
+            )
+        };
+        let union = {
+            let mesh_path = fixture(&format!("glued_blocks_{dim}d.msh"));
+            let text = format!(
+                "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"union\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n{lateral}\n[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = -0.01\n{lateral}\n",
+                mesh_path.display()
+            );
+            let (_dir, path) = write_case(&text);
+            let case = Case::load(&path).unwrap();
+            let mesh = read_msh(&mesh_path).unwrap();
+            let problem = case
+                .elastic_problem(mesh.body("union").unwrap(), &case.bodies[0])
+                .unwrap();
+            let settings = SolverSettings {
+                verbose: false,
+                ..SolverSettings::default()
+            };
+            let solution = internodes::elastic::solve(&problem, &settings).unwrap();
+            let (_, base) = (solution.reactions.iter())
+                .find(|(group, _)| group == "lower_base")
+                .unwrap()
+                .clone();
+            base[dim - 1].abs()
+        };
+        for primary in ["upper", "lower", "auto"] {
+            let text = clamp(two_blocks(dim, "frictionless", "", ""))
+                .replace("primary = \"upper\"", &format!("primary = \"{primary}\""));
+            assert!(text.matches(lateral).count() >= 2, "{text}");
+            let solution = solve(&text).unwrap();
+            let label = format!("{dim}D, primary {primary}");
+            assert_eq!(
+                solution.status,
+                ContactStatus::Converged,
+                "{label}: {}",
+                solution.ending()
+            );
+            assert!(solution.is_trusted(), "{label}: {}", solution.ending());
+            assert!(
+                solution.history.len() <= 2,
+                "{label}: {} iterations",
+                solution.history.len()
+            );
+            let force = solution.force_primary[dim - 1].abs();
+            let error = force / union - 1.0;
+            assert!(
+                error.abs() <= 0.01,
+                "{label}: force {force} against the union's {union}: {error:+.4}"
+            );
+            eprintln!(
+                "{label}: {} iteration(s), force {error:+.4} from the union's",
+                solution.history.len()
+            );
+        }
+    }
+}
+
+/// A stiff flat punch (E = 1e7) with sharp corners pressed by `delta` onto a block (E = 1000)
+/// twice its width and more, from `tests/fixtures/flat_punch_{dim}d.msh`.
+fn flat_punch(dim: usize, delta: f64, primary: &str) -> String {
+    let (top, base) = if dim == 2 {
+        (format!("ux = 0.0\nuy = {}", -delta), "ux = 0.0\nuy = 0.0")
+    } else {
+        (
+            format!("ux = 0.0\nuy = 0.0\nuz = {}", -delta),
+            "ux = 0.0\nuy = 0.0\nuz = 0.0",
+        )
+    };
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+bodies = ["punch", "block"]
+surfaces = ["punch_face", "block_top"]
+primary = "{primary}"
+
+[[body]]
+name = "punch"
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "punch_top"
+{top}
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "block_base"
+{base}
+"#,
+        mesh = fixture(&format!("flat_punch_{dim}d.msh")).display()
+    )
+}
+
+/// The vertical force on the block of `flat_punch_{dim}d.msh` alone, its base clamped and the
+/// punch's footprint `block_under_punch` pushed down by `delta` and free to slide: the rigid
+/// frictionless punch on the same block mesh, by the elastic solver.
+fn footprint_force(dim: usize, delta: f64) -> f64 {
+    let vertical = if dim == 2 { "uy" } else { "uz" };
+    let base = if dim == 2 {
+        "ux = 0.0\nuy = 0.0"
+    } else {
+        "ux = 0.0\nuy = 0.0\nuz = 0.0"
+    };
+    let mesh_path = fixture(&format!("flat_punch_{dim}d.msh"));
+    let text = format!(
+        "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"block\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n[[body.dirichlet]]\ngroup = \"block_base\"\n{base}\n[[body.dirichlet]]\ngroup = \"block_under_punch\"\n{vertical} = {}\n",
+        mesh_path.display(),
+        -delta
+    );
+    let (_dir, path) = write_case(&text);
+    let case = Case::load(&path).unwrap();
+    let mesh = read_msh(&mesh_path).unwrap();
+    let problem = case
+        .elastic_problem(mesh.body("block").unwrap(), &case.bodies[0])
+        .unwrap();
+    let settings = SolverSettings {
+        verbose: false,
+        ..SolverSettings::default()
+    };
+    let solution = internodes::elastic::solve(&problem, &settings).unwrap();
+    let (_, reaction) = (solution.reactions.iter())
+        .find(|(group, _)| group == "block_under_punch")
+        .unwrap()
+        .clone();
+    reaction[dim - 1].abs()
+}
+
+#[test]
+fn a_stiff_flat_punch_is_solved_and_accurate_with_the_defaults() {
+    // A punch with sharp corners, 1e4 times stiffer than the block and meshed about as finely,
+    // pressed by 0.2% and 2% of the block's height. The block's surface drops steeply at the
+    // punch's edges, where the punch's corner nodes cross the block's last facet; the answer is
+    // nonetheless the rigid punch's on the same block mesh. With the loop's previous
+    // certificate every one of these was refused (the sag judged against an indentation depth
+    // that a flat punch does not have; in 3D the interpolation transfer lost 2.5% of the force
+    // at the punch's edges).
+    for dim in [2, 3] {
+        for delta in [0.002, 0.02] {
+            let label = format!("{dim}D punch pressed by {delta}");
+            let (code, summary) = solve_cli(&flat_punch(dim, delta, "auto"));
+            let contact = &summary["contact"];
+            assert_eq!(code, Some(0), "{label}: {contact}");
+            assert_eq!(contact["status"], "converged", "{label}");
+            assert_eq!(contact["accuracy"]["passed"], true, "{label}");
+            assert_eq!(contact["primary"], "block", "{label}");
+            assert_eq!(contact["transfer"]["transfer"], "conservative", "{label}");
+            let force = contact["force_primary"][dim - 1].as_f64().unwrap().abs();
+            let reference = footprint_force(dim, delta);
+            let error = force / reference - 1.0;
+            assert!(
+                error.abs() <= 0.005,
+                "{label}: force {force} against {reference}: {error:+.4}"
+            );
+            eprintln!(
+                "{label}: {} iterations, force {error:+.5} from the rigid punch's",
+                contact["iterations"].as_array().unwrap().len()
+            );
+        }
+    }
+}
+
+#[test]
+fn a_stiff_punch_made_primary_by_hand_is_right_or_named() {
+    // The punch as primary: its nodes are held on the block's surface, the block's between
+    // them only through the transfer. In 2D that is the rigid punch's answer to 0.1%; in 3D
+    // the fine stiff multiplier surface on the compliant block is unstable (the inf-sup
+    // condition that `primary = "auto"` avoids). Either way: right, or named.
+    for dim in [2, 3] {
+        for delta in [0.002, 0.02] {
+            let label = format!("{dim}D punch primary pressed by {delta}");
+            let (code, summary) = solve_cli(&flat_punch(dim, delta, "punch"));
+            let contact = &summary["contact"];
+            let force = contact["force_primary"][dim - 1].as_f64().unwrap().abs();
+            let error = force / footprint_force(dim, delta) - 1.0;
+            if code == Some(0) {
+                assert!(error.abs() <= 0.01, "{label}: trusted, {error:+.4} off");
+            } else {
+                assert!(matches!(code, Some(2 | 3)), "{label}: {code:?}");
+                assert!(!failed_in_summary(contact).is_empty(), "{label}: {contact}");
+            }
+            eprintln!(
+                "{label}: exit {code:?}, status {}, force {error:+.4}",
+                contact["status"]
+            );
+        }
+    }
+}
+
+#[test]
 fn frictionless_patch_test_without_rollers_gives_the_uniaxial_stress() {
     // Each block is only pinned at corners (points) against rigid-body motions, so both expand
     // laterally under uniaxial stress: sigma = E' delta / 2 with E' = E in 3D and E / (1 - nu^2)
@@ -1234,7 +1460,12 @@ fn a_contact_zone_of_one_node_is_not_trusted_and_says_why() {
     // resolution, exit status 3.
     let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, "");
     let solution = solve(&text).unwrap();
-    assert_eq!(solution.status, ContactStatus::Converged, "{:?}", solution.certificate);
+    assert_eq!(
+        solution.status,
+        ContactStatus::Converged,
+        "{:?}",
+        solution.certificate
+    );
     assert!(!solution.is_trusted());
     let failed = failed_checks(&solution);
     assert!(failed.contains(&"resolution"), "{failed:?}");

@@ -128,20 +128,21 @@ fn solve_schur(
         || factor2.solve_in_place(&mut z2, 1),
     );
 
-    // Y_k = K^-1 (B e_k / s) for the multipliers not seen before (`super::compliance`).
-    let mut loads: [Vec<Vec<(usize, f64)>>; 2] = [vec![Vec::new(); m], vec![Vec::new(); m]];
-    for &(row, k, value) in &system.b {
-        let (body, dof) = if row < n1 { (0, row) } else { (1, row - n1) };
-        loads[body][k].push((dof, value / s));
-    }
-    let new = |response: &SurfaceResponse, loads: &mut Vec<Vec<(usize, f64)>>| {
-        (0..m)
-            .filter(|&k| !response.contains(&system.keys[k]))
-            .map(|k| (system.keys[k], std::mem::take(&mut loads[k])))
+    // The responses to the unit forces not seen before (`super::compliance`).
+    let new = |response: &SurfaceResponse, body: usize| {
+        (system.unit_loads.iter())
+            .filter(|(key, _)| !response.contains(key))
+            .map(|(key, load)| {
+                let on_body = load.iter().filter_map(|&(row, value)| match body {
+                    0 if row < n1 => Some((row, value)),
+                    1 if row >= n1 => Some((row - n1, value)),
+                    _ => None,
+                });
+                (*key, on_body.collect())
+            })
             .collect::<Vec<_>>()
     };
-    let [loads1, loads2] = &mut loads;
-    let (new1, new2) = (new(response1, loads1), new(response2, loads2));
+    let (new1, new2) = (new(response1, 0), new(response2, 1));
     rayon::join(
         || response1.extend(factor1, &new1),
         || response2.extend(factor2, &new2),
@@ -169,8 +170,15 @@ fn solve_schur(
         // One hash lookup per multiplier, not per entry: this runs every iteration.
         let rows = response.rows(&read);
         let mut y = DMatrix::<f64>::zeros(read.len(), m);
-        for (k, key) in system.keys.iter().enumerate() {
-            response.gather(key, &rows, y.column_mut(k).as_mut_slice());
+        let mut part = vec![0.0; read.len()];
+        for (k, column) in system.columns.iter().enumerate() {
+            for (key, weight) in column {
+                response.gather(key, &rows, &mut part);
+                let mut y_k = y.column_mut(k);
+                for (value, p) in y_k.iter_mut().zip(&part) {
+                    *value += weight * p;
+                }
+            }
         }
         schur -= (c * y) * s;
     }

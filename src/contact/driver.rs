@@ -64,7 +64,11 @@ impl StepRecord {
         if failed.is_empty() {
             self.status.name().to_string()
         } else if self.status.is_solution() {
-            format!("{}, accuracy report failed ({})", self.status.name(), failed.join(", "))
+            format!(
+                "{}, accuracy report failed ({})",
+                self.status.name(),
+                failed.join(", ")
+            )
         } else {
             format!("{} ({})", self.status.name(), failed.join(", "))
         }
@@ -201,7 +205,9 @@ fn check_against_other_primary<'m>(
     let (reference, other_steps) = match solve_load_steps(&other, solver, load_factors, label, log)
     {
         // The force the other primary's multiplier puts on this solve's primary body.
-        Ok((check, other_steps)) if check.status == ContactStatus::Converged && check.is_trusted() => {
+        Ok((check, other_steps))
+            if check.status == ContactStatus::Converged && check.is_trusted() =>
+        {
             (Ok(check.force_primary.map(|f| -f)), other_steps)
         }
         Ok((check, other_steps)) => (Err(check.ending()), other_steps),
@@ -211,9 +217,11 @@ fn check_against_other_primary<'m>(
     let earlier = steps.len().saturating_sub(1);
     for (k, step) in steps[..earlier].iter_mut().enumerate() {
         let other_step = match other_steps.get(k) {
-            Some(o) if o.status == ContactStatus::Converged && o.is_trusted() => Ok(std::array::from_fn(|c| {
-                -o.force_primary.get(c).unwrap_or(&0.0)
-            })),
+            Some(o) if o.status == ContactStatus::Converged && o.is_trusted() => {
+                Ok(std::array::from_fn(|c| {
+                    -o.force_primary.get(c).unwrap_or(&0.0)
+                }))
+            }
             Some(o) => Err(o.ending()),
             None => Err("before this load step (its load steps stopped)".to_string()),
         };

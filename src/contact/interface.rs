@@ -56,8 +56,6 @@ pub struct InterfaceOperators {
     /// How far the primary surface has slid over the secondary when the operators were
     /// built ([`Self::slide`]): the pairing's offset.
     pub slid: [f64; 3],
-    /// Whether each primary candidate faces the secondary surface (only those can be active).
-    pub facing: Vec<bool>,
     /// Contact normal at each primary candidate (pointing out of body 1).
     pub normals: Vec<[f64; 3]>,
     /// Reference gap `d_i` of each primary candidate along its contact normal.
@@ -85,7 +83,7 @@ impl InterfaceOperators {
     ) -> Result<Self, ContactError> {
         let [w1, w2] = weights;
         let back = slid.map(|v| -v);
-        let (targets12, facing) = paired_points(primary, secondary, [w1, w2], slid)?;
+        let (targets12, _) = paired_points(primary, secondary, [w1, w2], slid)?;
         let (on_primary, facing2) = paired_points(secondary, primary, [w2, w1], back)?;
         let r12 = covering_interpolation(secondary, radius, &targets12, primary, |t| t)?;
         // Only the secondary nodes that face the primary surface receive its traction.
@@ -118,7 +116,6 @@ impl InterfaceOperators {
             r21,
             receiving,
             slid,
-            facing,
             normals,
             reference_gaps,
             rows12: HashMap::new(),
@@ -196,7 +193,7 @@ impl InterfaceOperators {
                 }
             })
             .collect();
-        let (rows, constraint_normals, gaps) = match constraint {
+        let (rows, normals, gaps) = match constraint {
             Constraint::Interpolated { corrections } => (
                 active
                     .iter()
@@ -229,8 +226,7 @@ impl InterfaceOperators {
         Coupling {
             formulation,
             primary_nodes: active.iter().map(|&i| primary.nodes[i]).collect(),
-            normals: active.iter().map(|&i| self.normals[i]).collect(),
-            constraint_normals,
+            normals,
             areas1: active.iter().map(|&i| primary.nodal_area[i]).collect(),
             r12: rows,
             loads2,
@@ -340,9 +336,9 @@ pub fn geometric_gaps(
 /// map a sphere of radius `R` onto a flat stretched or shrunk by `delta / R`, and the transfer
 /// of the pressure with it (the contact forces were unbalanced by 1.6% in 3D with the closest
 /// point, 2.4% in 2D with the own normal, both overlapping by about 0.017 R); the deformed
-/// interface, along whose normal the bodies meet, is what the contact normal estimates. A node
-/// that does not face the other surface (the far side of a disc, the block beyond the sphere's
-/// candidate cap) can neither be activated nor receive a contact force.
+/// interface, along whose normal the bodies meet, is what the contact normal estimates. A
+/// secondary node that does not face the primary surface (the far side of a disc, the block
+/// beyond the sphere's candidate cap) receives no contact force through `R21`.
 ///
 /// Moved by how far the surfaces have slid over each other, so that they are paired where they
 /// touch, not where they started: paired where they started, a half-disc pushed sideways by

@@ -3,7 +3,8 @@
 //!
 //! **The gap.** A primary node at `x = X + u1` has its closest point `q` on the secondary's
 //! displaced P1 surface, on facet `f` with barycentric coordinates `b_k` of its corners `y_k`
-//! (`q = sum_k b_k y_k`), and `m` the facet's outward unit normal (out of body 2). Its gap is
+//! (`q = sum_k b_k y_k`; where several facets share `q`, the one that faces the node's own
+//! outward normal the most), and `m` the facet's outward unit normal (out of body 2). Its gap is
 //! the distance to the plane of that facet, `g = m . (x - q)`: positive outside body 2,
 //! negative inside. Where `q` lies inside the facet (every node that touches a smooth or flat
 //! surface) this is the signed closest-point distance of the certificate
@@ -68,7 +69,8 @@ pub fn gap_rows(
     (0..primary.len())
         .map(|i| {
             let x = u1.map_or(primary.coords[i], |u| primary.deformed(u, i));
-            let closest = index.project(&x).expect("a contact surface has facets");
+            let closest = (index.project_facing(&x, Some(&primary.normals[i])))
+                .expect("a contact surface has facets");
             let m = index.normal(closest.facet);
             let normal = m.map(|v| -v);
             let gap: f64 = (0..3).map(|k| m[k] * (x[k] - closest.point[k])).sum();

@@ -97,9 +97,20 @@ impl SurfaceIndex {
     /// The closest point of the surface to `x`, with the signed distance (module doc). `None`
     /// only for a surface without facets.
     pub fn project(&self, x: &[f64; 3]) -> Option<Projection> {
+        self.project_facing(x, None)
+    }
+
+    /// [`Self::project`], on the facet that faces `towards` the most when several share the
+    /// closest point (an edge or a vertex of the surface): the one whose outward normal is the
+    /// most opposed to `towards`. The gap's linearization holds the node on that facet's plane
+    /// (`super::linearization`): a block's node under a punch's corner is held on the punch's
+    /// face, not on its side.
+    pub fn project_facing(&self, x: &[f64; 3], towards: Option<&[f64; 3]>) -> Option<Projection> {
         let mut nearest = self.tree.nearest_neighbor_iter_with_distance_2(x);
         let (first, d2) = nearest.next()?;
-        let (point, barycentric) = closest_point(&first.corners, x);
+        let (mut point, mut barycentric) = closest_point(&first.corners, x);
+        let mut facet = first.index;
+        let facing = |f: usize| towards.map_or(0.0, |t| dot(&self.normals[f], t));
         // Facets sharing the closest point (to rounding) contribute to the pseudo-normal.
         let tie = d2 * (1.0 + 1e-9) + 1e-300;
         let mut normal = self.normals[first.index];
@@ -109,6 +120,10 @@ impl SurfaceIndex {
             }
             let n = self.normals[other.index];
             normal = std::array::from_fn(|k| normal[k] + n[k]);
+            if facing(other.index) < facing(facet) {
+                facet = other.index;
+                (point, barycentric) = closest_point(&other.corners, x);
+            }
         }
         let offset: [f64; 3] = std::array::from_fn(|k| x[k] - point[k]);
         let distance = d2.sqrt();
@@ -117,7 +132,7 @@ impl SurfaceIndex {
         let signed_distance = if along < 0.0 { -distance } else { distance };
         Some(Projection {
             point,
-            facet: first.index,
+            facet,
             barycentric,
             signed_distance,
         })

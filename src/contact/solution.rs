@@ -225,7 +225,15 @@ impl ContactSolution {
         let accuracy = if self.certificate.accurate() {
             "passed".to_string()
         } else {
-            format!("FAILED: {}", self.certificate.indicators().filter(|c| !c.passed).map(|c| c.describe()).collect::<Vec<_>>().join("; "))
+            format!(
+                "FAILED: {}",
+                self.certificate
+                    .indicators()
+                    .filter(|c| !c.passed)
+                    .map(|c| c.describe())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )
         };
         format!("{outcome}\n  checks: {certificate}\n  accuracy report: {accuracy}")
     }

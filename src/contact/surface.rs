@@ -149,6 +149,11 @@ impl ContactSurface {
         -normal_force / self.nodal_area[s]
     }
 
+    /// The number of facets.
+    pub fn num_facets(&self) -> usize {
+        self.facets.len() / self.dim
+    }
+
     /// The corners of facet `facet` (surface node indices), in the order of the barycentric
     /// coordinates of a [`super::projection::Projection`] onto it.
     pub fn facet_nodes(&self, facet: usize) -> &[usize] {

@@ -35,12 +35,11 @@ pub struct Coupling {
     pub formulation: Formulation,
     /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
-    /// Contact normal at each active node (pointing out of body 1): the direction of the
-    /// frictionless traction `lambda_n n`.
+    /// Normal at each active node (pointing out of body 1). Frictionless: the normal of the
+    /// secondary facet the node is held on, the direction of both its constraint row (the
+    /// gradient of its gap, `super::linearization`) and its traction `lambda_n n`. Tied: the
+    /// contact normal along which the gap is held.
     pub normals: Vec<[f64; 3]>,
-    /// Direction of each frictionless constraint row (pointing out of body 1): the gradient of
-    /// the gap it holds (`super::linearization`). Unused by tied contact.
-    pub constraint_normals: Vec<[f64; 3]>,
     /// Lumped interface mass of each active node: its area `A_i`.
     pub areas1: Vec<f64>,
     /// Constraint row of each active node: `(secondary body node, weight)`, a row of `R12`
@@ -88,16 +87,6 @@ impl Coupling {
         }
     }
 
-    /// Row `(multiplier, component)` coefficients of the constraint of node `b`: tied
-    /// `u1(b, c) - ...` is its own row; frictionless `n_b[c] (u1(b, c) - ...)`, `n_b` the
-    /// constraint's direction.
-    fn constraint_terms(&self, b: usize, c: usize, dim: usize) -> (usize, f64) {
-        match self.formulation {
-            Formulation::Tied => (dim * b + c, 1.0),
-            Formulation::Frictionless => (b, self.constraint_normals[b][c]),
-        }
-    }
-
     /// Column `(multiplier, component)` coefficients of the traction at node `b`:
     /// tied `lambda(b, c)` is its own unknown; frictionless `lambda(b) n_b[c]`.
     fn multiplier_terms(&self, b: usize, c: usize, dim: usize) -> (usize, f64) {
@@ -120,9 +109,15 @@ pub struct CoupledSystem {
     pub n2: usize,
     /// Number of multipliers.
     pub m: usize,
-    /// Which primary node (and component) each multiplier belongs to; its column of `B` over
-    /// `s` depends on nothing else (`super::compliance`).
-    pub keys: Vec<MultiplierKey>,
+    /// The column of `B` of each multiplier over `s`, as a combination of the unit forces of
+    /// [`Self::unit_loads`]: for tied contact the force of one component at one primary node,
+    /// for frictionless contact the sum of the components weighted by the node's normal
+    /// (`super::compliance` keeps the bodies' responses to the unit forces, which depend on
+    /// nothing else).
+    pub columns: Vec<Vec<(MultiplierKey, f64)>>,
+    /// The force that a unit traction of one component at one active primary node puts on
+    /// the bodies (rows `< n1 + n2`, unscaled).
+    pub unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
     /// Multiplier scaling: the unknown is `lambda / s`.
     pub s: f64,
     /// Entries `(row < n1 + n2, multiplier, value)` of B.
@@ -156,40 +151,38 @@ impl CoupledSystem {
         }
         let s = if m > 0 { k_scale / m_scale } else { 1.0 };
         let t = k_scale;
-        let keys: Vec<MultiplierKey> = match coupling.formulation {
-            Formulation::Tied => coupling
-                .primary_nodes
-                .iter()
-                .flat_map(|&node| (0..dim).map(move |c| (node, Some(c))))
-                .collect(),
-            Formulation::Frictionless => {
-                coupling.primary_nodes.iter().map(|&n| (n, None)).collect()
-            }
-        };
         let dropped: Vec<bool> = (0..m)
             .map(|col| coupling.is_dropped(col, body1, dim))
             .collect();
         let free1 = |dof: usize| !body1.constraints.is_fixed(dof);
         let free2 = |dof: usize| !body2.constraints.is_fixed(dof);
 
-        // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2.
+        // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2, one unit force
+        // per active node and component, combined per multiplier.
         let mut b = Vec::new();
+        let mut columns = vec![Vec::new(); m];
+        let mut unit_loads = Vec::new();
         for (k, &node) in coupling.primary_nodes.iter().enumerate() {
             for c in 0..dim {
                 let (col, weight) = coupling.multiplier_terms(k, c, dim);
                 if dropped[col] || weight == 0.0 {
                     continue;
                 }
+                let mut load = Vec::new();
                 let dof = dim * node + c;
                 if free1(dof) {
-                    b.push((dof, col, -s * coupling.areas1[k] * weight));
+                    load.push((dof, -coupling.areas1[k]));
                 }
-                for &(node2, load) in &coupling.loads2[k] {
+                for &(node2, value) in &coupling.loads2[k] {
                     let dof2 = dim * node2 + c;
                     if free2(dof2) {
-                        b.push((n1 + dof2, col, s * load * weight));
+                        load.push((n1 + dof2, value));
                     }
                 }
+                b.extend(load.iter().map(|&(row, v)| (row, col, s * v * weight)));
+                let key = (node, Some(c));
+                columns[col].push((key, weight));
+                unit_loads.push((key, load));
             }
         }
         // Constraint rows: u1 - R12 u2 = d (tied), or its normal component (frictionless).
@@ -198,7 +191,7 @@ impl CoupledSystem {
         let d: Vec<f64> = dropped.iter().map(|&x| if x { t } else { 0.0 }).collect();
         for (a, &node) in coupling.primary_nodes.iter().enumerate() {
             for c in 0..dim {
-                let (row, weight) = coupling.constraint_terms(a, c, dim);
+                let (row, weight) = coupling.multiplier_terms(a, c, dim);
                 if dropped[row] || weight == 0.0 {
                     continue;
                 }
@@ -220,7 +213,8 @@ impl CoupledSystem {
             n1,
             n2,
             m,
-            keys,
+            columns,
+            unit_loads,
             s,
             b,
             c: c_entries,

@@ -7,8 +7,8 @@ use serde::Serialize;
 
 use super::OutputError;
 use crate::contact::{
-    Certificate, CertificateCheck, ContactSettings, ContactStatus, HertzFit, IterationRecord, PrimaryReport,
-    StepRecord, TransferReport,
+    Certificate, CertificateCheck, ContactSettings, ContactStatus, HertzFit, IterationRecord,
+    PrimaryReport, StepRecord, TransferReport,
 };
 use crate::elastic::SolveStats;
 
