@@ -570,7 +570,8 @@ def run_case(binary: Path, case: FlatCase) -> tuple[list[Check], dict]:
     record: dict = {"parameters": asdict(case) | {"delta": case.delta, "gap": case.gap}}
     checks: list[Check] = []
     try:
-        msh = mesh(*case.geo()[:1], case.dim, case.geo()[1])
+        script, parameters = case.geo()
+        msh = mesh(script, case.dim, parameters)
         check, measured = mesh_check(case, msh)
         checks.append(check)
         record["spacings"] = measured
