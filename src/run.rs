@@ -73,8 +73,18 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
             return Err(e.into());
         }
     };
+    let Some(output) = options.output.as_ref().or(case.output.as_ref()) else {
+        return Err(CaseError::Invalid {
+            path: case.path.clone(),
+            context: "output".to_string(),
+            message: "no output folder: give the `output` key in the case file (e.g. output = \
+                      \"out\") or the --output flag of `internodes solve`"
+                .to_string(),
+        }
+        .into());
+    };
     let results = ResultFolder::create(
-        options.output.as_ref().unwrap_or(&case.output),
+        output,
         &origin,
         &[&case.path, &case.mesh],
         case.generates_mesh(),

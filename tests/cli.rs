@@ -305,3 +305,34 @@ fn inaccurate_solves_are_errors_not_results() {
         "{message}"
     );
 }
+
+#[test]
+fn the_output_folder_may_come_from_the_flag_alone() {
+    // `output` used to be required in the case file even with --output.
+    let (dir, path) = write_case(&block_case().replace("output = \"out\"\n", ""));
+    let out = dir.path().join("elsewhere");
+    let output = Command::new(BINARY)
+        .args(["solve", path.to_str().unwrap(), "--quiet", "--output"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(out.join("summary.json").exists() && out.join("solution.h5").exists());
+}
+
+#[test]
+fn without_the_output_key_or_flag_the_error_names_both() {
+    let (e, message) = failure(&block_case().replace("output = \"out\"\n", ""));
+    assert!(
+        matches!(e, RunError::Case(CaseError::Invalid { .. })),
+        "{message}"
+    );
+    assert!(
+        message.contains("`output` key") && message.contains("--output"),
+        "{message}"
+    );
+}

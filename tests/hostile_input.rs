@@ -486,6 +486,35 @@ fn exporting_matrices_with_a_dirichlet_point_group_does_not_panic() {
     assert!(!matrices.join("upper__upper_corner_mass.mtx").exists());
 }
 
+#[test]
+fn an_ascii_mesh_cut_inside_an_element_line_is_reported_truncated_not_duplicate() {
+    // Cut in the middle of the tag of an element line near the end: '976 80 471 472' becomes
+    // '97', a tag defined earlier, and the file was reported as defining it twice.
+    let text = std::fs::read_to_string(fixture("block_2d.msh")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| *l == "$EndElements").unwrap() - 2;
+    let tag = lines[at].split_whitespace().next().unwrap();
+    assert!(tag.len() >= 3, "{}", lines[at]);
+    let kept: usize = lines[..at].iter().map(|l| l.len() + 1).sum();
+    for cut in [&tag[..2], &format!("{} ", &tag[..2]), tag] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("block_2d.msh");
+        std::fs::write(&path, format!("{}{cut}", &text[..kept])).unwrap();
+        let (e, message) = mesh_error(&path);
+        assert!(
+            matches!(e, MeshError::Syntax { line, .. } if line == at + 1),
+            "'{cut}': {message}"
+        );
+        assert!(
+            message.contains(&format!("block_2d.msh:{}", at + 1))
+                && message.contains("the file ends")
+                && message.contains("truncated")
+                && !message.contains("twice"),
+            "'{cut}': {message}"
+        );
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // 3. The output folder holds one run's complete results, or a failure mark
 // ---------------------------------------------------------------------------------------------
@@ -737,6 +766,103 @@ fn an_output_folder_holding_an_input_under_a_result_name_is_refused() {
     assert!(exists(dir.path(), "lower.msh"));
 }
 
+/// Runs `internodes solve CASE --quiet` as a child process and kills it if it has not ended
+/// within `limit` (`None` then): a run that waits forever fails the test instead of hanging it.
+fn solve_within(case: &Path, limit: std::time::Duration) -> Option<std::process::Output> {
+    let mut child = Command::new(BINARY)
+        .args(["solve", case.to_str().unwrap(), "--quiet"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    Some(child.wait_with_output().unwrap())
+}
+
+#[test]
+fn a_folder_named_as_the_commit_lock_is_an_error_naming_it() {
+    // The run used to wait for it forever without a word.
+    let (dir, case) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let lock = dir.path().join("out/.internodes-commit.lock");
+    std::fs::create_dir_all(&lock).unwrap();
+    let output = solve_within(&case, std::time::Duration::from_secs(20))
+        .expect("the run must end at once, not wait for a folder to go away");
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains(&format!("the commit lock {} is a folder", lock.display()))
+            && stderr.contains("rm -r"),
+        "{stderr}"
+    );
+    assert!(lock.is_dir(), "the user's folder stays");
+}
+
+#[test]
+fn a_commit_lock_dated_in_the_future_is_not_fresh_forever() {
+    // A lock file left with a modification time a year ahead (a clock set back, a folder copied
+    // from another machine) used to make every run wait for it forever.
+    let (dir, case) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let lock = out.join(".internodes-commit.lock");
+    let file = std::fs::File::create(&lock).unwrap();
+    let year = std::time::Duration::from_secs(365 * 86_400);
+    file.set_modified(std::time::SystemTime::now() + year)
+        .unwrap();
+    drop(file);
+    let output = solve_within(&case, std::time::Duration::from_secs(20))
+        .expect("the run must not wait for a lock dated in the future");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(exists(&out, "summary.json") && !lock.exists());
+}
+
+#[test]
+fn bodies_pulled_apart_leave_no_null_in_the_iteration_history() {
+    // The upper block is lifted off the lower one: the first iteration finds every active node
+    // in tension and none compressed, and its tension over the largest pressure was
+    // p / f64::MIN_POSITIVE = inf, written as `null` into summary.json.
+    let contact = "[contact]\nbodies = [\"upper\", \"lower\"]\nsurfaces = [\"upper_contact\", \"lower_contact\"]\n";
+    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", contact).replace(
+        "group = \"upper_top\"\nux = 0.0\nuy = 0.0",
+        "group = \"upper_top\"\nux = 0.0\nuy = 0.01",
+    );
+    assert!(text.contains("uy = 0.01"), "{text}");
+    let (dir, case) = write_case(&text);
+    run_quiet(&case).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let contact = &summary["contact"];
+    assert_eq!(contact["status"], "no-contact");
+    let iterations = contact["iterations"].as_array().unwrap();
+    assert!(!iterations.is_empty());
+    // The first iteration starts with every facing node active (all of them then in tension).
+    assert!(
+        iterations[0]["removed"].as_u64().unwrap() > 0,
+        "{iterations:?}"
+    );
+    for record in iterations {
+        for (key, value) in record.as_object().unwrap() {
+            assert!(!value.is_null(), "{key} is null in {record}");
+        }
+        let tension = record["max_tension_over_p"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&tension), "{record}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // 4. 2D bodies must lie in the xy plane
 // ---------------------------------------------------------------------------------------------
@@ -920,6 +1046,82 @@ fn non_finite_loads_are_errors_naming_the_load() {
         message.contains("body_force") && message.contains("finite"),
         "{message}"
     );
+}
+
+#[test]
+fn finite_values_that_overflow_downstream_are_rejected_naming_the_key_and_range() {
+    // Each was accepted and failed in the solve with an unmet residual or a singular matrix
+    // that named neither the key nor the value.
+    let square = |from: &str, to: &str| {
+        let text = square_case("square_sorted.msh", "[1.0, 0.0]");
+        assert!(text.contains(from), "{from}");
+        text.replace(from, to)
+    };
+    let range = "of magnitude at most 1e40";
+    for (text, key, expected) in [
+        (
+            square("traction = [1.0, 0.0]", "traction = [1e308, 0.0]"),
+            "load on 'right'",
+            range,
+        ),
+        (
+            square("traction = [1.0, 0.0]", "pressure = 1e308"),
+            "load on 'right', pressure",
+            range,
+        ),
+        (
+            square(
+                "traction = [1.0, 0.0]",
+                "hertz_pressure = { p0 = 1e308, a = 0.5, center = [0.0, 0.0] }",
+            ),
+            "hertz_pressure.p0",
+            range,
+        ),
+        (
+            square(
+                "poisson_ratio = 0.25",
+                "poisson_ratio = 0.25\nbody_force = [1e308, 0.0]",
+            ),
+            "body_force",
+            range,
+        ),
+        (
+            square("ux = 0.0", "ux = 1e308"),
+            "Dirichlet condition on 'left', ux",
+            range,
+        ),
+        (
+            square("youngs_modulus = 100.0", "youngs_modulus = 1e308"),
+            "youngs_modulus",
+            "from 1e-40 to 1e40",
+        ),
+        (
+            square("youngs_modulus = 100.0", "youngs_modulus = 1e-300"),
+            "youngs_modulus",
+            "from 1e-40 to 1e40",
+        ),
+        (
+            common::half_disc_on_block("half_disc_on_block.msh", "load_steps = [1e300]"),
+            "load_steps",
+            range,
+        ),
+        (
+            common::half_disc_on_block("half_disc_on_block.msh", "rbf_radius = 1e300"),
+            "rbf_radius",
+            "<= 10",
+        ),
+        (
+            common::half_disc_on_block("half_disc_on_block.msh", "rbf_radius = 1e9"),
+            "rbf_radius",
+            "<= 10",
+        ),
+    ] {
+        let message = case_failure(&text);
+        assert!(
+            message.contains("case.toml") && message.contains(key) && message.contains(expected),
+            "{key}: {message}"
+        );
+    }
 }
 
 #[test]

@@ -15,14 +15,28 @@ use crate::mesh::{BodyMesh, Mesh};
 /// The most load steps a case may list (see [`Case::load`]).
 pub const MAX_LOAD_STEPS: usize = 1000;
 
+/// The largest magnitude a case accepts for a load (traction, pressure, Hertz `p0`), a body
+/// force, a prescribed displacement, a Hertz `a` and centre, a load factor and a Young's
+/// modulus, and the inverse of the smallest Young's modulus.
+///
+/// The principle: each figure the solver forms is a product of at most three of these (a load
+/// factor times a load over a modulus is a displacement; a modulus times a displacement is a
+/// stress or a force), so at most `1e120`, and a norm squares it, `1e240`: that leaves f64's
+/// range (`1.8e308`) a factor of `1e68` for the mesh's sizes and the sums over its nodes. A
+/// finite value beyond it (a load of `1e308`, `load_steps = [1e300]`) used to be accepted and
+/// fail in the solve with an unmet residual or a singular matrix that did not name it. No
+/// physical case in consistent units comes near `1e40` (steel in pascals is `2e11`).
+pub const MAX_MAGNITUDE: f64 = 1e40;
+
 /// A case file. Relative paths are relative to the case file's folder.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
     /// The mesh: a gmsh `.msh` (MSH 4.1), or a `.geo` that is meshed with gmsh first.
     pub mesh: PathBuf,
-    /// Output folder.
-    pub output: PathBuf,
+    /// Output folder (optional: `--output` gives it too, and overrides it; a run needs one of
+    /// the two).
+    pub output: Option<PathBuf>,
     /// gmsh `-setnumber` parameters for a `.geo` mesh (e.g. `{ level = 1 }`).
     #[serde(default)]
     pub geo_parameters: BTreeMap<String, f64>,
@@ -158,7 +172,7 @@ impl Case {
         })?;
         let folder = path.parent().unwrap_or(Path::new(""));
         case.mesh = folder.join(&case.mesh);
-        case.output = folder.join(&case.output);
+        case.output = case.output.map(|output| folder.join(output));
         case.path = path.to_owned();
         if case.bodies.is_empty() {
             return Err(case.invalid("[[body]]", "the case names no body"));
@@ -168,7 +182,7 @@ impl Case {
         }
         case.check_unique_bodies()?;
         case.check_geo_parameters()?;
-        case.check_load_step_count()?;
+        case.check_load_steps()?;
         Ok(case)
     }
 
@@ -258,8 +272,8 @@ impl Case {
 
     /// Each load step is a whole contact solve, and its record goes into the summary: a list
     /// longer than [`MAX_LOAD_STEPS`] is a mistake (it once took minutes and wrote a 490 MB
-    /// summary), not a load history.
-    fn check_load_step_count(&self) -> Result<(), CaseError> {
+    /// summary), not a load history. Each factor is finite and within [`MAX_MAGNITUDE`].
+    fn check_load_steps(&self) -> Result<(), CaseError> {
         let count = self
             .contact
             .as_ref()
@@ -271,6 +285,21 @@ impl Case {
                 format!(
                     "{count} load steps; at most {MAX_LOAD_STEPS} are allowed (each step is a \
                      whole contact solve)"
+                ),
+            ));
+        }
+        if let Some(steps) = self.contact.as_ref().and_then(|c| c.load_steps.as_ref())
+            && (steps.is_empty() || steps.iter().any(|&f| !in_range(f)))
+        {
+            return Err(self.invalid(
+                "[contact] load_steps",
+                format!(
+                    "expected a non-empty list of finite factors {}, got {}",
+                    magnitude_range(),
+                    match steps.iter().find(|&&f| !in_range(f)) {
+                        Some(f) => format!("{f:e}"),
+                        None => "an empty list".to_string(),
+                    }
                 ),
             ));
         }
@@ -433,22 +462,23 @@ impl Case {
         spec: &BodySpec,
     ) -> Result<ElasticProblem<'m>, CaseError> {
         let dim = body.dim;
+        let range = magnitude_range();
         let context = |what: &str| format!("body '{}', {what}", spec.name);
         let finite = |value: f64, what: &str| -> Result<f64, CaseError> {
-            if value.is_finite() {
+            if in_range(value) {
                 Ok(value)
             } else {
                 Err(self.invalid(
                     context(what),
-                    format!("expected a finite number, got {value}"),
+                    format!("expected a finite number {range}, got {value:e}"),
                 ))
             }
         };
         let vector = |v: &[f64], what: &str| -> Result<[f64; 3], CaseError> {
-            if let Some(bad) = v.iter().find(|x| !x.is_finite()) {
+            if let Some(bad) = v.iter().find(|&&x| !in_range(x)) {
                 return Err(self.invalid(
                     context(what),
-                    format!("expected finite components, got {bad} in {v:?}"),
+                    format!("expected finite components {range}, got {bad:e} in {v:?}"),
                 ));
             }
             if v.len() != dim {
@@ -472,6 +502,27 @@ impl Case {
                     source,
                 }
             })?;
+        let modulus = spec.youngs_modulus;
+        if !(1.0 / MAX_MAGNITUDE..=MAX_MAGNITUDE).contains(&modulus) {
+            return Err(self.invalid(
+                context("youngs_modulus"),
+                format!(
+                    "expected a value from {:e} to {MAX_MAGNITUDE:e} (MAX_MAGNITUDE in \
+                     src/case/schema.rs says why), got {modulus:e}",
+                    1.0 / MAX_MAGNITUDE
+                ),
+            ));
+        }
+        for d in &spec.dirichlet {
+            for (key, value) in ["ux", "uy", "uz"].iter().zip([d.ux, d.uy, d.uz]) {
+                if let Some(value) = value.filter(|&v| !in_range(v)) {
+                    return Err(self.invalid(
+                        context(&format!("Dirichlet condition on '{}', {key}", d.group)),
+                        format!("expected a finite number {range}, got {value:e}"),
+                    ));
+                }
+            }
+        }
         let dirichlet = spec
             .dirichlet
             .iter()
@@ -528,10 +579,13 @@ impl Case {
                 )?)),
                 (None, None, Some(h)) => {
                     finite(h.p0, &format!("{what}, hertz_pressure.p0"))?;
-                    if h.a.is_nan() || h.a <= 0.0 {
+                    if !(h.a > 0.0 && in_range(h.a)) {
                         return Err(self.invalid(
                             context(&what),
-                            format!("hertz_pressure.a must be positive, got {}", h.a),
+                            format!(
+                                "hertz_pressure.a must be positive and {range}, got {:e}",
+                                h.a
+                            ),
                         ));
                     }
                     SurfaceLoad::Pressure(PressureField::Hertz {
@@ -587,14 +641,6 @@ impl Case {
         spec.settings
             .validate()
             .map_err(|e| self.invalid("[contact]", e.to_string()))?;
-        if let Some(steps) = &spec.load_steps
-            && (steps.is_empty() || steps.iter().any(|f| !f.is_finite()))
-        {
-            return Err(self.invalid(
-                "[contact]",
-                "load_steps must be a non-empty list of finite factors",
-            ));
-        }
         let side = |body: &str, surface: &str| -> Result<ContactSide<'m>, CaseError> {
             let body_spec = self.bodies.iter().find(|b| b.name == body).ok_or_else(|| {
                 self.invalid(
@@ -617,6 +663,16 @@ impl Case {
             .map(Some)
             .map_err(|message| self.invalid("[contact]", message))
     }
+}
+
+/// Whether `value` is finite and within [`MAX_MAGNITUDE`].
+fn in_range(value: f64) -> bool {
+    value.abs() <= MAX_MAGNITUDE
+}
+
+/// The accepted range of [`in_range`], for messages.
+fn magnitude_range() -> String {
+    format!("of magnitude at most {MAX_MAGNITUDE:e} (MAX_MAGNITUDE in src/case/schema.rs says why)")
 }
 
 /// The identifiers a gmsh script mentions outside `//` comments: a parameter the script never

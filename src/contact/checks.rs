@@ -1,25 +1,37 @@
 //! The contact checks: the active-set update of each iteration ([`Update`]: tension of the
-//! active nodes, penetration of the inactive ones), and the certificate of the answer, with
-//! checks that do not reuse the active-set loop's operators (method.md section 3, "Certify the
-//! result").
+//! active nodes, penetration of the inactive ones), and the checks of the answer, measured
+//! without the active-set loop's operators (method.md section 3, "Certify the result"). They
+//! answer two questions apart, as a convex solver's termination criteria and an error
+//! estimate do.
 //!
-//! The certificate:
-//! - **Penetration.** Every candidate node of BOTH bodies, active or not, is projected onto the
-//!   other body's displaced P1 surface ([`geometric_gaps`]); the largest penetration over the
-//!   node's spacing must not exceed `penetration_tolerance` on the primary surface, whose
-//!   nodes the constraint holds, and `secondary_penetration_tolerance` on the secondary one,
-//!   whose nodes only the transfer holds (see [`super::ContactSettings`] for the figures).
-//! - **Tension.** The normal force every surface node of both bodies receives from the
-//!   interface (active or not: the inactive ring next to the contact zone included), over its
-//!   area, is its mean pressure ([`ContactSurface::mean_pressure`], along the node's own
-//!   outward normal, not the loop's contact normal); the largest tension over the largest
-//!   pressure of either surface must not exceed `certificate_tension_tolerance`, a bound for
-//!   the undershoot of the RBF transfer of the multiplier to the secondary surface.
-//! - **Secondary sag.** The secondary's largest penetration over the indentation depth (how far
-//!   the surfaces moved into each other over the contact zone) must not exceed `sag_tolerance`:
-//!   the constraint holds the secondary only at the primary's nodes, and a secondary surface
-//!   curved into a coarse flat primary sags between them (`secondary_sag`). The penetration
-//!   check above bounds that sag by the spacing; this one bounds its effect on the answer.
+//! **Is the discrete problem solved?** The residuals of its KKT conditions ([`CheckKind`]'s
+//! first five; [`contact_status`] turns them into the status):
+//! - **Penetration** (primal feasibility). Every candidate node of both bodies, active or not,
+//!   is projected onto the other body's displaced P1 surface ([`geometric_gaps`]); the largest
+//!   penetration over the node's spacing must not exceed `penetration_tolerance` on the
+//!   primary surface, whose nodes the constraint holds, and `secondary_penetration_tolerance`
+//!   on the secondary one, whose nodes only the transfer holds, counted where no active
+//!   primary node is within a facet ([`Held::Not`]: contact the active set missed; between
+//!   and beside constrained nodes the secondary's penetration is the discretization's, judged
+//!   by the accuracy indicators).
+//! - **Tension** (dual feasibility). The normal force every surface node of both bodies
+//!   receives from the interface (active or not), over its area, is its mean pressure
+//!   ([`ContactSurface::mean_pressure`], along the node's own outward normal); the largest
+//!   tension over the largest pressure must not exceed `certificate_tension_tolerance`, a
+//!   bound for the undershoot of the RBF transfer of the multiplier to the secondary surface.
+//! - **Complementarity.** Every active node lies on the other surface: the gap its constraint
+//!   holds, measured again at the answer, within `penetration_tolerance` of its spacing.
+//! - **Equilibrium.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
+//!   exceed `imbalance_tolerance`: the interpolation transfer `R21` conserves force only to its
+//!   accuracy; the conservative transfer (`R12^T`, [`super::Transfer`]) balances to round-off.
+//!
+//! **Can the answer be trusted?** The accuracy indicators, each an error measure of what users
+//! read (the contact force and zone); they never change the status:
+//! - **Secondary sag.** The secondary's largest penetration between constrained primary nodes
+//!   over how far the bodies are pressed into each other (the larger of the geometric
+//!   indentation depth and the elastic approach, [`elastic_approach`]) must not exceed
+//!   `sag_tolerance`: the contact is that much softer than the secondary's own
+//!   discretization (`secondary_sag`).
 //! - **Resolution.** The contact zone must be at least `min_zone_width` primary spacings wide,
 //!   and `secondary_min_zone_width` secondary spacings unless the secondary is nearly rigid
 //!   ([`zone_resolution`]): with one or two nodes across it, the pressure profile has too few
@@ -28,18 +40,13 @@
 //!   primary sees it only through the interpolation `R12` of its displacement, whose error over
 //!   a zone of three nodes is of the order of the force's (an explicit stiff primary on a
 //!   compliant secondary three nodes across: 1.3% off dolfinx's rigid flat).
-//! - **Force balance.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
-//!   exceed `imbalance_tolerance`: the interpolation transfer `R21` conserves force only to its
-//!   accuracy. The conservative transfer (`R12^T`, [`super::Transfer`]) balances to round-off
-//!   by construction, so with it this check guards the assembly, not the transfer; what then
-//!   bounds a coarse secondary is the resolution check.
-//!
+//! - **Force centre.** The two bodies' contact forces act at the same place ([`ForceCentres`]).
 //! - **Primary agreement** (only for a primary named in the case file and at least twice
 //!   stiffer than the other body, a choice `primary = "auto"` avoids):
 //!   the contact force must agree with the one found with the other body as primary, within
 //!   `primary_agreement_tolerance` ([`primary_agreement`]). Another multiplier space is an
 //!   independent discretization of the same problem; a stiff block primary twice finer than a
-//!   hemisphere passed every check above with a force 3% off, and the hemisphere as primary
+//!   hemisphere passed every other check with a force 3% off, and the hemisphere as primary
 //!   told it apart.
 //!
 //! A failed check names the body, the gmsh node tag and the figure.
@@ -55,7 +62,7 @@ use super::system::CoupledSolution;
 use super::{ContactProblem, ContactSurface, Formulation};
 
 /// What a check measures. The first five are residuals of the discrete contact problem: they
-/// decide whether it is solved (the status, [`contact_status`]). The others are accuracy
+/// decide whether it is solved (the status, `contact_status`). The others are accuracy
 /// indicators: they say whether the solved problem's answer can be trusted (the accuracy
 /// report), and never change the status.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -749,11 +756,19 @@ impl Update {
             .map(|(t, n)| -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]))
             .collect();
         let p_max = pressure.iter().copied().fold(0.0, f64::max);
+        // Tension is measured against the largest pressure; with no node in compression
+        // (bodies pulled apart) against the largest tension, so the worst node's is 1, not
+        // p / f64::MIN_POSITIVE, which overflowed to inf (`null` in summary.json).
+        let scale = if p_max > 0.0 {
+            p_max
+        } else {
+            -pressure.iter().copied().fold(0.0, f64::min)
+        };
         let tension: Vec<(usize, f64)> = active
             .iter()
             .zip(&pressure)
             .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
-            .map(|(&i, &p)| (i, -p / p_max.max(f64::MIN_POSITIVE)))
+            .map(|(&i, &p)| (i, -p / scale))
             .collect();
         let is_active: HashSet<usize> = active.iter().copied().collect();
         let penetrating: Vec<(usize, f64)> = (0..s1.len())

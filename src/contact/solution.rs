@@ -83,7 +83,8 @@ pub struct IterationRecord {
     pub removed: usize,
     /// Largest penetration of an inactive primary candidate over its spacing h (0 if none).
     pub max_penetration_over_h: f64,
-    /// Largest tension of an active node over the largest pressure (0 if none).
+    /// Largest tension of an active node over the largest pressure (0 if none; 1 if no active
+    /// node is compressed: the tension is then measured against the largest tension).
     pub max_tension_over_p: f64,
     /// Largest |geometric gap| of an active node over its h: how far the active nodes are
     /// from the other body's discrete surface.

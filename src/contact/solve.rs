@@ -1,22 +1,38 @@
 //! The INTERNODES active-set loop: a primal-dual active set method (a semismooth Newton method
 //! on the nodal complementarity conditions; Hüeber and Wohlmuth 2005) over interface operators
-//! built once (`super::interface`), with its answer certified by independent checks
+//! built once (`super::interface`), with its answer checked by independent measures
 //! ([`super::checks`]).
 //!
 //! ```text
-//! A <- primary candidates that touch or penetrate in the reference configuration, e <- 0
+//! A <- primary candidates that touch or penetrate in the reference configuration
+//! L <- the gap of every primary candidate linearized at u = 0            (frictionless)
 //! repeat
-//!   1. coupling of A: rows of R12, columns of M2 R21, lumped M1, gaps d + e   (fixed operators)
+//!   1. coupling of A: constraint rows from L (frictionless: node to segment on the secondary
+//!      facet each node projects onto; tied: rows of R12 with the correction e), traction
+//!      columns through the transfer (R21 or R12^T), lumped M1
 //!   2. solve the coupled system for u1, u2, lambda
-//!   3. gaps of every candidate: geometric g (closest point, deformed) and linearized g_lin;
-//!      the slide s of the surfaces over each other (mean tangential u1 - R12 u2 over A)
-//!   4. A' <- {i in A : p_i >= -tol_t p_max}  +  {i not in A : g_i < -tol_p h_i};  e <- g - g_lin
+//!   3. gaps of every candidate: geometric g (closest point, deformed); L <- linearized at u
+//!      (tied: e <- g - g_lin); the slide s of the surfaces over each other
+//!   4. A' <- {i in A : p_i >= -tol_t p_max}  +  {i not in A : g_i < -tol_p h_i}
 //!   5. if A' = A, settled, and s moved more than 0.05 h from the operators' pairing:
-//!      pair the operators again for s (each node moved by s), e <- g - g_lin, A' <- A
-//! until A' = A and every active node lies on the other surface (|g_i| <= 0.01 tol_p h_i)
-//! certify: geometric penetration, tension, force balance and where the forces act, measured
-//! independently
+//!      pair the operators again for s (each node moved by s), A' <- A
+//! until A' = A and every active node lies on the other surface (|g_i| <= 0.01 tol_p h_i),
+//!   or A' = A and |g_i| stopped shrinking (by half, twice): converged within tol_p h_i,
+//!   stalled beyond
+//! check: the residuals of the discrete problem (penetration of both bodies, tension,
+//!   complementarity, equilibrium) decide the status; the accuracy indicators are reported
 //! ```
+//!
+//! **Why it converges.** On a fixed active set, step 3 linearizes the very gap step 4 and the
+//! checks measure (`super::linearization`): steps 1-3 are Newton's method on `g_A(u) = 0`,
+//! exact in one step where the secondary surface is flat and quadratic where it is smooth; on
+//! a P1 surface the gap is piecewise linear, and a node on an edge can hold the error at the
+//! size of the kink, which the stall test accepts within the tolerance. Over active sets,
+//! step 4 is the semismooth Newton step of the complementarity function (below). The former
+//! constraint, the rows of `R12` with the gap correction `e = g - g_lin` of the last iterate,
+//! is a fixed-point iteration on `e` that contracts only where `R12` reproduces the P1
+//! surface; it diverged at the ends of two blocks pressed together, and tied contact, which
+//! keeps it, is judged by the same stall test.
 //!
 //! Step 5 is what lets the bodies slide: the operators pair each node with the point of the
 //! other surface it faces, and a body pushed sideways touches the other elsewhere than where it
@@ -28,11 +44,11 @@
 //! At an active node the constraint holds `g_i = 0`, at an inactive one `p_i = 0`, so the test
 //! reads `p_i > 0` on A and `g_i < 0` off it, and `c` drops out; the tolerances make the two
 //! tests robust to round-off. Removal and addition happen in one update, as in the seed's
-//! Algorithm 3. What differs from
-//! the seed's loop: the operators do not change with A (the seed rebuilds them, with Algorithm
+//! Algorithm 3. What differs from the seed's loop: the operators do not change with A (the seed rebuilds them, with Algorithm
 //! 2, for every active set, so that the discrete problem itself moves from one iteration to the
 //! next), the pressure `p_i = -lambda_i . n_i` tested is the unknown of the system (lumped
-//! interface mass, `super::surface`), and the gap is the geometric one.
+//! interface mass, `super::surface`), and the gap is the geometric one, for the loop and the
+//! checks alike.
 //!
 //! An update that would return to an active set seen before first keeps active (pins, for the
 //! rest of the solve) the nodes it removes for tension that had been removed before and came
@@ -42,8 +58,10 @@
 //! set satisfies both tests. If the set still repeats, it takes a single switch instead:
 //! only the node with the largest violation (penetration over `h`, tension over `p_max`)
 //! changes; if that set was seen too the loop stops as [`ContactStatus::Cycling`]. It never
-//! declares convergence. Running out of iterations is [`ContactStatus::IterationLimit`]; an
-//! active node held a spacing or more off the other surface is [`ContactStatus::Unstable`].
+//! declares convergence. A gap error that stops contracting on one active set beyond the
+//! tolerance is [`ContactStatus::Stalled`]; running out of iterations is
+//! [`ContactStatus::IterationLimit`]; an active node held a spacing or more off the other
+//! surface is [`ContactStatus::Unstable`].
 
 use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
@@ -95,7 +113,7 @@ pub(super) const SETTLED: f64 = 0.01;
 
 /// Where an active-set loop starts: the active primary candidates (surface indices) and the
 /// linearization point of their constraints: the gap rows of every primary candidate
-/// (frictionless, [`super::linearization`]) or the gap corrections `e` (tied,
+/// (frictionless, `super::linearization`) or the gap corrections `e` (tied,
 /// `super::interface`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ActiveSet {

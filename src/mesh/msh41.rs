@@ -359,6 +359,13 @@ fn elements(cursor: &mut Cursor) -> Result<Vec<ElementBlock>, MeshError> {
         for _ in 0..count {
             let at = cursor.value_start();
             let tag = cursor.size_t("an element tag")?;
+            // The whole element first: a line cut short is reported as such, not as a
+            // duplicate of the tag its first digits make.
+            for _ in 0..nodes_per_element {
+                block
+                    .node_tags
+                    .push(cursor.size_t("a node tag of an element")?);
+            }
             if let Some(&first) = seen.get(&tag) {
                 let first_line = cursor.line_at(first);
                 return Err(cursor.error_at(
@@ -368,11 +375,6 @@ fn elements(cursor: &mut Cursor) -> Result<Vec<ElementBlock>, MeshError> {
             }
             seen.insert(tag, at);
             block.element_tags.push(tag);
-            for _ in 0..nodes_per_element {
-                block
-                    .node_tags
-                    .push(cursor.size_t("a node tag of an element")?);
-            }
         }
         read = read.saturating_add(count);
         blocks.push(block);
@@ -506,6 +508,18 @@ impl Cursor<'_> {
             return Err(self.error_at(
                 start,
                 format!("the file ends where {what} was expected (truncated?)"),
+            ));
+        }
+        // Every number of a file is followed by more (at least the section's `$End` line): one
+        // that runs into the end of the file was cut, and its digits may well parse (a tag cut
+        // to one defined before must not be reported as defined twice).
+        if self.pos == self.bytes.len() {
+            return Err(self.error_at(
+                start,
+                format!(
+                    "the file ends inside {what} ('{}'): the line is incomplete (truncated?)",
+                    clip(&token)
+                ),
             ));
         }
         token

@@ -18,7 +18,7 @@
 use std::ffi::OsStr;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use super::OutputError;
@@ -51,8 +51,22 @@ const STAGING_PREFIX: &str = ".internodes-partial-";
 const COMMIT_LOCK: &str = ".internodes-commit.lock";
 
 /// A lock older than this belongs to a run that was killed while committing (a commit is a few
-/// renames): it is removed.
+/// renames): it is removed. A lock's age is the distance between its modification time and
+/// now, either way: one dated more than this in the future (a clock set back, a folder copied
+/// from a machine whose clock was ahead) was not made by a run committing now, and is removed
+/// too; one dated less far ahead (clocks of a network file system a little apart) is stale
+/// within twice this.
 const STALE_LOCK: Duration = Duration::from_secs(30);
+
+/// The longest a run waits for the commit lock before it fails, naming the lock. A commit is a
+/// few file renames and takes milliseconds, and a lock left by a killed run is stale within
+/// `2 * STALE_LOCK` (above), so a run waits this long only when other runs have held the lock
+/// all that time or the lock cannot be removed: something is wrong, and it must be said rather
+/// than waited for without a word.
+const MAX_LOCK_WAIT: Duration = Duration::from_secs(90);
+
+/// After this long waiting for the commit lock, a run says which lock it waits for.
+const LOCK_WAIT_NOTICE: Duration = Duration::from_secs(2);
 
 /// Distinguishes staging folders of runs in one process (tests run cases in parallel).
 static RUNS: AtomicUsize = AtomicUsize::new(0);
@@ -62,6 +76,9 @@ static RUNS: AtomicUsize = AtomicUsize::new(0);
 pub struct ResultFolder {
     dir: PathBuf,
     staging: PathBuf,
+    /// The commit waited [`MAX_LOCK_WAIT`] for the lock in vain: the failure mark does not
+    /// wait for it a second time.
+    lock_timed_out: AtomicBool,
 }
 
 impl ResultFolder {
@@ -91,6 +108,7 @@ impl ResultFolder {
         Ok(ResultFolder {
             dir: dir.to_owned(),
             staging,
+            lock_timed_out: AtomicBool::new(false),
         })
     }
 
@@ -115,7 +133,11 @@ impl ResultFolder {
     /// Moves every staged result into the output folder, replacing earlier ones, and removes
     /// the failure mark of an earlier run.
     pub fn commit(&self) -> Result<(), OutputError> {
-        let _lock = CommitLock::acquire(&self.dir)?;
+        let _lock = CommitLock::acquire(&self.dir).inspect_err(|e| {
+            if matches!(e, OutputError::LockTimeout { .. }) {
+                self.lock_timed_out.store(true, Ordering::Relaxed);
+            }
+        })?;
         remove_results(&self.dir)?;
         for name in RESULT_FILES {
             let staged = self.staging.join(name);
@@ -138,8 +160,16 @@ impl ResultFolder {
     /// Best effort: the error itself is what the caller reports, so a folder that cannot be
     /// cleaned is reported on stderr only.
     pub fn fail(&self, command: &str, error: &dyn std::error::Error) {
-        if let Err(e) = mark_failed(&self.dir, Some(&self.staging), command, error) {
-            eprintln!("warning: {e}");
+        let wait = if self.lock_timed_out.load(Ordering::Relaxed) {
+            Duration::ZERO
+        } else {
+            MAX_LOCK_WAIT
+        };
+        match mark_failed(&self.dir, Some(&self.staging), command, error, wait) {
+            // The run's own error names the lock: no mark can be written without it.
+            Err(OutputError::LockTimeout { .. }) if wait.is_zero() => {}
+            Err(e) => eprintln!("warning: {e}"),
+            Ok(()) => {}
         }
     }
 }
@@ -160,7 +190,7 @@ pub fn mark_failed_folder(
         return;
     }
     let marked = check_inputs(dir, origin, &[case_file], false)
-        .and_then(|()| mark_failed(dir, None, command, error));
+        .and_then(|()| mark_failed(dir, None, command, error, MAX_LOCK_WAIT));
     if let Err(e) = marked {
         eprintln!("warning: {e}");
     }
@@ -225,11 +255,12 @@ fn mark_failed(
     staging: Option<&Path>,
     command: &str,
     error: &dyn std::error::Error,
+    lock_wait: Duration,
 ) -> Result<(), OutputError> {
     if let Some(staging) = staging {
         remove_staging(staging)?;
     }
-    let _lock = CommitLock::acquire(dir)?;
+    let _lock = CommitLock::acquire_within(dir, lock_wait)?;
     remove_results(dir)?;
     let path = dir.join(FAILURE_MARK);
     std::fs::write(&path, failure_text(command, error))
@@ -369,11 +400,21 @@ fn not_found_is_fine(path: &Path, result: std::io::Result<()>) -> Result<(), Out
 }
 
 /// The commit lock of an output folder, released when dropped.
+#[derive(Debug)]
 struct CommitLock(PathBuf);
 
 impl CommitLock {
     fn acquire(dir: &Path) -> Result<Self, OutputError> {
+        Self::acquire_within(dir, MAX_LOCK_WAIT)
+    }
+
+    /// Takes the lock of `dir`, waiting at most `max_wait` (tests pass a short one). A lock
+    /// older than [`STALE_LOCK`] is removed; a folder of the lock's name is an error at once
+    /// (it is no lock of ours, and would never go away).
+    fn acquire_within(dir: &Path, max_wait: Duration) -> Result<Self, OutputError> {
         let path = dir.join(COMMIT_LOCK);
+        let start = std::time::Instant::now();
+        let mut said = false;
         loop {
             match std::fs::OpenOptions::new()
                 .write(true)
@@ -382,15 +423,37 @@ impl CommitLock {
             {
                 Ok(_) => return Ok(CommitLock(path)),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let age = std::fs::metadata(&path)
+                    let metadata = std::fs::symlink_metadata(&path);
+                    if metadata.as_ref().is_ok_and(std::fs::Metadata::is_dir) {
+                        return Err(OutputError::LockIsFolder { path });
+                    }
+                    let age = metadata
                         .and_then(|m| m.modified())
                         .ok()
-                        .and_then(|t| t.elapsed().ok());
+                        .map(|t| t.elapsed().unwrap_or_else(|future| future.duration()));
                     if age.is_some_and(|a| a > STALE_LOCK) {
-                        remove_file(&path)?;
-                    } else {
-                        std::thread::sleep(Duration::from_millis(10));
+                        not_found_is_fine(&path, std::fs::remove_file(&path))?;
+                        continue;
                     }
+                    let waited = start.elapsed();
+                    if waited >= max_wait {
+                        return Err(OutputError::LockTimeout {
+                            path,
+                            seconds: waited.as_secs_f64(),
+                        });
+                    }
+                    if !said && waited >= LOCK_WAIT_NOTICE {
+                        eprintln!(
+                            "waiting for the commit lock {} (another run into this folder is \
+                             moving its results into place; a lock older than {} s is removed, \
+                             and the wait ends with an error after {} s)",
+                            path.display(),
+                            STALE_LOCK.as_secs(),
+                            max_wait.as_secs()
+                        );
+                        said = true;
+                    }
+                    std::thread::sleep(Duration::from_millis(10));
                 }
                 Err(source) => return Err(OutputError::Io { path, source }),
             }
@@ -406,7 +469,23 @@ impl Drop for CommitLock {
 
 #[cfg(test)]
 mod tests {
-    use super::utc;
+    use super::{CommitLock, Duration, OutputError, utc};
+
+    #[test]
+    fn a_lock_held_past_the_wait_is_an_error_naming_it_and_its_removal() {
+        let dir = tempfile::tempdir().unwrap();
+        let held = CommitLock::acquire(dir.path()).unwrap();
+        let e = CommitLock::acquire_within(dir.path(), Duration::from_millis(50)).unwrap_err();
+        assert!(matches!(e, OutputError::LockTimeout { .. }), "{e}");
+        let message = e.to_string();
+        let lock = dir.path().join(".internodes-commit.lock");
+        assert!(
+            message.contains(&format!("rm '{}'", lock.display())),
+            "{message}"
+        );
+        drop(held);
+        CommitLock::acquire_within(dir.path(), Duration::ZERO).unwrap();
+    }
 
     #[test]
     fn utc_dates_match_known_timestamps() {

@@ -40,6 +40,18 @@ pub enum OutputError {
         /// The result name it has.
         name: String,
     },
+    #[error(
+        "the commit lock {path} is a folder: a run creates that name as a file while it moves \
+         its results into place, so no run into this output folder can finish; remove the \
+         folder (rm -r '{path}')"
+    )]
+    LockIsFolder { path: PathBuf },
+    #[error(
+        "waited {seconds:.0} s for the commit lock {path}: a commit takes milliseconds, so \
+         other runs into this output folder held it all that time or it cannot be removed; if \
+         no other run is writing into this folder, remove the lock (rm '{path}')"
+    )]
+    LockTimeout { path: PathBuf, seconds: f64 },
     #[error("cannot write {path}: {source}")]
     Json {
         path: PathBuf,
