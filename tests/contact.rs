@@ -1012,29 +1012,15 @@ fn flat_blocks_clamped_at_both_ends_match_their_union() {
                 &format!("group = \"upper_top\"\n{vertical} = -0.01\n{lateral}"),
             )
         };
-        let union = {
-            let mesh_path = fixture(&format!("glued_blocks_{dim}d.msh"));
-            let text = format!(
-                "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"union\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n{lateral}\n[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = -0.01\n{lateral}\n",
-                mesh_path.display()
-            );
-            let (_dir, path) = write_case(&text);
-            let case = Case::load(&path).unwrap();
-            let mesh = read_msh(&mesh_path).unwrap();
-            let problem = case
-                .elastic_problem(mesh.body("union").unwrap(), &case.bodies[0])
-                .unwrap();
-            let settings = SolverSettings {
-                verbose: false,
-                ..SolverSettings::default()
-            };
-            let solution = internodes::elastic::solve(&problem, &settings).unwrap();
-            let (_, base) = (solution.reactions.iter())
-                .find(|(group, _)| group == "lower_base")
-                .unwrap()
-                .clone();
-            base[dim - 1].abs()
-        };
+        let union = one_body_reaction(
+            &format!("glued_blocks_{dim}d.msh"),
+            "union",
+            &format!(
+                "[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n{lateral}\n[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = -0.01\n{lateral}\n"
+            ),
+            "lower_base",
+        )[dim - 1]
+            .abs();
         for primary in ["upper", "lower", "auto"] {
             let text = clamp(two_blocks(dim, "frictionless", "", ""))
                 .replace("primary = \"upper\"", &format!("primary = \"{primary}\""));
@@ -1107,37 +1093,51 @@ group = "block_base"
     )
 }
 
-/// The vertical force on the block of `flat_punch_{dim}d.msh` alone, its base clamped and the
-/// punch's footprint `block_under_punch` pushed down by `delta` and free to slide: the rigid
-/// frictionless punch on the same block mesh, by the elastic solver.
-fn footprint_force(dim: usize, delta: f64) -> f64 {
-    let vertical = if dim == 2 { "uy" } else { "uz" };
-    let base = if dim == 2 {
-        "ux = 0.0\nuy = 0.0"
-    } else {
-        "ux = 0.0\nuy = 0.0\nuz = 0.0"
-    };
-    let mesh_path = fixture(&format!("flat_punch_{dim}d.msh"));
+/// The reaction on `group` of body `body` of the fixture `mesh` solved alone (E = 1000,
+/// nu = 0.3) with the Dirichlet conditions `conditions` (TOML `[[body.dirichlet]]` tables).
+fn one_body_reaction(mesh: &str, body: &str, conditions: &str, group: &str) -> Vec<f64> {
+    let mesh_path = fixture(mesh);
     let text = format!(
-        "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"block\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n[[body.dirichlet]]\ngroup = \"block_base\"\n{base}\n[[body.dirichlet]]\ngroup = \"block_under_punch\"\n{vertical} = {}\n",
-        mesh_path.display(),
-        -delta
+        "mesh = \"{}\"\noutput = \"out\"\n[[body]]\nname = \"{body}\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n{conditions}",
+        mesh_path.display()
     );
     let (_dir, path) = write_case(&text);
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&mesh_path).unwrap();
     let problem = case
-        .elastic_problem(mesh.body("block").unwrap(), &case.bodies[0])
+        .elastic_problem(mesh.body(body).unwrap(), &case.bodies[0])
         .unwrap();
     let settings = SolverSettings {
         verbose: false,
         ..SolverSettings::default()
     };
     let solution = internodes::elastic::solve(&problem, &settings).unwrap();
-    let (_, reaction) = (solution.reactions.iter())
-        .find(|(group, _)| group == "block_under_punch")
+    (solution.reactions.iter())
+        .find(|(name, _)| name == group)
         .unwrap()
-        .clone();
+        .1
+        .clone()
+}
+
+/// The vertical force on the block of `flat_punch_{dim}d.msh` alone, its base clamped and the
+/// punch's footprint `block_under_punch` pushed down by `delta` and free to slide: the rigid
+/// frictionless punch on the same block mesh, by the elastic solver.
+fn footprint_force(dim: usize, delta: f64) -> f64 {
+    let (vertical, base) = if dim == 2 {
+        ("uy", "ux = 0.0\nuy = 0.0")
+    } else {
+        ("uz", "ux = 0.0\nuy = 0.0\nuz = 0.0")
+    };
+    let conditions = format!(
+        "[[body.dirichlet]]\ngroup = \"block_base\"\n{base}\n[[body.dirichlet]]\ngroup = \"block_under_punch\"\n{vertical} = {}\n",
+        -delta
+    );
+    let reaction = one_body_reaction(
+        &format!("flat_punch_{dim}d.msh"),
+        "block",
+        &conditions,
+        "block_under_punch",
+    );
     reaction[dim - 1].abs()
 }
 
@@ -1200,6 +1200,70 @@ fn a_stiff_punch_made_primary_by_hand_is_right_or_named() {
             );
         }
     }
+}
+
+/// Two equal-material flat blocks on rollers, the upper 0.6 times as wide and meshed twice
+/// coarser (`tests/fixtures/flat_blocks_narrow_2d.msh`, from `geo/flat_blocks_2d.geo`), pressed
+/// by 0.01, with `extra` in the `[contact]` table.
+fn narrow_blocks(extra: &str) -> String {
+    format!(
+        r#"mesh = "{mesh}"
+output = "out"
+
+[contact]
+bodies = ["upper", "lower"]
+surfaces = ["upper_contact", "lower_contact"]
+{extra}
+
+[[body]]
+name = "upper"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "upper_top"
+uy = -0.01
+[[body.dirichlet]]
+group = "upper_sides"
+ux = 0.0
+
+[[body]]
+name = "lower"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+[[body.dirichlet]]
+group = "lower_base"
+uy = 0.0
+[[body.dirichlet]]
+group = "lower_sides"
+ux = 0.0
+"#,
+        mesh = fixture("flat_blocks_narrow_2d.msh").display()
+    )
+}
+
+#[test]
+fn a_named_transfer_is_checked_against_the_automatic_one() {
+    // The defaults: converged and accurate. Naming the conservative transfer with the coarser
+    // upper block primary loads the finer lower block unevenly between the projections of the
+    // primary's nodes: 2.3% softer, and every residual and the sag pass. The answer is then
+    // compared with auto's transfer (interpolation here, which does not balance the forces on
+    // this pair: nothing trusted to compare with), and the accuracy report names it.
+    let (code, summary) = solve_cli(&narrow_blocks(""));
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(0), "{contact}");
+    let trusted = contact["force_primary"][1].as_f64().unwrap().abs();
+
+    let text = narrow_blocks("primary = \"upper\"\ntransfer = \"conservative\"");
+    let solution = solve(&text).unwrap();
+    let error = solution.force_primary[1].abs() / trusted - 1.0;
+    assert!(
+        error < -0.01,
+        "the premise: {error:+.4} from the default answer"
+    );
+    assert_eq!(solution.status, ContactStatus::Converged);
+    assert_eq!(failed_checks(&solution), ["transfer agreement"]);
+    let (code, summary) = solve_cli(&text);
+    assert_eq!(code, Some(3), "{}", summary["contact"]);
 }
 
 #[test]
@@ -1486,6 +1550,26 @@ fn a_contact_zone_of_one_node_is_not_trusted_and_says_why() {
     assert_eq!(contact["solved"]["passed"], true, "{contact}");
     assert_eq!(contact["accuracy"]["passed"], false, "{contact}");
     assert!(failed_in_summary(contact).contains(&"resolution".to_string()));
+}
+
+#[test]
+fn no_setting_switches_the_resolution_check_off() {
+    // The zone of the resolution check once counted the nodes within
+    // `secondary_penetration_tolerance` spacings of the other surface, so that a stricter
+    // tolerance could empty it and pass the check. The zone no longer depends on any setting:
+    // whatever this one, a one-node zone is named.
+    for tolerance in ["1e-6", "0.05", "0.5"] {
+        let extra = format!("secondary_penetration_tolerance = {tolerance}");
+        let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, &extra);
+        assert!(text.contains(&extra), "{text}");
+        let solution = solve(&text).unwrap();
+        assert!(!solution.is_trusted(), "{tolerance}: {}", solution.ending());
+        assert!(
+            failed_checks(&solution).contains(&"resolution"),
+            "{tolerance}: {:?}",
+            failed_checks(&solution)
+        );
+    }
 }
 
 #[test]

@@ -94,6 +94,9 @@ pub enum CheckKind {
     /// The contact force against the other primary's.
     #[serde(rename = "primary agreement")]
     PrimaryAgreement,
+    /// The contact force against the one with the transfer `auto` chooses.
+    #[serde(rename = "transfer agreement")]
+    TransferAgreement,
 }
 
 impl CheckKind {
@@ -109,6 +112,7 @@ impl CheckKind {
             Self::Resolution => "resolution",
             Self::ForceCentre => "force centre",
             Self::PrimaryAgreement => "primary agreement",
+            Self::TransferAgreement => "transfer agreement",
         }
     }
 
@@ -134,7 +138,7 @@ impl CheckKind {
                 " of the coarser spacing (between the two bodies' centres of normal force)"
             }
             Self::Resolution => " (spacing over the contact zone's width, over the minimum's, rim)",
-            Self::PrimaryAgreement | Self::Equilibrium => " of the force",
+            Self::PrimaryAgreement | Self::TransferAgreement | Self::Equilibrium => " of the force",
         }
     }
 }
@@ -363,15 +367,17 @@ pub fn certify(
     (Certificate { checks }, gaps)
 }
 
-/// The primary agreement check: `|F - F_other| / |F_other|`, `F` the total contact force on
-/// this solve's primary body and `F_other` the force on the same body when `other_body`
-/// carries the multiplier (`Ok`), against `tolerance`. Without a certified answer to compare
-/// with (`Err`: how that solve ended), the check fails with the figure 1 (the force is not
-/// confirmed to any fraction of itself), and the note says why.
-pub fn primary_agreement(
+/// An agreement check (`kind`: primary or transfer agreement): `|F - F_other| / |F_other|`,
+/// `F` the total contact force on this solve's primary body and `F_other` the force on the same
+/// body from the other discretization, solved `with` the other primary or transfer (`Ok`),
+/// against `tolerance`. Without a trusted answer to compare with (`Err`: how that solve
+/// ended), the check fails with the figure 1 (the force is not confirmed to any fraction of
+/// itself), and the note says why.
+pub fn agreement(
+    kind: CheckKind,
     force: [f64; 3],
     other: Result<[f64; 3], String>,
-    other_body: &str,
+    with: &str,
     tolerance: f64,
 ) -> CertificateCheck {
     let norm = |f: [f64; 3]| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
@@ -388,7 +394,7 @@ pub fn primary_agreement(
             (
                 value,
                 format!(
-                    "force {:.6e} here, {:.6e} with '{other_body}' as primary",
+                    "force {:.6e} here, {:.6e} with {with}",
                     norm(force),
                     norm(reference)
                 ),
@@ -396,13 +402,11 @@ pub fn primary_agreement(
         }
         Err(ended) => (
             1.0,
-            format!(
-                "no certified answer with '{other_body}' as primary to compare with: it ended {ended}"
-            ),
+            format!("no trusted answer with {with} to compare with: it ended {ended}"),
         ),
     };
     CertificateCheck {
-        name: CheckKind::PrimaryAgreement,
+        name: kind,
         value,
         tolerance,
         passed: value <= tolerance,

@@ -6,7 +6,9 @@
 //! 2. if "auto" chose between bodies of similar stiffness and the answer is not a solution:
 //!      every load step with the other primary; keep its answer if that one is
 //! 3. if the primary was named and is much stiffer than the other body:
-//!      every load step with the other primary; certify that the two contact forces agree
+//!      every load step with the other primary; check that the two contact forces agree
+//! 4. if a transfer was named that auto would not choose:
+//!      every load step with auto's transfer; check that the two contact forces agree
 //! ```
 //!
 //! Step 2 answers the sag of a curved secondary between the nodes of a coarse flat primary
@@ -18,9 +20,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::checks::{CheckKind, primary_agreement};
+use super::checks::{CheckKind, agreement};
 use super::{
     CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus,
+    Transfer,
 };
 use crate::elastic::SolverSettings;
 
@@ -113,20 +116,27 @@ pub fn solve_contact<'m>(
         } else {
             (problem, solution, steps)
         };
-    // 3. The other primary's forces, when a stiff primary was named.
-    let (problem, solution) =
-        if problem.primary_report.check_other && steps.iter().any(|s| s.status.is_solution()) {
-            check_against_other_primary(
+    // 3. The other primary's forces, when a stiff primary was named; 4. auto's transfer's,
+    //    when another transfer was named.
+    let any_solved = steps.iter().any(|s| s.status.is_solution());
+    let (mut problem, mut solution) = (problem, solution);
+    for alternative in [Alternative::OtherPrimary, Alternative::AutoTransfer] {
+        let due = match alternative {
+            Alternative::OtherPrimary => problem.primary_report.check_other,
+            Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
+        };
+        if due && any_solved {
+            (problem, solution) = check_against(
                 problem,
+                alternative,
                 solution,
                 &mut steps,
                 solver,
                 load_factors,
                 &mut log,
-            )
-        } else {
-            (problem, solution)
-        };
+            );
+        }
+    }
     // The last step's record is the answer's, checks made after the loop included.
     if let Some(last) = steps.last_mut() {
         last.status = solution.status;
@@ -181,69 +191,91 @@ fn retry_with_other_primary<'m>(
     }
 }
 
-/// Every load step again with the other body as primary, and the `primary agreement` check
-/// of each step's force: in the last step's certificate, and in every step's record (the
-/// force-displacement curve is an answer too). The answer kept is the named primary's.
-fn check_against_other_primary<'m>(
+/// Another discretization of the same problem, to check an answer against.
+#[derive(Clone, Copy, PartialEq)]
+enum Alternative {
+    /// The other body as primary (its force on this primary is the opposite of its own).
+    OtherPrimary,
+    /// The same primary, with the transfer `auto` would choose.
+    AutoTransfer,
+}
+
+/// Every load step again with the `alternative` discretization, and an agreement check of each
+/// step's force against it (`primary agreement` or `transfer agreement`): in the last step's
+/// accuracy report, and in every step's record (the force-displacement curve is an answer
+/// too). The answer kept is the named choice's.
+fn check_against<'m>(
     problem: ContactProblem<'m>,
+    alternative: Alternative,
     mut solution: ContactSolution,
     steps: &mut [StepRecord],
     solver: &SolverSettings,
     load_factors: &[f64],
     log: &mut Log,
 ) -> (ContactProblem<'m>, ContactSolution) {
-    let (tolerance, formulation) = (
+    let (tolerance, formulation, named) = (
         problem.settings.primary_agreement_tolerance,
         problem.settings.formulation,
+        problem.settings.transfer,
     );
-    let other = problem.with_other_primary();
-    let other_name = other.primary.body.name.clone();
-    log.say(format!(
-        "checking the answer: solving again with '{other_name}' as primary"
-    ));
-    let label = "check with other primary: ";
-    let (reference, other_steps) = match solve_load_steps(&other, solver, load_factors, label, log)
+    let (other, kind, sign) = match alternative {
+        Alternative::OtherPrimary => (
+            problem.with_other_primary(),
+            CheckKind::PrimaryAgreement,
+            -1.0,
+        ),
+        Alternative::AutoTransfer => (
+            problem.with_transfer(Transfer::Auto),
+            CheckKind::TransferAgreement,
+            1.0,
+        ),
+    };
+    let with = match alternative {
+        Alternative::OtherPrimary => format!("'{}' as primary", other.primary.body.name),
+        Alternative::AutoTransfer => format!(
+            "the {} transfer",
+            serde_json::to_value(other.transfer().transfer).expect("a unit enum serializes")
+        )
+        .replace('"', ""),
+    };
+    log.say(format!("checking the answer: solving again with {with}"));
+    let label = format!("check with {with}: ");
+    let trusted = |o: &StepRecord| o.status == ContactStatus::Converged && o.is_trusted();
+    let (reference, other_steps) = match solve_load_steps(&other, solver, load_factors, &label, log)
     {
-        // The force the other primary's multiplier puts on this solve's primary body.
         Ok((check, other_steps))
             if check.status == ContactStatus::Converged && check.is_trusted() =>
         {
-            (Ok(check.force_primary.map(|f| -f)), other_steps)
+            (Ok(check.force_primary.map(|f| sign * f)), other_steps)
         }
         Ok((check, other_steps)) => (Err(check.ending()), other_steps),
         Err(e) => (Err(format!("with an error ({e})")), Vec::new()),
     };
-    // The earlier steps, each against the other primary's step at the same load factor.
+    // The earlier steps, each against the other solve's step at the same load factor.
     let earlier = steps.len().saturating_sub(1);
     for (k, step) in steps[..earlier].iter_mut().enumerate() {
         let other_step = match other_steps.get(k) {
-            Some(o) if o.status == ContactStatus::Converged && o.is_trusted() => {
-                Ok(std::array::from_fn(|c| {
-                    -o.force_primary.get(c).unwrap_or(&0.0)
-                }))
-            }
+            Some(o) if trusted(o) => Ok(std::array::from_fn(|c| {
+                sign * o.force_primary.get(c).unwrap_or(&0.0)
+            })),
             Some(o) => Err(o.ending()),
             None => Err("before this load step (its load steps stopped)".to_string()),
         };
         let force = std::array::from_fn(|c| *step.force_primary.get(c).unwrap_or(&0.0));
-        step.certify_further(&primary_agreement(
-            force,
-            other_step,
-            &other_name,
-            tolerance,
-        ));
+        step.certify_further(&agreement(kind, force, other_step, &with, tolerance));
     }
-    let check = primary_agreement(solution.force_primary, reference, &other_name, tolerance);
-    log.say(format!(
-        "check with '{other_name}' as primary: {}",
-        check.describe()
-    ));
+    let check = agreement(kind, solution.force_primary, reference, &with, tolerance);
+    log.say(format!("check with {with}: {}", check.describe()));
     solution.certify_further(check);
     log.say(format!(
         "contact status: {}",
         solution.describe(formulation)
     ));
-    (other.with_other_primary(), solution)
+    let problem = match alternative {
+        Alternative::OtherPrimary => other.with_other_primary(),
+        Alternative::AutoTransfer => other.with_transfer(named),
+    };
+    (problem, solution)
 }
 
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
