@@ -210,10 +210,13 @@ class RigidFlatContact:
 
     def __init__(self, body: BodyMesh, contact: str, top: str, youngs_modulus: float, poisson_ratio: float,
                  obstacle=None):
-        """``obstacle``: None for the flat x_v = 0; else a function of the contact nodes' lateral
-        coordinates (k, dim - 1) giving the height s of a rigid obstacle's surface below each of them
-        (-inf where there is none): the constraint is then x_v + u_v >= s (the gap measured
-        vertically, at the node's reference lateral position: small sliding)."""
+        """``obstacle``: None for the flat x_v = 0; else a function of the contact nodes' coordinates
+        (k, 3) returning (g0, n): each node's initial gap to a rigid obstacle's surface below it and
+        that surface's unit normal there (k, dim), pointing into the body (g0 = inf where there is no
+        obstacle: no constraint). The constraint is then n . u >= -g0 (small sliding: the node to
+        the plane of the obstacle's facet under it), solved in rotated coordinates: at each
+        constrained node the vertical dof slot carries n . u, the others the tangential components,
+        which stay free (frictionless)."""
         self.body, self.contact_group, self.top_group = body, contact, top
         self.E, self.nu = youngs_modulus, poisson_ratio
         d = self.dim = body.dim
@@ -234,17 +237,48 @@ class RigidFlatContact:
         self.top_dofs = self._dofs(self.top_nodes, range(d))
         self.contact_dofs = self._dofs(self.contact_nodes, [self.v])
         self.height = body.x[self.contact_nodes, self.v]
+        self.rotation = None  # solver dofs -> displacements (None: the identity)
         if obstacle is not None:
-            lateral = [c for c in range(d) if c != self.v]
-            self.height = self.height - np.asarray(obstacle(body.x[self.contact_nodes][:, lateral]), float)
+            gap, normals = obstacle(body.x[self.contact_nodes])
+            self.height = np.asarray(gap, float)
+            self.normals = np.asarray(normals, float)
         # nodes with no obstacle below them carry no constraint (an infinite gap)
         self.bounded = np.isfinite(self.height)
         if (self.height[self.bounded] < -1e-14).any():
-            raise ReferenceFailure(f"{body.path}: contact-surface nodes below the plane x_v = 0 (initial overlap)")
-        self.K_bc = self.K.copy()
+            raise ReferenceFailure(f"{body.path}: contact-surface nodes below the obstacle (initial overlap)")
+        self.K_solve = self.K
+        if obstacle is not None:
+            self.rotation = self._rotation(self.contact_nodes[self.bounded], self.normals[self.bounded])
+            self.K_solve = self.K.PtAP(self.rotation)
+        self.K_bc = self.K_solve.copy()
         self.K_bc.zeroRowsColumns(self.top_dofs.astype(np.int32), diag=1.0)
 
     # -- set-up ---------------------------------------------------------
+
+    def _rotation(self, nodes: np.ndarray, normals: np.ndarray) -> PETSc.Mat:
+        """R with u = R x: the identity but at ``nodes``, where the vertical slot of x is n . u and
+        the other slots the components along orthonormal tangents (R orthogonal)."""
+        d, v = self.dim, self.v
+        size = self.K.getSize()[0]
+        R = PETSc.Mat().createAIJ([size, size], nnz=d)
+        rotated = np.zeros(size, bool)
+        for node, n in zip(nodes, normals):
+            n = n[:d] / np.linalg.norm(n[:d])
+            if d == 2:
+                basis = [np.array([n[1], -n[0]]), n]
+            else:
+                helper = np.eye(3)[int(np.argmin(np.abs(n)))]
+                t1 = np.cross(n, helper)
+                t1 /= np.linalg.norm(t1)
+                basis = [t1, np.cross(n, t1), n]
+            dofs = d * self.vertex_of_node[node] + np.arange(d)
+            rotated[dofs] = True
+            for slot, column in enumerate(basis):  # slot v holds n, the others tangents
+                R.setValues(dofs.astype(np.int32), [int(dofs[slot])], column[:, None])
+        for i in np.flatnonzero(~rotated):
+            R.setValue(int(i), int(i), 1.0)
+        R.assemble()
+        return R
 
     def _node_of_vertex(self) -> np.ndarray:
         """Local node (gmsh order) of each dolfinx P1 vertex dof, through input_global_indices."""
@@ -333,7 +367,7 @@ class RigidFlatContact:
         """SNES residual F(x) = K x (+ extra), with F = x - g on the top-face dofs."""
 
         def residual(snes, x, F):
-            self.K.mult(x, F)
+            self.K_solve.mult(x, F)
             if extra is not None:
                 F.array[:] += extra(x.array)
             F.array[self.top_dofs] = x.array[self.top_dofs] - g
@@ -409,15 +443,24 @@ class RigidFlatContact:
         return self._solution(delta, f"penalty kappa={kappa:g}", x, snes, norms, time.perf_counter() - start)
 
     def _solution(self, delta, method, x, snes, norms, seconds) -> ContactSolution:
-        """Displacements and reactions K u in the local numbering, plus the KKT check."""
-        r = x.duplicate()
-        self.K.mult(x, r)
+        """Displacements and reactions K u in the local numbering, plus the KKT check (made in the
+        solver's coordinates: rotated at the constrained nodes of an obstacle)."""
         d = self.dim
-        u = x.array.reshape(-1, d)[self.vertex_of_node].copy()
-        reaction = r.array.reshape(-1, d)[self.vertex_of_node].copy()
-        solution = ContactSolution(delta, method, u, reaction, snes.getIterationNumber(),
-                                   snes.getConvergedReason(), norms, seconds)
-        solution.kkt = self.kkt(solution)
+        r = x.duplicate()
+        self.K_solve.mult(x, r)
+        frame = ContactSolution(delta, method, x.array.reshape(-1, d)[self.vertex_of_node].copy(),
+                                r.array.reshape(-1, d)[self.vertex_of_node].copy(), snes.getIterationNumber(),
+                                snes.getConvergedReason(), norms, seconds)
+        kkt = self.kkt(frame)
+        if self.rotation is None:
+            frame.kkt = kkt
+            return frame
+        u = x.duplicate()
+        self.rotation.mult(x, u)
+        self.K.mult(u, r)
+        solution = ContactSolution(delta, method, u.array.reshape(-1, d)[self.vertex_of_node].copy(),
+                                   r.array.reshape(-1, d)[self.vertex_of_node].copy(), snes.getIterationNumber(),
+                                   snes.getConvergedReason(), norms, seconds, kkt)
         return solution
 
     def kkt(self, s: ContactSolution) -> dict:
@@ -594,6 +637,59 @@ def turned_mesh(msh: Path, dim: int) -> Path:
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
         gmsh.write(str(out))
     return out
+
+
+def obstacle_below(facets: np.ndarray, dim: int, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A rigid P1 surface (segments (k, 2, 3) / triangles (k, 3, 3)) below ``points`` (m, 3), the
+    vertical axis dim - 1: for each point, the facet whose projection on the lateral plane contains
+    the point's (the highest if several; a point on a shared edge or vertex belongs to every facet
+    there, barycentric tolerance 1e-9), its unit normal n pointing up (n_v > 0) and the point's
+    distance n . (x - p0) from the facet's plane; (inf, e_v) where no facet is below or above."""
+    v = dim - 1
+    m = len(points)
+    best = np.full(m, -np.inf)  # height of the surface under the point
+    gap = np.full(m, np.inf)
+    normals = np.zeros((m, dim))
+    normals[:, v] = 1.0
+    scale = max(np.abs(facets[..., :dim]).max(), 1.0)
+    if dim == 2:
+        for a, b in zip(facets[:, 0, :2], facets[:, 1, :2]):
+            span = b[0] - a[0]
+            if abs(span) <= 1e-12 * scale:
+                continue
+            t = (points[:, 0] - a[0]) / span
+            inside = (t >= -1e-9) & (t <= 1 + 1e-9)
+            s = a[1] + np.clip(t, 0, 1) * (b[1] - a[1])
+            take = inside & (s > best)
+            n = np.array([-(b[1] - a[1]), b[0] - a[0]])
+            n = n / np.linalg.norm(n) * np.sign(n[1])
+            best[take] = s[take]
+            normals[take] = n
+            gap[take] = (points[take, :2] - a) @ n
+        return gap, normals
+    p = facets[:, :, :2]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    lo, hi = p.min(axis=1) - 1e-9 * scale, p.max(axis=1) + 1e-9 * scale
+    for k in np.flatnonzero(np.abs(det) > 1e-12 * scale**2):
+        near = np.flatnonzero((points[:, 0] >= lo[k, 0]) & (points[:, 0] <= hi[k, 0])
+                              & (points[:, 1] >= lo[k, 1]) & (points[:, 1] <= hi[k, 1]))
+        if len(near) == 0:
+            continue
+        d = points[near, :2] - p[k, 0]
+        b1 = (d[:, 0] * e2[k, 1] - d[:, 1] * e2[k, 0]) / det[k]
+        b2 = (e1[k, 0] * d[:, 1] - e1[k, 1] * d[:, 0]) / det[k]
+        b0 = 1 - b1 - b2
+        z = facets[k, :, 2]
+        s = b0 * z[0] + b1 * z[1] + b2 * z[2]
+        take = (b0 >= -1e-9) & (b1 >= -1e-9) & (b2 >= -1e-9) & (s > best[near])
+        rows = near[take]
+        n = np.cross(facets[k, 1] - facets[k, 0], facets[k, 2] - facets[k, 0])
+        n = n / np.linalg.norm(n) * np.sign(n[2])
+        best[rows] = s[take]
+        normals[rows] = n
+        gap[rows] = (points[rows] - facets[k, 0]) @ n
+    return gap, normals
 
 
 def lifted_mesh(msh: Path, dim: int, shift: float) -> Path:

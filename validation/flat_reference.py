@@ -20,10 +20,11 @@ internodes:
 * ``punch_solve``: a block under a rigid punch (``geo/punch_*.geo``). The block of the two-body mesh
   (exactly its gmsh nodes and cells), turned upside down (``contact_reference.turned_mesh``), is
   pressed by ``delta`` onto the punch's contact surface taken as a rigid obstacle: every node of the
-  block's top face whose lateral position lies under the punch's discrete (P1) face is held by
-  x_v + u_v >= s(x), s the height of the punch's facets there (vertical gap, small sliding), by the
-  bound-constrained solver of ``contact_reference.RigidFlatContact`` (PETSc SNES ``vinewtonrsls``,
-  KKT checked). For a sharp punch every footprint node ends in contact: this is the block with the
+  block's top face whose lateral position lies under the punch's discrete (P1) face is held on the
+  plane of the punch's facet there, n . u >= -g0 (n the facet's normal, g0 the node's initial
+  distance to that plane; small sliding, frictionless: the tangential components are free), by the
+  bound-constrained solver of ``contact_reference.RigidFlatContact`` in coordinates rotated to n
+  (PETSc SNES ``vinewtonrsls``, KKT checked). For a sharp punch every footprint node ends in contact: this is the block with the
   punch's footprint prescribed as the punch's approach, the vertical displacement only
   (frictionless). For rounded corners the contact edge is the solution's. The punch of the
   internodes run is 1e3 to 1e4 times stiffer than the block, not rigid.
@@ -46,7 +47,7 @@ import numpy as np
 VALIDATION = Path(__file__).resolve().parent
 sys.path.insert(0, str(VALIDATION))
 
-from contact_reference import RigidFlatContact, read_body, turned_mesh  # noqa: E402
+from contact_reference import RigidFlatContact, obstacle_below, read_body, turned_mesh  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, solve_constrained  # noqa: E402
 
 SUPPORTS = ("clamped", "rollers", "sliding")
@@ -125,47 +126,6 @@ def union_solve(msh: Path, dim: int, supports: str, delta: float, youngs_modulus
     }
 
 
-def surface_height(facets: np.ndarray, dim: int, lateral: np.ndarray) -> np.ndarray:
-    """Highest point of a P1 surface (segments (k, 2, 3) / triangles (k, 3, 3), vertical axis dim - 1)
-    above each lateral position (m, dim - 1); -inf where the surface is not above or below it.
-
-    A position on a shared edge or vertex belongs to every facet there (barycentric tolerance 1e-9),
-    so the rim nodes of a sharp punch whose nodes the block shares are under the punch."""
-    v = dim - 1
-    height = np.full(len(lateral), -np.inf)
-    if dim == 2:
-        x0, x1 = facets[:, 0, 0], facets[:, 1, 0]
-        y0, y1 = facets[:, 0, v], facets[:, 1, v]
-        span = x1 - x0
-        keep = np.abs(span) > 1e-12 * max(np.abs(facets[..., 0]).max(), 1.0)
-        for a, b, ya, yb, d in zip(x0[keep], x1[keep], y0[keep], y1[keep], span[keep]):
-            t = (lateral[:, 0] - a) / d
-            inside = (t >= -1e-9) & (t <= 1 + 1e-9)
-            height[inside] = np.maximum(height[inside], ya + np.clip(t[inside], 0, 1) * (yb - ya))
-        return height
-    p = facets[:, :, :2]
-    z = facets[:, :, v]
-    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    scale = max(np.abs(p).max(), 1.0)
-    keep = np.abs(det) > 1e-12 * scale**2
-    lo, hi = p.min(axis=1), p.max(axis=1)
-    for k in np.flatnonzero(keep):
-        near = np.flatnonzero((lateral[:, 0] >= lo[k, 0] - 1e-9 * scale) & (lateral[:, 0] <= hi[k, 0] + 1e-9 * scale)
-                              & (lateral[:, 1] >= lo[k, 1] - 1e-9 * scale) & (lateral[:, 1] <= hi[k, 1] + 1e-9 * scale))
-        if len(near) == 0:
-            continue
-        d = lateral[near] - p[k, 0]
-        b1 = (d[:, 0] * e2[k, 1] - d[:, 1] * e2[k, 0]) / det[k]
-        b2 = (e1[k, 0] * d[:, 1] - e1[k, 1] * d[:, 0]) / det[k]
-        b0 = 1 - b1 - b2
-        inside = (b0 >= -1e-9) & (b1 >= -1e-9) & (b2 >= -1e-9)
-        value = b0 * z[k, 0] + b1 * z[k, 1] + b2 * z[k, 2]
-        rows = near[inside]
-        height[rows] = np.maximum(height[rows], value[inside])
-    return height
-
-
 def punch_solve(msh: Path, dim: int, delta: float, youngs_modulus: float, poisson_ratio: float,
                 sharp: bool) -> dict:
     """The block of ``msh`` under its punch taken as rigid (module doc); force and contact set."""
@@ -175,17 +135,18 @@ def punch_solve(msh: Path, dim: int, delta: float, youngs_modulus: float, poisso
     punch = read_body(turned, "punch", ["punch_contact"])
     facets = punch.x[punch.facets["punch_contact"]]
     model = RigidFlatContact(block, "block_contact", "block_base", youngs_modulus, poisson_ratio,
-                             obstacle=lambda lateral: surface_height(facets, dim, lateral))
+                             obstacle=lambda points: obstacle_below(facets, dim, points))
     solution = model.solve(delta)
     v = dim - 1
     bounded = model.contact_nodes[model.bounded]
-    gap = model.height[model.bounded] + solution.u[bounded, v]
-    reaction = solution.reaction[bounded, v]
-    force = float(reaction.sum())
+    normals = model.normals[model.bounded]
+    gap = model.height[model.bounded] + (solution.u[bounded] * normals).sum(axis=1)
+    reaction = solution.reaction[bounded]
+    force = float(reaction[:, v].sum())
     top_reaction = float(solution.reaction[model.top_nodes, v].sum())
-    in_contact = (gap <= GAP_TOLERANCE * delta) & (reaction > 0)
-    # under the punch's flat face (obstacle height within round-off of its lowest point)
-    flat = model.height[model.bounded] <= model.height[model.bounded].min() + 1e-9 * delta
+    in_contact = (gap <= GAP_TOLERANCE * delta) & ((reaction * normals).sum(axis=1) > 0)
+    # under the punch's flat face: a horizontal facet, touching at the start
+    flat = (normals[:, v] > 1 - 1e-12) & (model.height[model.bounded] <= 1e-12)
     lateral = [c for c in range(dim) if c != v]
     r = np.linalg.norm(block.x[bounded][:, lateral], axis=1)
     return {

@@ -88,7 +88,7 @@ before any run and none is set from a result):
 * two-equal: ``symmetry``: the largest distance of a contact-zone node of either body (deformed)
   from the plane where the two discrete bodies meet (the lower support clamped, the upper pole
   meshed at gap and its support moved by -(delta + gap)), over the finer surface's spacing;
-  tolerance 0.01 (the issue) for two bodies meshed alike, 0.02 for two bodies meshed differently
+  tolerance 0.01 for two bodies meshed alike, 0.02 for two bodies meshed differently
   (ruling on a P1 discretization limit: two different surface meshes are two discrete surfaces
   that cannot coincide node for node; the R/50 hemispheres measured 1.2%; every two-equal case of
   the sweep is meshed differently, the upper 1.5 times coarser). Contact zone (DECISION): the
