@@ -375,14 +375,16 @@ struct Safeguard {
     released: HashSet<usize>,
     readded: HashSet<usize>,
     pinned: HashSet<usize>,
-    /// The active nodes' gap error of the last iteration, if it solved the same active set.
-    last_error: Option<f64>,
+    /// The smallest active nodes' gap error of the iterations on the current active set.
+    best_error: Option<f64>,
     /// How many iterations in a row on one active set failed to contract the gap error.
     slow: usize,
 }
 
 /// On an unchanged active set the linearized constraint must shrink the active nodes' gap
-/// error (`Update::max_gap_error_over_h`) by at least this factor per iteration: Newton's
+/// error (`Update::max_gap_error_over_h`) to at most this factor of the smallest error seen on
+/// that set (not of the last one: an error alternating between two values, 9.6e-5 h and
+/// 2.9e-5 h on a 3D block held by a narrower one, halves every other iteration): Newton's
 /// method on the gap ([`super::linearization`]) does far better (quadratic, exact in one step
 /// on a flat), the tied fixed-point correction by about ten. An iteration that does not is
 /// outside the regime where the iteration converges for a reason: [`STALLED_AFTER`] such
@@ -412,11 +414,9 @@ impl Safeguard {
                 return Step::Stop(ContactStatus::Converged);
             }
             let error = update.max_gap_error_over_h;
-            let contracted = self
-                .last_error
-                .is_none_or(|last| error <= CONTRACTION * last);
+            let contracted = (self.best_error).is_none_or(|best| error <= CONTRACTION * best);
             self.slow = if contracted { 0 } else { self.slow + 1 };
-            self.last_error = Some(error);
+            self.best_error = Some(self.best_error.map_or(error, |best| best.min(error)));
             return if self.slow >= STALLED_AFTER {
                 // Newton's method on a piecewise linear gap stops contracting where a node sits
                 // on an edge of the other surface, its closest facet changing from one
@@ -431,7 +431,7 @@ impl Safeguard {
                 Step::Solve(active.clone())
             };
         }
-        (self.last_error, self.slow) = (None, 0);
+        (self.best_error, self.slow) = (None, 0);
         self.seen.insert(active.clone());
         let mut next = update.next.clone();
         if self.seen.contains(&next) {
@@ -506,6 +506,23 @@ mod tests {
         assert_eq!(
             status(safeguard.next(&active, &unchanged(&active, 8.5e-3, false))),
             Some(ContactStatus::Stalled)
+        );
+    }
+
+    #[test]
+    fn an_alternating_gap_error_ends_the_loop() {
+        let active: BTreeSet<usize> = [1, 2].into();
+        let mut safeguard = Safeguard::default();
+        let errors = [4.6e-4, 9.6e-5, 2.9e-5, 9.6e-5, 2.9e-5];
+        for error in &errors[..4] {
+            assert_eq!(
+                status(safeguard.next(&active, &unchanged(&active, *error, false))),
+                None
+            );
+        }
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, errors[4], false))),
+            Some(ContactStatus::Converged)
         );
     }
 
