@@ -379,7 +379,26 @@ struct Safeguard {
     best_error: Option<f64>,
     /// How many iterations in a row on one active set failed to contract the gap error.
     slow: usize,
+    /// The smallest violation of the contact conditions so far ([`violation`]), and how many
+    /// iterations have passed without going below it.
+    best_violation: Option<f64>,
+    since_best: usize,
 }
+
+/// The largest violation of the nodal contact conditions an update found: penetration of an
+/// inactive node (over `h`), tension of an active one (over `p_max`), and the active nodes'
+/// distance to the other surface (over `h`).
+fn violation(update: &Update) -> f64 {
+    let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
+    max(&update.penetrating) + max(&update.tension) + update.max_gap_error_over_h
+}
+
+/// The primal-dual active set method converges superlinearly once near the solution: on the
+/// sweep the set settles in 3 to 9 iterations. An iteration that does not reduce the smallest
+/// violation found so far makes no progress; this many in a row end the loop as
+/// [`ContactStatus::Stalled`] (the active set wandering through new sets, as a stiff primary
+/// named by hand did for 50 iterations on a 3D foreign mesh), instead of running to the cap.
+const NO_PROGRESS_AFTER: usize = 10;
 
 /// On an unchanged active set the linearized constraint must shrink the active nodes' gap
 /// error (`Update::max_gap_error_over_h`) to at most this factor of the smallest error seen on
@@ -408,6 +427,15 @@ impl Safeguard {
         self.released.extend(nodes(&update.tension));
         if update.max_gap_error_over_h > UNSTABLE_GAP_OVER_H {
             return Step::Stop(ContactStatus::Unstable);
+        }
+        let v = violation(update);
+        if self.best_violation.is_none_or(|best| v < best) {
+            (self.best_violation, self.since_best) = (Some(v), 0);
+        } else {
+            self.since_best += 1;
+            if self.since_best >= NO_PROGRESS_AFTER && !update.settled {
+                return Step::Stop(ContactStatus::Stalled);
+            }
         }
         if update.next == *active {
             if update.settled {
@@ -524,6 +552,23 @@ mod tests {
             status(safeguard.next(&active, &unchanged(&active, errors[4], false))),
             Some(ContactStatus::Converged)
         );
+    }
+
+    #[test]
+    fn an_active_set_that_wanders_without_progress_ends_stalled() {
+        let mut safeguard = Safeguard::default();
+        for k in 0..NO_PROGRESS_AFTER + 1 {
+            let active: BTreeSet<usize> = [k].into();
+            let mut update = unchanged(&active, 1e-4, false);
+            update.next = [k + 1].into();
+            update.penetrating = vec![(k + 1, 0.02)];
+            let expected = (k == NO_PROGRESS_AFTER).then_some(ContactStatus::Stalled);
+            assert_eq!(
+                status(safeguard.next(&active, &update)),
+                expected,
+                "iteration {k}"
+            );
+        }
     }
 
     #[test]
