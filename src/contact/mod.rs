@@ -7,11 +7,14 @@
 //!   C2 interpolation (`rbf.rs`) evaluated at each node's closest point on the other surface
 //!   (`projection.rs`), the lumped interface mass, the contact normal and the gaps;
 //! - `solve.rs`: the active-set loop (primal-dual active set), each iteration assembling the
-//!   coupled system (`system.rs`) and solving it (`coupled_solver.rs`, `compliance.rs`);
-//! - `checks.rs`: the active-set update of each iteration and the certificate of the answer,
-//!   checked independently of the loop's operators; `post.rs`: fields, forces, Hertz fit;
+//!   coupled system (`system.rs`) with the frictionless constraint linearized at the last
+//!   iterate (`linearization.rs`) and solving it (`coupled_solver.rs`, `compliance.rs`);
+//! - `checks.rs`: the active-set update of each iteration, and the checks of the answer,
+//!   measured independently of the loop's operators: the residuals that decide the status and
+//!   the accuracy report; `post.rs`: fields, forces, Hertz fit;
 //! - `driver.rs`: [`solve_contact`], the solve a caller asks for: the load steps, and a second
-//!   solve with the other body as primary when the first choice may be the wrong one.
+//!   solve with the other body as primary, or auto's transfer, when a choice made may be the
+//!   wrong one.
 //!
 //! Method, signs and known traps: `shared/notes/method.md`.
 
