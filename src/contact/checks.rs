@@ -28,11 +28,10 @@
 //!
 //! **Can the answer be trusted?** The accuracy indicators, each an error measure of what users
 //! read (the contact force and zone); they never change the status:
-//! - **Secondary sag.** The secondary's largest penetration between constrained primary nodes
-//!   over how far the bodies are pressed into each other (the larger of the geometric
-//!   indentation depth and the elastic approach, [`elastic_approach`]) must not exceed
-//!   `sag_tolerance`: the contact is that much softer than the secondary's own
-//!   discretization (`secondary_sag`).
+//! - **Secondary sag.** The relative error of the contact force that the secondary's
+//!   penetration between constrained primary nodes makes, estimated from the pressure-weighted
+//!   sag over how far the bodies are pressed into each other (`secondary_sag`), must not
+//!   exceed `accuracy_tolerance`.
 //! - **Resolution.** The contact zone must be at least `min_zone_width` primary spacings wide,
 //!   and `secondary_min_zone_width` secondary spacings unless the secondary is nearly rigid
 //!   ([`zone_resolution`]): with one or two nodes across it, the pressure profile has too few
@@ -45,10 +44,12 @@
 //! - **Primary agreement** (only for a primary named in the case file and at least twice
 //!   stiffer than the other body, a choice `primary = "auto"` avoids):
 //!   the contact force must agree with the one found with the other body as primary, within
-//!   `primary_agreement_tolerance` ([`primary_agreement`]). Another multiplier space is an
-//!   independent discretization of the same problem; a stiff block primary twice finer than a
-//!   hemisphere passed every other check with a force 3% off, and the hemisphere as primary
-//!   told it apart.
+//!   `accuracy_tolerance` ([`agreement`], solved by `super::driver`). Another multiplier space
+//!   is an independent discretization of the same problem; a stiff block primary twice finer
+//!   than a hemisphere passed every other check with a force 3% off, and the hemisphere as
+//!   primary told it apart.
+//! - **Transfer agreement** (only for a transfer named in the case file that `auto` would not
+//!   choose): the same, against the automatic transfer.
 //!
 //! A failed check names the body, the gmsh node tag and the figure.
 
@@ -167,7 +168,7 @@ pub struct CertificateCheck {
 }
 
 impl Certificate {
-    /// Adds a check made outside [`certify`] (e.g. [`primary_agreement`]).
+    /// Adds a check made outside [`certify`] (e.g. an [`agreement`]).
     pub fn push(&mut self, check: CertificateCheck) {
         self.checks.push(check);
     }
@@ -326,7 +327,7 @@ pub fn certify(
 
     let indentation = indentation_depth(s1, s2, [u1, u2], &gaps[0], &mean[0])
         .max(elastic_approach(s1, &mean[0], problem.contact_modulus()));
-    let secondary_sag = secondary_sag(s2, &held, &gaps[1], indentation, settings);
+    let secondary_sag = secondary_sag(s2, &held, &gaps[1], &mean[1], indentation, settings);
 
     // A nearly rigid secondary's spacing does not bound the answer: only its position does.
     let secondary_width =
@@ -561,33 +562,67 @@ fn elastic_approach(primary: &ContactSurface, pressure: &[f64], contact_modulus:
     3.0 * std::f64::consts::PI / 16.0 * (force / area) * 2.0 * radius / contact_modulus
 }
 
-/// The secondary's largest penetration into the primary over the indentation depth (the
-/// larger of the geometric one and the [`elastic_approach`]). Only the
-/// transfer holds the secondary nodes: between two constrained primary nodes `h_p` apart, a
-/// secondary surface of curvature `1/R` sags into a flat primary by about `h_p^2 / (8R)`, which
-/// is `(h_p / a)^2 / 4` of the indentation depth `a^2 / (2R)`: the contact is that much softer
-/// than the secondary's own discretization, and the force (`P ~ delta^(3/2)` in 3D) lower by
-/// about 3/4 of it. A figure below the primary's penetration tolerance times the node's
-/// spacing always passes (touching flat surfaces have no indentation and no sag).
+/// The relative error of the contact force that the secondary's sag between constrained
+/// primary nodes makes, estimated (the "secondary sag" indicator):
 ///
-/// Only the secondary nodes [`Held::Inside`] the zone count: the sag is the secondary's shape
-/// between constrained nodes.
+/// ```text
+/// eta = (3/4) sum_s F_s sag_s / (delta sum_s F_s)
+/// ```
+///
+/// over the secondary nodes in contact, `F_s` a node's compressive force (mean pressure times
+/// area), `sag_s` its penetration into the primary where it lies [`Held::Inside`] the zone
+/// (beyond the primary's penetration tolerance times its spacing; 0 elsewhere), `delta` the
+/// indentation depth (the larger of the geometric one and the [`elastic_approach`]). Only the
+/// transfer holds the secondary nodes: between two constrained primary nodes `h_p` apart, a
+/// secondary surface of curvature `1/R` sags into a flat primary by about `h_p^2 / (8R)`, and
+/// the contact is that much shallower there than the secondary's own discretization makes it.
+/// By reciprocity (Betti), a change `w(x)` of the indentation over a zone of fixed extent
+/// changes the force by `integral p_1 w dA`, `p_1` the pressure of a unit approach: the
+/// pressure-weighted mean sag over the approach. The factor 3/4 turns the indentation depth
+/// into the approach for both kinds of contact: a Hertz zone's depth `a^2 / (2R)` is half its
+/// approach and its force grows as `delta^(3/2)` (`dP / P = (3/2) d(delta) / delta`); the
+/// elastic approach is 3/4 of a flat punch's. Weighted, not the largest sag: at a rounded punch
+/// corner a few nodes sag by a quarter of the approach while the flat face, which carries the
+/// force, has none (the largest sag over the depth read 0.24 on a 3D punch whose force is the
+/// rigid punch's to 8e-4). Measured (half-disc on a block meshed twice coarser, the block as
+/// primary): the estimate 1.4% for a force 2.0% below the disc primary's.
 fn secondary_sag(
     secondary: &ContactSurface,
     held: &[Held],
     gaps: &[f64],
+    pressure: &[f64],
     indentation: f64,
     settings: &super::ContactSettings,
 ) -> CertificateCheck {
-    let mut worst = Worst::default();
+    let mut deepest = Worst::default();
+    let (mut weighted, mut total) = (0.0, 0.0);
     for (s, g) in gaps.iter().enumerate() {
-        if held[s] != Held::Inside {
-            continue;
+        let force = pressure[s].max(0.0) * secondary.nodal_area[s];
+        if held[s] != Held::Not {
+            total += force;
         }
-        let floor = settings.penetration_tolerance * secondary.spacing[s] / settings.sag_tolerance;
-        worst.offer(-g / indentation.max(floor), secondary, s);
+        let floor = settings.penetration_tolerance * secondary.spacing[s];
+        if held[s] == Held::Inside && -g > floor {
+            weighted += force * -g;
+            deepest.offer(-g, secondary, s);
+        }
     }
-    worst.check(CheckKind::SecondarySag, settings.sag_tolerance)
+    let estimate = if total > 0.0 && indentation > 0.0 {
+        0.75 * weighted / (total * indentation)
+    } else {
+        0.0
+    };
+    let tolerance = settings.accuracy_tolerance;
+    let mut check = deepest.check(CheckKind::SecondarySag, tolerance);
+    check.note = (check.value > 0.0).then(|| {
+        format!(
+            "deepest sag {:.3e} of an indentation depth {indentation:.3e}",
+            check.value
+        )
+    });
+    check.value = estimate;
+    check.passed = estimate <= tolerance;
+    check
 }
 
 /// How the constraint holds a secondary node: by the primary facet it faces (its closest

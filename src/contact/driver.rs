@@ -214,7 +214,7 @@ fn check_against<'m>(
     log: &mut Log,
 ) -> (ContactProblem<'m>, ContactSolution) {
     let (tolerance, formulation, named) = (
-        problem.settings.primary_agreement_tolerance,
+        problem.settings.accuracy_tolerance,
         problem.settings.formulation,
         problem.settings.transfer,
     );

@@ -90,10 +90,12 @@ pub struct ContactSettings {
     /// spacings across the contact zone, falling with h), far below the spacing-sized
     /// penetration of a wrong active set.
     pub secondary_penetration_tolerance: f64,
-    /// The certificate's bound on the secondary's penetration over the indentation depth
-    /// (`super::checks`; default 0.03): how much softer than the secondary's own
-    /// discretization the coupling lets the contact be.
-    pub sag_tolerance: f64,
+    /// The accuracy report's bound on the relative error of the contact force, for each
+    /// indicator that estimates it (default 0.01): the secondary's sag, and the agreement with
+    /// the other primary or with the automatic transfer when one was named (`super::checks`).
+    /// One tolerance, because each of them answers the same question: how far the force the
+    /// user reads may be from the one of a better discretization.
+    pub accuracy_tolerance: f64,
     /// The certificate's bound on the tensile normal force any surface node receives over its
     /// area (along the node's own outward normal), relative to the largest pressure (default
     /// 0.1). The secondary pressure is the RBF transfer `R21 lambda` of the multiplier, which
@@ -114,10 +116,6 @@ pub struct ContactSettings {
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
-    /// The certificate's bound on the relative difference between the contact force and the
-    /// one found with the other body as primary (default 0.01), checked only when the primary
-    /// was named and is the stiffer body ([`PrimaryReport::check_other`]).
-    pub primary_agreement_tolerance: f64,
     /// Support radius of each node's RBF in the transfer operators, in units of the distance
     /// to its nearest node (default 2, the radius seed Algorithm 1 starts from; see
     /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
@@ -134,13 +132,12 @@ impl Default for ContactSettings {
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
             secondary_penetration_tolerance: 0.05,
-            sag_tolerance: 0.03,
+            accuracy_tolerance: 0.01,
             min_zone_width: 1.5,
             secondary_min_zone_width: 2.5,
             certificate_tension_tolerance: 0.1,
             imbalance_tolerance: 0.01,
             force_centre_tolerance: 1.0,
-            primary_agreement_tolerance: 0.01,
             rbf_radius: 2.0,
         }
     }
@@ -196,13 +193,9 @@ impl ContactSettings {
                 "certificate_tension_tolerance",
                 self.certificate_tension_tolerance,
             ),
-            ("sag_tolerance", self.sag_tolerance),
+            ("accuracy_tolerance", self.accuracy_tolerance),
             ("imbalance_tolerance", self.imbalance_tolerance),
             ("force_centre_tolerance", self.force_centre_tolerance),
-            (
-                "primary_agreement_tolerance",
-                self.primary_agreement_tolerance,
-            ),
         ] {
             if !(value >= 0.0 && value.is_finite()) {
                 return error(name, "a finite number >= 0", value);

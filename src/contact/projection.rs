@@ -57,6 +57,8 @@ pub struct SurfaceIndex {
     tree: RTree<Facet>,
     /// Outward unit normal of each facet.
     normals: Vec<[f64; 3]>,
+    /// Longest edge of each facet.
+    sizes: Vec<f64>,
     /// Mean facet diameter: the length scale of "on the surface".
     length: f64,
 }
@@ -79,8 +81,13 @@ impl SurfaceIndex {
             })
             .collect();
         let mut normals = vec![[0.0; 3]; facets.len()];
+        let mut sizes = vec![0.0; facets.len()];
         for facet in &facets {
             normals[facet.index] = facet_measure_and_normal(&facet.corners, dim).1;
+            let corners = &facet.corners;
+            sizes[facet.index] = (0..corners.len())
+                .map(|a| distance_squared(&corners[a], &corners[(a + 1) % corners.len()]).sqrt())
+                .fold(0.0, f64::max);
         }
         let length = facets
             .iter()
@@ -90,6 +97,7 @@ impl SurfaceIndex {
         Self {
             tree: RTree::bulk_load(facets),
             normals,
+            sizes,
             length,
         }
     }
@@ -168,6 +176,11 @@ impl SurfaceIndex {
     /// Outward unit normal of facet `facet`.
     pub fn normal(&self, facet: usize) -> [f64; 3] {
         self.normals[facet]
+    }
+
+    /// Longest edge of facet `facet` (its length in 2D).
+    pub fn facet_size(&self, facet: usize) -> f64 {
+        self.sizes[facet]
     }
 }
 

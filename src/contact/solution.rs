@@ -260,7 +260,7 @@ impl ContactSolution {
     }
 
     /// Adds an accuracy indicator computed after the loop (e.g.
-    /// `super::checks::primary_agreement`) to the report.
+    /// `super::checks::agreement`) to the report.
     pub fn certify_further(&mut self, check: super::CertificateCheck) {
         debug_assert!(!check.name.is_residual());
         self.certificate.push(check);
