@@ -1,7 +1,8 @@
 //! # internodes
 //!
 //! Elastic bodies with non-matching meshes in frictionless contact, solved with the INTERNODES
-//! method (Deparis, Forti, Gervasio, Quarteroni 2016; the seed report in `shared/seed`).
+//! method (Deparis, Forti, Gervasio, Quarteroni 2016); the method is described in
+//! `docs/method.md`.
 //!
 //! Each body `k` is a P1 linear-elastic body, `K_k u_k = f_k`. Two bodies in contact are
 //! coupled on their active interface nodes through rescaled Wendland C2 radial-basis
@@ -14,7 +15,7 @@
 //! ```
 //!
 //! with `lambda` the traction on body 1 and `d` the nodal gaps, the active set updated until no
-//! node is in tension and none penetrates (the seed's Algorithm 3).
+//! node is in tension and none penetrates (`docs/method.md`, section 3).
 //!
 //! The crate is organised as the solve proceeds:
 //! - [`mesh`]: gmsh MSH 4.1 input, bodies and boundary groups by physical name;

@@ -162,7 +162,7 @@ fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
 
     assert_contact_conditions(&solution, 0.01, "2D half-disc");
 
-    // Hertz for the measured force per unit length (method.md section 4):
+    // Hertz for the measured force per unit length (`docs/method.md`, section 5):
     // a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), 1/E* = 2 (1 - nu^2) / E.
     let e_star = 1000.0 / (2.0 * (1.0 - 0.09));
     let force = solution.force_primary[1].abs();
@@ -1366,8 +1366,8 @@ fn assert_contact_conditions(solution: &ContactSolution, max_imbalance: f64, lab
     eprintln!("{label}: force imbalance {:.2e}", solution.force_imbalance);
 }
 
-/// What a converged 3D Hertz solve must show (issue: "hemisphere on a large block at a/R about
-/// 0.1"): no active node in tension on either surface, no candidate penetrating beyond the
+/// What a converged 3D Hertz solve must show (the target case: a hemisphere on a large block at
+/// a/R about 0.1): no active node in tension on either surface, no candidate penetrating beyond the
 /// tolerance, no hole (every primary candidate closer to the axis than `a - h` is active, `a`
 /// Hertz's radius for the measured force and `h` the node's spacing: the discrete rim is one
 /// spacing wide), a small force imbalance, and the fitted contact radius and peak pressure
@@ -1384,7 +1384,7 @@ fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &
     // is only approximate (measured: see the README's contact table).
     assert_contact_conditions(solution, 0.03, label);
 
-    // Hertz (method.md section 4): a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2), R = 1.
+    // Hertz (`docs/method.md` 5): a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2), R = 1.
     let force = solution.force_primary[2].abs();
     let a = (3.0 * force / (4.0 * e_star)).cbrt();
     let p0 = 3.0 * force / (2.0 * std::f64::consts::PI * a * a);
@@ -1438,9 +1438,9 @@ fn hertz_hemisphere_on_block_matches_theory() {
 
 #[test]
 fn bodies_meshed_overlapping_are_pushed_apart_into_hertz_contact() {
-    // The seed's set-up: no imposed displacement, the bodies meshed overlapping (pole 0.01
-    // below the block top in 3D, 0.02 in 2D, the same overlaps as the pressed cases), the
-    // sphere's top held and the block's base clamped.
+    // The set-up of earlier INTERNODES contact tests: no imposed displacement, the bodies
+    // meshed overlapping (pole 0.01 below the block top in 3D, 0.02 in 2D, the same overlaps
+    // as the pressed cases), the sphere's top held and the block's base clamped.
     let text = hemisphere_on_block("hemisphere_on_block_overlap.msh", 0.0, 1000.0, 1000.0, "");
     let solution = solve(&text).unwrap();
     let (error_a, error_p0) = assert_hertz_3d(

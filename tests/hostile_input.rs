@@ -1,6 +1,6 @@
-//! Hostile but fair input (issue 12): every case here once gave a misread mesh, a panic, a
-//! stale result or a vague message. Each test names what must happen instead; future fixes of
-//! bad-input handling add their case here.
+//! Hostile but fair input, found by review and by fuzzing (`fuzz/README.md`): every case here
+//! once gave a misread mesh, a panic, a stale result or a vague message. Each test names what
+//! must happen instead; future fixes of bad-input handling add their case here.
 
 mod common;
 
@@ -202,7 +202,7 @@ fn shuffled_node_tags_give_the_same_mesh_as_sorted_ones() {
     }
 }
 
-/// The issue's example: a unit square whose four nodes are written in the order 3, 4, 1, 2
+/// A unit square whose four nodes are written in the order 3, 4, 1, 2
 /// (a dense tag range, so the old reader numbered them 1, 2, 3, 4 by position).
 const SQUARE_3412: &str = r#"$MeshFormat
 4.1 0 8

@@ -1,7 +1,7 @@
 //! Rescaled localized RBF interpolation between non-matching interfaces (`contact::rbf`):
-//! exact reproduction of constants, convergence on smooth fields, radii (seed Algorithm 1 against
-//! twice the spacing), and the sparse rows and columns the contact operators use. Everything is
-//! deterministic.
+//! exact reproduction of constants, convergence on smooth fields, radii (Algorithm 1 of
+//! `docs/method.md` 2.2 against twice the spacing), and the sparse rows and columns the contact
+//! operators use. Everything is deterministic.
 
 use std::f64::consts::PI;
 

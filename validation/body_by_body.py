@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Cross-check with FEniCSx, body by body (issue 5, item 3).
+"""Cross-check with FEniCSx, body by body.
 
 internodes solves a two-body contact problem; its output holds, for each
 body k, the displacement u_k, the cell stresses and the nodal contact

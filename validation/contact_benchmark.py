@@ -31,7 +31,7 @@ other, so that its wall time and peak resident memory (``ru_maxrss`` from
                        space) or MUMPS Cholesky, as in ``benchmark.py``; the faster
                        (assembly + setup + solve) is dolfinx's best.
 
-Aims (issue 4): the contact solve (set-up + active-set loop; run 1) within twice
+Aims: the contact solve (set-up + active-set loop; run 1) within twice
 dolfinx's best elastic solve, and each extra load step under a tenth of the first
 step (run 2).
 
@@ -84,7 +84,7 @@ MAX_RSS_GB = 18.0
 MAX_SECONDS_OURS = 1200.0
 MAX_SECONDS_DOLFINX = 600.0
 
-# Aims of issue 4.
+# The aims of the module doc.
 AIM_TOTAL = 2.0  # contact total / dolfinx best elastic solve
 AIM_STEP = 0.1  # extra load step / first load step
 

@@ -136,7 +136,7 @@ class RunFailed(RuntimeError):
 
 
 def hertz(force: float, radius: float, dim: int) -> dict:
-    """Hertz half-width / radius a and peak pressure p0 for the contact force P (method.md 4)."""
+    """Hertz half-width / radius a and peak pressure p0 for the contact force P (docs/method.md, section 5)."""
     if dim == 3:
         a = (3 * force * radius / (4 * E_STAR)) ** (1 / 3)
         return {"a": a, "p0": 3 * force / (2 * math.pi * a**2)}
@@ -344,7 +344,7 @@ def observed_rate(h: list, error: list) -> float:
 
 
 def target_checks(case: HertzCase, finest: dict, level: int) -> list[Check]:
-    """The issue's targets at the finest level run (frictionless)."""
+    """The accuracy targets at the finest level run (frictionless)."""
     where = f"{case.name} l{level} frictionless"
     numbers = (f"a = {finest['a']:.5f}, a_H = {finest['a_hertz']:.5f}, p0 = {finest['p0']:.4g}, "
                f"p0_H = {finest['p0_hertz']:.4g}, h = {finest['h']:.4g}")

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Outside check: the contact solver on meshes and approaches that no suite was tuned on.
 
-The question of issue 11: does ``converged`` ever come with a wrong answer? A half-disc (2D) and a
+The question: does ``converged`` ever come with a wrong answer? A half-disc (2D) and a
 hemisphere (3D) of E = 1000 pressed onto a block 1e4 times stiffer, with ``primary = "auto"``, at
 contact-zone spacings, block ratios and approaches that the sweep does not use (h_c R/25, R/40,
 R/60 in 3D and R/30, R/120, R/400 in 2D; block spacing 1, 2 and 0.7 times the curved body's;

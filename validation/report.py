@@ -7,7 +7,7 @@ Two kinds of checks, kept apart in the tables and in the exit status of ``run.py
 * gate checks: properties that hold to round-off or by construction when the code is right
   (FEniCSx cross-checks of matrices and single-body solutions, the body-by-body check of contact
   solutions). One failure fails ``make validate`` and ``make test``.
-* targets: the accuracy targets of the contact issue (Hertz, convergence, the rigid-flat
+* targets: the accuracy targets of the contact solver (Hertz, convergence, the rigid-flat
   reference). They are reported with their figures, met or missed; a miss is a finding about
   the method and the meshes, stated plainly, and does not fail the run.
 """
@@ -130,7 +130,7 @@ def write(report_dir: Path, gate: list[SuiteResult], targets: list[SuiteResult],
         f"**Targets:** {counts['targets_met']} met, {counts['targets_missed']} missed.",
         "",
         "Gate checks hold to round-off when the code is right; one failure fails the run. Targets are "
-        "the accuracy targets of the contact issue; each is reported with its figure, met or missed, "
+        "the accuracy targets of the contact solver; each is reported with its figure, met or missed, "
         "and a miss is explained in its section.",
         "",
         "## Headline",

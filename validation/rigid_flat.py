@@ -1,11 +1,11 @@
 #!/usr/bin/python3
-"""Report suite: internodes against an independent dolfinx contact reference (issue 5, item 4).
+"""Report suite: internodes against an independent dolfinx contact reference.
 
 The half-disc (2D) and the hemisphere (3D) of ``geo/half_disc_on_block.geo`` and
 ``geo/hemisphere_on_block.geo`` are pressed onto a rigid flat and solved by dolfinx with PETSc's
 variational-inequality Newton method (``contact_reference.py``, which owes nothing to our code).
 internodes solves the same mesh with the block 1e4 times stiffer than the curved body (E = 1e7
-against 1e3), twice: with the stiff block as the primary body (as the issue asks) and with the
+against 1e3), twice: with the stiff block as the primary body (a choice the solver must survive) and with the
 curved body as the primary.
 
 For the stiff-block-primary runs the block is meshed BLOCK_RATIO = 2 times coarser than the curved

@@ -74,13 +74,13 @@ def mesh_geo(script: str, dim: int, parameters: dict, path: Path) -> Path:
 # The [contact] table of a case file
 # ---------------------------------------------------------------------------
 
-# Keys of the [contact] table before the solver rewrite (issue 11), replaced by bodies / surfaces / primary.
+# Keys of the [contact] table before the solver rewrite, replaced by bodies / surfaces / primary.
 OLD_CONTACT_KEYS = ("primary_surface", "secondary", "secondary_surface")
 
 
 def contact_table(bodies: tuple[str, str], surfaces: tuple[str, str], primary: str = "auto",
                   formulation: str = "frictionless", **extra) -> str:
-    """The ``[contact]`` table of a case file, in the form of the rewritten solver (issue 11).
+    """The ``[contact]`` table of a case file, in the form of the rewritten solver.
 
     ``bodies`` are the two bodies in contact, ``surfaces`` their candidate surfaces in the same
     order, ``primary`` "auto" or one of the two body names (an explicit choice). ``extra`` are

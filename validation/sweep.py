@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Gated sweep of the contact solver (issue 11, item 5): a covering set of named cases.
+"""Gated sweep of the contact solver: a covering set of named cases.
 
-Why a covering set. The issue lists the parameters the rewritten solver must survive: half-disc on
+Why a covering set. The parameters the rewritten solver must survive are: half-disc on
 a block (2D) and hemisphere on a block (3D); the curved body primary and the stiff block primary,
 chosen automatically or explicitly; contact-zone spacing R/20 to R/500 (2D) and R/15 to R/100 (3D);
 contact zones about 3 to 100 spacings across (2D) and 3 to 30 (3D); the block's contact spacing
@@ -24,7 +24,7 @@ over the curved body's: geo parameter ``block_ratio``; two-equal: the geo's ``ra
 
 Approach. The intended half-width a = across h / 2 gives the approach delta (the net displacement of
 the curved body's support towards the other body): 3D, Hertz's delta = a^2 / R_eff (R_eff = R on a
-block, R/2 for two equal bodies); 2D has no closed form (method.md 4), so delta comes from the dolfinx
+block, R/2 for two equal bodies); 2D has no closed form (docs/method.md 5), so delta comes from the dolfinx
 rigid-flat curve a(delta) of the half-disc measured once at R/160 (``RIGID_FLAT_2D``, log-log
 interpolation), times 1.12 for E ratio 1 and 1.03 for E ratio 10 (the elastic block's own
 compliance: measured 0.111 against 0.118 at delta = 0.02, E ratio 1), and, for two equal half-discs,
@@ -56,13 +56,13 @@ before any run and none is set from a result):
   h_c = 0.01, r_c = 0.19, d_far = 1, block_ratio 2 leaves the block top unrefined), and a case
   whose mesh is not what its name says would test nothing.
 * rigid-flat: ``reference`` (dolfinx's VI solve converged and its KKT check passed: a failed
-  reference fails the row, it is not skipped); ``force``: |P - P_ref| / P_ref <= 1% (the issue),
+  reference fails the row, it is not skipped); ``force``: |P - P_ref| / P_ref <= 1% (the target),
   P the vertical contact force on the curved body; ``radius / h``: |a_nodes - a_nodes,ref| in units
   of the curved body's spacing h (measured over the contact zone), a_nodes the largest distance from
   the axis of an active primary node with nodal pressure above 1e-9 of the largest (the reference's
   rule; DECISION: internodes' contact zone is its primary's active set, the multiplier's support,
   whichever body is primary: the secondary's flags and interpolated pressures reach beyond it, down
-  to 1e-9 p_max at 0.39 R on the 2D stiff-primary case), tolerance max(1, h_primary / h): one spacing (the issue), but one
+  to 1e-9 p_max at 0.39 R on the 2D stiff-primary case), tolerance max(1, h_primary / h): one spacing (the target), but one
   spacing of the primary surface when the primary is the block meshed block_ratio = 2 times coarser
   (DECISION: the contact radius seen through a multiplier on a surface twice coarser moves in steps
   of that surface's spacing; judging it to one spacing of the finer surface would judge the mesh,
@@ -71,7 +71,7 @@ before any run and none is set from a result):
   a least-squares fit p^2 = p0^2 - (p0/a)^2 r^2 over the active primary nodes whose mean pressure
   (contact_mean_pressure) exceeds 1e-9 of the largest, r from the contact axis (computed here from
   solution.h5, not the solver's own fit), a_H and p0_H Hertz's for the measured force on the primary (1/E* = sum
-  (1 - nu^2) / E_i, 1/R_eff = sum 1/R_i). Tolerance 3% (the issue) where the fit's surface resolves
+  (1 - nu^2) / E_i, 1/R_eff = sum 1/R_i). Tolerance 3% (the target) where the fit's surface resolves
   the zone, a_H / h >= 5 (at least 10 spacings across); below that (DECISION) a 3% band is narrower
   than a fraction of a spacing that the discrete rim cannot place: a is judged to one spacing,
   tolerance h / a_H, and p0 to what one spacing of a means at the measured force, (dim - 1) h / a_H
@@ -149,7 +149,7 @@ YOUNGS_MODULUS = 1000.0  # the curved body's (both bodies' in two-equal cases)
 POISSON_RATIO = 0.3
 TWO_EQUAL_RATIO = 1.5  # upper mesh sizes / lower ones: "two equal bodies with different meshes"
 
-# Tolerances (the issue's, and the decisions of the module doc), fixed before any run.
+# Tolerances (the targets', and the decisions of the module doc), fixed before any run.
 FORCE_TOLERANCE = 0.01
 RADIUS_TOLERANCE = 1.0  # spacings
 HERTZ_TOLERANCE = 0.03
@@ -308,7 +308,7 @@ CASES = (
              "limit); auto choice with a 1e4 times stiffer block"),
     Case("2d-rigid-R40-stiff-fine", 2, "rigid-flat", 40, 8, 1e4, "block", quick=True, premise="stiff-fine",
          supported=False,
-         why="the stiff block primary (explicit) meshed as finely as the curved body: the issue asks for the "
+         why="the stiff block primary (explicit) meshed as finely as the curved body: the solver must give the "
              "right answer or a status naming the reason"),
     Case("2d-rigid-R80-stiff-coarse", 2, "rigid-flat", 80, 18, 1e4, "block", block_ratio=2.0,
          why="the stiff block primary (explicit), its surface twice coarser"),
@@ -440,7 +440,7 @@ def e_star(case: Case) -> float:
 
 
 def hertz(case: Case, force: float) -> dict:
-    """Hertz half-width / radius and peak pressure for the force P (method.md 4)."""
+    """Hertz half-width / radius and peak pressure for the force P (docs/method.md, section 5)."""
     es, r = e_star(case), case.radius_eff
     if case.dim == 3:
         a = (3 * force * r / (4 * es)) ** (1 / 3)
@@ -849,7 +849,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
     seconds = time.perf_counter() - start
     text = report_text(cases, checks, records, quick, seconds)
     data = {"quick": quick, "seconds": seconds, "cases": json_safe(records)}
-    return SuiteResult("Sweep: the contact solver over the issue's parameter ranges (gate)", checks, figures, text,
+    return SuiteResult("Sweep: the contact solver over its required parameter ranges (gate)", checks, figures, text,
                        data)
 
 
@@ -859,7 +859,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
 
 
 DECISIONS = """\
-**Decisions where the issue is silent** (fixed before any run; module doc of `validation/sweep.py`):
+**Decisions the targets leave open** (fixed before any run; module doc of `validation/sweep.py`):
 
 * *Hertz a and p0 within 3%* applies where the fitted surface resolves the zone, a_H / h >= 5 (10
   spacings across). Below that a 3% band is a fraction of a spacing, which the discrete rim cannot
@@ -885,8 +885,8 @@ DECISIONS = """\
   equilibrium; accuracy indicators: secondary sag, resolution, force centre) or a "passed" flag
   contradicting the figures fails the row. An unsupported case the solver does not vouch for must
   name the reason: a failure status, or a failed accuracy indicator.
-* *Supported*: two cases the issue lists among those that must certify (two equal hemispheres at
-  R/33; the 3D zone 3 spacings across, until the conservative transfer) or that it lets name a
+* *Supported*: two cases the targets list among those that must certify (two equal hemispheres at
+  R/33; the 3D zone 3 spacings across, until the conservative transfer) or that they let name a
   reason (the stiff 2D primary as fine as the disc) failed the secondary sag check since it was
   added (sag 11%, 4.0%, 3.2% of the indentation against 3%); they are judged
   as unsupported cases (right, or a named status), and two equal hemispheres at R/50 (the coarser

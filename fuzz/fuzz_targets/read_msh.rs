@@ -1,5 +1,5 @@
 //! Any bytes given to the mesh reader give a mesh or an error, never a panic, an abort or a
-//! runaway allocation (issue 12). See `fuzz/README.md`.
+//! runaway allocation. See `fuzz/README.md`.
 #![no_main]
 
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! The contact checks: the active-set update of each iteration ([`Update`]: tension of the
 //! active nodes, penetration of the inactive ones), and the checks of the answer, measured
-//! without the active-set loop's operators (method.md section 3, "Certify the result"). They
+//! without the active-set loop's operators (`docs/method.md`, section 4). They
 //! answer two questions apart, as a convex solver's termination criteria and an error
 //! estimate do.
 //!

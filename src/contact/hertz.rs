@@ -2,7 +2,7 @@
 //!
 //! Hertz's pressure is `p(r) = p0 sqrt(1 - r^2 / a^2)`, so `p^2 = p0^2 - (p0^2 / a^2) r^2` is
 //! linear in `r^2`: a least-squares line through `(r_i^2, p_i^2)` over the active nodes in
-//! compression gives `p0^2` (intercept) and `-p0^2 / a^2` (slope) (method.md section 4). `r` is
+//! compression gives `p0^2` (intercept) and `-p0^2 / a^2` (slope) (`docs/method.md` 5). `r` is
 //! the distance from the pressure-weighted centroid, measured in the plane normal to the mean
 //! normal of the loaded nodes (in 2D, along the surface line).
 //!

@@ -5,7 +5,7 @@
 //! **Interpolation along the surfaces.** Every primary candidate `x_i` is projected onto the
 //! secondary surface along its outward normal (point `p_i`, reference geometry,
 //! [`super::projection`]), and `R12`
-//! is the rescaled Wendland interpolation (seed eqs. 2.4-2.7) from all secondary candidates to
+//! is the rescaled Wendland interpolation (`docs/method.md` 2.2) from all secondary candidates to
 //! the points `p_i`; likewise `R21` from all primary candidates to the projections of the
 //! secondary candidates onto the primary surface. The targets lie on the source surface, so
 //! every node is covered however far apart the two surfaces start (a rim many spacings from

@@ -16,7 +16,7 @@
 //!   solve with the other body as primary, or auto's transfer, when a choice made may be the
 //!   wrong one.
 //!
-//! Method, signs and known traps: `shared/notes/method.md`.
+//! Method, signs and the reasons behind each rule: `docs/method.md`.
 
 mod boundary;
 mod checks;

@@ -15,14 +15,15 @@ pub enum Formulation {
     /// Normal constraint only, one scalar multiplier per primary node: surfaces may slide.
     #[default]
     Frictionless,
-    /// Vector constraint (the seed's system): active surfaces are glued together.
+    /// Vector constraint (the original INTERNODES contact system): active surfaces are glued
+    /// together.
     Tied,
 }
 
 /// How the multiplier's force reaches the secondary body (README, "The force on the
 /// secondary").
 ///
-/// - `Interpolation` (INTERNODES, the seed's system): the secondary receives the traction
+/// - `Interpolation` (INTERNODES' own transfer): the secondary receives the traction
 ///   interpolated at its own nodes, `lambda_2 = -R21 lambda`, integrated by its interface mass:
 ///   nodal forces `-M2 R21 lambda`. A secondary coarser than the primary samples a field finer
 ///   than itself there, and the total force no longer balances `M1 lambda` (the imbalance grows
@@ -117,7 +118,7 @@ pub struct ContactSettings {
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
     /// Support radius of each node's RBF in the transfer operators, in units of the distance
-    /// to its nearest node (default 2, the radius seed Algorithm 1 starts from; see
+    /// to its nearest node (default 2, the radius Algorithm 1 of `docs/method.md` starts from; see
     /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
     pub rbf_radius: f64,
 }

@@ -1,5 +1,5 @@
-//! The geometric gap: closest-point projection of a point onto a contact surface (method.md
-//! section 3), the one gap measure of the contact checks, the `normal_gap` output and the
+//! The geometric gap: closest-point projection of a point onto a contact surface (`docs/method.md`
+//! section 3.1), the one gap measure of the contact checks, the `normal_gap` output and the
 //! certificate.
 //!
 //! A surface is its P1 facets (segments in 2D, triangles in 3D) at given node positions, the

@@ -1,24 +1,25 @@
 //! Rescaled, compactly supported radial-basis interpolation between contact interfaces.
 //!
 //! The INTERNODES method transfers fields between the two non-matching interfaces of a contact
-//! problem with the rescaled localized radial-basis interpolation of the seed report (section 2):
+//! problem with the rescaled localized radial-basis interpolation of Deparis, Forti and
+//! Quarteroni (2014; `docs/method.md`, section 2.2):
 //!
-//! * Wendland C2 basis (eq. 2.2): `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`, with
+//! * Wendland C2 basis: `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`, with
 //!   `delta = |x - xi_j| / r_j` and a support radius `r_j` per interpolation node.
 //! * Source nodes `xi_1..xi_M` with radii `r_j`, target points `zeta_1..zeta_N`:
-//!   `(Phi_MM)_ij = phi(|xi_i - xi_j| / r_j)` (eq. 2.4), `(Phi_NM)_ij = phi(|zeta_i - xi_j| / r_j)`
-//!   (eq. 2.5), and the interpolation matrix is `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` (eq. 2.6) with
-//!   `D_NN = diag(Phi_NM Phi_MM^-1 1)` (eq. 2.7). Every row of `R_NM` therefore sums to one:
+//!   `(Phi_MM)_ij = phi(|xi_i - xi_j| / r_j)`, `(Phi_NM)_ij = phi(|zeta_i - xi_j| / r_j)`, and the
+//!   interpolation matrix is `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` with
+//!   `D_NN = diag(Phi_NM Phi_MM^-1 1)`. Every row of `R_NM` therefore sums to one:
 //!   constants are reproduced exactly.
 //! * Because column `j` uses its own radius `r_j`, `Phi_MM` is not symmetric; it is factored with a
 //!   sparse LU. Both RBF matrices are sparse (compact support) and are assembled with a k-d tree
 //!   radius search, never by visiting all pairs.
-//! * Radii: seed Algorithm 1 ([`support_radii`]) is the reference; the transfer operators of a
+//! * Radii: Algorithm 1 ([`support_radii`]) is the reference; the transfer operators of a
 //!   contact solve use radii of the same form with `c` held at Algorithm 1's starting value
-//!   ([`interpolation_radii`]), for the accuracy reason given there. Seed Algorithm 2 (keeping
-//!   only the nodes within reach of the other side) is not needed: the operators interpolate
-//!   at each node's projection onto the source surface, which every support covers
-//!   (`super::interface`).
+//!   ([`interpolation_radii`]), for the accuracy reason given there. An iterative search for
+//!   interface nodes (keeping only the nodes within reach of the other side) is not needed: the
+//!   operators interpolate at each node's projection onto the source surface, which every
+//!   support covers (`super::interface`).
 //!
 //! Points are `[f64; 3]`; 2D problems pass `z = 0` (points on a curve), 3D problems points on a
 //! surface. Nothing here depends on the dimension.
@@ -34,13 +35,13 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-/// Starting value of the constant `c` of seed Algorithm 1 (`r_i = d_i / c`).
+/// Starting value of the constant `c` of Algorithm 1 (`r_i = d_i / c`).
 pub const C_START: f64 = 0.5;
 
-/// Upper bound `C` of seed Condition 1: Algorithm 1 fails when `c` would exceed it.
+/// Upper bound `C` of Algorithm 1: it fails when `c` would exceed it.
 pub const C_MAX: f64 = 0.95;
 
-/// Relative threshold for the rescaling factors `D_ii` (eq. 2.7).
+/// Relative threshold for the rescaling factors `D_ii`.
 ///
 /// Target `i` is *uncovered* when `D_ii = sum_j (Phi_NM)_ij y_j <= UNCOVERED_TOL * sum_j
 /// (Phi_NM)_ij |y_j|`, with `y = Phi_MM^-1 1`. The right-hand side is the size of the terms that are
@@ -114,7 +115,7 @@ pub enum RbfError {
     Assembly(String),
 }
 
-/// Wendland C2 radial basis function (seed eq. 2.2): `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`
+/// Wendland C2 radial basis function: `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`
 /// for `delta >= 0`. It is `1` at `0`, vanishes with its first and second derivatives at `1` and is
 /// zero beyond.
 pub fn wendland_c2(delta: f64) -> f64 {
@@ -127,7 +128,7 @@ pub fn wendland_c2(delta: f64) -> f64 {
     }
 }
 
-/// Support radii of a node set by seed Algorithm 1.
+/// Support radii of a node set by Algorithm 1 (`docs/method.md`, section 2.2).
 ///
 /// With `d_i` the distance from node `i` to its nearest other node, the radii are `r_i = d_i / c`
 /// for the smallest `c` of the sequence `0.5, 0.75, 0.875, 0.9375` (`c <- (1 + c) / 2`, bounded by
@@ -188,7 +189,7 @@ pub fn support_radii(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
 /// Support radii for the transfer operators: `r_i = radius * d_i`, `d_i` the distance from
 /// node `i` to its nearest other node.
 ///
-/// This is the form of seed Algorithm 1 (`r_i = d_i / c`, one `c` for all nodes) with `c` held
+/// This is the form of Algorithm 1 (`r_i = d_i / c`, one `c` for all nodes) with `c` held
 /// at `1 / radius` instead of raised until Condition 1 holds. With the default `radius = 2`,
 /// `c` stays at the value Algorithm 1 starts from, 0.5. On a curve (2D) Condition 1 holds there
 /// already, so the radii are Algorithm 1's. On a triangulated surface (3D) a node has more than
@@ -213,8 +214,8 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
         .collect())
 }
 
-/// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` (seed eq. 2.6) from
-/// source nodes with support radii to target points.
+/// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` from source nodes with
+/// support radii to target points.
 ///
 /// Holds `Phi_NM` (sparse rows), the sparse LU factors of `Phi_MM` and `D_NN^-1`; `R_NM` itself
 /// (dense in general) is never formed, except on request by [`Interpolation::matrix`].
@@ -236,8 +237,8 @@ pub struct Interpolation {
 }
 
 impl Interpolation {
-    /// Assembles `Phi_MM` (eq. 2.4) and `Phi_NM` (eq. 2.5) with a k-d tree radius search, factors
-    /// `Phi_MM` by sparse LU and computes `D_NN = diag(Phi_NM Phi_MM^-1 1)` (eq. 2.7).
+    /// Assembles `Phi_MM` and `Phi_NM` with a k-d tree radius search, factors `Phi_MM` by sparse
+    /// LU and computes `D_NN = diag(Phi_NM Phi_MM^-1 1)`.
     ///
     /// Targets whose `D_ii` is not clearly positive (outside every source support; threshold
     /// [`UNCOVERED_TOL`]) do not make `new` fail: their row of `R` is zero and they are listed by
@@ -383,7 +384,7 @@ impl Interpolation {
         out
     }
 
-    /// The dense `N x M` interpolation matrix `R_NM` (eq. 2.6). Costs `M` solves and `N * M`
+    /// The dense `N x M` interpolation matrix `R_NM`. Costs `M` solves and `N * M`
     /// memory: meant for small interfaces and tests.
     pub fn matrix(&self) -> nalgebra::DMatrix<f64> {
         let m = self.num_sources;
@@ -484,7 +485,7 @@ fn check_finite(points: &[[f64; 3]]) -> Result<(), RbfError> {
     }
 }
 
-/// Distance from every point to its nearest other point: the nodal spacing `d_i` of seed
+/// Distance from every point to its nearest other point: the nodal spacing `d_i` of
 /// Algorithm 1, also the local spacing `h` of the contact tolerances. Needs two or more
 /// distinct, finite points.
 pub fn nearest_distances(points: &[[f64; 3]]) -> Result<Vec<f64>, RbfError> {
@@ -536,7 +537,7 @@ fn search_radius_squared(radius: f64) -> f64 {
 }
 
 /// Rows of the RBF matrix `(Phi)_tj = phi(|x_t - xi_j| / r_j)` for the given points against the
-/// sources in `tree` (eqs. 2.4 and 2.5), in compressed-row form `(offsets, columns, values)`
+/// sources in `tree` (`Phi_MM` or `Phi_NM`), in compressed-row form `(offsets, columns, values)`
 /// with the columns of each row sorted.
 fn rbf_rows(
     tree: &ImmutableKdTree<f64, 3>,

@@ -43,9 +43,9 @@
 //! `C_i = p_i - max(0, p_i - c g_i)`, `c = E*/h`: a node is active next when `p_i - c g_i > 0`.
 //! At an active node the constraint holds `g_i = 0`, at an inactive one `p_i = 0`, so the test
 //! reads `p_i > 0` on A and `g_i < 0` off it, and `c` drops out; the tolerances make the two
-//! tests robust to round-off. Removal and addition happen in one update, as in the seed's
-//! Algorithm 3. What differs from the seed's loop: the operators do not change with A (the seed rebuilds them, with Algorithm
-//! 2, for every active set, so that the discrete problem itself moves from one iteration to the
+//! tests robust to round-off. Removal and addition happen in one update (`docs/method.md` 3.3).
+//! What differs from earlier INTERNODES contact loops: the operators do not change with A
+//! (rebuilding them for every active set moves the discrete problem from one iteration to the
 //! next), the pressure `p_i = -lambda_i . n_i` tested is the unknown of the system (lumped
 //! interface mass, `super::surface`), and the gap is the geometric one, for the loop and the
 //! checks alike.

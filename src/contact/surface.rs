@@ -3,13 +3,13 @@
 //!
 //! Nodal normals are area-weighted averages of the normals of ALL candidate facets touching a
 //! node (not only active ones, so rim nodes have well-defined normals), each facet oriented out
-//! of its adjacent cell by the mesh reader (method.md section 3).
+//! of its adjacent cell by the mesh reader (`docs/method.md`, section 1.3).
 //!
 //! The interface mass matrix is lumped: node `s` stands for the area `A_s = int phi_s ds`
 //! ([`ContactSurface::nodal_area`]), so a nodal traction `t_s` exerts the force `A_s t_s` and the
 //! mean pressure of a node (its normal force over its area) is its nodal pressure. The contact
 //! conditions are then nodewise, `p_s >= 0, g_s >= 0, p_s g_s = 0`, and the active-set test on
-//! the pressure judges exactly the unknown the system solves for (method.md section 3; with the
+//! the pressure judges exactly the unknown the system solves for (`docs/method.md` 2.1; with the
 //! consistent matrix the two differ at the rim, where the P1 multiplier undershoots).
 
 use std::collections::HashMap;

@@ -1,4 +1,5 @@
-//! The linear system of one active-set iteration (method.md section 2), assembled in one place.
+//! The linear system of one active-set iteration (`docs/method.md`, section 2.5), assembled in
+//! one place.
 //!
 //! ```text
 //! [ K1        0        -M1 (rows I) ] [u1    ]   [f1]
@@ -132,7 +133,7 @@ pub struct CoupledSystem {
 }
 
 impl CoupledSystem {
-    /// Assembles the blocks of the coupled system (method.md section 2), with the loads and
+    /// Assembles the blocks of the coupled system (`docs/method.md` 2.5), with the loads and
     /// prescribed displacements scaled by `load_factor`.
     pub fn assemble(
         body1: &AssembledBody,

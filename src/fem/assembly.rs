@@ -93,8 +93,9 @@ pub fn assemble_stiffness(
 /// The scalar surface mass matrix `M[a, b] = int_G phi_a phi_b ds` of a boundary group `G`,
 /// `num_nodes x num_nodes` (rows and columns of nodes off the group are empty).
 ///
-/// This is the interface mass matrix of the INTERNODES system (method.md section 2): a surface
-/// integral without density, not the volume mass matrix restricted to the interface.
+/// This is the consistent interface mass matrix of the INTERNODES system (`docs/method.md`,
+/// section 2.1): a surface integral without density, not the volume mass matrix restricted to
+/// the interface. The contact solver uses its row sums (the lumped mass).
 pub fn assemble_surface_mass(body: &BodyMesh, group: &FacetGroup) -> SparseColMat<usize, f64> {
     let dim = body.dim;
     let pattern = SparsityPattern::new(body.num_nodes(), &group.facets, dim, 1);

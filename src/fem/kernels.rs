@@ -8,7 +8,7 @@
 //! Stiffness: `K_e = |T| B^T D B`, with `B` the strain-displacement matrix (Voigt, engineering
 //! shear) and dofs interleaved per node, `(u_x, u_y[, u_z])`.
 //!
-//! Facet mass (the interface mass matrix of method.md section 2): `M_e[a, b] = int phi_a phi_b ds`
+//! Facet mass (the interface mass matrix, `docs/method.md` 2.1): `M_e[a, b] = int phi_a phi_b ds`
 //! = `L/6 [[2,1],[1,2]]` on a segment of length `L` and `A/12 (1 + delta_ab)` on a triangle of
 //! area `A`.
 

@@ -2,7 +2,7 @@
 //! `$Entities`, `$Nodes` and `$Elements`; other sections are skipped.
 //!
 //! Our own parser rather than the `mshio` crate, for three reasons found by hostile inputs and
-//! fuzzing (issue 12): `mshio` numbers the nodes of a file with a dense tag range by their
+//! fuzzing (`fuzz/README.md`): `mshio` numbers the nodes of a file with a dense tag range by their
 //! position and never reads the tags written there (gmsh's API writes blocks in any order, so a
 //! valid file was read with its nodes permuted), it accepts a node tag defined twice, and it
 //! panics on some corrupt headers (a data size other than 8, one that overflows an `i32`).
