@@ -83,6 +83,8 @@ impl BodySolverKind {
 }
 
 /// A body's solver, set up for one matrix.
+// The Cholesky variant is larger, but there is one value per body, never a collection.
+#[allow(clippy::large_enum_variant)]
 pub enum BodySolver {
     Cholesky(Cholesky),
     #[cfg(feature = "petsc")]

@@ -208,11 +208,6 @@ impl CgAmg {
         Ok(Self { raw, n })
     }
 
-    /// Number of unknowns.
-    pub fn size(&self) -> usize {
-        self.n
-    }
-
     /// Solves `K x = rhs` from `x = 0`. Fails with [`LinalgError::NotConverged`] unless CG
     /// reached the relative residual it was set up with.
     pub fn solve(&self, rhs: &[f64]) -> Result<(Vec<f64>, CgStats), LinalgError> {
