@@ -10,7 +10,10 @@
 //! `"auto"` (the default). `auto` takes CG + AMG for a 3D body of at least
 //! [`AUTO_CG_AMG_MIN_DOFS_3D`] dofs when the binary is built with PETSc, and Cholesky
 //! otherwise; see that constant for the measurement. In 2D the Cholesky factor stays cheap
-//! (nested dissection fill grows like `n log n`), so `auto` keeps it.
+//! (nested dissection fill grows like `n log n`): on block_2d meshes Cholesky's factorization +
+//! solve took 1.68 s against CG + AMG's 2.37 s at 219,916 dofs, and 8.84 s against 8.27 s at
+//! 875,562 dofs (2026-11-26, fastest of 2 runs, same machine and load as below), so `auto`
+//! keeps Cholesky in 2D.
 //!
 //! The contact solve takes Cholesky for `auto` whatever the size: it solves one right-hand
 //! side per multiplier and component, which a factor does for the price of two triangular
@@ -39,14 +42,26 @@ pub enum BodySolverKind {
 
 /// From this many dofs on, `auto` solves a 3D body by CG + AMG (when built with PETSc).
 ///
-/// Measured on this project's 2-core machine, 2026-11-26, block_3d meshes (P1 tetrahedra,
-/// E = 1000, nu = 0.3), rtol 1e-10, time of factorization + solve against CG + AMG
-/// setup + solve, in seconds (`internodes solve`'s own timings):
+/// Measured 2026-11-26 on this project's 2-core machine (shared: load average about 5 during
+/// the runs), block_3d meshes (`geo/block_3d.geo`, P1 tetrahedra, E = 1000, nu = 0.3, clamped
+/// base, Hertzian pressure), rtol 1e-10; seconds of factorization + solve against CG + AMG
+/// setup + solve (`internodes solve`'s own timings, fastest of 3 runs), and the wall time of
+/// the whole process:
 ///
-/// | dofs | Cholesky | CG + AMG |
-/// |---|---|---|
-/// | MEASURE | | |
-pub const AUTO_CG_AMG_MIN_DOFS_3D: usize = 20_000;
+/// | dofs | Cholesky | CG + AMG (iterations) | wall, Cholesky / CG + AMG |
+/// |---|---|---|---|
+/// | 6,132 | 0.068 | 0.512 (21) | 0.18 / 0.65 |
+/// | 10,542 | 0.256 | 0.550 (22) | 0.45 / 0.71 |
+/// | 16,692 | 0.560 | 0.707 (23) | 0.80 / 0.94 |
+/// | 22,182 | 0.868 | 0.979 (25) | 1.19 / 1.28 |
+/// | 29,469 | 1.318 | 1.179 (24) | 1.70 / 1.71 |
+/// | 47,757 | 3.091 | 1.949 (24) | 3.77 / 2.66 |
+/// | 100,530 | 10.38 | 4.888 (25) | 11.98 / 7.00 |
+///
+/// The setup includes PETSc's (and MPI's) initialization, 0.3 to 0.45 s once per process,
+/// which is most of CG + AMG's time below 10k dofs. The two cross near 30k dofs; above, the
+/// factor's `n^2` work and `n^(4/3)` memory lose to CG + AMG's `O(n)`.
+pub const AUTO_CG_AMG_MIN_DOFS_3D: usize = 30_000;
 
 /// Whether this binary can solve by CG + AMG.
 pub const CG_AMG_AVAILABLE: bool = cfg!(feature = "petsc");
