@@ -224,7 +224,10 @@ mod with_petsc {
         let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
         let solve = &summary["bodies"][0]["solve"];
         assert_eq!(solve["body_solver"], "cg-amg", "{solve}");
-        assert!(solve["cg_iterations"].as_u64().is_some_and(|n| n > 0), "{solve}");
+        assert!(
+            solve["cg_iterations"].as_u64().is_some_and(|n| n > 0),
+            "{solve}"
+        );
     }
 
     /// The linear field `u(x) = A x + b`.
@@ -432,7 +435,10 @@ uy = 0.0
         assert_eq!(cg.status, ContactStatus::Converged);
         let d = relative_difference(&cg.force_primary, &cholesky.force_primary);
         assert!(d < 1e-8, "contact force: relative difference {d:.2e}");
-        let d = relative_difference(&cg.primary_fields.pressure, &cholesky.primary_fields.pressure);
+        let d = relative_difference(
+            &cg.primary_fields.pressure,
+            &cholesky.primary_fields.pressure,
+        );
         assert!(d < 1e-8, "pressure: relative difference {d:.2e}");
     }
 }

@@ -9,8 +9,8 @@ use super::CaseError;
 use crate::contact::{ContactProblem, ContactSettings, ContactSide, ContactSurface, PrimaryChoice};
 use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use crate::fem::Material;
-use crate::linalg::{BodySolverKind, CG_AMG_AVAILABLE};
 use crate::fem::loads::{PressureField, SurfaceLoad};
+use crate::linalg::{BodySolverKind, CG_AMG_AVAILABLE};
 use crate::mesh::{BodyMesh, Mesh};
 
 /// The most load steps a case may list (see [`Case::load`]).

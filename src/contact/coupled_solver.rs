@@ -2,8 +2,8 @@
 //!
 //! - [`CoupledSolver::Schur`] (default): each body's constrained stiffness is factored once
 //!   (sparse Cholesky; or CG + AMG set up once, with `[solver] body = "cg-amg"`: see
-//!   `crate::linalg::BodySolver`) for the whole contact solve, and every iteration solves only the
-//!   interface problem by block elimination:
+//!   `crate::linalg::BodySolver`) for the whole contact solve, and every iteration solves
+//!   only the interface problem by block elimination:
 //!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`.
 //!   `C K^-1 B = s C Y` is formed densely from each body's responses `Y_k` to the
 //!   multipliers ([`super::compliance`]), computed once per multiplier (primary node) and

@@ -265,8 +265,10 @@ pub fn solve(
         BodySolverKind::CgAmg => "CG + AMG solve",
         _ => "triangular solves",
     };
-    let iterations = timed(&mut stats, verbose, phase, || solver.solve_in_place(&mut u, 1))
-        .map_err(linalg)?;
+    let iterations = timed(&mut stats, verbose, phase, || {
+        solver.solve_in_place(&mut u, 1)
+    })
+    .map_err(linalg)?;
     if solver.kind() == BodySolverKind::CgAmg {
         stats.cg_iterations = Some(iterations);
     }

@@ -213,7 +213,11 @@ impl CgAmg {
     pub fn solve(&self, rhs: &[f64]) -> Result<(Vec<f64>, CgStats), LinalgError> {
         if rhs.len() != self.n {
             return Err(LinalgError::Petsc {
-                step: format!("a right-hand side of {} values for {} unknowns", rhs.len(), self.n),
+                step: format!(
+                    "a right-hand side of {} values for {} unknowns",
+                    rhs.len(),
+                    self.n
+                ),
                 code: 0,
                 message: "inconsistent sizes".into(),
             });
@@ -241,7 +245,11 @@ impl CgAmg {
         }
         let iterations = iterations.max(0) as usize;
         let norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let relative_residual = if norm > 0.0 { residual / norm } else { residual };
+        let relative_residual = if norm > 0.0 {
+            residual / norm
+        } else {
+            residual
+        };
         // Converged on the relative (2, 1) or absolute (3, 9) residual, or CG's exact
         // breakdown (8); CONVERGED_ITS and the CG trust-region reasons do not apply here.
         if !matches!(reason, 1 | 2 | 3 | 8 | 9) {
