@@ -4,6 +4,9 @@
 PYTHON  := /usr/bin/python3
 BINARY  := target/release/internodes
 LEVELS  ?= 0 1 2
+# Cargo features: petsc = the CG + AMG body solver (links the system's PETSc). `make FEATURES=`
+# builds and tests without it.
+FEATURES ?= petsc
 
 .PHONY: deps build demo test validate meshes bench clean
 
@@ -11,7 +14,7 @@ deps:
 	bash .ci/install-deps.sh
 
 build: deps
-	cargo build --release
+	cargo build --release --features "$(FEATURES)"
 
 # Mesh geo/hemisphere_on_block.geo with gmsh and solve the 3D Hertz contact of an elastic
 # hemisphere pressed onto an elastic block (INTERNODES, frictionless).
@@ -23,7 +26,7 @@ demo: build
 # Unit and integration tests (no gmsh or Python needed), then the quick validation: the
 # coarsest level of every suite, same thresholds (report in validation/build/report-quick/).
 test: build
-	cargo test --release
+	cargo test --release --features "$(FEATURES)"
 	$(PYTHON) validation/run.py --quick
 
 # The full validation: every suite at every level; writes validation/report/ (committed).

@@ -2,12 +2,14 @@
 # Installs the Debian packages that building, testing, meshing and validating need, when they
 # are missing. Idempotent; needs root (or sudo) only when something is missing.
 #   libhdf5-dev pkg-config : the hdf5 crate links Debian's serial HDF5
+#   libpetsc-real3.18-dev  : the CG + AMG body solver (cargo feature petsc); brings Open MPI
+#   libopenmpi-dev           (pkg-config `mpi`: mpi.h and libmpi, which the PETSc shim needs)
 #   gmsh python3-gmsh      : mesh generation (geo/), and dolfinx's gmsh reader
 #   python3-dolfinx ...    : validation/ (FEniCSx reference), never used by the solver
 #   fonts-dejavu-core      : the font of force_displacement.png (plotters draws text with a font
 #                            file read at run time; without it the run skips the PNG and warns)
 set -euo pipefail
-packages=(pkg-config libhdf5-dev fonts-dejavu-core gmsh python3-gmsh python3-dolfinx python3-h5py python3-scipy python3-matplotlib)
+packages=(pkg-config libhdf5-dev libpetsc-real3.18-dev libopenmpi-dev fonts-dejavu-core gmsh python3-gmsh python3-dolfinx python3-h5py python3-scipy python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -10,6 +10,7 @@ use crate::contact::{ContactProblem, ContactSettings, ContactSide, ContactSurfac
 use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
+use crate::linalg::{BodySolverKind, CG_AMG_AVAILABLE};
 use crate::mesh::{BodyMesh, Mesh};
 
 /// The most load steps a case may list (see [`Case::load`]).
@@ -179,6 +180,17 @@ impl Case {
         }
         if case.solver.residual_tolerance.is_nan() || case.solver.residual_tolerance <= 0.0 {
             return Err(case.invalid("[solver]", "residual_tolerance must be positive"));
+        }
+        if !(case.solver.rtol > 0.0 && case.solver.rtol < 1.0) {
+            return Err(case.invalid("[solver]", "rtol must be in (0, 1)"));
+        }
+        if case.solver.body == BodySolverKind::CgAmg && !CG_AMG_AVAILABLE {
+            return Err(case.invalid(
+                "[solver]",
+                "body = \"cg-amg\" needs PETSc, and this binary was built without it \
+                 (rebuild with `cargo build --release --features petsc`, as `make build` does, \
+                 or use body = \"cholesky\" or \"auto\")",
+            ));
         }
         case.check_unique_bodies()?;
         case.check_geo_parameters()?;

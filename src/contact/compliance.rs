@@ -8,7 +8,7 @@
 //! columns of `C` (the interface displacements) are candidate-surface dofs, so the Schur
 //! complement is `D - s C Y` with `Y = [Y_k]` restricted to those dofs. While the operators
 //! stay as built (`super::interface`), `b_(i,c)` depends only on the node and the component:
-//! it is computed (one solve with the body's Cholesky factor per component) the first time
+//! it is computed (one solve with the body's solver per component) the first time
 //! the node is active, and kept for every later iteration and load step, until the operators
 //! are paired again. Per component, not per multiplier: the frictionless traction acts along
 //! the normal of the secondary facet the node is held on (`super::linearization`), which
@@ -22,7 +22,8 @@
 
 use std::collections::HashMap;
 
-use crate::linalg::Cholesky;
+use super::ContactError;
+use crate::linalg::BodySolver;
 
 /// Identifies a unit traction across iterations: the primary body node it acts at, and its
 /// component (always `Some`; `super::system::CoupledSystem::columns` combines them).
@@ -68,7 +69,11 @@ impl SurfaceResponse {
 
     /// Computes and keeps the responses to the `loads` (each a key and its sparse body force
     /// `(dof, value)`), with multi-right-hand-side solves; a key already known is skipped.
-    pub fn extend(&mut self, factor: &Cholesky, loads: &[(MultiplierKey, Vec<(usize, f64)>)]) {
+    pub fn extend(
+        &mut self,
+        factor: &BodySolver,
+        loads: &[(MultiplierKey, Vec<(usize, f64)>)],
+    ) -> Result<(), ContactError> {
         // In chunks, so that the right-hand sides of a large first active set fit in memory.
         const CHUNK: usize = 64;
         let n = self.row.len();
@@ -83,13 +88,16 @@ impl SurfaceResponse {
                     rhs[j * n + dof] += value;
                 }
             }
-            factor.solve_in_place(&mut rhs, chunk.len());
+            factor
+                .solve_in_place(&mut rhs, chunk.len())
+                .map_err(|e| ContactError::Linalg(format!("a body's response: {e}")))?;
             for (j, (key, _)) in chunk.iter().enumerate() {
                 let full = &rhs[j * n..(j + 1) * n];
                 let response = self.surface_dofs.iter().map(|&d| full[d]).collect();
                 self.responses.insert(*key, response);
             }
         }
+        Ok(())
     }
 
     /// The rows of the stored responses that hold the body dofs `dofs`.

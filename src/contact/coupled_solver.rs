@@ -1,8 +1,9 @@
 //! How the coupled system of an iteration is solved, behind one interface.
 //!
 //! - [`CoupledSolver::Schur`] (default): each body's constrained stiffness is factored once
-//!   (sparse Cholesky) for the whole contact solve, and every iteration solves only the
-//!   interface problem by block elimination:
+//!   (sparse Cholesky; or CG + AMG set up once, with `[solver] body = "cg-amg"`: see
+//!   `crate::linalg::BodySolver`) for the whole contact solve, and every iteration solves
+//!   only the interface problem by block elimination:
 //!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`.
 //!   `C K^-1 B = s C Y` is formed densely from each body's responses `Y_k` to the
 //!   multipliers ([`super::compliance`]), computed once per multiplier (primary node) and
@@ -22,7 +23,8 @@ use super::compliance::SurfaceResponse;
 use super::system::CoupledSystem;
 use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
-use crate::linalg::{Cholesky, CholeskySymbolic, Ordering};
+use crate::elastic::SolverSettings;
+use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -34,29 +36,35 @@ pub enum CoupledSolver {
     MonolithicLu,
 }
 
-/// The Cholesky factors of both bodies' constrained stiffness matrices, and the bodies'
-/// responses to the multipliers computed with them so far.
+/// The solvers (Cholesky factors, or CG + AMG) of both bodies' constrained stiffness matrices,
+/// and the bodies' responses to the multipliers computed with them so far.
 pub struct BodyFactors {
-    factor1: Cholesky,
-    factor2: Cholesky,
+    factor1: BodySolver,
+    factor2: BodySolver,
     response1: SurfaceResponse,
     response2: SurfaceResponse,
 }
 
 impl BodyFactors {
-    /// Factors both bodies; the response caches cover their candidate surfaces.
+    /// Factors both bodies (or sets up CG + AMG: `settings.body`, `auto` being Cholesky
+    /// here); the response caches cover their candidate surfaces.
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
         surface1: &ContactSurface,
         surface2: &ContactSurface,
-        ordering: Ordering,
+        settings: &SolverSettings,
     ) -> Result<Self, ContactError> {
         let dim = surface1.dim;
-        let factor = |body: &AssembledBody| {
-            CholeskySymbolic::new(&body.pattern, ordering)
+        let factor = |body: &AssembledBody| match settings.body.resolve_for_contact() {
+            BodySolverKind::CgAmg => {
+                BodySolver::cg_amg(&body.k_c, body.dim, &body.coordinates, settings.rtol)
+                    .map_err(|e| ContactError::Linalg(format!("CG + AMG of a body: {e}")))
+            }
+            _ => CholeskySymbolic::new(&body.pattern, settings.ordering)
                 .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
-                .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))
+                .map(BodySolver::Cholesky)
+                .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}"))),
         };
         // The two factorizations are independent: side by side.
         let (factor1, factor2) = rayon::join(|| factor(body1), || factor(body2));
@@ -108,6 +116,10 @@ fn solve_monolithic(
     Ok(x)
 }
 
+fn body_solve_error(e: crate::linalg::LinalgError) -> ContactError {
+    ContactError::Linalg(format!("a body's solve: {e}"))
+}
+
 fn solve_schur(
     system: &CoupledSystem,
     factors: &mut BodyFactors,
@@ -123,10 +135,11 @@ fn solve_schur(
     // z = K^-1 f. The bodies are independent: solved side by side.
     let mut z1 = system.f[..n1].to_vec();
     let mut z2 = system.f[n1..].to_vec();
-    rayon::join(
+    let (done1, done2) = rayon::join(
         || factor1.solve_in_place(&mut z1, 1),
         || factor2.solve_in_place(&mut z2, 1),
     );
+    done1.and(done2).map_err(body_solve_error)?;
 
     // The responses to the unit forces not seen before (`super::compliance`).
     let new = |response: &SurfaceResponse, body: usize| {
@@ -143,10 +156,11 @@ fn solve_schur(
             .collect::<Vec<_>>()
     };
     let (new1, new2) = (new(response1, 0), new(response2, 1));
-    rayon::join(
+    let (done1, done2) = rayon::join(
         || response1.extend(factor1, &new1),
         || response2.extend(factor2, &new2),
     );
+    done1.and(done2)?;
 
     // S = D - s C Y, and r = g - C z; C and Y as dense blocks on the dofs C reads.
     let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
@@ -204,10 +218,11 @@ fn solve_schur(
             w2[row - n1] += value * lambda[k];
         }
     }
-    rayon::join(
+    let (done1, done2) = rayon::join(
         || factor1.solve_in_place(&mut w1, 1),
         || factor2.solve_in_place(&mut w2, 1),
     );
+    done1.and(done2).map_err(body_solve_error)?;
     let mut x: Vec<f64> = z1.iter().zip(&w1).map(|(z, w)| z - w).collect();
     x.extend(z2.iter().zip(&w2).map(|(z, w)| z - w));
     x.extend(lambda.iter());

@@ -165,7 +165,7 @@ impl<'a> ContactSolver<'a> {
         let factors = match problem.settings.solver {
             CoupledSolver::Schur => {
                 let start = Instant::now();
-                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver.ordering)?;
+                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver)?;
                 if solver.verbose {
                     eprintln!(
                         "  Cholesky of both bodies: {:.3} s",

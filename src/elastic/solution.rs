@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use crate::fem::stress::CellFields;
+use crate::linalg::BodySolverKind;
 
 /// Displacement, cell fields, reactions and solver statistics of one body.
 #[derive(Debug, Clone)]
@@ -22,7 +23,15 @@ pub struct SolveStats {
     pub num_dofs: usize,
     pub num_prescribed_dofs: usize,
     pub stiffness_nnz: usize,
+    /// Entries of the Cholesky factor (0 when solved by CG + AMG).
     pub factor_nnz: usize,
+    /// The body solver that ran (absent where the body was not solved alone, as in contact
+    /// runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub body_solver: Option<BodySolverKind>,
+    /// CG iterations of the solve (CG + AMG only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cg_iterations: Option<usize>,
     /// `||K_c u - f_c|| / ||f_c||` of the constrained system.
     pub relative_residual: f64,
     /// Seconds per phase, in order.

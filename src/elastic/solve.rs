@@ -1,4 +1,4 @@
-//! One body, `K u = f`, solved by sparse Cholesky.
+//! One body, `K u = f`, solved by sparse Cholesky or by CG + AMG (`crate::linalg::BodySolver`).
 
 use std::time::Instant;
 
@@ -10,13 +10,28 @@ use crate::fem::assembly::{assemble_stiffness, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::stress::cell_fields;
 use crate::fem::{Constraints, SparsityPattern};
-use crate::linalg::{Cholesky, CholeskySymbolic, LinalgError, Ordering, relative_residual};
+use crate::linalg::{
+    BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
+    relative_residual,
+};
 use faer::sparse::SparseColMat;
 
 /// How to solve; every field has a documented default.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
+    /// The body solver: `"auto"` (default), `"cholesky"` or `"cg-amg"` (PETSc; see
+    /// `crate::linalg::BodySolverKind` for what `auto` picks).
+    pub body: BodySolverKind,
+    /// CG + AMG stops at this relative residual `||f_c - K_c u|| / ||f_c||` (default 1e-10).
+    ///
+    /// Why 1e-10: two orders below `residual_tolerance`, so that a converged CG always passes
+    /// that check; and the displacement then differs from Cholesky's by about 1e-10 relative
+    /// (1e-10 to 1e-9 on the block fixtures and benchmark meshes: the error is at most the
+    /// residual times the condition number, and CG's error is much smaller in practice), far
+    /// below the 4 to 6 digits a user reads. Each factor of 10 costs about 2 CG iterations
+    /// of the 20 to 30 a solve takes.
+    pub rtol: f64,
     /// Fill-reducing ordering of the Cholesky factorization (default: nested dissection).
     pub ordering: Ordering,
     /// A solve whose relative residual exceeds this is reported as failed (default 1e-8).
@@ -29,6 +44,8 @@ pub struct SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         Self {
+            body: BodySolverKind::default(),
+            rtol: 1e-10,
             ordering: Ordering::default(),
             residual_tolerance: 1e-8,
             verbose: true,
@@ -102,6 +119,11 @@ pub(crate) fn timed<T>(
 /// A body's assembled system: `K` and `f` as assembled, and the Dirichlet-constrained
 /// `K_c`, `f_c` on the same pattern.
 pub struct AssembledBody {
+    /// Dofs per node.
+    pub dim: usize,
+    /// Node coordinates, `dim` per node: the rigid-body modes an iterative solver's
+    /// multigrid needs (its near-null space).
+    pub coordinates: Vec<f64>,
     pub pattern: SparsityPattern,
     pub k: SparseColMat<usize, f64>,
     pub f: Vec<f64>,
@@ -149,7 +171,10 @@ pub fn assemble(
     let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
         constraints.apply(&k, &f)
     });
+    let dim = body.dim;
     Ok(AssembledBody {
+        dim,
+        coordinates: body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect(),
         pattern,
         k,
         f,
@@ -206,22 +231,50 @@ pub fn solve(
     let system = assemble(problem, &mut stats, verbose)?;
     let (pattern, k_c, f_c) = (&system.pattern, &system.k_c, &system.f_c);
 
-    // 4. Cholesky: symbolic (ordering) then numeric.
-    let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
-        CholeskySymbolic::new(pattern, settings.ordering)
-    })
-    .map_err(linalg)?;
-    stats.factor_nnz = symbolic.factor_nnz();
-    let factor = timed(&mut stats, verbose, "numeric factorization", || {
-        Cholesky::factorize(symbolic, k_c)
-    })
-    .map_err(linalg)?;
+    // 4. The body solver: Cholesky (symbolic, then numeric) or CG + AMG (matrix and multigrid
+    //    hierarchy). Both take K_c as it is: Dirichlet rows and columns zeroed with K_dd kept on
+    //    the diagonal (`crate::fem::Constraints::apply`). That keeps every node's dim x dim
+    //    blocks, which the multigrid aggregates by (block size dim) and whose rigid-body modes
+    //    are its near-null space; removing the fixed dofs instead would break the blocks of
+    //    partly fixed nodes. dolfinx does the same, with 1 on the diagonal.
+    let kind = settings.body.resolve(body.dim, body.num_dofs());
+    let solver = match kind {
+        BodySolverKind::CgAmg => timed(&mut stats, verbose, "CG + AMG setup", || {
+            BodySolver::cg_amg(k_c, system.dim, &system.coordinates, settings.rtol)
+        })
+        .map_err(linalg)?,
+        _ => {
+            let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
+                CholeskySymbolic::new(pattern, settings.ordering)
+            })
+            .map_err(linalg)?;
+            stats.factor_nnz = symbolic.factor_nnz();
+            BodySolver::Cholesky(
+                timed(&mut stats, verbose, "numeric factorization", || {
+                    Cholesky::factorize(symbolic, k_c)
+                })
+                .map_err(linalg)?,
+            )
+        }
+    };
+    stats.body_solver = Some(solver.kind());
 
     // 5. Solve and check the residual of the constrained system.
     let mut u = f_c.clone();
-    timed(&mut stats, verbose, "triangular solves", || {
-        factor.solve_in_place(&mut u, 1)
-    });
+    let phase = match solver.kind() {
+        BodySolverKind::CgAmg => "CG + AMG solve",
+        _ => "triangular solves",
+    };
+    let iterations = timed(&mut stats, verbose, phase, || {
+        solver.solve_in_place(&mut u, 1)
+    })
+    .map_err(linalg)?;
+    if solver.kind() == BodySolverKind::CgAmg {
+        stats.cg_iterations = Some(iterations);
+    }
+    // The factor or multigrid hierarchy can be the largest object of the run: freed before
+    // the cell fields.
+    drop(solver);
     stats.relative_residual = relative_residual(k_c, &u, f_c);
     if stats.relative_residual.is_nan() || stats.relative_residual > settings.residual_tolerance {
         return Err(SolveError::Inaccurate {

@@ -1,9 +1,14 @@
 //! Sparse linear algebra: fill-reducing orderings and the Cholesky factorization of a body's
-//! stiffness, plus the residual check every solve reports.
+//! stiffness, the iterative alternative (PETSc CG + AMG, cargo feature `petsc`), the choice
+//! between them, plus the residual check every solve reports.
 
+mod body_solver;
 mod cholesky;
 mod ordering;
+#[cfg(feature = "petsc")]
+pub mod petsc;
 
+pub use body_solver::{AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE};
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
 
 use faer::sparse::SparseColMat;
@@ -21,6 +26,26 @@ pub enum LinalgError {
         "out of memory: the Cholesky factor needs {bytes} bytes; use a coarser mesh or a larger machine"
     )]
     OutOfMemory { bytes: usize },
+    #[error(
+        "the body solver \"cg-amg\" needs PETSc, and this binary was built without it \
+         (rebuild with `cargo build --release --features petsc`, or use body = \"cholesky\")"
+    )]
+    PetscUnavailable,
+    #[error("PETSc error {code} ({message}) in {step}")]
+    Petsc {
+        step: String,
+        code: i32,
+        message: String,
+    },
+    #[error(
+        "CG + AMG did not converge: {reason} after {iterations} iterations \
+         (relative residual {relative_residual:.2e})"
+    )]
+    NotConverged {
+        reason: String,
+        iterations: usize,
+        relative_residual: f64,
+    },
 }
 
 /// `y = A x` for a compressed-column matrix.

@@ -1,0 +1,164 @@
+//! The solver of one body's constrained system `K_c u = f_c`: sparse Cholesky, or (cargo
+//! feature `petsc`) conjugate gradients preconditioned by smoothed-aggregation AMG.
+//!
+//! Both are set up once per matrix and then solve any number of right-hand sides: the
+//! single-body solve needs one, the contact solve one per unit interface load.
+//!
+//! # Which one
+//!
+//! `[solver] body` in the case file ([`BodySolverKind`]): `"cholesky"`, `"cg-amg"` or
+//! `"auto"` (the default). `auto` takes CG + AMG for a 3D body of at least
+//! [`AUTO_CG_AMG_MIN_DOFS_3D`] dofs when the binary is built with PETSc, and Cholesky
+//! otherwise; see that constant for the measurement. In 2D the Cholesky factor stays cheap
+//! (nested dissection fill grows like `n log n`): on block_2d meshes Cholesky's factorization +
+//! solve took 1.68 s against CG + AMG's 2.37 s at 219,916 dofs, and 8.84 s against 8.27 s at
+//! 875,562 dofs (2026-11-26, fastest of 2 runs, same machine and load as below), so `auto`
+//! keeps Cholesky in 2D.
+//!
+//! The contact solve takes Cholesky for `auto` whatever the size: it solves one right-hand
+//! side per multiplier and component, which a factor does for the price of two triangular
+//! solves and CG for a full iterative solve each.
+
+use faer::sparse::SparseColMat;
+use serde::{Deserialize, Serialize};
+
+use super::{Cholesky, LinalgError};
+
+#[cfg(feature = "petsc")]
+use super::petsc::{CgAmg, Communicator};
+
+/// The body solver a case asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BodySolverKind {
+    /// Cholesky, or CG + AMG for large 3D bodies when built with PETSc.
+    #[default]
+    Auto,
+    /// Sparse Cholesky (faer, supernodal).
+    Cholesky,
+    /// PETSc CG + GAMG (cargo feature `petsc`).
+    CgAmg,
+}
+
+/// From this many dofs on, `auto` solves a 3D body by CG + AMG (when built with PETSc).
+///
+/// Measured 2026-11-26 on this project's 2-core machine (shared: load average about 5 during
+/// the runs), block_3d meshes (`geo/block_3d.geo`, P1 tetrahedra, E = 1000, nu = 0.3, clamped
+/// base, Hertzian pressure), rtol 1e-10; seconds of factorization + solve against CG + AMG
+/// setup + solve (`internodes solve`'s own timings, fastest of 3 runs), and the wall time of
+/// the whole process:
+///
+/// | dofs | Cholesky | CG + AMG (iterations) | wall, Cholesky / CG + AMG |
+/// |---|---|---|---|
+/// | 6,132 | 0.068 | 0.512 (21) | 0.18 / 0.65 |
+/// | 10,542 | 0.256 | 0.550 (22) | 0.45 / 0.71 |
+/// | 16,692 | 0.560 | 0.707 (23) | 0.80 / 0.94 |
+/// | 22,182 | 0.868 | 0.979 (25) | 1.19 / 1.28 |
+/// | 29,469 | 1.318 | 1.179 (24) | 1.70 / 1.71 |
+/// | 47,757 | 3.091 | 1.949 (24) | 3.77 / 2.66 |
+/// | 100,530 | 10.38 | 4.888 (25) | 11.98 / 7.00 |
+///
+/// The setup includes PETSc's (and MPI's) initialization, 0.3 to 0.45 s once per process,
+/// which is most of CG + AMG's time below 10k dofs. The two cross near 30k dofs; above, the
+/// factor's `n^2` work and `n^(4/3)` memory lose to CG + AMG's `O(n)`.
+pub const AUTO_CG_AMG_MIN_DOFS_3D: usize = 30_000;
+
+/// Whether this binary can solve by CG + AMG.
+pub const CG_AMG_AVAILABLE: bool = cfg!(feature = "petsc");
+
+impl BodySolverKind {
+    /// The solver `auto` stands for on a single body of `num_dofs` dofs in dimension `dim`
+    /// (other kinds stand for themselves).
+    pub fn resolve(self, dim: usize, num_dofs: usize) -> Self {
+        match self {
+            Self::Auto if CG_AMG_AVAILABLE && dim == 3 && num_dofs >= AUTO_CG_AMG_MIN_DOFS_3D => {
+                Self::CgAmg
+            }
+            Self::Auto => Self::Cholesky,
+            kind => kind,
+        }
+    }
+
+    /// The solver `auto` stands for in a contact solve: Cholesky (see the module doc).
+    pub fn resolve_for_contact(self) -> Self {
+        match self {
+            Self::Auto => Self::Cholesky,
+            kind => kind,
+        }
+    }
+
+    /// The name used in case files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Cholesky => "cholesky",
+            Self::CgAmg => "cg-amg",
+        }
+    }
+}
+
+/// A body's solver, set up for one matrix.
+// The Cholesky variant is larger, but there is one value per body, never a collection.
+#[allow(clippy::large_enum_variant)]
+pub enum BodySolver {
+    Cholesky(Cholesky),
+    #[cfg(feature = "petsc")]
+    CgAmg(CgAmg),
+}
+
+impl BodySolver {
+    /// CG + AMG on `matrix` (symmetric positive definite, `dim` dofs per node, interleaved,
+    /// nodes at `coords`, `dim` values each), solving to the relative residual `rtol`. Without
+    /// the feature `petsc`: [`LinalgError::PetscUnavailable`].
+    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
+    pub fn cg_amg(
+        matrix: &SparseColMat<usize, f64>,
+        dim: usize,
+        coords: &[f64],
+        rtol: f64,
+    ) -> Result<Self, LinalgError> {
+        #[cfg(feature = "petsc")]
+        {
+            CgAmg::new(Communicator::solo()?, matrix, dim, coords, rtol).map(Self::CgAmg)
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            Err(LinalgError::PetscUnavailable)
+        }
+    }
+
+    pub fn kind(&self) -> BodySolverKind {
+        match self {
+            Self::Cholesky(_) => BodySolverKind::Cholesky,
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(_) => BodySolverKind::CgAmg,
+        }
+    }
+
+    /// Overwrites the columns of `rhs` (n x `num_rhs`, column-major) with the solutions of
+    /// `K x = rhs`; returns the most CG iterations a column took (0 for Cholesky).
+    ///
+    /// Cholesky solves the columns in parallel blocks ([`Cholesky::solve_in_place`]); CG one
+    /// after the other (PETSc calls are serialized).
+    pub fn solve_in_place(&self, rhs: &mut [f64], num_rhs: usize) -> Result<usize, LinalgError> {
+        match self {
+            Self::Cholesky(factor) => {
+                factor.solve_in_place(rhs, num_rhs);
+                Ok(0)
+            }
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => {
+                let mut most = 0;
+                if num_rhs == 0 {
+                    return Ok(0);
+                }
+                for column in rhs.chunks_mut(rhs.len() / num_rhs) {
+                    let (x, stats) = cg.solve(column)?;
+                    column.copy_from_slice(&x);
+                    most = most.max(stats.iterations);
+                }
+                Ok(most)
+            }
+        }
+    }
+}

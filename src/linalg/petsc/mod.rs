@@ -1,0 +1,280 @@
+//! Conjugate gradients preconditioned by smoothed-aggregation algebraic multigrid (PETSc's
+//! `KSPCG` + `PCGAMG`) for one body's constrained stiffness `K_c`: an iterative alternative to
+//! the sparse Cholesky factor, whose memory grows like `n^(4/3)` and work like `n^2` in 3D
+//! (out of memory near 1M dofs on a 24 GiB machine), where CG + AMG costs about `O(n)` per
+//! iteration with a nearly constant iteration count.
+//!
+//! The C side (`shim.c`, built by `build.rs` with the cargo feature `petsc`) builds the AIJ
+//! matrix from our compressed arrays with block size `dim`, the rigid-body modes of the nodes
+//! as GAMG's near-null space (`MatNullSpaceCreateRigidBody` on the nodal coordinates: the
+//! modes of `crate::fem::rigid_modes`), and the KSP; [`CgAmg::new`] does this once (the
+//! GAMG hierarchy included), and [`CgAmg::solve`] can then be called for any number of
+//! right-hand sides.
+//!
+//! # PETSc in a Rust process
+//!
+//! - PETSc is initialized once per process, on first use, without its signal handlers and
+//!   with `PetscReturnErrorHandler`: a PETSc error is a return code, turned into
+//!   [`LinalgError::Petsc`], never a message and an abort. It is never finalized (the process
+//!   ends instead; PETSc's objects are destroyed with their Rust owners).
+//! - PETSc is not thread-safe, and `cargo test` and rayon call from several threads: every
+//!   call into PETSc, destruction included, holds one global mutex. Two bodies solved "side
+//!   by side" by rayon therefore take turns.
+//! - Objects are created on a communicator given by the caller ([`Communicator::solo`] today),
+//!   so that a distributed version changes the set-up, not this solver.
+
+use std::ffi::{CStr, c_char, c_int};
+use std::ptr::NonNull;
+use std::sync::{Mutex, MutexGuard, OnceLock, PoisonError};
+
+use faer::sparse::SparseColMat;
+
+use super::LinalgError;
+
+/// MPI's Fortran communicator handle (`MPI_Fint`, an `int` in Open MPI and MPICH alike).
+type MpiFint = c_int;
+
+#[repr(C)]
+struct RawCgAmg {
+    _opaque: [u8; 0],
+}
+
+unsafe extern "C" {
+    fn internodes_petsc_initialize(step: *mut *const c_char) -> c_int;
+    fn internodes_petsc_comm_self() -> MpiFint;
+    fn internodes_petsc_error_text(code: c_int) -> *const c_char;
+    fn internodes_ksp_reason_name(reason: c_int) -> *const c_char;
+    fn internodes_cgamg_create(
+        comm: MpiFint,
+        n: i64,
+        block: i64,
+        row_ptr: *const i64,
+        col_idx: *const i64,
+        values: *const f64,
+        coords: *const f64,
+        rtol: f64,
+        max_iterations: i64,
+        out: *mut *mut RawCgAmg,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_cgamg_solve(
+        solver: *mut RawCgAmg,
+        rhs: *const f64,
+        x: *mut f64,
+        iterations: *mut i64,
+        residual_norm: *mut f64,
+        reason: *mut c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_cgamg_destroy(solver: *mut RawCgAmg);
+}
+
+/// Serializes every PETSc call of the process.
+static PETSC: Mutex<()> = Mutex::new(());
+/// The outcome of PETSc's initialization (made once, under [`PETSC`]).
+static INITIALIZED: OnceLock<Result<(), (String, i32)>> = OnceLock::new();
+
+/// A C string from the shim (static storage) as Rust text.
+fn text(s: *const c_char) -> String {
+    if s.is_null() {
+        return String::from("?");
+    }
+    // SAFETY: the shim returns null or pointers to static NUL-terminated strings.
+    unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned()
+}
+
+fn petsc_error(step: *const c_char, code: c_int) -> LinalgError {
+    LinalgError::Petsc {
+        step: text(step),
+        code,
+        // SAFETY: plain lookup of a static string.
+        message: text(unsafe { internodes_petsc_error_text(code) }),
+    }
+}
+
+/// The PETSc lock, with PETSc initialized. A poisoned lock is taken anyway: a panic cannot
+/// happen inside a PETSc call (they return codes), so PETSc's state is whole.
+fn petsc() -> Result<MutexGuard<'static, ()>, LinalgError> {
+    let guard = PETSC.lock().unwrap_or_else(PoisonError::into_inner);
+    let outcome = INITIALIZED.get_or_init(|| {
+        let mut step = std::ptr::null();
+        // SAFETY: called once per process, under the lock.
+        let code = unsafe { internodes_petsc_initialize(&mut step) };
+        if code == 0 {
+            Ok(())
+        } else {
+            Err((text(step), code))
+        }
+    });
+    match outcome {
+        Ok(()) => Ok(guard),
+        Err((step, code)) => Err(LinalgError::Petsc {
+            step: format!("initializing PETSc: {step}"),
+            code: *code,
+            message: text(unsafe { internodes_petsc_error_text(*code) }),
+        }),
+    }
+}
+
+/// The communicator PETSc objects are created on.
+#[derive(Debug, Clone, Copy)]
+pub struct Communicator(MpiFint);
+
+impl Communicator {
+    /// `PETSC_COMM_SELF`: this process alone (initializes PETSc if needed).
+    pub fn solo() -> Result<Self, LinalgError> {
+        let _lock = petsc()?;
+        // SAFETY: PETSc is initialized.
+        Ok(Self(unsafe { internodes_petsc_comm_self() }))
+    }
+}
+
+/// How one CG solve went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CgStats {
+    pub iterations: usize,
+    /// `||b - K x|| / ||b||` as CG last computed it (0 when `b = 0`).
+    pub relative_residual: f64,
+}
+
+/// CG + GAMG set up for one matrix.
+pub struct CgAmg {
+    raw: NonNull<RawCgAmg>,
+    n: usize,
+}
+
+// SAFETY: the PETSc objects behind `raw` are only touched under the global PETSc lock.
+unsafe impl Send for CgAmg {}
+// SAFETY: as above; `solve(&self)` takes the lock.
+unsafe impl Sync for CgAmg {}
+
+/// The iteration cap of a solve: CG + GAMG takes about 20 iterations at rtol 1e-10 on the
+/// block_3d meshes from 30k to 300k dofs (validation/BENCHMARK.md), so a cap this far above
+/// only stops a solve that is not converging.
+const MAX_ITERATIONS: i64 = 2000;
+
+impl CgAmg {
+    /// Builds the operator `matrix` (symmetric positive definite; its compressed columns are
+    /// read as compressed rows) with `dim` dofs per node, interleaved, the nodes at `coords`
+    /// (`dim` per node), and its GAMG hierarchy, on `comm`. Solves stop at the relative
+    /// residual `rtol`.
+    pub fn new(
+        comm: Communicator,
+        matrix: &SparseColMat<usize, f64>,
+        dim: usize,
+        coords: &[f64],
+        rtol: f64,
+    ) -> Result<Self, LinalgError> {
+        let (symbolic, values) = matrix.parts();
+        let n = symbolic.nrows();
+        if symbolic.ncols() != n || coords.len() != n || dim == 0 || n % dim != 0 {
+            return Err(LinalgError::Petsc {
+                step: format!(
+                    "sizes: a {n} x {} matrix, {} coordinates, {dim} per node",
+                    symbolic.ncols(),
+                    coords.len()
+                ),
+                code: 0,
+                message: "inconsistent sizes".into(),
+            });
+        }
+        let to_i64 = |v: &[usize]| v.iter().map(|&x| x as i64).collect::<Vec<i64>>();
+        let row_ptr = to_i64(symbolic.col_ptr());
+        let col_idx = to_i64(symbolic.row_idx());
+        let _lock = petsc()?;
+        let mut raw = std::ptr::null_mut();
+        let mut step = std::ptr::null();
+        // SAFETY: the arrays have the lengths the shim reads (n + 1, nnz, nnz, n), it copies
+        // them, and the lock is held.
+        let code = unsafe {
+            internodes_cgamg_create(
+                comm.0,
+                n as i64,
+                dim as i64,
+                row_ptr.as_ptr(),
+                col_idx.as_ptr(),
+                values.as_ptr(),
+                coords.as_ptr(),
+                rtol,
+                MAX_ITERATIONS,
+                &mut raw,
+                &mut step,
+            )
+        };
+        if code != 0 {
+            return Err(petsc_error(step, code));
+        }
+        let raw = NonNull::new(raw).ok_or_else(|| petsc_error(step, 0))?;
+        Ok(Self { raw, n })
+    }
+
+    /// Solves `K x = rhs` from `x = 0`. Fails with [`LinalgError::NotConverged`] unless CG
+    /// reached the relative residual it was set up with.
+    pub fn solve(&self, rhs: &[f64]) -> Result<(Vec<f64>, CgStats), LinalgError> {
+        if rhs.len() != self.n {
+            return Err(LinalgError::Petsc {
+                step: format!(
+                    "a right-hand side of {} values for {} unknowns",
+                    rhs.len(),
+                    self.n
+                ),
+                code: 0,
+                message: "inconsistent sizes".into(),
+            });
+        }
+        let mut x = vec![0.0; self.n];
+        let (mut iterations, mut residual, mut reason) = (0i64, 0.0, 0);
+        let mut step = std::ptr::null();
+        let code = {
+            let _lock = petsc()?;
+            // SAFETY: `rhs` and `x` hold `n` values, `raw` is alive, the lock is held.
+            unsafe {
+                internodes_cgamg_solve(
+                    self.raw.as_ptr(),
+                    rhs.as_ptr(),
+                    x.as_mut_ptr(),
+                    &mut iterations,
+                    &mut residual,
+                    &mut reason,
+                    &mut step,
+                )
+            }
+        };
+        if code != 0 {
+            return Err(petsc_error(step, code));
+        }
+        let iterations = iterations.max(0) as usize;
+        let norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let relative_residual = if norm > 0.0 {
+            residual / norm
+        } else {
+            residual
+        };
+        // Converged on the relative (2, 1) or absolute (3, 9) residual, or CG's exact
+        // breakdown (8); CONVERGED_ITS and the CG trust-region reasons do not apply here.
+        if !matches!(reason, 1 | 2 | 3 | 8 | 9) {
+            return Err(LinalgError::NotConverged {
+                // SAFETY: plain lookup of a static string.
+                reason: text(unsafe { internodes_ksp_reason_name(reason) }),
+                iterations,
+                relative_residual,
+            });
+        }
+        Ok((
+            x,
+            CgStats {
+                iterations,
+                relative_residual,
+            },
+        ))
+    }
+}
+
+impl Drop for CgAmg {
+    fn drop(&mut self) {
+        // The lock is taken even if initialization had failed (it cannot have: `self` exists).
+        let _lock = PETSC.lock().unwrap_or_else(PoisonError::into_inner);
+        // SAFETY: `raw` came from the shim's create and is destroyed once.
+        unsafe { internodes_cgamg_destroy(self.raw.as_ptr()) };
+    }
+}

@@ -1,0 +1,215 @@
+/*
+ * The C side of internodes' PETSc body solver: conjugate gradients preconditioned by
+ * smoothed-aggregation algebraic multigrid (KSPCG + PCGAMG) on one body's stiffness matrix.
+ * Compiled by build.rs only with the cargo feature `petsc`; src/linalg/petsc/mod.rs is its only
+ * caller and serializes every call (PETSc is not thread-safe).
+ *
+ * Every function returns 0 or a PETSc error code; on error `*step` names the call that failed
+ * (a static string). PETSc's own error printing is replaced by PetscReturnErrorHandler at
+ * initialization, so an error is only a return code.
+ *
+ * Communicators cross the Rust boundary as MPI Fortran handles (MPI_Fint, an int): their
+ * C type MPI_Comm differs between MPI implementations (a pointer in Open MPI, an int in
+ * MPICH), the Fortran handle does not.
+ */
+#include <stdint.h>
+#include <string.h>
+#include <petscksp.h>
+
+#define TRY(call)                   \
+    do {                            \
+        PetscErrorCode ierr_ = (call); \
+        if (ierr_) {                \
+            *step = #call;          \
+            return (int)ierr_;      \
+        }                           \
+    } while (0)
+
+/* A body's operator and its preconditioner, built once, and the vectors of one solve. */
+typedef struct {
+    Mat a;
+    KSP ksp;
+    Vec b, x;
+    PetscInt n;
+} InternodesCgAmg;
+
+/* PetscInitializeNoArguments, once per process (the caller guarantees it), without PETSc's
+ * signal handlers (a crash stays a crash of this process, reported by Rust, not a PETSc
+ * message), with errors returned rather than printed. The options database also reads the
+ * PETSC_OPTIONS environment variable (e.g. -ksp_view, -log_view to inspect a solve). */
+int internodes_petsc_initialize(const char **step)
+{
+    TRY(PetscOptionsSetValue(NULL, "-no_signal_handler", NULL));
+    TRY(PetscInitializeNoArguments());
+    TRY(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    return 0;
+}
+
+/* PETSC_COMM_SELF as a Fortran handle. */
+MPI_Fint internodes_petsc_comm_self(void)
+{
+    return MPI_Comm_c2f(PETSC_COMM_SELF);
+}
+
+/* The generic text of a PETSc error code. */
+const char *internodes_petsc_error_text(int code)
+{
+    const char *text = NULL;
+    if (PetscErrorMessage((PetscErrorCode)code, &text, NULL) || !text) return "unknown PETSc error";
+    return text;
+}
+
+/* The name of a KSPConvergedReason (e.g. "DIVERGED_ITS"). */
+const char *internodes_ksp_reason_name(int reason)
+{
+    if (reason < -11 || reason > 9) return "UNKNOWN";
+    const char *name = KSPConvergedReasons[reason];
+    return name ? name : "UNKNOWN";
+}
+
+static int to_petsc_ints(const int64_t *from, size_t len, PetscInt **to, const char **step)
+{
+    TRY(PetscMalloc1(len, to));
+    for (size_t k = 0; k < len; k++) {
+        if (from[k] < 0 || from[k] > PETSC_MAX_INT) {
+            PetscFree(*to);
+            *step = "index conversion (an index exceeds PetscInt; PETSc is built with 32-bit indices)";
+            return PETSC_ERR_ARG_OUTOFRANGE;
+        }
+        (*to)[k] = (PetscInt)from[k];
+    }
+    return 0;
+}
+
+static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, const int64_t *row_ptr,
+                 const int64_t *col_idx, const double *values, const double *coords, double rtol,
+                 int64_t max_it, const char **step)
+{
+    PetscInt *i = NULL, *j = NULL;
+    Vec xyz = NULL;
+    MatNullSpace near_null = NULL;
+    PC pc;
+    int code;
+
+    if ((code = to_petsc_ints(row_ptr, (size_t)n + 1, &i, step))) return code;
+    if ((code = to_petsc_ints(col_idx, (size_t)row_ptr[n], &j, step))) {
+        PetscFree(i);
+        return code;
+    }
+    s->n = (PetscInt)n;
+
+    /* The matrix: AIJ (SEQAIJ on one process, MPIAIJ on several) with the node block size, so
+     * that GAMG aggregates nodes, not single dofs. Both preallocation calls are made: the one
+     * that does not match the type is a no-op. They copy i, j, values and assemble. */
+    code = MatCreate(comm, &s->a);
+    if (!code) code = MatSetSizes(s->a, (PetscInt)n, (PetscInt)n, PETSC_DETERMINE, PETSC_DETERMINE);
+    if (!code) code = MatSetBlockSize(s->a, (PetscInt)block);
+    if (!code) code = MatSetType(s->a, MATAIJ);
+    if (!code) code = MatSeqAIJSetPreallocationCSR(s->a, i, j, values);
+    if (!code) code = MatMPIAIJSetPreallocationCSR(s->a, i, j, values);
+    PetscFree(i);
+    PetscFree(j);
+    if (code) {
+        *step = "creating the AIJ matrix from CSR arrays";
+        return code;
+    }
+    TRY(MatSetOption(s->a, MAT_SPD, PETSC_TRUE));
+
+    /* Near-null space: the rigid-body modes of the nodes (3 in 2D, 6 in 3D). */
+    TRY(VecCreate(comm, &xyz));
+    code = VecSetSizes(xyz, (PetscInt)n, PETSC_DETERMINE);
+    if (!code) code = VecSetBlockSize(xyz, (PetscInt)block);
+    if (!code) code = VecSetType(xyz, VECSTANDARD);
+    if (!code) {
+        PetscScalar *data;
+        code = VecGetArray(xyz, &data);
+        if (!code) {
+            memcpy(data, coords, (size_t)n * sizeof(double));
+            code = VecRestoreArray(xyz, &data);
+        }
+    }
+    if (!code) code = MatNullSpaceCreateRigidBody(xyz, &near_null);
+    if (!code) code = MatSetNearNullSpace(s->a, near_null);
+    MatNullSpaceDestroy(&near_null);
+    VecDestroy(&xyz);
+    if (code) {
+        *step = "setting the rigid-body near-null space";
+        return code;
+    }
+
+    /* CG + GAMG. The convergence test reads the unpreconditioned residual, so that rtol bounds
+     * ||b - A x|| / ||b|| (zero initial guess), the figure the caller checks. */
+    TRY(KSPCreate(comm, &s->ksp));
+    TRY(KSPSetOperators(s->ksp, s->a, s->a));
+    TRY(KSPSetType(s->ksp, KSPCG));
+    TRY(KSPGetPC(s->ksp, &pc));
+    TRY(PCSetType(pc, PCGAMG));
+    TRY(KSPSetNormType(s->ksp, KSP_NORM_UNPRECONDITIONED));
+    TRY(KSPSetTolerances(s->ksp, (PetscReal)rtol, 0.0, PETSC_DEFAULT, (PetscInt)max_it));
+    /* GAMG's defaults are only complete after SetFromOptions (without it its setup was 5x
+     * slower in validation/benchmark.py); it also lets PETSC_OPTIONS add e.g. -ksp_view. */
+    TRY(KSPSetFromOptions(s->ksp));
+    TRY(KSPSetUp(s->ksp));
+    TRY(MatCreateVecs(s->a, &s->x, &s->b));
+    return 0;
+}
+
+void internodes_cgamg_destroy(InternodesCgAmg *s)
+{
+    if (!s) return;
+    KSPDestroy(&s->ksp);
+    MatDestroy(&s->a);
+    VecDestroy(&s->b);
+    VecDestroy(&s->x);
+    PetscFree(s);
+}
+
+/* Builds the operator (n x n CSR, symmetric positive definite, `block` dofs per node,
+ * interleaved) and its GAMG hierarchy on the communicator `fcomm`; `coords` holds the node
+ * coordinates, `block` per node (n values). */
+int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int64_t *row_ptr,
+                            const int64_t *col_idx, const double *values, const double *coords,
+                            double rtol, int64_t max_it, InternodesCgAmg **out, const char **step)
+{
+    InternodesCgAmg *s = NULL;
+    *out = NULL;
+    if (n < 0 || n > PETSC_MAX_INT || block < 1 || n % block) {
+        *step = "checking the sizes (n a multiple of the block size, within PetscInt)";
+        return PETSC_ERR_ARG_OUTOFRANGE;
+    }
+    TRY(PetscCalloc1(1, &s));
+    int code = build(s, MPI_Comm_f2c(fcomm), n, block, row_ptr, col_idx, values, coords, rtol, max_it, step);
+    if (code) {
+        internodes_cgamg_destroy(s);
+        return code;
+    }
+    *out = s;
+    return 0;
+}
+
+/* Solves A x = rhs from x = 0: the iterations, the final residual norm ||rhs - A x|| and the
+ * KSPConvergedReason (positive: converged). */
+int internodes_cgamg_solve(InternodesCgAmg *s, const double *rhs, double *x, int64_t *iterations,
+                           double *residual_norm, int *reason, const char **step)
+{
+    PetscScalar *data;
+    PetscInt its;
+    PetscReal rnorm;
+    KSPConvergedReason why;
+
+    TRY(VecGetArray(s->b, &data));
+    memcpy(data, rhs, (size_t)s->n * sizeof(double));
+    TRY(VecRestoreArray(s->b, &data));
+    TRY(VecSet(s->x, 0.0));
+    TRY(KSPSolve(s->ksp, s->b, s->x));
+    TRY(KSPGetIterationNumber(s->ksp, &its));
+    TRY(KSPGetResidualNorm(s->ksp, &rnorm));
+    TRY(KSPGetConvergedReason(s->ksp, &why));
+    TRY(VecGetArray(s->x, &data));
+    memcpy(x, data, (size_t)s->n * sizeof(double));
+    TRY(VecRestoreArray(s->x, &data));
+    *iterations = its;
+    *residual_norm = rnorm;
+    *reason = (int)why;
+    return 0;
+}
