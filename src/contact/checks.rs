@@ -858,7 +858,7 @@ impl Update {
     }
 
     /// The iteration's record; `pairing_drift_over_h` is measured by the loop
-    /// ([`super::interface::InterfaceOperators::pairing_drift`]).
+    /// (`super::solve::pairing_drift`).
     pub(super) fn record(
         &self,
         iteration: usize,

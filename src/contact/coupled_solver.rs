@@ -6,11 +6,11 @@
 //!   only the interface problem by block elimination:
 //!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`.
 //!   `C K^-1 B = s C Y` is formed densely from each body's responses `Y_k` to the
-//!   multipliers ([`super::compliance`]), computed once per multiplier (primary node) and
-//!   reused by every later iteration and load step; the Schur complement is factored by dense
-//!   LU with partial pivoting (interfaces have hundreds to a few thousand multipliers). Each
-//!   iteration then costs two single-column solves per body, plus one solve per body for each
-//!   node that becomes active for the first time.
+//!   multipliers ([`super::compliance`]), computed once per active primary node and component
+//!   and reused by every later iteration and load step; the Schur complement is factored by
+//!   dense LU with partial pivoting (interfaces have hundreds to a few thousand multipliers).
+//!   Each iteration then costs two single-column solves per body, plus `dim` solves per body
+//!   for each node that becomes active for the first time.
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
 

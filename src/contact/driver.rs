@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! 1. every load step with the chosen primary (one set-up, one active-set loop per step)
-//! 2. if "auto" chose between bodies of similar stiffness and the answer is not a solution:
+//! 2. if "auto" chose between bodies of similar stiffness and the answer is not trusted
+//!    (not solved, or its accuracy report failed):
 //!      every load step with the other primary; keep its answer if that one is
 //! 3. if the primary was named and is much stiffer than the other body:
 //!      every load step with the other primary; check that the two contact forces agree
@@ -280,7 +281,7 @@ fn check_against<'m>(
 
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
 /// load step, each starting from the previous active set; stops at the first step whose loop
-/// does not settle (`not-certified` steps go on). `label` prefixes the timing names.
+/// does not settle (`not-solved` steps go on). `label` prefixes the timing names.
 fn solve_load_steps(
     problem: &ContactProblem,
     solver: &SolverSettings,

@@ -3,7 +3,7 @@
 //! transfers `R12`, `R21`, the (lumped) interface mass, the contact normal, and the gaps.
 //!
 //! **Interpolation along the surfaces.** Every primary candidate `x_i` is projected onto the
-//! secondary surface along its outward normal (point `p_i`, reference geometry,
+//! secondary surface along the contact normal below (point `p_i`, reference geometry,
 //! [`super::projection`]), and `R12`
 //! is the rescaled Wendland interpolation (`docs/method.md` 2.2) from all secondary candidates to
 //! the points `p_i`; likewise `R21` from all primary candidates to the projections of the
@@ -22,13 +22,12 @@
 //!
 //! **Gaps.** The reference gap `d_i = n_i . (p_i - x_i)` is exact against a flat at any
 //! distance. The linearized gap of a displacement is
-//! `g_i(u) = d_i - n_i . (u1_i - (R12 u2)_i)` ([`InterfaceOperators::linearized_gaps`]); the
-//! frictionless constraint of an active node is `g_i(u) + e_i = 0`, `e_i` the difference between
-//! the geometric gap of the last iterate ([`geometric_gaps`]: closest-point projection onto the
-//! displaced P1 facets) and its linearized gap. That difference is the interpolation error of
-//! `R12 u2` against the P1 surface (first order in `h`, times the displacement gradient): with
-//! it, an active node ends ON the other body's discrete surface, as the certificate measures
-//! it, not on the RBF reconstruction of that surface.
+//! `g_i(u) = d_i - n_i . (u1_i - (R12 u2)_i)` ([`InterfaceOperators::linearized_gaps`]). It is
+//! the constraint of tied contact, `g_i(u) + e_i = 0` with `e_i` the difference between the
+//! geometric gap of the last iterate ([`geometric_gaps`]) and its linearized gap, so that an
+//! active node ends ON the other body's discrete surface, not on the RBF reconstruction of it.
+//! Frictionless contact constrains the geometric gap itself, linearized node to segment
+//! ([`super::linearization`]); `R12` then only measures how far the pairing has slid.
 //!
 //! **Lumped interface mass.** Node `s` stands for its area `A_s` ([`ContactSurface`]): the
 //! multiplier `lambda_i` exerts `-A_i lambda_i` on body 1 and, on body 2, either

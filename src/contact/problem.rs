@@ -30,9 +30,10 @@ pub enum Formulation {
 ///   as the contact zone spans fewer secondary spacings).
 /// - `Conservative`: the secondary receives the primary's nodal forces distributed by the
 ///   transpose of the displacement interpolation, `-R12^T M1 lambda` (the mortar method's
-///   transfer). The rows of `R12` sum to one, so the forces on the two bodies balance exactly,
-///   and the coupling is the transpose of the constraint: the system is the Lagrange
-///   multiplier form of `u1 - R12 u2 = d`. Onto a secondary finer than the primary it leaves the
+///   transfer). The rows of `R12` sum to one, so the forces on the two bodies balance exactly.
+///   For tied contact the coupling is then the transpose of the constraint (the Lagrange
+///   multiplier form of `u1 - R12 u2 = d`); frictionless rows are node to segment
+///   (`super::linearization`), and the system stays unsymmetric. Onto a secondary finer than the primary it leaves the
 ///   secondary nodes between the projections of primary nodes unloaded, which is why
 ///   INTERNODES interpolates there.
 /// - `Auto` (default): conservative when the secondary's contact surface is coarser than the
@@ -434,7 +435,9 @@ impl<'m> ContactProblem<'m> {
         // What "auto" chooses (module doc of `PrimaryChoice::Auto`); an explicit choice is
         // compared with it.
         let stiffness = modulus(&sides[1]) / modulus(&sides[0]);
-        let similar = (1.0 / SIMILAR_STIFFNESS..SIMILAR_STIFFNESS).contains(&stiffness);
+        // Symmetric in the two bodies: at a ratio of exactly 2 the order they are listed in
+        // must not decide.
+        let similar = stiffness.max(1.0 / stiffness) < SIMILAR_STIFFNESS;
         let (auto_first, auto_reason) = if !similar {
             let first = usize::from(stiffness < 1.0);
             (

@@ -89,8 +89,9 @@ pub struct IterationRecord {
     /// Largest |geometric gap| of an active node over its h: how far the active nodes are
     /// from the other body's discrete surface.
     pub max_gap_error_over_h: f64,
-    /// Largest distance an active node's paired point on the secondary has slid since the
-    /// interface operators were built, over its spacing (they are paired again beyond 0.05).
+    /// How far the surfaces have slid over each other since the interface operators were
+    /// paired (the change of the active nodes' mean slide), over the smallest spacing of the
+    /// active primary nodes (they are paired again beyond 0.05).
     pub pairing_drift_over_h: f64,
     pub relative_residual: f64,
     pub seconds: PhaseSeconds,

@@ -20,7 +20,7 @@
 //! rows of prescribed dofs carry no coupling.
 //!
 //! Scaling: the multiplier columns are multiplied by `s = k / m` and the constraint rows by `k`,
-//! with `k` the largest diagonal entry of `K1` and `m` that of `M1`, so that every block has
+//! with `k` the largest diagonal entry of `K1` and `K2` and `m` that of `M1`, so that every block has
 //! the magnitude of `K`; the solution is unscaled on return.
 
 use faer::sparse::{SparseColMat, Triplet};
