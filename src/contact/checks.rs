@@ -377,39 +377,47 @@ pub fn certify(
     (Certificate { checks }, gaps)
 }
 
-/// An agreement check (`kind`: primary or transfer agreement): `|F - F_other| / |F_other|`,
-/// `F` the total contact force on this solve's primary body and `F_other` the force on the same
-/// body from the other discretization, solved `with` the other primary or transfer (`Ok`),
-/// against `tolerance`. Without a trusted answer to compare with (`Err`: how that solve
-/// ended), the check fails with the figure 1 (the force is not confirmed to any fraction of
-/// itself), and the note says why.
+/// An agreement check (`kind`: primary or transfer agreement): the total contact force on
+/// each body, `F_b`, against the force on the same body from the other discretization, `F'_b`,
+/// solved `with` the other primary or transfer (`Ok`); the figure is the larger of
+/// `|F_b - F'_b| / |F'_b|` over the two bodies, against `tolerance`. Both bodies, because a
+/// user reads the force on each, and they differ by the interpolation transfer's imbalance
+/// (within the equilibrium residual's 1%): a stiff block named primary had its own force 0.4%
+/// from the sphere primary's, and the force on the sphere 1.1% (dolfinx's rigid flat: 1.1%).
+/// `forces` and the reference are ordered [this solve's primary body, its secondary body].
+/// Without a trusted answer to compare with (`Err`: how that solve ended), the check fails
+/// with the figure 1 (the force is not confirmed to any fraction of itself), and the note says
+/// why.
 pub fn agreement(
     kind: CheckKind,
-    force: [f64; 3],
-    other: Result<[f64; 3], String>,
+    forces: [[f64; 3]; 2],
+    other: Result<[[f64; 3]; 2], String>,
     with: &str,
     tolerance: f64,
 ) -> CertificateCheck {
     let norm = |f: [f64; 3]| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-    let (value, note) = match other {
-        Ok(reference) => {
-            let difference = norm(std::array::from_fn(|c| force[c] - reference[c]));
-            let value = if norm(reference) > 0.0 {
-                difference / norm(reference)
-            } else if difference > 0.0 {
-                1.0
-            } else {
-                0.0
-            };
-            (
-                value,
-                format!(
-                    "force {:.6e} here, {:.6e} with {with}",
-                    norm(force),
-                    norm(reference)
-                ),
-            )
+    let relative = |force: [f64; 3], reference: [f64; 3]| {
+        let difference = norm(std::array::from_fn(|c| force[c] - reference[c]));
+        if norm(reference) > 0.0 {
+            difference / norm(reference)
+        } else if difference > 0.0 {
+            1.0
+        } else {
+            0.0
         }
+    };
+    let (value, note) = match other {
+        Ok(reference) => (
+            relative(forces[0], reference[0]).max(relative(forces[1], reference[1])),
+            format!(
+                "forces on the primary and the secondary {:.6e}, {:.6e} here, {:.6e}, {:.6e} \
+                 with {with}",
+                norm(forces[0]),
+                norm(forces[1]),
+                norm(reference[0]),
+                norm(reference[1])
+            ),
+        ),
         Err(ended) => (
             1.0,
             format!("no trusted answer with {with} to compare with: it ended {ended}"),

@@ -219,17 +219,26 @@ fn check_against<'m>(
         problem.settings.formulation,
         problem.settings.transfer,
     );
-    let (other, kind, sign) = match alternative {
+    // The other solve's forces on [this primary body, this secondary body]: its primary is
+    // this solve's secondary when the primaries are swapped.
+    let (other, kind, swapped) = match alternative {
         Alternative::OtherPrimary => (
             problem.with_other_primary(),
             CheckKind::PrimaryAgreement,
-            -1.0,
+            true,
         ),
         Alternative::AutoTransfer => (
             problem.with_transfer(Transfer::Auto),
             CheckKind::TransferAgreement,
-            1.0,
+            false,
         ),
+    };
+    let on_these_bodies = |primary: [f64; 3], secondary: [f64; 3]| {
+        if swapped {
+            [secondary, primary]
+        } else {
+            [primary, secondary]
+        }
     };
     let with = match alternative {
         Alternative::OtherPrimary => format!("'{}' as primary", other.primary.body.name),
@@ -247,7 +256,10 @@ fn check_against<'m>(
         Ok((check, other_steps))
             if check.status == ContactStatus::Converged && check.is_trusted() =>
         {
-            (Ok(check.force_primary.map(|f| sign * f)), other_steps)
+            (
+                Ok(on_these_bodies(check.force_primary, check.force_secondary)),
+                other_steps,
+            )
         }
         Ok((check, other_steps)) => (Err(check.ending()), other_steps),
         Err(e) => (Err(format!("with an error ({e})")), Vec::new()),
@@ -256,16 +268,18 @@ fn check_against<'m>(
     let earlier = steps.len().saturating_sub(1);
     for (k, step) in steps[..earlier].iter_mut().enumerate() {
         let other_step = match other_steps.get(k) {
-            Some(o) if trusted(o) => Ok(std::array::from_fn(|c| {
-                sign * o.force_primary.get(c).unwrap_or(&0.0)
-            })),
+            Some(o) if trusted(o) => Ok(on_these_bodies(
+                vector(&o.force_primary),
+                vector(&o.force_secondary),
+            )),
             Some(o) => Err(o.ending()),
             None => Err("before this load step (its load steps stopped)".to_string()),
         };
-        let force = std::array::from_fn(|c| *step.force_primary.get(c).unwrap_or(&0.0));
-        step.certify_further(&agreement(kind, force, other_step, &with, tolerance));
+        let forces = [vector(&step.force_primary), vector(&step.force_secondary)];
+        step.certify_further(&agreement(kind, forces, other_step, &with, tolerance));
     }
-    let check = agreement(kind, solution.force_primary, reference, &with, tolerance);
+    let forces = [solution.force_primary, solution.force_secondary];
+    let check = agreement(kind, forces, reference, &with, tolerance);
     log.say(format!("check with {with}: {}", check.describe()));
     solution.certify_further(check);
     log.say(format!(
@@ -344,6 +358,11 @@ fn solve_load_steps(
         }
     }
     Ok((last.expect("solve_contact checks the load factors"), steps))
+}
+
+/// A step record's force (`dim` components) as a 3-vector.
+fn vector(force: &[f64]) -> [f64; 3] {
+    std::array::from_fn(|c| *force.get(c).unwrap_or(&0.0))
 }
 
 /// Progress messages (when verbose) and phase timings of a solve.
