@@ -180,7 +180,9 @@ def write_cases(size: Size) -> dict[str, Path]:
     """The case file for this mesh (dolfinx: "base") and one per ordering of ours.
 
     The base case is validation/cases/block_3d.toml with ``mesh`` replaced;
-    ours add a ``[solver]`` table with the ordering.
+    ours add a ``[solver]`` table with the ordering, and ``body = "cholesky"``: this benchmark times
+    the sparse Cholesky path (``auto`` would take CG + AMG for the larger 3D meshes in a PETSc
+    build; ``validation/body_solver_benchmark.py`` compares the two).
     """
     size.folder.mkdir(parents=True, exist_ok=True)
     text, count = re.subn(r"(?m)^mesh\s*=.*$", f"mesh = {json.dumps(str(size.mesh))}", BASE_CASE.read_text())
@@ -191,7 +193,7 @@ def write_cases(size: Size) -> dict[str, Path]:
     for run, (_, kind, ordering) in RUNS.items():
         if kind == "ours":
             cases[run] = size.folder / f"block_3d_{run}.toml"
-            cases[run].write_text(f'{text}\n[solver]\nordering = "{ordering}"\n')
+            cases[run].write_text(f'{text}\n[solver]\nbody = "cholesky"\nordering = "{ordering}"\n')
     return cases
 
 
