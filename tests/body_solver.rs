@@ -101,6 +101,24 @@ fn rtol_outside_zero_one_is_rejected() {
 }
 
 #[test]
+fn rtol_above_the_residual_tolerance_is_rejected_unless_cholesky() {
+    for body in ["auto", "cg-amg"] {
+        let (_dir, path) = write_case(&block_case(&format!(
+            "body = \"{body}\"\nrtol = 1e-6\nresidual_tolerance = 1e-8"
+        )));
+        let e = Case::load(&path).unwrap_err();
+        assert!(
+            e.to_string().contains("rtol") && e.to_string().contains("residual_tolerance"),
+            "{body}: {e}"
+        );
+    }
+    let (_dir, path) = write_case(&block_case(
+        "body = \"cholesky\"\nrtol = 1e-6\nresidual_tolerance = 1e-8",
+    ));
+    Case::load(&path).unwrap();
+}
+
+#[test]
 fn auto_is_cholesky_for_small_bodies_and_in_2d() {
     assert_eq!(
         BodySolverKind::Auto.resolve(3, 1000),
@@ -342,6 +360,47 @@ mod with_petsc {
                 eprintln!("{e}");
             }
             other => panic!("expected a CG or PETSc error, got {other:?}"),
+        }
+    }
+
+    /// PETSc is initialized without its signal handlers (which it installs by default for
+    /// SIGFPE, SIGSEGV, SIGBUS, SIGILL and SIGHUP): a fault stays the process's own, not a
+    /// PETSc message and `MPI_Abort`. (Open MPI's initialization installs its own backtrace
+    /// printer on SIGFPE, SIGSEGV and SIGBUS where no handler was set; it re-raises.)
+    #[test]
+    fn petsc_installs_no_signal_handler() {
+        let mesh = read_fixture("block_2d.msh");
+        let problem = hertz_block(&mesh.bodies[0]);
+        solve(&problem, &settings(BodySolverKind::CgAmg)).unwrap();
+        for signal in [
+            libc::SIGFPE,
+            libc::SIGSEGV,
+            libc::SIGBUS,
+            libc::SIGILL,
+            libc::SIGHUP,
+        ] {
+            // SAFETY: a query (null new action) into a zeroed sigaction, then a lookup of the
+            // handler's address among the loaded libraries.
+            let library = unsafe {
+                let mut old: libc::sigaction = std::mem::zeroed();
+                assert_eq!(libc::sigaction(signal, std::ptr::null(), &mut old), 0);
+                let mut info: libc::Dl_info = std::mem::zeroed();
+                if old.sa_sigaction > 1
+                    && libc::dladdr(old.sa_sigaction as *const libc::c_void, &mut info) != 0
+                    && !info.dli_fname.is_null()
+                {
+                    std::ffi::CStr::from_ptr(info.dli_fname)
+                        .to_string_lossy()
+                        .into_owned()
+                } else {
+                    String::new()
+                }
+            };
+            let file = library.rsplit('/').next().unwrap_or_default();
+            assert!(
+                !file.starts_with("libpetsc"),
+                "signal {signal} is handled by {library}"
+            );
         }
     }
 

@@ -15,8 +15,10 @@
 //!
 //! - PETSc is initialized once per process, on first use, without its signal handlers and
 //!   with `PetscReturnErrorHandler`: a PETSc error is a return code, turned into
-//!   [`LinalgError::Petsc`], never a message and an abort. It is never finalized (the process
-//!   ends instead; PETSc's objects are destroyed with their Rust owners).
+//!   [`LinalgError::Petsc`], never a message and an abort. (MPI's initialization, inside
+//!   PETSc's, lets Open MPI put a backtrace printer on SIGSEGV, SIGBUS and SIGFPE where no
+//!   handler was set; it re-raises the signal.) PETSc is never finalized (the process ends
+//!   instead; PETSc's objects are destroyed with their Rust owners).
 //! - PETSc is not thread-safe, and `cargo test` and rayon call from several threads: every
 //!   call into PETSc, destruction included, holds one global mutex. Two bodies solved "side
 //!   by side" by rayon therefore take turns.
@@ -178,9 +180,12 @@ impl CgAmg {
                 message: "inconsistent sizes".into(),
             });
         }
-        let to_i64 = |v: &[usize]| v.iter().map(|&x| x as i64).collect::<Vec<i64>>();
-        let row_ptr = to_i64(symbolic.col_ptr());
-        let col_idx = to_i64(symbolic.row_idx());
+        // The index arrays go to the shim as they are, read as `int64_t`: usize has that size
+        // here (checked below), and its values, counts of allocated entries, are below
+        // i64::MAX. A converted copy would cost 8 bytes per stored entry at the peak.
+        const _: () = assert!(size_of::<usize>() == size_of::<i64>());
+        let row_ptr = symbolic.col_ptr().as_ptr().cast::<i64>();
+        let col_idx = symbolic.row_idx().as_ptr().cast::<i64>();
         let _lock = petsc()?;
         let mut raw = std::ptr::null_mut();
         let mut step = std::ptr::null();
@@ -191,8 +196,8 @@ impl CgAmg {
                 comm.0,
                 n as i64,
                 dim as i64,
-                row_ptr.as_ptr(),
-                col_idx.as_ptr(),
+                row_ptr,
+                col_idx,
                 values.as_ptr(),
                 coords.as_ptr(),
                 rtol,
