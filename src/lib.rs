@@ -20,7 +20,8 @@
 //! The crate is organised as the solve proceeds:
 //! - [`mesh`]: gmsh MSH 4.1 input, bodies and boundary groups by physical name;
 //! - [`fem`]: P1 elasticity kernels, sparsity patterns, assembly, loads, Dirichlet conditions;
-//! - [`linalg`]: fill-reducing orderings and the sparse Cholesky factorization;
+//! - [`linalg`]: fill-reducing orderings, the sparse Cholesky factorization, and the iterative
+//!   body solver (PETSc CG + GAMG, cargo feature `petsc`) beside it;
 //! - [`elastic`]: one body's problem, solve and solution;
 //! - [`contact`]: two bodies coupled by INTERNODES: interpolation, interface operators, the
 //!   coupled system and its solvers, the active-set loop;

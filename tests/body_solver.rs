@@ -50,11 +50,13 @@ fn hertz_block(body: &BodyMesh) -> ElasticProblem<'_> {
     .unwrap()
 }
 
+#[cfg(feature = "petsc")]
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
 /// `max |a - b| / max |b|`.
+#[cfg(feature = "petsc")]
 fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
     let diff: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
     max_abs(&diff) / max_abs(b)
@@ -96,6 +98,25 @@ fn rtol_outside_zero_one_is_rejected() {
         assert!(
             matches!(e, CaseError::Invalid { .. }) && e.to_string().contains("rtol"),
             "{rtol}: {e}"
+        );
+    }
+}
+
+#[test]
+fn rtol_above_the_residual_tolerance_is_rejected_for_cg_amg_and_makes_auto_cholesky() {
+    let solver = |body: &str| format!("body = \"{body}\"\nrtol = 1e-6\nresidual_tolerance = 1e-8");
+    let (_dir, path) = write_case(&block_case(&solver("cg-amg")));
+    let e = Case::load(&path).unwrap_err();
+    assert!(
+        e.to_string().contains("rtol") && e.to_string().contains("residual_tolerance"),
+        "{e}"
+    );
+    for body in ["auto", "cholesky"] {
+        let (_dir, path) = write_case(&block_case(&solver(body)));
+        let case = Case::load(&path).unwrap();
+        assert_eq!(
+            case.solver.body_solver(3, 10_000_000),
+            BodySolverKind::Cholesky
         );
     }
 }
@@ -345,6 +366,47 @@ mod with_petsc {
         }
     }
 
+    /// PETSc is initialized without its signal handlers (which it installs by default for
+    /// SIGFPE, SIGSEGV, SIGBUS, SIGILL and SIGHUP): a fault stays the process's own, not a
+    /// PETSc message and `MPI_Abort`. (Open MPI's initialization installs its own backtrace
+    /// printer on SIGFPE, SIGSEGV and SIGBUS where no handler was set; it re-raises.)
+    #[test]
+    fn petsc_installs_no_signal_handler() {
+        let mesh = read_fixture("block_2d.msh");
+        let problem = hertz_block(&mesh.bodies[0]);
+        solve(&problem, &settings(BodySolverKind::CgAmg)).unwrap();
+        for signal in [
+            libc::SIGFPE,
+            libc::SIGSEGV,
+            libc::SIGBUS,
+            libc::SIGILL,
+            libc::SIGHUP,
+        ] {
+            // SAFETY: a query (null new action) into a zeroed sigaction, then a lookup of the
+            // handler's address among the loaded libraries.
+            let library = unsafe {
+                let mut old: libc::sigaction = std::mem::zeroed();
+                assert_eq!(libc::sigaction(signal, std::ptr::null(), &mut old), 0);
+                let mut info: libc::Dl_info = std::mem::zeroed();
+                if old.sa_sigaction > 1
+                    && libc::dladdr(old.sa_sigaction as *const libc::c_void, &mut info) != 0
+                    && !info.dli_fname.is_null()
+                {
+                    std::ffi::CStr::from_ptr(info.dli_fname)
+                        .to_string_lossy()
+                        .into_owned()
+                } else {
+                    String::new()
+                }
+            };
+            let file = library.rsplit('/').next().unwrap_or_default();
+            assert!(
+                !file.starts_with("libpetsc"),
+                "signal {signal} is handled by {library}"
+            );
+        }
+    }
+
     #[test]
     fn inconsistent_sizes_are_errors() {
         let mesh = read_fixture("block_2d.msh");
@@ -352,7 +414,10 @@ mod with_petsc {
         let mut stats = Default::default();
         let system = assemble(&problem, &mut stats, false).unwrap();
         let short = &system.coordinates[1..];
-        assert!(BodySolver::cg_amg(&system.k_c, system.dim, short, 1e-10).is_err());
+        assert!(matches!(
+            BodySolver::cg_amg(&system.k_c, system.dim, short, 1e-10),
+            Err(LinalgError::Sizes(_))
+        ));
     }
 
     #[test]

@@ -184,6 +184,18 @@ impl Case {
         if !(case.solver.rtol > 0.0 && case.solver.rtol < 1.0) {
             return Err(case.invalid("[solver]", "rtol must be in (0, 1)"));
         }
+        if case.solver.body == BodySolverKind::CgAmg
+            && case.solver.rtol > case.solver.residual_tolerance
+        {
+            return Err(case.invalid(
+                "[solver]",
+                format!(
+                    "rtol ({:e}) is above residual_tolerance ({:e}): a CG solve stopped at rtol \
+                     would fail the residual check",
+                    case.solver.rtol, case.solver.residual_tolerance
+                ),
+            ));
+        }
         if case.solver.body == BodySolverKind::CgAmg && !CG_AMG_AVAILABLE {
             return Err(case.invalid(
                 "[solver]",

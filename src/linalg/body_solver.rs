@@ -149,7 +149,7 @@ impl BodySolver {
             #[cfg(feature = "petsc")]
             Self::CgAmg(cg) => {
                 let mut most = 0;
-                if num_rhs == 0 {
+                if num_rhs == 0 || rhs.is_empty() {
                     return Ok(0);
                 }
                 for column in rhs.chunks_mut(rhs.len() / num_rhs) {

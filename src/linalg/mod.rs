@@ -31,6 +31,8 @@ pub enum LinalgError {
          (rebuild with `cargo build --release --features petsc`, or use body = \"cholesky\")"
     )]
     PetscUnavailable,
+    #[error("inconsistent sizes: {0}")]
+    Sizes(String),
     #[error("PETSc error {code} ({message}) in {step}")]
     Petsc {
         step: String,

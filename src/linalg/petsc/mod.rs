@@ -15,8 +15,10 @@
 //!
 //! - PETSc is initialized once per process, on first use, without its signal handlers and
 //!   with `PetscReturnErrorHandler`: a PETSc error is a return code, turned into
-//!   [`LinalgError::Petsc`], never a message and an abort. It is never finalized (the process
-//!   ends instead; PETSc's objects are destroyed with their Rust owners).
+//!   [`LinalgError::Petsc`], never a message and an abort. (MPI's initialization, inside
+//!   PETSc's, lets Open MPI put a backtrace printer on SIGSEGV, SIGBUS and SIGFPE where no
+//!   handler was set; it re-raises the signal.) PETSc is never finalized (the process ends
+//!   instead; PETSc's objects are destroyed with their Rust owners).
 //! - PETSc is not thread-safe, and `cargo test` and rayon call from several threads: every
 //!   call into PETSc, destruction included, holds one global mutex. Two bodies solved "side
 //!   by side" by rayon therefore take turns.
@@ -148,9 +150,10 @@ unsafe impl Send for CgAmg {}
 // SAFETY: as above; `solve(&self)` takes the lock.
 unsafe impl Sync for CgAmg {}
 
-/// The iteration cap of a solve: CG + GAMG takes about 20 iterations at rtol 1e-10 on the
-/// block_3d meshes from 30k to 300k dofs (validation/BENCHMARK.md), so a cap this far above
-/// only stops a solve that is not converging.
+/// The iteration cap of a solve: CG + GAMG takes 21 to 26 iterations at rtol 1e-10 on the
+/// block_3d meshes from 6k to 677k dofs (`AUTO_CG_AMG_MIN_DOFS_3D`'s table,
+/// validation/BODY_SOLVER_BENCHMARK.md), so a cap this far above only stops a solve that is
+/// not converging.
 const MAX_ITERATIONS: i64 = 2000;
 
 impl CgAmg {
@@ -167,20 +170,26 @@ impl CgAmg {
     ) -> Result<Self, LinalgError> {
         let (symbolic, values) = matrix.parts();
         let n = symbolic.nrows();
-        if symbolic.ncols() != n || coords.len() != n || dim == 0 || n % dim != 0 {
-            return Err(LinalgError::Petsc {
-                step: format!(
-                    "sizes: a {n} x {} matrix, {} coordinates, {dim} per node",
-                    symbolic.ncols(),
-                    coords.len()
-                ),
-                code: 0,
-                message: "inconsistent sizes".into(),
-            });
+        // Compressed columns without gaps (`col_nnz` absent): the layout the shim reads.
+        if symbolic.ncols() != n
+            || coords.len() != n
+            || dim == 0
+            || n % dim != 0
+            || symbolic.col_nnz().is_some()
+        {
+            return Err(LinalgError::Sizes(format!(
+                "CG + AMG of a {n} x {} matrix (compact: {}) with {} coordinates, {dim} per node",
+                symbolic.ncols(),
+                symbolic.col_nnz().is_none(),
+                coords.len()
+            )));
         }
-        let to_i64 = |v: &[usize]| v.iter().map(|&x| x as i64).collect::<Vec<i64>>();
-        let row_ptr = to_i64(symbolic.col_ptr());
-        let col_idx = to_i64(symbolic.row_idx());
+        // The index arrays go to the shim as they are, read as `int64_t`: usize has that size
+        // here (checked below), and its values, counts of allocated entries, are below
+        // i64::MAX. A converted copy would cost 8 bytes per stored entry at the peak.
+        const _: () = assert!(size_of::<usize>() == size_of::<i64>());
+        let row_ptr = symbolic.col_ptr().as_ptr().cast::<i64>();
+        let col_idx = symbolic.row_idx().as_ptr().cast::<i64>();
         let _lock = petsc()?;
         let mut raw = std::ptr::null_mut();
         let mut step = std::ptr::null();
@@ -191,8 +200,8 @@ impl CgAmg {
                 comm.0,
                 n as i64,
                 dim as i64,
-                row_ptr.as_ptr(),
-                col_idx.as_ptr(),
+                row_ptr,
+                col_idx,
                 values.as_ptr(),
                 coords.as_ptr(),
                 rtol,
@@ -212,15 +221,11 @@ impl CgAmg {
     /// reached the relative residual it was set up with.
     pub fn solve(&self, rhs: &[f64]) -> Result<(Vec<f64>, CgStats), LinalgError> {
         if rhs.len() != self.n {
-            return Err(LinalgError::Petsc {
-                step: format!(
-                    "a right-hand side of {} values for {} unknowns",
-                    rhs.len(),
-                    self.n
-                ),
-                code: 0,
-                message: "inconsistent sizes".into(),
-            });
+            return Err(LinalgError::Sizes(format!(
+                "a right-hand side of {} values for {} unknowns",
+                rhs.len(),
+                self.n
+            )));
         }
         let mut x = vec![0.0; self.n];
         let (mut iterations, mut residual, mut reason) = (0i64, 0.0, 0);
