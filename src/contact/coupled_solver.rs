@@ -1,31 +1,48 @@
 //! How the coupled system of an iteration is solved, behind one interface.
 //!
-//! - [`CoupledSolver::Schur`] (default): each body's constrained stiffness is factored once
+//! - [`CoupledSolver::Krylov`] (default): each body's constrained stiffness is factored once
 //!   (sparse Cholesky; or CG + AMG set up once, with `[solver] body = "cg-amg"`: see
 //!   `crate::linalg::BodySolver`) for the whole contact solve, and every iteration solves
 //!   only the interface problem by block elimination:
-//!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`.
-//!   `C K^-1 B = s C Y` is formed densely from each body's responses `Y_k` to the
-//!   multipliers ([`super::compliance`]), computed once per multiplier (primary node) and
-//!   reused by every later iteration and load step; the Schur complement is factored by dense
-//!   LU with partial pivoting (interfaces have hundreds to a few thousand multipliers). Each
-//!   iteration then costs two single-column solves per body, plus one solve per body for each
-//!   node that becomes active for the first time.
-//!   With CG + AMG body solves the per-column responses cost a full CG solve each (`dim` per
-//!   active node and body): `schur` then runs the [`CoupledSolver::Krylov`] path, the same
-//!   elimination with the interface problem solved matrix-free.
-//! - [`CoupledSolver::Krylov`]: the same elimination, with `(D - C K^-1 B) lambda = g - C z`
-//!   solved by preconditioned GMRES ([`super::interface_krylov`]): one solve per body per
-//!   product, nothing per multiplier, warm-started from the last iteration's tractions.
+//!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`,
+//!   the middle equation by preconditioned GMRES ([`super::interface_krylov`]): one solve per
+//!   body per product, nothing per multiplier, warm-started from the last iteration's
+//!   tractions.
+//! - [`CoupledSolver::Schur`]: the same elimination with `C K^-1 B = s C Y` formed densely
+//!   from each body's responses `Y_k` to the multipliers ([`super::compliance`]), computed
+//!   once per multiplier (`dim` solves per primary node) and reused by every later iteration
+//!   and load step; the Schur complement is factored by dense LU with partial pivoting
+//!   (interfaces have hundreds to a few thousand multipliers). Each iteration then costs two
+//!   single-column solves per body, plus `dim` solves per body for each node that becomes
+//!   active for the first time. With CG + AMG body solves each of those columns is a full CG
+//!   solve: `schur` then runs the Krylov path.
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
 //!
-//! # What `[solver] body = "auto"` means here
+//! # Which one, and what `[solver] body = "auto"` means here
 //!
-//! Cholesky, for both `schur` and `krylov` (`BodySolverKind::resolve_for_contact`), and
-//! `schur` stays the default. Measured on the contact benchmark's hemisphere on block
-//! (`validation/contact_benchmark.py --solver`, one step, wall seconds of the whole process):
-//! (measurements follow in a later commit).
+//! Measured 2026-11-26 on this project's 2-core machine, shared (load average about 6 during
+//! the runs, so the absolute figures are about 2.5 times the quiet machine's of
+//! `validation/CONTACT_BENCHMARK.md`; the runs of one size were back to back), the contact
+//! benchmark's hemisphere on block in one step (`validation/interface_solver_timing.py`):
+//! wall seconds of the whole process, and the GMRES iterations of each active-set iteration
+//! (the first has no contact yet):
+//!
+//! | DOFs | schur + Cholesky | krylov + Cholesky (GMRES its) | krylov + CG + AMG (GMRES its) |
+//! |---|---|---|---|
+//! | 31,113 | 9.06 | 7.39 (1, 20, 19, 18, 18, 16, 14) | 12.82 (1, 15, 14, 14, 13, 11, 9) |
+//! | 98,700 | 75.9 | 44.3 (1, 23, 21, 21, 20, 19, 17, 14) | 119.8 (1, 17, 15, 15, 14, 13, 12, 8) |
+//!
+//! All six runs end converged after the same 7 and 8 active-set iterations with the same
+//! active nodes (240, 558) and contact force (to the 7 digits printed). The Krylov path on
+//! Cholesky factors wins, and more so as the interface grows (the dense path pays `dim`
+//! solves per new active node: about 3 x 1048 at 99k DOFs, where the first contact
+//! iteration makes the whole overlap active), so it is the default. CG + AMG loses to
+//! Cholesky at these sizes even without per-node solves: a product costs two CG solves of
+//! 15 to 25 iterations each where the factor costs two triangular solves. So `auto` stays
+//! Cholesky for a contact solve (`BodySolverKind::resolve_for_contact`), whichever coupled
+//! solver runs.
+
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
@@ -43,12 +60,13 @@ use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
 #[serde(rename_all = "kebab-case")]
 pub enum CoupledSolver {
     /// Cholesky of each body once, dense Schur complement on the multipliers per iteration.
-    #[default]
     Schur,
     /// Sparse LU of the whole saddle-point matrix per iteration (reference).
     MonolithicLu,
     /// Each body's solver set up once, the interface problem solved matrix-free by
     /// preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies).
+    /// The default: faster than `schur` at the contact benchmark's sizes (module doc).
+    #[default]
     Krylov,
 }
 
