@@ -22,26 +22,27 @@
 //! # Which one, and what `[solver] body = "auto"` means here
 //!
 //! Measured 2026-11-26 on this project's 2-core machine, shared (load average about 6 during
-//! the runs, so the absolute figures are about 2.5 times the quiet machine's of
+//! the runs, so the schur figures are 1.5 to 2.7 times the quiet machine's of
 //! `validation/CONTACT_BENCHMARK.md`; the runs of one size were back to back), the contact
 //! benchmark's hemisphere on block in one step (`validation/interface_solver_timing.py`):
 //! wall seconds of the whole process, and the GMRES iterations of each active-set iteration
-//! (the first has no contact yet):
+//! (the first, on the one node touching at the start, takes one):
 //!
 //! | DOFs | schur + Cholesky | krylov + Cholesky (GMRES its) | krylov + CG + AMG (GMRES its) |
 //! |---|---|---|---|
 //! | 31,113 | 9.06 | 7.39 (1, 20, 19, 18, 18, 16, 14) | 12.82 (1, 15, 14, 14, 13, 11, 9) |
 //! | 98,700 | 75.9 | 44.3 (1, 23, 21, 21, 20, 19, 17, 14) | 119.8 (1, 17, 15, 15, 14, 13, 12, 8) |
+//! | 216,537 | 234.8 | 126.2 (1, 25, 22, 21, 21, 20, 19, 17, 14) | not run |
 //!
-//! All six runs end converged after the same 7 and 8 active-set iterations with the same
-//! active nodes (240, 558) and contact force (to the 7 digits printed). The Krylov path on
-//! Cholesky factors wins, and more so as the interface grows (the dense path pays `dim`
-//! solves per new active node: about 3 x 1048 at 99k DOFs, where the first contact
-//! iteration makes the whole overlap active), so it is the default. CG + AMG loses to
-//! Cholesky at these sizes even without per-node solves: a product costs two CG solves of
-//! 15 to 25 iterations each where the factor costs two triangular solves. So `auto` stays
-//! Cholesky for a contact solve (`BodySolverKind::resolve_for_contact`), whichever coupled
-//! solver runs.
+//! Every run ends converged after the same 7, 8 and 9 active-set iterations per size with
+//! the same active nodes (240, 558, 966) and contact force (to the 7 digits printed). The
+//! Krylov path on Cholesky factors wins, and more so as the interface grows (1.2, 1.7, 1.9
+//! times faster: the dense path pays `dim` solves per new active node, about 3 x 1048 at 99k
+//! DOFs, where the first contact iteration makes the whole overlap active), so it is the
+//! default. CG + AMG loses to Cholesky at these sizes even without per-node solves: a
+//! product costs two CG solves (20 to 25 CG iterations each, `crate::linalg::body_solver`)
+//! where the factor costs two pairs of triangular solves. So `auto` stays Cholesky for a
+//! contact solve (`BodySolverKind::resolve_for_contact`), whichever coupled solver runs.
 
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
