@@ -1696,3 +1696,100 @@ fn a_body_slid_sideways_is_paired_where_it_touches() {
         "block loaded about x = {block}, disc {disc}"
     );
 }
+
+/// The largest `|a - b|` over the largest `|b|`.
+fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
+    let max = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = max(&mut a.iter().zip(b).map(|(x, y)| x - y));
+    let scale = max(&mut b.iter().copied());
+    if scale > 0.0 { diff / scale } else { diff }
+}
+
+/// `a` (a solve through the interface GMRES) against `b` (the dense Schur path): the same
+/// active-set history and status, and displacements, pressures and forces within `tolerance`.
+fn assert_same_contact(a: &ContactSolution, b: &ContactSolution, tolerance: f64, label: &str) {
+    assert_eq!(a.status, b.status, "{label}: status");
+    assert_eq!(a.history.len(), b.history.len(), "{label}: iterations");
+    for (x, y) in a.history.iter().zip(&b.history) {
+        assert_eq!(
+            (x.active, x.added, x.removed),
+            (y.active, y.added, y.removed),
+            "{label}: active sets"
+        );
+    }
+    let pairs = [
+        (
+            "primary displacement",
+            &a.primary.displacement,
+            &b.primary.displacement,
+        ),
+        (
+            "secondary displacement",
+            &a.secondary.displacement,
+            &b.secondary.displacement,
+        ),
+        (
+            "pressure",
+            &a.primary_fields.pressure,
+            &b.primary_fields.pressure,
+        ),
+    ];
+    for (name, x, y) in pairs {
+        let difference = relative_difference(x, y);
+        eprintln!("{label}: {name} differs by {difference:.1e} relative");
+        assert!(
+            difference <= tolerance,
+            "{label}: {name} differs by {difference:.2e}"
+        );
+    }
+    let force = relative_difference(&a.force_primary, &b.force_primary);
+    eprintln!("{label}: force differs by {force:.1e} relative");
+    assert!(force <= tolerance, "{label}: force differs by {force:.2e}");
+}
+
+#[test]
+fn krylov_and_schur_solves_agree() {
+    // The interface GMRES against the dense Schur complement, both on Cholesky factors: 2D
+    // Hertz (a partial active set, both formulations), the 3D patch test (both formulations)
+    // and the 3D Hertz hemisphere (a partial set reached after several iterations).
+    let cases = [
+        ("2D frictionless", half_disc_on_block("")),
+        ("2D tied", half_disc_on_block("formulation = \"tied\"")),
+        (
+            "3D patch frictionless",
+            two_blocks(
+                3,
+                "frictionless",
+                &rollers("lower", 3),
+                &rollers("upper", 3),
+            ),
+        ),
+        (
+            "3D patch tied",
+            two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
+        ),
+        (
+            "3D Hertz",
+            hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, ""),
+        ),
+    ];
+    for (label, text) in cases {
+        let with =
+            |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+        let krylov = solve(&with("krylov")).unwrap();
+        let schur = solve(&with("schur")).unwrap();
+        assert_same_contact(&krylov, &schur, 1e-8, label);
+        assert!(krylov.history.iter().all(|h| h.relative_residual < 1e-10));
+    }
+}
+
+#[test]
+fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
+    // With CG + AMG bodies, `schur` runs the interface GMRES (one body solve per product, no
+    // per-node CG solves); each product is exact to CG's rtol (1e-10), GMRES stops at 1e-9.
+    let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
+    let cholesky =
+        solve(&text.replace("[contact]", "[solver]\nbody = \"cholesky\"\n\n[contact]")).unwrap();
+    let cg = solve(&text.replace("[contact]", "[solver]\nbody = \"cg-amg\"\n\n[contact]")).unwrap();
+    assert_same_contact(&cg, &cholesky, 1e-6, "CG + AMG");
+}

@@ -25,6 +25,7 @@ mod coupled_solver;
 mod driver;
 mod hertz;
 mod interface;
+mod interface_krylov;
 mod linearization;
 mod post;
 mod problem;
@@ -38,6 +39,7 @@ pub mod system;
 pub use checks::{Certificate, CertificateCheck, CheckKind};
 pub use coupled_solver::CoupledSolver;
 pub use driver::{ContactRun, StepRecord, solve_contact};
+pub use interface_krylov::{KrylovError, KrylovFailure};
 pub use problem::{
     ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,
     SettingsError, Transfer, TransferReport,
@@ -84,4 +86,6 @@ pub enum ContactError {
     Linalg(String),
     #[error("the coupled solve is inaccurate (relative residual {residual:.2e} > {tolerance:.0e})")]
     Inaccurate { residual: f64, tolerance: f64 },
+    #[error(transparent)]
+    Krylov(#[from] interface_krylov::KrylovError),
 }

@@ -163,9 +163,10 @@ impl<'a> ContactSolver<'a> {
         let body1 = assemble(&problem.primary, &mut stats1, false)?;
         let body2 = assemble(&problem.secondary, &mut stats2, false)?;
         let factors = match problem.settings.solver {
-            CoupledSolver::Schur => {
+            CoupledSolver::MonolithicLu => None,
+            method => {
                 let start = Instant::now();
-                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver)?;
+                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver, method)?;
                 if solver.verbose {
                     eprintln!(
                         "  Cholesky of both bodies: {:.3} s",
@@ -174,7 +175,6 @@ impl<'a> ContactSolver<'a> {
                 }
                 Some(factors)
             }
-            CoupledSolver::MonolithicLu => None,
         };
         let operators = pair(problem, [0.0; 3])?;
         Ok(Self {
@@ -348,7 +348,14 @@ impl ContactSolver<'_> {
     ) -> Result<CoupledSolution, ContactError> {
         let dim = self.problem.primary_surface.dim;
         let system = CoupledSystem::assemble(&self.body1, &self.body2, coupling, dim, load_factor)?;
-        let x = coupled_solver::solve(&system, &self.body1, &self.body2, self.factors.as_mut())?;
+        let x = coupled_solver::solve(
+            &system,
+            coupling,
+            dim,
+            &self.body1,
+            &self.body2,
+            self.factors.as_mut(),
+        )?;
         let residual = system.relative_residual(&self.body1, &self.body2, &x);
         if residual.is_nan() || residual > self.solver.residual_tolerance {
             return Err(ContactError::Inaccurate {
