@@ -1381,7 +1381,7 @@ fn assert_hertz_3d(solution: &ContactSolution, mesh: &str, e_star: f64, label: &
         solution.certificate.failures()
     );
     // INTERNODES transfers forces through R21, which is not the transpose of R12: the balance
-    // is only approximate (measured: see the README's contact table).
+    // is only approximate (the equilibrium residual bounds it: `docs/method.md` 4.1).
     assert_contact_conditions(solution, 0.03, label);
 
     // Hertz (`docs/method.md` 5): a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2), R = 1.

@@ -10,7 +10,7 @@ curved body as the primary.
 
 For the stiff-block-primary runs the block is meshed BLOCK_RATIO = 2 times coarser than the curved
 body (``block_ratio`` of the geo scripts; the curved-primary runs keep 1): the coarser contact
-surface carries the multiplier, as ``primary = "auto"`` would choose (README, Contact). A multiplier
+surface carries the multiplier, as ``primary = "auto"`` would choose (`docs/method.md` 3.6). A multiplier
 mesh coarser than the mesh it constrains is the classical inf-sup-stable choice; with a nearly
 rigid primary as fine as the secondary the multiplier has modes that nothing controls (the sweep
 has such cases: they must be right or end with a named failure).
@@ -268,7 +268,7 @@ def _text(rows, data: dict) -> str:
         "",
         "Choosing the primary. The stiff block runs are meshed "
         f"{BLOCK_RATIO} times coarser, the configuration `primary = \"auto\"` picks (the coarser contact "
-        "surface carries the multiplier: README, Contact). The force on the curved body is the one "
+        "surface carries the multiplier: docs/method.md 3.6). The force on the curved body is the one "
         "compared.",
     ]
     return "\n".join(lines)

@@ -190,7 +190,7 @@ class Case:
     mesh_overrides: tuple = ()  # (geo parameter, value) pairs replacing the defaults of ``geo``
     slide: float = 0.0  # spacings the curved body's support is also pushed sideways (x)
     why: str = ""
-    # False: outside the supported range (README, "Contact"): the solve must then either be right
+    # False: outside the supported range (`validation/README.md`, supported range): the solve must then either be right
     # (converged, certified, every accuracy check met) or end with a status other than
     # "converged" that names its reason; never a wrong "converged".
     supported: bool = True

@@ -1,6 +1,6 @@
 //! Case files: the TOML that names the mesh, the bodies, their materials and boundary
-//! conditions, the solver settings and the output folder. The format is documented in the
-//! README; every key has one meaning, unknown or misspelled keys are errors.
+//! conditions, the solver settings and the output folder. The format is documented in
+//! `docs/case-file.md`; every key has one meaning, unknown or misspelled keys are errors.
 
 mod error;
 mod schema;

@@ -8,7 +8,7 @@ use super::ContactSurface;
 use super::coupled_solver::CoupledSolver;
 use crate::elastic::ElasticProblem;
 
-/// Which constraint couples the active surfaces (README, "Contact formulations").
+/// Which constraint couples the active surfaces (`docs/method.md` 1.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Formulation {
@@ -20,8 +20,7 @@ pub enum Formulation {
     Tied,
 }
 
-/// How the multiplier's force reaches the secondary body (README, "The force on the
-/// secondary").
+/// How the multiplier's force reaches the secondary body (`docs/method.md` 2.4).
 ///
 /// - `Interpolation` (INTERNODES' own transfer): the secondary receives the traction
 ///   interpolated at its own nodes, `lambda_2 = -R21 lambda`, integrated by its interface mass:
@@ -246,8 +245,7 @@ pub struct PrimaryReport {
     /// Whether the other body may carry the multiplier when this choice does not end
     /// `converged`: auto between bodies of similar stiffness. Between a compliant and a stiff
     /// body the stiff primary is the unstable choice (`ContactProblem::new`), and a retry with
-    /// it turned uncertified answers into certified wrong ones (README, "Choosing the primary
-    /// body").
+    /// it turned uncertified answers into certified wrong ones (`docs/method.md` 3.6).
     #[serde(skip)]
     pub other_may_retry: bool,
     /// Whether the answer must agree with the one the other body gives as primary: an
@@ -414,8 +412,8 @@ impl<'m> ContactProblem<'m> {
     /// it constrains is the classical inf-sup-stable choice, and the finer secondary receives
     /// the interpolated traction (`R21`), which balances the forces to the interpolation's
     /// accuracy. The mortar rule (the finer side primary, the conservative transfer to the
-    /// coarser one) measured worse on two equal hemispheres meshed 1.5 times apart (README,
-    /// "Choosing the primary body"). The price is the sag of a curved secondary between the
+    /// coarser one) measured worse on two equal hemispheres meshed 1.5 times apart (`docs/method.md`
+    /// 3.6). The price is the sag of a curved secondary between the
     /// nodes of a coarse flat primary, which the certificate measures; the retry with the
     /// other primary (`super::driver`) answers it.
     pub fn new(

@@ -4,7 +4,7 @@
 //! to the `block` unknowns of each node, which keeps each node's unknowns together and makes
 //! the graph `block^2` times smaller than the dof graph. faer's own AMD is the alternative.
 //! On 3D elasticity nested dissection measured about 2x faster than AMD with a third less
-//! memory (benches/README.md has this machine's figures).
+//! memory (`validation/BENCHMARK.md` has this machine's figures).
 
 use std::ptr;
 use std::sync::{Mutex, PoisonError};
