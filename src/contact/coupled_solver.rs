@@ -1,6 +1,6 @@
 //! How the coupled system of an iteration is solved, behind one interface.
 //!
-//! - [`CoupledSolver::Krylov`] (default): each body's constrained stiffness is factored once
+//! - [`CoupledSolver::Krylov`]: each body's constrained stiffness is factored once
 //!   (sparse Cholesky; or CG + AMG set up once, with `[solver] body = "cg-amg"`: see
 //!   `crate::linalg::BodySolver`) for the whole contact solve, and every iteration solves
 //!   only the interface problem by block elimination:
@@ -38,8 +38,12 @@
 //! the same active nodes (240, 558, 966) and contact force (to the 7 digits printed). The
 //! Krylov path on Cholesky factors wins, and more so as the interface grows (1.2, 1.7, 1.9
 //! times faster: the dense path pays `dim` solves per new active node, about 3 x 1048 at 99k
-//! DOFs, where the first contact iteration makes the whole overlap active), so it is the
-//! default. CG + AMG loses to Cholesky at these sizes even without per-node solves: a
+//! DOFs, where the first contact iteration makes the whole overlap active). It is not the
+//! default yet: with a stiff body named primary on a compliant one (E ratio 1e4, 2D R/600 and
+//! 3D R/45 foreign meshes), the half-space preconditioner does not tame the interface
+//! problem, and GMRES stagnated or reached its 600 iterations in 16 of 180 such runs (an
+//! error that names it, never an answer), where the dense path solves every one; `schur`
+//! stays the default until the Krylov path is robust there. CG + AMG loses to Cholesky at these sizes even without per-node solves: a
 //! product costs two CG solves (20 to 25 CG iterations each, `crate::linalg::body_solver`)
 //! where the factor costs two pairs of triangular solves. So `auto` stays Cholesky for a
 //! contact solve (`BodySolverKind::resolve_for_contact`), whichever coupled solver runs.
@@ -61,13 +65,15 @@ use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
 #[serde(rename_all = "kebab-case")]
 pub enum CoupledSolver {
     /// Cholesky of each body once, dense Schur complement on the multipliers per iteration.
+    /// The default: exact whatever the conditioning of the interface problem (below).
+    #[default]
     Schur,
     /// Sparse LU of the whole saddle-point matrix per iteration (reference).
     MonolithicLu,
     /// Each body's solver set up once, the interface problem solved matrix-free by
     /// preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies).
-    /// The default: faster than `schur` at the contact benchmark's sizes (module doc).
-    #[default]
+    /// Faster than `schur` at the contact benchmark's sizes, but not yet the default (module
+    /// doc).
     Krylov,
 }
 
