@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{fixture, read_fixture, write_case};
+use common::{block_3d_case, fixture, read_fixture, write_case};
 use internodes::case::{Case, CaseError};
 use internodes::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use internodes::fem::Material;
@@ -62,32 +62,9 @@ fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
     max_abs(&diff) / max_abs(b)
 }
 
-/// A valid 3D case on the `block_3d` fixture with `solver` as its `[solver]` table.
+/// The `block_3d` case with `solver` as its `[solver]` table.
 fn block_case(solver: &str) -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-uz = 0.0
-
-[[body.load]]
-group = "block_top"
-hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
-
-[solver]
-{solver}
-"#,
-        fixture("block_3d.msh").display()
-    )
+    format!("{}\n[solver]\n{solver}\n", block_3d_case())
 }
 
 #[test]

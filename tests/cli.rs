@@ -6,38 +6,13 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{fixture, write_case};
+use common::{block_3d_case, fixture, write_case};
 use internodes::case::CaseError;
 use internodes::elastic::{ProblemError, SolveError};
 use internodes::fem::MaterialError;
 use internodes::run::{RunError, RunOptions, solve_case};
 
 const BINARY: &str = env!("CARGO_BIN_EXE_internodes");
-
-/// A valid 3D case on the `block_3d` fixture; tests edit its text.
-fn block_case() -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-uz = 0.0
-
-[[body.load]]
-group = "block_top"
-hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
-"#,
-        fixture("block_3d.msh").display()
-    )
-}
 
 fn run_quiet(case: &Path) -> Result<internodes::run::RunReport, RunError> {
     solve_case(
@@ -66,7 +41,7 @@ fn failure(text: &str) -> (RunError, String) {
 
 #[test]
 fn solve_writes_xdmf_hdf5_and_summary() {
-    let (dir, path) = write_case(&block_case());
+    let (dir, path) = write_case(&block_3d_case());
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap(), "--export-matrices"])
         .output()
@@ -137,7 +112,7 @@ fn info_prints_groups_and_counts() {
 
 #[test]
 fn cli_reports_errors_with_a_failure_status() {
-    let (_dir, path) = write_case(&block_case().replace("youngs_modulus", "youngs_modulu"));
+    let (_dir, path) = write_case(&block_3d_case().replace("youngs_modulus", "youngs_modulu"));
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap()])
         .output()
@@ -153,7 +128,7 @@ fn cli_reports_errors_with_a_failure_status() {
 
 #[test]
 fn misspelled_key_names_the_key_and_line() {
-    let (e, message) = failure(&block_case().replace("poisson_ratio", "poison_ratio"));
+    let (e, message) = failure(&block_3d_case().replace("poisson_ratio", "poison_ratio"));
     assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
     assert!(
         message.contains("poison_ratio") && message.contains("line 7"),
@@ -163,7 +138,7 @@ fn misspelled_key_names_the_key_and_line() {
 
 #[test]
 fn missing_key_is_named() {
-    let (e, message) = failure(&block_case().replace("poisson_ratio = 0.3\n", ""));
+    let (e, message) = failure(&block_3d_case().replace("poisson_ratio = 0.3\n", ""));
     assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
     assert!(message.contains("poisson_ratio"), "{message}");
 }
@@ -171,7 +146,7 @@ fn missing_key_is_named() {
 #[test]
 fn non_physical_materials_are_rejected() {
     let (e, message) =
-        failure(&block_case().replace("youngs_modulus = 1000.0", "youngs_modulus = 0.0"));
+        failure(&block_3d_case().replace("youngs_modulus = 1000.0", "youngs_modulus = 0.0"));
     assert!(
         matches!(
             e,
@@ -183,7 +158,8 @@ fn non_physical_materials_are_rejected() {
         "{message}"
     );
     assert!(message.contains("body 'block'"));
-    let (e, message) = failure(&block_case().replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
+    let (e, message) =
+        failure(&block_3d_case().replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
     assert!(
         matches!(
             e,
@@ -194,14 +170,14 @@ fn non_physical_materials_are_rejected() {
         ),
         "{message}"
     );
-    let (e, _) = failure(&block_case().replace("poisson_ratio = 0.3", "poisson_ratio = -1.2"));
+    let (e, _) = failure(&block_3d_case().replace("poisson_ratio = 0.3", "poisson_ratio = -1.2"));
     assert!(matches!(e, RunError::Case(CaseError::Material { .. })));
 }
 
 #[test]
 fn unknown_group_lists_the_groups_of_the_body() {
     let (e, message) =
-        failure(&block_case().replace("group = \"block_top\"", "group = \"block_tpo\""));
+        failure(&block_3d_case().replace("group = \"block_top\"", "group = \"block_tpo\""));
     assert!(matches!(
         e,
         RunError::Case(CaseError::Problem {
@@ -217,7 +193,7 @@ fn unknown_group_lists_the_groups_of_the_body() {
 
 #[test]
 fn unknown_body_lists_the_bodies_of_the_mesh() {
-    let (e, message) = failure(&block_case().replace("name = \"block\"", "name = \"sphere\""));
+    let (e, message) = failure(&block_3d_case().replace("name = \"block\"", "name = \"sphere\""));
     assert!(matches!(e, RunError::Case(CaseError::UnknownBody { .. })));
     assert!(
         message.contains("'sphere'") && message.contains("its bodies: block"),
@@ -227,7 +203,7 @@ fn unknown_body_lists_the_bodies_of_the_mesh() {
 
 #[test]
 fn a_body_without_dirichlet_condition_is_singular() {
-    let text = block_case();
+    let text = block_3d_case();
     let start = text.find("[[body.dirichlet]]").unwrap();
     let end = text.find("[[body.load]]").unwrap();
     let (e, message) = failure(&format!("{}{}", &text[..start], &text[end..]));
@@ -247,7 +223,7 @@ fn a_body_without_dirichlet_condition_is_singular() {
 #[test]
 fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
     // Only uz = 0 on the flat base: translations in x, y and the rotation about z are free.
-    let (e, message) = failure(&block_case().replace("ux = 0.0\nuy = 0.0\n", ""));
+    let (e, message) = failure(&block_3d_case().replace("ux = 0.0\nuy = 0.0\n", ""));
     assert!(
         matches!(
             e,
@@ -263,7 +239,7 @@ fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
 #[test]
 fn a_load_must_have_exactly_one_kind() {
     let (e, message) =
-        failure(&block_case().replace("hertz_pressure =", "pressure = 1.0\nhertz_pressure ="));
+        failure(&block_3d_case().replace("hertz_pressure =", "pressure = 1.0\nhertz_pressure ="));
     assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
     assert!(
         message.contains("exactly one of") && message.contains("load on 'block_top'"),
@@ -274,14 +250,14 @@ fn a_load_must_have_exactly_one_kind() {
 #[test]
 fn vectors_must_match_the_mesh_dimension() {
     let (e, message) =
-        failure(&block_case().replace("center = [0.0, 0.0, 0.0]", "center = [0.0, 0.0]"));
+        failure(&block_3d_case().replace("center = [0.0, 0.0, 0.0]", "center = [0.0, 0.0]"));
     assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
     assert!(message.contains("expected 3 components"), "{message}");
 }
 
 #[test]
 fn a_bad_mesh_is_reported_through_the_case() {
-    let (e, message) = failure(&block_case().replace("block_3d.msh", "no_such.msh"));
+    let (e, message) = failure(&block_3d_case().replace("block_3d.msh", "no_such.msh"));
     assert!(matches!(e, RunError::Case(CaseError::Mesh { .. })));
     assert!(message.contains("no_such.msh"), "{message}");
 }
@@ -289,7 +265,7 @@ fn a_bad_mesh_is_reported_through_the_case() {
 #[test]
 fn inaccurate_solves_are_errors_not_results() {
     // A residual tolerance below round-off cannot be met: the solve must say so.
-    let text = block_case().replace(
+    let text = block_3d_case().replace(
         "[[body]]",
         "[solver]\nresidual_tolerance = 1e-30\n\n[[body]]",
     );
@@ -309,7 +285,7 @@ fn inaccurate_solves_are_errors_not_results() {
 #[test]
 fn the_output_folder_may_come_from_the_flag_alone() {
     // `output` used to be required in the case file even with --output.
-    let (dir, path) = write_case(&block_case().replace("output = \"out\"\n", ""));
+    let (dir, path) = write_case(&block_3d_case().replace("output = \"out\"\n", ""));
     let out = dir.path().join("elsewhere");
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap(), "--quiet", "--output"])
@@ -326,7 +302,7 @@ fn the_output_folder_may_come_from_the_flag_alone() {
 
 #[test]
 fn without_the_output_key_or_flag_the_error_names_both() {
-    let (e, message) = failure(&block_case().replace("output = \"out\"\n", ""));
+    let (e, message) = failure(&block_3d_case().replace("output = \"out\"\n", ""));
     assert!(
         matches!(e, RunError::Case(CaseError::Invalid { .. })),
         "{message}"

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
-use common::{fixture, write_case};
+use common::{block_3d_case, fixture, write_case};
 use internodes::elastic::{
     DirichletCondition, ElasticProblem, SolveStats, SolverSettings, assemble, solve,
 };
@@ -231,27 +231,7 @@ fn assert_thread_independent(text: &str, fields: &[&str]) {
 
 #[test]
 fn a_single_body_run_is_identical_for_any_thread_count() {
-    let text = format!(
-        r#"mesh = "{}"
-output = "out"
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-uz = 0.0
-
-[[body.load]]
-group = "block_top"
-hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
-"#,
-        fixture("block_3d.msh").display()
-    );
+    let text = block_3d_case();
     assert_thread_independent(&text, &["fields/displacement", "fields/stress"]);
 }
 

@@ -76,6 +76,32 @@ pub fn run_solve_with(case: &Path, env: &[(&str, &str)]) -> Output {
         .expect("run the internodes binary")
 }
 
+/// A valid 3D case on the `block_3d` fixture: the block clamped at its base under a Hertzian
+/// pressure on its top; tests edit its text.
+pub fn block_3d_case() -> String {
+    format!(
+        r#"mesh = "{}"
+output = "out"
+
+[[body]]
+name = "block"
+youngs_modulus = 1000.0
+poisson_ratio = 0.3
+
+[[body.dirichlet]]
+group = "block_base"
+ux = 0.0
+uy = 0.0
+uz = 0.0
+
+[[body.load]]
+group = "block_top"
+hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
+"#,
+        fixture("block_3d.msh").display()
+    )
+}
+
 /// The contact case of `geo/half_disc_on_block.toml` on the fixture `mesh`: the half-disc
 /// (R = 1) pressed by 0.02 onto the block, both E = 1000, nu = 0.3; `extra` lines go into the
 /// `[contact]` table.
