@@ -16,8 +16,8 @@ use crate::mesh::BodyMesh;
 use crate::mesh::{Mesh, MeshError, mesh_geo, read_msh, read_msh_bytes};
 use crate::output::{
     BodyFields, BodySummary, CaseSummary, ContactSummary, GENERATED_MESH, OutputError,
-    ResultFolder, force_displacement_csv, mark_failed_folder, write_force_displacement_png,
-    write_matrix_market, write_xdmf,
+    ResultFolder, force_displacement_csv, mark_failed_folder, peak_memory_mb,
+    write_force_displacement_png, write_matrix_market, write_xdmf,
 };
 
 /// Command-line overrides of the case file.
@@ -397,6 +397,7 @@ fn summarize(
         bodies,
         contact,
         timings,
+        peak_memory_mb: peak_memory_mb(),
     }
 }
 
@@ -423,6 +424,7 @@ fn summarize_contact(
         solved,
         accuracy,
         settings: problem.settings,
+        linear_solvers: solution.linear_solvers.clone(),
         force_primary: solution.force_primary[..dim].to_vec(),
         force_secondary: solution.force_secondary[..dim].to_vec(),
         force_imbalance: solution.force_imbalance,

@@ -12,7 +12,7 @@ use internodes::case::{Case, CaseError};
 use internodes::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use internodes::fem::Material;
 use internodes::fem::loads::{PressureField, SurfaceLoad};
-use internodes::linalg::BodySolverKind;
+use internodes::linalg::{AUTO_CG_AMG_MIN_DOFS_CONTACT, BodySolverKind};
 use internodes::mesh::BodyMesh;
 
 fn material() -> Material {
@@ -109,7 +109,11 @@ fn auto_is_cholesky_for_small_bodies_and_in_2d() {
         BodySolverKind::Cholesky
     );
     assert_eq!(
-        BodySolverKind::Auto.resolve_for_contact(),
+        BodySolverKind::Auto.resolve_for_contact(3, AUTO_CG_AMG_MIN_DOFS_CONTACT - 1),
+        BodySolverKind::Cholesky
+    );
+    assert_eq!(
+        BodySolverKind::Auto.resolve_for_contact(2, 10_000_000),
         BodySolverKind::Cholesky
     );
     assert_eq!(

@@ -1752,9 +1752,22 @@ fn krylov_and_schur_solves_agree() {
     // The interface GMRES against the dense Schur complement, both on Cholesky factors: 2D
     // Hertz (a partial active set, both formulations), the 3D patch test (both formulations)
     // and the 3D Hertz hemisphere (a partial set reached after several iterations).
+    //
+    // GMRES stops early on the iterations that change the active set (`LOOSE_GAP` in
+    // src/contact/solve.rs), so the next iteration's gaps are linearized at a slightly
+    // different point. Where the active set is right from the first solve (the patch tests,
+    // the 2D cases here) the two paths solve the same systems and agree to round-off. On the
+    // 3D hemisphere they reach the same active sets and each final iterate holds its active
+    // gaps within the settled tolerance (`SETTLED` = 0.01 of the penetration tolerance 1e-3
+    // h, 1e-5 h), so the answers may differ by that much: 1e-5 h / delta = 1.5e-5 relative
+    // for h = R/67, delta = 0.01 R. 1e-6 asks for fifteen times less.
     let cases = [
-        ("2D frictionless", half_disc_on_block("")),
-        ("2D tied", half_disc_on_block("formulation = \"tied\"")),
+        ("2D frictionless", half_disc_on_block(""), 1e-8),
+        (
+            "2D tied",
+            half_disc_on_block("formulation = \"tied\""),
+            1e-8,
+        ),
         (
             "3D patch frictionless",
             two_blocks(
@@ -1763,23 +1776,31 @@ fn krylov_and_schur_solves_agree() {
                 &rollers("lower", 3),
                 &rollers("upper", 3),
             ),
+            1e-8,
         ),
         (
             "3D patch tied",
             two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
+            1e-8,
         ),
         (
             "3D Hertz",
             hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, ""),
+            1e-6,
         ),
     ];
-    for (label, text) in cases {
+    for (label, text, tolerance) in cases {
         let with =
             |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
         let krylov = solve(&with("krylov")).unwrap();
         let schur = solve(&with("schur")).unwrap();
-        assert_same_contact(&krylov, &schur, 1e-8, label);
-        assert!(krylov.history.iter().all(|h| h.relative_residual < 1e-10));
+        assert_same_contact(&krylov, &schur, tolerance, label);
+        // Iterations that change the active set may stop GMRES early (a loose solve); the
+        // answer is the last iteration's, solved to round-off.
+        let last = krylov.history.last().unwrap();
+        assert!(last.relative_residual < 1e-10, "{label}: {last:?}");
+        assert_eq!(krylov.linear_solvers.interface, "krylov");
+        assert_eq!(schur.linear_solvers.interface, "schur");
     }
 }
 

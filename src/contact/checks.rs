@@ -885,6 +885,7 @@ impl Update {
             max_gap_error_over_h: self.max_gap_error_over_h,
             pairing_drift_over_h,
             relative_residual: residual,
+            krylov_iterations: None,
             seconds,
         }
     }

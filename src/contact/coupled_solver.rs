@@ -16,37 +16,40 @@
 //!   single-column solves per body, plus `dim` solves per body for each node that becomes
 //!   active for the first time. With CG + AMG body solves each of those columns is a full CG
 //!   solve: `schur` then runs the Krylov path.
+//! - [`CoupledSolver::Auto`]: Krylov, and Schur after a GMRES failure (below).
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
 //!
-//! # Which one, and what `[solver] body = "auto"` means here
+//! # Which one: `auto`
 //!
-//! Measured 2026-11-26 on this project's 2-core machine, shared (load average about 6 during
-//! the runs, so the schur figures are 1.5 to 2.7 times the quiet machine's of
-//! `validation/CONTACT_BENCHMARK.md`; the runs of one size were back to back), the contact
-//! benchmark's hemisphere on block in one step (`validation/interface_solver_timing.py`):
-//! wall seconds of the whole process, and the GMRES iterations of each active-set iteration
-//! (the first, on the one node touching at the start, takes one):
+//! `auto` (the default) runs the Krylov path and moves to the dense Schur complement for the
+//! rest of the solve at the first GMRES failure. The Krylov path is faster wherever it was
+//! measured; the dense path is exact whatever the conditioning of the interface problem,
+//! which GMRES needs: with a stiff body named primary on a compliant one (E ratio 1e4, 2D
+//! R/600 and 3D R/45 foreign meshes), the half-space preconditioner does not tame the
+//! interface problem, and GMRES stagnated or reached its cap in 16 of 180 such runs (with
+//! `krylov` an error that names it; with `auto` the dense path then solves them, as `schur`
+//! does). A failed GMRES solve costs at most its iteration cap in products, which is why the
+//! fallback is for the rest of the solve and not retried per iteration.
 //!
-//! | DOFs | schur + Cholesky | krylov + Cholesky (GMRES its) | krylov + CG + AMG (GMRES its) |
+//! Measured 2026-11-26 on this project's 2-core machine (shared, so within 2x), the contact
+//! benchmark's hemisphere on block in one step: wall seconds of the whole process and peak
+//! memory; every run converged after the same 8 (99k) and 9 (217k) active-set iterations,
+//! with the same active nodes and contact force to the 7 digits printed:
+//!
+//! | DOFs | schur + Cholesky | krylov + Cholesky | krylov + CG + AMG |
 //! |---|---|---|---|
-//! | 31,113 | 9.06 | 7.39 (1, 20, 19, 18, 18, 16, 14) | 12.82 (1, 15, 14, 14, 13, 11, 9) |
-//! | 98,700 | 75.9 | 44.3 (1, 23, 21, 21, 20, 19, 17, 14) | 119.8 (1, 17, 15, 15, 14, 13, 12, 8) |
-//! | 216,537 | 234.8 | 126.2 (1, 25, 22, 21, 21, 20, 19, 17, 14) | not run |
+//! | 98,700 | 27 s, 1.7 GB | 19.6 s, 1.3 GB | 52 s, 0.6 GB |
+//! | 216,537 | 133 s, 4.4 GB | 42 s, 3.2 GB | 207 s, 1.2 GB |
 //!
-//! Every run ends converged after the same 7, 8 and 9 active-set iterations per size with
-//! the same active nodes (240, 558, 966) and contact force (to the 7 digits printed). The
-//! Krylov path on Cholesky factors wins, and more so as the interface grows (1.2, 1.7, 1.9
-//! times faster: the dense path pays `dim` solves per new active node, about 3 x 1048 at 99k
-//! DOFs, where the first contact iteration makes the whole overlap active). It is not the
-//! default yet: with a stiff body named primary on a compliant one (E ratio 1e4, 2D R/600 and
-//! 3D R/45 foreign meshes), the half-space preconditioner does not tame the interface
-//! problem, and GMRES stagnated or reached its 600 iterations in 16 of 180 such runs (an
-//! error that names it, never an answer), where the dense path solves every one; `schur`
-//! stays the default until the Krylov path is robust there. CG + AMG loses to Cholesky at these sizes even without per-node solves: a
-//! product costs two CG solves (20 to 25 CG iterations each, `crate::linalg::body_solver`)
-//! where the factor costs two pairs of triangular solves. So `auto` stays Cholesky for a
-//! contact solve (`BodySolverKind::resolve_for_contact`), whichever coupled solver runs.
+//! (schur from `validation/CONTACT_BENCHMARK.md` of the same day; the Krylov runs with the
+//! loose solves of `super::solve`, which cut GMRES iterations per active-set iteration from
+//! 15-25 to 2-10.) CG + AMG loses on time at these sizes: a product costs two CG solves, run
+//! one after the other because PETSc calls are serialized, where a factor costs two pairs of
+//! triangular solves. It wins on memory, which is what bounds the direct path: the factors
+//! grow like `n^(4/3)` (3.2 GB at 217k, 15 GB for one body of 677k DOFs), so `auto` bodies
+//! become CG + AMG from [`crate::linalg::AUTO_CG_AMG_MIN_DOFS_CONTACT`] dofs in the larger
+//! body (`BodySolverKind::resolve_for_contact`).
 
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -54,7 +57,9 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
 use super::compliance::SurfaceResponse;
-use super::interface_krylov::{self, Bodies, KRYLOV_RTOL, KRYLOV_RTOL_OVER_BODY_RTOL, KrylovState};
+use super::interface_krylov::{
+    self, Bodies, KRYLOV_RTOL, KRYLOV_RTOL_OVER_BODY_RTOL, KrylovState, KrylovStats, Target,
+};
 use super::system::{CoupledSystem, Coupling};
 use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
@@ -64,17 +69,31 @@ use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum CoupledSolver {
-    /// Cholesky of each body once, dense Schur complement on the multipliers per iteration.
-    /// The default: exact whatever the conditioning of the interface problem (below).
+    /// The default: [`Self::Krylov`], and [`Self::Schur`] from the first iteration whose GMRES
+    /// solve fails (module doc).
     #[default]
+    Auto,
+    /// Each body's solver set up once, dense Schur complement on the multipliers per
+    /// iteration: exact whatever the conditioning of the interface problem.
     Schur,
     /// Sparse LU of the whole saddle-point matrix per iteration (reference).
     MonolithicLu,
     /// Each body's solver set up once, the interface problem solved matrix-free by
-    /// preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies).
-    /// Faster than `schur` at the contact benchmark's sizes, but not yet the default (module
-    /// doc).
+    /// preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies); a
+    /// GMRES solve that fails ends the contact solve with that error.
     Krylov,
+}
+
+impl CoupledSolver {
+    /// The name used in case files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Schur => "schur",
+            Self::MonolithicLu => "monolithic-lu",
+            Self::Krylov => "krylov",
+        }
+    }
 }
 
 /// The solvers (Cholesky factors, or CG + AMG) of both bodies' constrained stiffness matrices,
@@ -83,7 +102,16 @@ pub enum CoupledSolver {
 pub struct BodyFactors {
     factor1: BodySolver,
     factor2: BodySolver,
+    /// CG's relative residual (`None` for factors).
+    body_rtol: Option<f64>,
     interface: Interface,
+    /// The candidate nodes of each body, for the dense Schur path `auto` falls back to.
+    fallback: Option<[Vec<usize>; 2]>,
+    /// Why the interface solve left GMRES for the dense Schur complement, if it did.
+    pub fell_back: Option<String>,
+    /// The last Krylov solve's figures (`None` when the last solve was not a Krylov one).
+    pub last_krylov: Option<KrylovStats>,
+    dim: usize,
     verbose: bool,
 }
 
@@ -101,20 +129,28 @@ enum Interface {
     },
 }
 
+impl Interface {
+    fn dense(nodes: [&[usize]; 2], dim: usize, sizes: [usize; 2]) -> Self {
+        Self::Dense {
+            response1: SurfaceResponse::new(nodes[0], dim, sizes[0]),
+            response2: SurfaceResponse::new(nodes[1], dim, sizes[1]),
+        }
+    }
+}
+
 impl BodyFactors {
-    /// Factors both bodies (or sets up CG + AMG: `settings.body`, `auto` being Cholesky
-    /// here) for the interface solve `method` (`Schur` or `Krylov`; `Schur` on CG + AMG is
-    /// `Krylov`, see the module doc); the response caches cover their candidate surfaces.
+    /// Sets up both bodies' solvers (`kind`: Cholesky or CG + AMG, resolved by the caller)
+    /// for the interface solve `method`; the response caches cover the candidate surfaces.
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
         surface1: &ContactSurface,
         surface2: &ContactSurface,
         settings: &SolverSettings,
+        kind: BodySolverKind,
         method: CoupledSolver,
     ) -> Result<Self, ContactError> {
         let dim = surface1.dim;
-        let kind = settings.body.resolve_for_contact();
         let factor = |body: &AssembledBody| match kind {
             BodySolverKind::CgAmg => {
                 BodySolver::cg_amg(&body.k_c, body.dim, &body.coordinates, settings.rtol)
@@ -125,35 +161,38 @@ impl BodyFactors {
                 .map(BodySolver::Cholesky)
                 .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}"))),
         };
-        // The two factorizations are independent: side by side.
+        // The two set-ups are independent: side by side.
         let (factor1, factor2) = rayon::join(|| factor(body1), || factor(body2));
-        let interface = if method == CoupledSolver::Krylov || kind == BodySolverKind::CgAmg {
-            let tolerance = match kind {
-                BodySolverKind::CgAmg => {
-                    KRYLOV_RTOL.max(KRYLOV_RTOL_OVER_BODY_RTOL * settings.rtol)
-                }
-                _ => KRYLOV_RTOL,
+        let cg = kind == BodySolverKind::CgAmg;
+        let krylov = cg || matches!(method, CoupledSolver::Krylov | CoupledSolver::Auto);
+        let sizes = [body1.f_c.len(), body2.f_c.len()];
+        let interface = if krylov {
+            let tolerance = match cg {
+                true => KRYLOV_RTOL.max(KRYLOV_RTOL_OVER_BODY_RTOL * settings.rtol),
+                false => KRYLOV_RTOL,
             };
             Interface::Krylov {
                 state: KrylovState::default(),
                 tolerance,
             }
         } else {
-            Interface::Dense {
-                response1: SurfaceResponse::new(&surface1.nodes, dim, body1.f_c.len()),
-                response2: SurfaceResponse::new(&surface2.nodes, dim, body2.f_c.len()),
-            }
+            Interface::dense([&surface1.nodes, &surface2.nodes], dim, sizes)
         };
+        let fallback = (method == CoupledSolver::Auto)
+            .then(|| [surface1.nodes.clone(), surface2.nodes.clone()]);
         Ok(Self {
             factor1: factor1?,
             factor2: factor2?,
+            body_rtol: cg.then_some(settings.rtol),
             interface,
+            fallback,
+            fell_back: None,
+            last_krylov: None,
+            dim,
             verbose: settings.verbose,
         })
     }
-}
 
-impl BodyFactors {
     /// Forgets the bodies' responses to the multipliers: the interface operators changed.
     /// (The Krylov warm start is kept: tractions mapped by node stay a good first guess.)
     pub fn forget_responses(&mut self) {
@@ -166,63 +205,79 @@ impl BodyFactors {
             response2.clear();
         }
     }
-}
 
-/// Solves the coupled system of `coupling` (on bodies of dimension `dim`); returns
-/// `x = [u1; u2; lambda / s]`.
-pub fn solve(
-    system: &CoupledSystem,
-    coupling: &Coupling,
-    dim: usize,
-    body1: &AssembledBody,
-    body2: &AssembledBody,
-    factors: Option<&mut BodyFactors>,
-) -> Result<Vec<f64>, ContactError> {
-    let Some(factors) = factors else {
-        return solve_monolithic(system, body1, body2);
-    };
-    let BodyFactors {
-        factor1,
-        factor2,
-        interface,
-        verbose,
-    } = factors;
-    match interface {
-        Interface::Dense {
-            response1,
-            response2,
-        } => solve_schur(system, factor1, factor2, response1, response2),
-        Interface::Krylov { state, tolerance } => {
-            let bodies = Bodies {
-                solver1: factor1,
-                solver2: factor2,
-            };
-            let x = interface_krylov::solve(
-                system,
-                coupling,
-                &body1.coordinates,
-                dim,
-                &bodies,
-                state,
-                *tolerance,
-            )?;
-            if *verbose {
-                let stats = state.last;
-                eprintln!(
-                    "    interface GMRES: {} iterations (+{} residuals), relative residual \
-                     {:.1e} (start {:.1e})",
-                    stats.iterations,
-                    stats.residual_products,
-                    stats.relative_residual,
-                    stats.initial_residual
-                );
+    /// Whether the interface problem is solved by GMRES (whose solves can stop short of
+    /// round-off on request: [`Self::solve`]).
+    pub fn is_krylov(&self) -> bool {
+        matches!(self.interface, Interface::Krylov { .. })
+    }
+
+    /// Solves the coupled system of `coupling`; returns `x = [u1; u2; lambda / s]`.
+    ///
+    /// `gap_tolerance` (a length), on the Krylov path only: GMRES may stop once every active
+    /// node's constraint holds its gap to within it, instead of at round-off; the caller
+    /// then owns the residual check. A GMRES failure under `auto` moves this and every later
+    /// iteration to the dense Schur complement ([`Self::fell_back`] says why).
+    pub fn solve(
+        &mut self,
+        system: &CoupledSystem,
+        coupling: &Coupling,
+        coordinates1: &[f64],
+        gap_tolerance: Option<f64>,
+    ) -> Result<Vec<f64>, ContactError> {
+        self.last_krylov = None;
+        let (state, tolerance) = match &mut self.interface {
+            Interface::Dense {
+                response1,
+                response2,
+            } => return solve_schur(system, &self.factor1, &self.factor2, response1, response2),
+            Interface::Krylov { state, tolerance } => (state, *tolerance),
+        };
+        let bodies = Bodies {
+            solver1: &self.factor1,
+            solver2: &self.factor2,
+            rtol: self.body_rtol,
+        };
+        let target = Target {
+            relative: tolerance,
+            absolute: gap_tolerance.map_or(0.0, |gap| system.t * gap),
+        };
+        let dim = self.dim;
+        let solved =
+            interface_krylov::solve(system, coupling, coordinates1, dim, &bodies, state, target);
+        let stats = state.last;
+        self.last_krylov = Some(stats);
+        if self.verbose {
+            eprintln!(
+                "    interface GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
+                 (start {:.1e}, target {:.1e})",
+                stats.iterations,
+                stats.residual_products,
+                stats.relative_residual,
+                stats.initial_residual,
+                stats.tolerance,
+            );
+        }
+        match (solved, self.fallback.take()) {
+            (Err(ContactError::Krylov(failure)), Some([nodes1, nodes2])) => {
+                if self.verbose {
+                    eprintln!("    {failure}: the dense Schur complement from here on");
+                }
+                let sizes = [system.n1, system.n2];
+                self.interface = Interface::dense([&nodes1, &nodes2], dim, sizes);
+                self.fell_back = Some(failure.to_string());
+                self.solve(system, coupling, coordinates1, gap_tolerance)
             }
-            Ok(x)
+            (solved, fallback) => {
+                self.fallback = fallback;
+                solved
+            }
         }
     }
 }
 
-fn solve_monolithic(
+/// The coupled system solved by one sparse LU of its whole matrix.
+pub fn solve_monolithic(
     system: &CoupledSystem,
     body1: &AssembledBody,
     body2: &AssembledBody,

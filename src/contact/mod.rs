@@ -45,7 +45,8 @@ pub use problem::{
     SettingsError, Transfer, TransferReport,
 };
 pub use solution::{
-    ContactSolution, ContactStatus, HertzFit, IterationRecord, PhaseSeconds, SurfaceFields,
+    ContactSolution, ContactStatus, HertzFit, IterationRecord, LinearSolvers, PhaseSeconds,
+    SurfaceFields,
 };
 pub use solve::{ActiveSet, ContactSolver};
 pub use surface::{ContactSurface, SurfaceError};

@@ -24,6 +24,7 @@ pub(super) fn finish(
     active_set: ActiveSet,
 ) -> Result<ContactSolution, ContactError> {
     let problem = solver.problem;
+    let linear_solvers = solver.linear_solvers();
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let dim = s1.dim;
     let [gaps1, gaps2] = gaps;
@@ -100,6 +101,7 @@ pub(super) fn finish(
         &solver.stats2,
     );
     Ok(ContactSolution {
+        linear_solvers,
         status,
         history,
         primary,

@@ -72,8 +72,9 @@ pub struct ContactSettings {
     pub formulation: Formulation,
     /// How the multiplier's force reaches the secondary (default: auto, [`Transfer`]).
     pub transfer: Transfer,
-    /// How each iteration's linear system is solved (default: `krylov`, the interface Schur
-    /// system by GMRES on the bodies' solvers set up once; `super::coupled_solver`).
+    /// How each iteration's linear system is solved (default: `auto`, the interface Schur
+    /// system by GMRES on the bodies' solvers set up once, the dense Schur complement if
+    /// GMRES fails; `super::coupled_solver`).
     pub solver: CoupledSolver,
     /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
     pub max_iterations: usize,

@@ -94,6 +94,9 @@ pub struct IterationRecord {
     /// active primary nodes (they are paired again beyond 0.05).
     pub pairing_drift_over_h: f64,
     pub relative_residual: f64,
+    /// GMRES iterations of the iteration's interface solves (a loose solve and, when its
+    /// answer keeps the active set, the exact one); `None` on the dense paths.
+    pub krylov_iterations: Option<usize>,
     pub seconds: PhaseSeconds,
 }
 
@@ -149,8 +152,21 @@ pub struct HertzFit {
     pub center: [f64; 3],
 }
 
+/// The linear solvers a contact solve ran, `auto` resolved.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LinearSolvers {
+    /// Each body's: `"cholesky"` or `"cg-amg"` (`"monolithic-lu"` factors the whole system).
+    pub body: &'static str,
+    /// The interface problem's: `"krylov"`, `"schur"` or `"monolithic-lu"`.
+    pub interface: &'static str,
+    /// Why an `auto` solve left GMRES for the dense Schur complement (then `interface` is
+    /// `"schur"` from that iteration on).
+    pub krylov_failure: Option<String>,
+}
+
 /// Everything a contact solve produces.
 pub struct ContactSolution {
+    pub linear_solvers: LinearSolvers,
     pub status: ContactStatus,
     pub history: Vec<IterationRecord>,
     pub primary: ElasticSolution,

@@ -70,10 +70,11 @@ use super::checks::{Update, certify, contact_status};
 use super::coupled_solver::{self, BodyFactors, CoupledSolver};
 use super::interface::{Constraint, InterfaceOperators, geometric_gaps};
 use super::linearization::{GapRow, gap_rows};
-use super::solution::{ContactSolution, ContactStatus, PhaseSeconds};
+use super::solution::{ContactSolution, ContactStatus, LinearSolvers, PhaseSeconds};
 use super::system::{CoupledSolution, CoupledSystem, Coupling};
 use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer, post};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
+use crate::linalg::BodySolverKind;
 
 /// An active node this many spacings off the other surface after a solve means the constraint
 /// no longer controls the geometry ([`ContactStatus::Unstable`]). On converging cases the active
@@ -134,6 +135,8 @@ pub struct ContactSolver<'a> {
     pub(super) stats1: SolveStats,
     pub(super) stats2: SolveStats,
     factors: Option<BodyFactors>,
+    /// The body solver `factors` holds (`auto` resolved).
+    body_solver: BodySolverKind,
     /// Paired for the slide of the last solve; a solve without a start pairs them again
     /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
@@ -162,16 +165,20 @@ impl<'a> ContactSolver<'a> {
         let (mut stats1, mut stats2) = (SolveStats::default(), SolveStats::default());
         let body1 = assemble(&problem.primary, &mut stats1, false)?;
         let body2 = assemble(&problem.secondary, &mut stats2, false)?;
+        let dofs = body1.f_c.len().max(body2.f_c.len());
+        let kind = solver.body.resolve_for_contact(s1.dim, dofs);
         let factors = match problem.settings.solver {
             CoupledSolver::MonolithicLu => None,
             method => {
                 let start = Instant::now();
-                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver, method)?;
+                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver, kind, method)?;
                 if solver.verbose {
-                    eprintln!(
-                        "  Cholesky of both bodies: {:.3} s",
-                        start.elapsed().as_secs_f64()
-                    );
+                    let what = match kind {
+                        BodySolverKind::CgAmg => "CG + AMG set-up",
+                        _ => "Cholesky",
+                    };
+                    let seconds = start.elapsed().as_secs_f64();
+                    eprintln!("  {what} of both bodies: {seconds:.3} s");
                 }
                 Some(factors)
             }
@@ -185,8 +192,28 @@ impl<'a> ContactSolver<'a> {
             stats1,
             stats2,
             factors,
+            body_solver: kind,
             operators,
         })
+    }
+
+    /// The body and interface solvers that ran.
+    pub fn linear_solvers(&self) -> LinearSolvers {
+        match &self.factors {
+            None => LinearSolvers {
+                body: CoupledSolver::MonolithicLu.name(),
+                interface: CoupledSolver::MonolithicLu.name(),
+                krylov_failure: None,
+            },
+            Some(factors) => LinearSolvers {
+                body: self.body_solver.name(),
+                interface: match factors.is_krylov() {
+                    true => CoupledSolver::Krylov.name(),
+                    false => CoupledSolver::Schur.name(),
+                },
+                krylov_failure: factors.fell_back.clone(),
+            },
+        }
     }
 
     /// The primary candidates that touch or penetrate in the reference configuration, with
@@ -241,38 +268,54 @@ impl<'a> ContactSolver<'a> {
                 };
                 (self.operators).coupling(s1, s2, formulation, &nodes, constraint)
             });
-            // 2. The coupled solve, checked by its residual.
-            let solution = timed(&mut seconds.solve, || {
-                self.coupled_solve(&coupling, load_factor)
-            })?;
-            // 3. Gaps of every primary candidate: geometric (the search), and the constraints
-            //    linearized at this iterate; how far the active nodes' pairing has slid.
-            let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
-            let (gaps, linear, slid) = timed(&mut seconds.search, || {
-                let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                rows = gap_rows(s1, s2, Some(u1), Some(u2));
-                let jumps = self.operators.jumps(s1, s2, u1, u2);
-                let slid = self.operators.slide(s1, &jumps, &nodes);
-                (gaps, self.operators.linearized_gaps(&jumps), slid)
-            });
-            // The gap each active node's constraint holds: the gap of its linearization.
-            let held: Vec<f64> = match settings.formulation {
-                Formulation::Frictionless => rows.iter().map(|r| r.gap).collect(),
-                Formulation::Tied => gaps.clone(),
+            // 2-4. The coupled solve; the gaps of every primary candidate, geometric (the
+            //    search) and linearized at this iterate, and how far the active nodes' pairing
+            //    has slid; the primal-dual active set update. On the Krylov path the solve is
+            //    first loose (`LOOSE_GAP`) and solved again exactly when its update would keep
+            //    the active set or return to one seen before.
+            let mut loose = self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
+            let h = (nodes.iter().map(|&i| s1.spacing[i])).fold(f64::INFINITY, f64::min);
+            let loose_gap = LOOSE_GAP * settings.penetration_tolerance * h;
+            let mut krylov_iterations = None;
+            let (solution, gaps, slid, update, linear) = loop {
+                let solution = timed(&mut seconds.solve, || {
+                    let gap_tolerance = (loose && loose_gap.is_finite()).then_some(loose_gap);
+                    self.coupled_solve(&coupling, load_factor, gap_tolerance)
+                })?;
+                if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
+                    *krylov_iterations.get_or_insert(0) += stats.iterations;
+                }
+                let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+                let (gaps, linear, slid) = timed(&mut seconds.search, || {
+                    let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
+                    rows = gap_rows(s1, s2, Some(u1), Some(u2));
+                    let jumps = self.operators.jumps(s1, s2, u1, u2);
+                    let slid = self.operators.slide(s1, &jumps, &nodes);
+                    (gaps, self.operators.linearized_gaps(&jumps), slid)
+                });
+                // The gap each active node's constraint holds: the gap of its linearization.
+                let held: Vec<f64> = match settings.formulation {
+                    Formulation::Frictionless => rows.iter().map(|r| r.gap).collect(),
+                    Formulation::Tied => gaps.clone(),
+                };
+                let update = timed(&mut seconds.checks, || {
+                    let (traction, normals) = (&solution.traction, &coupling.normals);
+                    Update::new(
+                        problem,
+                        &nodes,
+                        traction,
+                        normals,
+                        [&gaps, &held],
+                        &safeguard.pinned,
+                    )
+                });
+                if loose && (update.next == active || safeguard.seen.contains(&update.next)) {
+                    loose = false;
+                    continue;
+                }
+                break (solution, gaps, slid, update, linear);
             };
             let drift = pairing_drift(&self.operators.slid, &slid, s1, &nodes);
-            // 4. The primal-dual active set update, and the gap corrections.
-            let update = timed(&mut seconds.checks, || {
-                let (traction, normals) = (&solution.traction, &coupling.normals);
-                Update::new(
-                    problem,
-                    &nodes,
-                    traction,
-                    normals,
-                    [&gaps, &held],
-                    &safeguard.pinned,
-                )
-            });
             if settings.formulation == Formulation::Tied {
                 corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
             }
@@ -291,7 +334,8 @@ impl<'a> ContactSolver<'a> {
                 step => step,
             };
             let residual = solution.relative_residual;
-            let record = update.record(iteration, residual, drift, seconds);
+            let mut record = update.record(iteration, residual, drift, seconds);
+            record.krylov_iterations = krylov_iterations;
             if self.solver.verbose {
                 eprintln!("{}", record.line());
             }
@@ -340,24 +384,27 @@ impl ContactSolver<'_> {
         Ok(())
     }
 
-    /// The coupled system of `coupling`, solved and checked by its relative residual.
+    /// The coupled system of `coupling`, solved and checked by its relative residual; or,
+    /// with a `gap_tolerance` (a length; Krylov path), solved until every active node's gap
+    /// is held to it, its residual only recorded.
     fn coupled_solve(
         &mut self,
         coupling: &Coupling,
         load_factor: f64,
+        gap_tolerance: Option<f64>,
     ) -> Result<CoupledSolution, ContactError> {
         let dim = self.problem.primary_surface.dim;
         let system = CoupledSystem::assemble(&self.body1, &self.body2, coupling, dim, load_factor)?;
-        let x = coupled_solver::solve(
-            &system,
-            coupling,
-            dim,
-            &self.body1,
-            &self.body2,
-            self.factors.as_mut(),
-        )?;
+        let x = match self.factors.as_mut() {
+            None => coupled_solver::solve_monolithic(&system, &self.body1, &self.body2)?,
+            Some(factors) => {
+                factors.solve(&system, coupling, &self.body1.coordinates, gap_tolerance)?
+            }
+        };
+        let loose =
+            gap_tolerance.is_some() && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let residual = system.relative_residual(&self.body1, &self.body2, &x);
-        if residual.is_nan() || residual > self.solver.residual_tolerance {
+        if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
             return Err(ContactError::Inaccurate {
                 residual,
                 tolerance: self.solver.residual_tolerance,
@@ -366,6 +413,15 @@ impl ContactSolver<'_> {
         Ok(system.solution(&x, coupling, dim, residual))
     }
 }
+
+/// A loose interface solve holds every active node's gap to this fraction of the penetration
+/// tolerance `tol_p h` (the smallest spacing of the active nodes). The update only reads gaps
+/// against `tol_p h` (a node penetrating beyond it joins the active set) and the signs of the
+/// pressures, so an iterate that is about to change the active set needs no more: its exact
+/// solve would be thrown away with the set. The iteration that keeps the set, and so may
+/// end the loop, is solved again to round-off (from the loose answer) before it is judged:
+/// no answer, status or check rests on a loose solve.
+const LOOSE_GAP: f64 = 0.1;
 
 /// What the loop does after an iteration.
 enum Step {

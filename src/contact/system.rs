@@ -121,6 +121,8 @@ pub struct CoupledSystem {
     pub unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
     /// Multiplier scaling: the unknown is `lambda / s`.
     pub s: f64,
+    /// Constraint row scaling: a row's residual is `t` times the gap error of its node.
+    pub t: f64,
     /// Entries `(row < n1 + n2, multiplier, value)` of B.
     pub b: Vec<(usize, usize, f64)>,
     /// Entries `(multiplier, column < n1 + n2, value)` of C.
@@ -129,6 +131,8 @@ pub struct CoupledSystem {
     pub d: Vec<f64>,
     /// `[f1; f2]` (constrained) and `g`.
     pub f: Vec<f64>,
+    /// The factor `f` is scaled by: `f = load_factor [f1(1); f2(1)]`.
+    pub load_factor: f64,
     pub g: Vec<f64>,
 }
 
@@ -217,10 +221,12 @@ impl CoupledSystem {
             columns,
             unit_loads,
             s,
+            t,
             b,
             c: c_entries,
             d,
             f,
+            load_factor,
             g,
         })
     }

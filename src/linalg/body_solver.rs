@@ -15,9 +15,10 @@
 //! 875,562 dofs (2026-11-26, fastest of 2 runs, same machine and load as below), so `auto`
 //! keeps Cholesky in 2D.
 //!
-//! The contact solve takes Cholesky for `auto` whatever the size: it solves one right-hand
-//! side per multiplier and component, which a factor does for the price of two triangular
-//! solves and CG for a full iterative solve each.
+//! A contact solve takes Cholesky for `auto` up to [`AUTO_CG_AMG_MIN_DOFS_CONTACT`] dofs in
+//! its larger body: it solves a few hundred right-hand sides (the interface GMRES products),
+//! which a factor does for the price of two triangular solves each and CG for a full
+//! iterative solve each; above, the factors no longer fit in memory.
 
 use faer::sparse::SparseColMat;
 use serde::{Deserialize, Serialize};
@@ -63,6 +64,15 @@ pub enum BodySolverKind {
 /// factor's `n^2` work and `n^(4/3)` memory lose to CG + AMG's `O(n)`.
 pub const AUTO_CG_AMG_MIN_DOFS_3D: usize = 30_000;
 
+/// From this many dofs in the larger body on, `auto` solves the bodies of a 3D contact problem
+/// by CG + AMG (when built with PETSc). A contact solve spends a few hundred body solves
+/// (GMRES products), so a factor's cheap repeated solves win on time as long as the factors
+/// fit: on the hemisphere on block (`crate::contact::coupled_solver`'s table, 2026-11-26)
+/// Cholesky bodies took 42 s and 3.2 GB at 216,537 dofs (larger body 116,733) where CG + AMG
+/// took 207 s and 1.2 GB. Factor memory grows like `n^(4/3)`: about 8 to 9 GB for two bodies
+/// of this size, a third of this project's 24 GiB machine; one body of 676,719 dofs took 15 GB.
+pub const AUTO_CG_AMG_MIN_DOFS_CONTACT: usize = 250_000;
+
 /// Whether this binary can solve by CG + AMG.
 pub const CG_AMG_AVAILABLE: bool = cfg!(feature = "petsc");
 
@@ -79,9 +89,15 @@ impl BodySolverKind {
         }
     }
 
-    /// The solver `auto` stands for in a contact solve: Cholesky (see the module doc).
-    pub fn resolve_for_contact(self) -> Self {
+    /// The solver `auto` stands for in a contact solve whose larger body has `num_dofs`
+    /// dofs (see [`AUTO_CG_AMG_MIN_DOFS_CONTACT`]).
+    pub fn resolve_for_contact(self, dim: usize, num_dofs: usize) -> Self {
         match self {
+            Self::Auto
+                if CG_AMG_AVAILABLE && dim == 3 && num_dofs >= AUTO_CG_AMG_MIN_DOFS_CONTACT =>
+            {
+                Self::CgAmg
+            }
             Self::Auto => Self::Cholesky,
             kind => kind,
         }
@@ -139,8 +155,21 @@ impl BodySolver {
     /// `K x = rhs`; returns the most CG iterations a column took (0 for Cholesky).
     ///
     /// Cholesky solves the columns in parallel blocks ([`Cholesky::solve_in_place`]); CG one
-    /// after the other (PETSc calls are serialized).
+    /// after the other (PETSc calls are serialized), to the relative residual it was set up
+    /// with.
     pub fn solve_in_place(&self, rhs: &mut [f64], num_rhs: usize) -> Result<usize, LinalgError> {
+        self.solve_in_place_within(rhs, num_rhs, None)
+    }
+
+    /// [`Self::solve_in_place`], CG stopping at the relative residual `rtol` when given (a
+    /// factor solves exactly whatever `rtol` says).
+    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
+    pub fn solve_in_place_within(
+        &self,
+        rhs: &mut [f64],
+        num_rhs: usize,
+        rtol: Option<f64>,
+    ) -> Result<usize, LinalgError> {
         match self {
             Self::Cholesky(factor) => {
                 factor.solve_in_place(rhs, num_rhs);
@@ -153,7 +182,10 @@ impl BodySolver {
                     return Ok(0);
                 }
                 for column in rhs.chunks_mut(rhs.len() / num_rhs) {
-                    let (x, stats) = cg.solve(column)?;
+                    let (x, stats) = match rtol {
+                        Some(rtol) => cg.solve_within(column, rtol)?,
+                        None => cg.solve(column)?,
+                    };
                     column.copy_from_slice(&x);
                     most = most.max(stats.iterations);
                 }

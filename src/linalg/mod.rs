@@ -8,7 +8,10 @@ mod ordering;
 #[cfg(feature = "petsc")]
 pub mod petsc;
 
-pub use body_solver::{AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE};
+pub use body_solver::{
+    AUTO_CG_AMG_MIN_DOFS_3D, AUTO_CG_AMG_MIN_DOFS_CONTACT, BodySolver, BodySolverKind,
+    CG_AMG_AVAILABLE,
+};
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
 
 use faer::sparse::SparseColMat;

@@ -12,7 +12,9 @@ pub use folder::{
 };
 pub use matrix_market::write_matrix_market;
 pub use plot::{PlotError, write_force_displacement_png};
-pub use summary::{BodySummary, CaseSummary, ContactSummary, force_displacement_csv};
+pub use summary::{
+    BodySummary, CaseSummary, ContactSummary, force_displacement_csv, peak_memory_mb,
+};
 pub use xdmf::{BodyFields, write_xdmf};
 
 use std::path::PathBuf;

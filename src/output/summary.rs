@@ -6,6 +6,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::OutputError;
+use crate::contact::LinearSolvers;
 use crate::contact::{
     Certificate, CertificateCheck, ContactSettings, ContactStatus, HertzFit, IterationRecord,
     PrimaryReport, StepRecord, TransferReport,
@@ -23,6 +24,17 @@ pub struct CaseSummary {
     pub contact: Option<ContactSummary>,
     /// Seconds per phase of the whole run, in order.
     pub timings: Vec<(String, f64)>,
+    /// The process's peak resident memory up to writing the summary, in MB (`VmHWM` of
+    /// `/proc/self/status`; absent where the system does not report it).
+    pub peak_memory_mb: Option<f64>,
+}
+
+/// The process's peak resident set size in MB, where Linux reports it.
+pub fn peak_memory_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
 }
 
 #[derive(Debug, Serialize)]
@@ -57,6 +69,8 @@ pub struct ContactSummary {
     /// Whether the last load step's answer can be trusted: its accuracy indicators.
     pub accuracy: AccuracyReport,
     pub settings: ContactSettings,
+    /// The body and interface solvers that ran (`auto` resolved).
+    pub linear_solvers: LinearSolvers,
     /// Total contact force on each body, and `|F1 + F2| / |F1|`.
     pub force_primary: Vec<f64>,
     pub force_secondary: Vec<f64>,

@@ -63,6 +63,7 @@ unsafe extern "C" {
         solver: *mut RawCgAmg,
         rhs: *const f64,
         x: *mut f64,
+        rtol: f64,
         iterations: *mut i64,
         residual_norm: *mut f64,
         reason: *mut c_int,
@@ -143,6 +144,8 @@ pub struct CgStats {
 pub struct CgAmg {
     raw: NonNull<RawCgAmg>,
     n: usize,
+    /// The relative residual [`Self::solve`] stops at.
+    rtol: f64,
 }
 
 // SAFETY: the PETSc objects behind `raw` are only touched under the global PETSc lock.
@@ -214,12 +217,17 @@ impl CgAmg {
             return Err(petsc_error(step, code));
         }
         let raw = NonNull::new(raw).ok_or_else(|| petsc_error(step, 0))?;
-        Ok(Self { raw, n })
+        Ok(Self { raw, n, rtol })
     }
 
     /// Solves `K x = rhs` from `x = 0`. Fails with [`LinalgError::NotConverged`] unless CG
     /// reached the relative residual it was set up with.
     pub fn solve(&self, rhs: &[f64]) -> Result<(Vec<f64>, CgStats), LinalgError> {
+        self.solve_within(rhs, self.rtol)
+    }
+
+    /// [`Self::solve`] to the relative residual `rtol` instead of the one it was set up with.
+    pub fn solve_within(&self, rhs: &[f64], rtol: f64) -> Result<(Vec<f64>, CgStats), LinalgError> {
         if rhs.len() != self.n {
             return Err(LinalgError::Sizes(format!(
                 "a right-hand side of {} values for {} unknowns",
@@ -238,6 +246,7 @@ impl CgAmg {
                     self.raw.as_ptr(),
                     rhs.as_ptr(),
                     x.as_mut_ptr(),
+                    rtol,
                     &mut iterations,
                     &mut residual,
                     &mut reason,

@@ -187,10 +187,11 @@ int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int6
     return 0;
 }
 
-/* Solves A x = rhs from x = 0: the iterations, the final residual norm ||rhs - A x|| and the
- * KSPConvergedReason (positive: converged). */
-int internodes_cgamg_solve(InternodesCgAmg *s, const double *rhs, double *x, int64_t *iterations,
-                           double *residual_norm, int *reason, const char **step)
+/* Solves A x = rhs from x = 0 to the relative residual rtol: the iterations, the final residual
+ * norm ||rhs - A x|| and the KSPConvergedReason (positive: converged). */
+int internodes_cgamg_solve(InternodesCgAmg *s, const double *rhs, double *x, double rtol,
+                           int64_t *iterations, double *residual_norm, int *reason,
+                           const char **step)
 {
     PetscScalar *data;
     PetscInt its;
@@ -201,6 +202,7 @@ int internodes_cgamg_solve(InternodesCgAmg *s, const double *rhs, double *x, int
     memcpy(data, rhs, (size_t)s->n * sizeof(double));
     TRY(VecRestoreArray(s->b, &data));
     TRY(VecSet(s->x, 0.0));
+    TRY(KSPSetTolerances(s->ksp, (PetscReal)rtol, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
     TRY(KSPSolve(s->ksp, s->b, s->x));
     TRY(KSPGetIterationNumber(s->ksp, &its));
     TRY(KSPGetResidualNorm(s->ksp, &rnorm));
