@@ -5,41 +5,72 @@ Problem: the 3D hemisphere-on-block contact of ``geo/hemisphere_on_block.toml``
 (sphere R = 1 pushed down by delta = 0.01 at its flat top, block base clamped,
 E = 1000, nu = 0.3, frictionless, contact radius a ~ 0.1 R), meshed with the
 case's geo parameters (h_c = R/67 in the contact zone r < 0.16, h_far = R/2)
-at three refinement levels of ``geo/hemisphere_on_block.geo`` (every mesh size
-times 2^-level): about 31k, 99k and 217k DOFs (both bodies). The contact zone
-stays resolved at every size (h_c = R/80 .. R/160).
+at four refinement levels of ``geo/hemisphere_on_block.geo`` (every mesh size
+times 2^-level): about 31k, 99k, 217k and 1.02M DOFs (both bodies). The contact
+zone stays resolved at every size (h_c = R/80 .. R/270).
+
+Our two paths (``internodes solve``), each with its own case file:
+
+  direct     ``[solver] body = "cholesky"``, ``[contact] solver = "schur"``: a sparse
+             Cholesky factor of each body; the interface (Schur complement) matrix
+             formed densely from the responses to the multipliers (one solve per body
+             per active primary node, cached across iterations and load steps).
+  iterative  ``[solver] body = "cg-amg"``, ``[contact] solver = "krylov"``: PETSc
+             CG + GAMG for each body; the interface equation by GMRES (half-space
+             preconditioner), each product one CG solve per body.
 
 For every size, each of these runs is a separate process, run one after the
 other, so that its wall time and peak resident memory (``ru_maxrss`` from
 ``os.wait4``, through ``benchmark.measure``) are its own:
 
-  1. ours, one step    ``internodes solve CASE``: the case as given, the full
-                       displacement in one step (``load_steps = [1.0]``).
-  2. ours, load steps  the same with ``load_steps = [0.5, 1.0]``: half, then the
-                       full displacement; the second step starts from the first
-                       step's active set and reuses the Cholesky factors and the
-                       cached responses to the multipliers.
-     For both, the per-iteration times of every step are read from the run's log
-     (``summary.json`` keeps the last step's only), the phases from
-     ``summary.json``.
-  3. dolfinx, CG + GAMG  ONE linear elastic solve of the same two-body mesh:
-  4. dolfinx, MUMPS      both volumes in one dolfinx mesh, the same Dirichlet
-                       data (sphere_top displaced by (0, 0, -delta), block_base
-                       clamped) and no contact coupling. The bodies are then
-                       independent, each held by its own Dirichlet data, so the
-                       matrix is SPD. CG + GAMG (rtol 1e-10, rigid-body near-null
-                       space) or MUMPS Cholesky, as in ``benchmark.py``; the faster
-                       (assembly + setup + solve) is dolfinx's best.
+  1. direct, one step       the full displacement in one step (``load_steps = [1.0]``);
+  2. direct, load steps     ``load_steps = [0.5, 1.0]``: half, then the full displacement;
+                            the second step starts from the first step's active set and
+                            reuses the set-up (factors / AMG hierarchies, operators; the
+                            direct path also its cached responses);
+  3. iterative, one step    as 1;
+  4. iterative, load steps  as 2;
+     For 1-4, the per-iteration times (and, iterative, the GMRES iterations: the log's
+     ``interface GMRES: K iterations (+R residuals) ...`` line before each iteration)
+     of every step are read from the run's log (``summary.json`` keeps the last step's
+     only), the phases from ``summary.json``.
+  5. dolfinx, CG + GAMG     ONE linear elastic solve of the same two-body mesh:
+  6. dolfinx, MUMPS         both volumes in one dolfinx mesh, the same Dirichlet
+                            data (sphere_top displaced by (0, 0, -delta), block_base
+                            clamped) and no contact coupling. The bodies are then
+                            independent, each held by its own Dirichlet data, so the
+                            matrix is SPD. CG + GAMG (rtol 1e-10, rigid-body near-null
+                            space) or MUMPS Cholesky, as in ``benchmark.py``; the faster
+                            (assembly + setup + solve) is dolfinx's best.
 
-Aims: the contact solve (set-up + active-set loop; run 1) within twice
-dolfinx's best elastic solve, and each extra load step under a tenth of the first
-step (run 2).
+The direct path is not run at a size where its Cholesky factors would not fit in
+MAX_RSS_GB: the estimate grows the measured Cholesky peak of the largest run of
+``validation/BODY_SOLVER_BENCHMARK.md`` (15,094 MB for one body of 676,719 DOFs) like
+n^(4/3) (a 3D factor's fill), the DOFs split evenly between the two bodies (the
+split that minimizes it): about 20 GB at 1.02M DOFs, where only the iterative path
+runs. A run that exceeds a limit anyway is killed and reported as skipped (MUMPS
+at 1.02M DOFs probably is: dolfinx's best is then CG + GAMG).
+
+Aims, per path:
+  1. the contact solve (set-up + active-set loop of the one-step run) within twice
+     dolfinx's best elastic solve, at every size;
+  2. each extra load step at most 0.25 of the first, the set-up counted in the first:
+     step 2 / (set-up + step 1) of the load-stepped run;
+  3. at most 8 active-set iterations in every load step (both runs);
+  4. peak memory (the larger of the path's two runs) within twice that of dolfinx's
+     best run, at the size of >= 1M DOFs (shown at every size).
 
 Results: a table on stdout, the report ``validation/CONTACT_BENCHMARK.md`` and
 the raw numbers ``validation/build/contact_bench/results.json``.
 
-Usage:  /usr/bin/python3 validation/contact_benchmark.py [--sizes small|all] [--binary PATH]
+Usage:  /usr/bin/python3 validation/contact_benchmark.py [--sizes small|all|NAME[,NAME...]]
+                                                        [--paths direct,iterative] [--binary PATH]
         /usr/bin/python3 validation/contact_benchmark.py --report-only
+
+``--sizes small`` is the 31k mesh only, ``all`` the four, or names: ``--sizes 1M``,
+``--sizes 31k,99k``. ``--paths`` runs one path only (the other is reported as not run).
+The exit status is 1 if one of our runs failed, stopped at a limit or did not converge,
+or no dolfinx run finished at a size (a path not run is not a failure).
 
 Run it with nothing else running on the machine: timings are wall times.
 """
@@ -71,22 +102,38 @@ from benchmark import (CG_RTOL, SERIAL_ENV, RunFailed, environment, fmt,  # noqa
 REPO = VALIDATION.parent
 BENCH = VALIDATION / "build" / "contact_bench"
 REPORT = VALIDATION / "CONTACT_BENCHMARK.md"
+BODY_SOLVER_REPORT = VALIDATION / "BODY_SOLVER_BENCHMARK.md"
 BASE_CASE = REPO / "geo" / "hemisphere_on_block.toml"
 GEO = REPO / "geo" / "hemisphere_on_block.geo"
 COMMAND = "make bench   # second command: /usr/bin/python3 validation/contact_benchmark.py --sizes all"
-# Our two runs per size: the case as given (one step, the full imposed displacement), and the
-# displacement in two load steps.
+# Our two runs per path and size: the full imposed displacement in one step, and in two load steps.
 ONE_STEP = (1.0,)
 LOAD_STEPS = (0.5, 1.0)
 
-# A run is killed (and reported as skipped) beyond these limits.
+# path -> the case file's [solver] body and [contact] solver, and a description.
+PATHS = {
+    "direct": {"body": "cholesky", "solver": "schur",
+               "label": "Cholesky factor of each body, dense Schur complement from the responses"},
+    "iterative": {"body": "cg-amg", "solver": "krylov",
+                  "label": "CG + AMG for each body, interface equation by GMRES"},
+}
+
+# A run is killed (and reported as skipped) beyond these limits. An iterative run at 1M DOFs
+# may take 30 to 60 minutes.
 MAX_RSS_GB = 18.0
-MAX_SECONDS_OURS = 1200.0
+MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0}
 MAX_SECONDS_DOLFINX = 600.0
 
 # The aims of the module doc.
-AIM_TOTAL = 2.0  # contact total / dolfinx best elastic solve
-AIM_STEP = 0.1  # extra load step / first load step
+AIM_TOTAL = 2.0  # one-step contact total / dolfinx best elastic solve
+AIM_STEP = 0.25  # extra load step / (set-up + first load step)
+AIM_ITERATIONS = 8  # active-set iterations per load step
+AIM_MEMORY = 2.0  # our peak memory / dolfinx best run's, ...
+AIM_MEMORY_MIN_DOFS = 1_000_000  # ... at this size and above
+
+# The largest Cholesky run of BODY_SOLVER_BENCHMARK.md (block_3d, one body, report of 2026-11-26 at
+# commit 5096dde): used if that report's table cannot be read. The direct path's estimate starts from it.
+CHOLESKY_MEASURED = {"dofs": 676_719, "setup": 191.0, "peak_mb": 15_094.0}
 
 
 @dataclass(frozen=True)
@@ -105,21 +152,26 @@ class Size:
         return BENCH / self.name
 
 
-# With gmsh 4.8: 31 113, 98 700 and 216 537 DOFs (sphere + block).
-SIZES = (Size("31k", 0.25), Size("99k", 0.85), Size("217k", 1.25))
+# With gmsh 4.8: 31 113, 98 700, 216 537 and 1 018 125 DOFs (sphere + block). 2.02 is the smallest
+# level (in steps of 0.01) with >= 1M DOFs: level 2.01 gives 997 473, level 2.0 977 565.
+SIZES = (Size("31k", 0.25), Size("99k", 0.85), Size("217k", 1.25), Size("1M", 2.02))
 
-# name -> (label, load steps); dolfinx runs have no load steps.
+# name -> (label, path, load steps); dolfinx runs have neither.
 RUNS = {
-    "ours_one": ("ours, one step (1.0)", ONE_STEP),
-    "ours_steps": ("ours, load steps (0.5, 1.0)", LOAD_STEPS),
-    "dolfinx_cg": ("dolfinx, CG + GAMG", None),
-    "dolfinx_mumps": ("dolfinx, MUMPS Cholesky", None),
+    "direct_one": ("direct, one step (1.0)", "direct", ONE_STEP),
+    "direct_steps": ("direct, load steps (0.5, 1.0)", "direct", LOAD_STEPS),
+    "iterative_one": ("iterative, one step (1.0)", "iterative", ONE_STEP),
+    "iterative_steps": ("iterative, load steps (0.5, 1.0)", "iterative", LOAD_STEPS),
+    "dolfinx_cg": ("dolfinx, CG + GAMG", None, None),
+    "dolfinx_mumps": ("dolfinx, MUMPS Cholesky", None, None),
 }
-OURS = [run for run, (_, steps) in RUNS.items() if steps]
+OURS = [run for run, (_, path, _) in RUNS.items() if path]
 
 
 def status(run: dict) -> str:
-    """"ok", "skipped" (stopped at a limit), "failed", or the contact status when not converged."""
+    """"ok", "not run", "skipped" (stopped at a limit), "failed", or the contact status when not converged."""
+    if "not_run" in run:
+        return "not run"
     if "error" in run:
         return "skipped" if "stopped after" in run["error"] else "failed"
     return "ok" if run.get("contact_status", "converged") == "converged" else run["contact_status"]
@@ -127,11 +179,11 @@ def status(run: dict) -> str:
 
 def timed(run: dict) -> bool:
     """Whether the run finished (converged or not) and has timings."""
-    return "error" not in run
+    return "error" not in run and "not_run" not in run
 
 
 # ---------------------------------------------------------------------------
-# Step 1: meshes and case files
+# Step 1: meshes, case files, which runs fit
 # ---------------------------------------------------------------------------
 
 
@@ -165,16 +217,22 @@ def generate_mesh(size: Size) -> None:
         raise RunFailed(f"gmsh level {size.level}: {result.stdout[-500:]}{result.stderr[-500:]}")
 
 
-def write_case(size: Size, run: str, steps: tuple[float, ...]) -> Path:
+def write_case(size: Size, run: str, steps: tuple[float, ...], path: str | None) -> Path:
     """The case file of one run: geo/hemisphere_on_block.toml with ``mesh`` pointing at the .msh,
-    no ``geo_parameters`` and ``load_steps = steps`` added to its ``[contact]`` table."""
+    no ``geo_parameters``, ``load_steps = steps`` added to its ``[contact]`` table and, for one of
+    our paths, its ``[solver] body`` and ``[contact] solver``."""
     size.folder.mkdir(parents=True, exist_ok=True)
     text, data = base_case()
-    if "load_steps" in data.get("contact", {}):
-        raise RunFailed(f"{BASE_CASE}: already has load_steps; the benchmark sets its own")
+    for table, key in (("contact", "load_steps"), ("contact", "solver"), ("solver", "body")):
+        if key in data.get(table, {}):
+            raise RunFailed(f"{BASE_CASE}: already has [{table}] {key}; the benchmark sets its own")
+    contact = f"[contact]\nload_steps = {list(steps)}"
+    if path:
+        contact = (f"[solver]\nbody = {json.dumps(PATHS[path]['body'])}\n\n"
+                   f"{contact}\nsolver = {json.dumps(PATHS[path]['solver'])}")
     replacements = [(r"(?m)^mesh\s*=.*$", f"mesh = {json.dumps(str(size.mesh))}"),
                     (r"(?m)^geo_parameters\s*=.*\n", ""),
-                    (r"(?m)^\[contact\]\s*$", f"[contact]\nload_steps = {list(steps)}")]
+                    (r"(?m)^\[contact\]\s*$", contact)]
     for pattern, replacement in replacements:
         text, count = re.subn(pattern, replacement, text)
         if count != 1:
@@ -184,35 +242,100 @@ def write_case(size: Size, run: str, steps: tuple[float, ...]) -> Path:
     return case
 
 
+def cholesky_measured() -> dict:
+    """The largest Cholesky run of validation/BODY_SOLVER_BENCHMARK.md: its DOFs, factorization seconds
+    and peak MB (CHOLESKY_MEASURED if the report's table cannot be read)."""
+    try:
+        lines = BODY_SOLVER_REPORT.read_text().splitlines()
+        start = next(i for i, line in enumerate(lines) if line.startswith("|") and "Chol. MB" in line)
+        header = [cell.strip() for cell in lines[start].strip().strip("|").split("|")]
+        rows = []
+        for line in lines[start + 2:]:
+            cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
+            if not line.startswith("|") or len(cells) != len(header):
+                break
+            rows.append(dict(zip(header, cells)))
+        row = max(rows, key=lambda r: int(r["DOFs"].replace(",", "")))
+        return {"dofs": int(row["DOFs"].replace(",", "")), "setup": float(row["Chol. setup"]),
+                "peak_mb": float(row["Chol. MB"])}
+    except (OSError, StopIteration, KeyError, ValueError):
+        return dict(CHOLESKY_MEASURED)
+
+
+def direct_memory_gb(count: int, measured: dict) -> float:
+    """Estimated peak of the direct path's two Cholesky factors: the measured one-body peak grown like
+    n^(4/3) (nested-dissection fill in 3D), the DOFs split evenly between the bodies (the least sum)."""
+    return measured["peak_mb"] / 1024 * 2 * (count / 2 / measured["dofs"]) ** (4 / 3)
+
+
+def not_run_reason(path: str, count: int) -> str | None:
+    """Why a path is not run at a mesh of ``count`` DOFs (None: it is run)."""
+    if path != "direct":
+        return None
+    measured = cholesky_measured()
+    estimate = direct_memory_gb(count, measured)
+    if estimate <= MAX_RSS_GB:
+        return None
+    return (f"the Cholesky factors of both bodies do not fit in {MAX_RSS_GB:g} GB: "
+            f"{BODY_SOLVER_REPORT.relative_to(REPO)} measured a {measured['peak_mb']:,.0f} MB peak "
+            f"({measured['setup']:.0f} s factorization) for the Cholesky of ONE body of {measured['dofs']:,} DOFs; "
+            f"grown like n^(4/3) (a 3D factor's fill) to this mesh's {count:,} DOFs split evenly between the two "
+            f"bodies (the most favourable split), that is {estimate:.1f} GB before the responses to the "
+            "multipliers")
+
+
 # ---------------------------------------------------------------------------
 # Step 2: the runs
 # ---------------------------------------------------------------------------
 
 LOAD_STEP_LINE = re.compile(r"^load step (\d+)/(\d+): factor (\S+)$")
-ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-(\d+)\s.*; ([-+0-9.eE]+) s \(")
-CHOLESKY_LINE = re.compile(r"^\s+Cholesky of both bodies: ([-+0-9.eE]+) s$")
+ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-(\d+)\s.*; ([-+0-9.eE]+) s"
+                            r"(?: \((.*)\))?\s*$")
+# "  Cholesky of both bodies: 0.290 s": the body solvers' set-up (the factors, or PETSc + the AMG
+# hierarchies on the iterative path, whatever the label says).
+BODY_SETUP_LINE = re.compile(r"^\s+(\S.*?) of both bodies: ([-+0-9.eE]+) s$")
+KRYLOV_LINE = re.compile(r"^\s+interface GMRES: (\d+) iterations \(\+(\d+) residuals\), "
+                         r"relative residual (\S+) \(start (\S+)\)\s*$")
 
 
-def parse_log(log: Path) -> tuple[float, list[list[dict]]]:
-    """(Cholesky seconds, iterations of every load step) from the log of a verbose run."""
-    cholesky, steps = None, []
+def _phases(text: str | None) -> dict:
+    """"operators 0.001, solve 2.732, search 0.011" -> {"operators": 0.001, ...}."""
+    phases = {}
+    for part in (text or "").split(","):
+        name, _, value = part.strip().rpartition(" ")
+        try:
+            phases[name] = float(value)
+        except ValueError:
+            continue
+    return phases
+
+
+def parse_log(log: Path) -> tuple[str, float, list[list[dict]]]:
+    """(label and seconds of the body solvers' set-up, iterations of every load step) from the log of
+    a verbose run; an iteration's ``krylov`` is its GMRES line (None on the direct path)."""
+    label, set_up, steps, krylov = None, None, [], None
     for line in log.read_text().splitlines():
-        if match := CHOLESKY_LINE.match(line):
-            cholesky = float(match[1])
+        if set_up is None and (match := BODY_SETUP_LINE.match(line)):
+            label, set_up = match[1], float(match[2])
         elif LOAD_STEP_LINE.match(line):
             steps.append([])
+        elif match := KRYLOV_LINE.match(line):
+            krylov = {"iterations": int(match[1]), "residuals": int(match[2]),
+                      "relative_residual": float(match[3]), "start": float(match[4])}
         elif match := ITERATION_LINE.match(line):
             if not steps:  # a single load step prints no "load step" line
                 steps.append([])
             steps[-1].append({"iteration": int(match[1]), "active_primary": int(match[2]),
-                              "added": int(match[3]), "removed": int(match[4]), "seconds": float(match[5])})
-    if cholesky is None:
-        raise RunFailed(f"{log}: no 'Cholesky of both bodies' line (log format changed?)")
-    return cholesky, steps
+                              "added": int(match[3]), "removed": int(match[4]), "seconds": float(match[5]),
+                              "phases": _phases(match[6]), "krylov": krylov})
+            krylov = None
+    if set_up is None:
+        raise RunFailed(f"{log}: no '... of both bodies: X s' line (log format changed?)")
+    return label, set_up, steps
 
 
 def compliance_estimate(iterations: list[dict]) -> float:
-    """Seconds of a step attributed to new responses to the multipliers (an estimate).
+    """Seconds of a step attributed to new responses to the multipliers (an estimate; direct path).
 
     An iteration that reuses every cached column costs about the step's median
     iteration (dense Schur complement, two solves per body, contact checks); the
@@ -226,11 +349,25 @@ def compliance_estimate(iterations: list[dict]) -> float:
     return sum(max(0.0, t - typical) for t in seconds)
 
 
-def run_ours(binary: Path, case: Path, output: Path) -> dict:
+def krylov_counts(iterations: list[dict]) -> list[int] | None:
+    """GMRES iterations of each active-set iteration of a step (None if the run logged none)."""
+    counts = [i["krylov"]["iterations"] for i in iterations if i.get("krylov")]
+    return counts if counts and len(counts) == len(iterations) else None
+
+
+def body_solves(iterations: list[dict]) -> int | None:
+    """Solves per body of a step's loop: per active-set iteration z = K^-1 f, the GMRES iterations
+    and the residual products (interface_krylov.rs); None without the GMRES lines."""
+    if krylov_counts(iterations) is None or any("residuals" not in i["krylov"] for i in iterations):
+        return None
+    return sum(1 + i["krylov"]["iterations"] + i["krylov"]["residuals"] for i in iterations)
+
+
+def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
     """One internodes contact solve (verbose: the log has every step's iterations)."""
     shutil.rmtree(output, ignore_errors=True)  # never read a stale summary
     log = output.with_suffix(".log")
-    usage = measure([binary, "solve", case, "--output", output], log, max_seconds=MAX_SECONDS_OURS,
+    usage = measure([binary, "solve", case, "--output", output], log, max_seconds=MAX_SECONDS_OURS[path],
                     max_rss_gb=MAX_RSS_GB, check=False)
     summary_file = output / "summary.json"
     if not summary_file.is_file():  # an error before the result files: no timings
@@ -238,13 +375,22 @@ def run_ours(binary: Path, case: Path, output: Path) -> dict:
         raise RunFailed(f"exit status {usage['exit_status']}: {tail}")
     summary = json.loads(summary_file.read_text())
     contact = summary["contact"]
+    # The coupled solver asked for (contact.settings.solver); the resolved names (contact.solver,
+    # contact.body_solver) are recorded where the binary writes them.
+    solver = contact.get("settings", {}).get("solver")
+    if solver != PATHS[path]["solver"]:
+        raise RunFailed(f"{summary_file}: the run used the coupled solver {solver!r}, not {PATHS[path]['solver']!r}")
     phases = dict(summary["timings"])
-    cholesky, iterations = parse_log(log)
+    label, body_setup, iterations = parse_log(log)
     # The log and the summary must tell the same story.
     if [len(s) for s in iterations] != [s["iterations"] for s in contact["steps"]] or any(
             abs(logged["seconds"] - sum(i["seconds"].values())) > 2e-3
-        for logged, i in zip(iterations[-1], contact["iterations"])):
+            for logged, i in zip(iterations[-1], contact["iterations"])):
         raise RunFailed(f"{log}: the iterations in the log do not match summary.json (log format changed?)")
+    # GMRES iterations of the last step: summary.json's krylov_iterations where the binary writes them.
+    for logged, record in zip(iterations[-1], contact["iterations"]):
+        if solver == "krylov" and record.get("krylov_iterations") is not None:
+            logged["krylov"] = dict(logged["krylov"] or {}, iterations=int(record["krylov_iterations"]))
     bodies = {b["name"]: b for b in summary["bodies"]}
     assembly = sum(t for b in bodies.values() for phase, t in b["solve"]["timings"]
                    if phase in ("sparsity pattern", "assemble stiffness", "assemble loads",
@@ -254,17 +400,19 @@ def run_ours(binary: Path, case: Path, output: Path) -> dict:
         last = its[-1]
         steps.append({"load_factor": record["load_factor"], "status": record["status"],
                       "iterations": its, "seconds": phases[f"contact step {record['step']}"],
-                      "compliance_estimate": compliance_estimate(its),
+                      "compliance_estimate": compliance_estimate(its) if path == "direct" else None,
                       "active_primary": last["active_primary"],
                       "force": record["force_primary"][-1], "hertz_a": record["hertz_a"]})
     set_up = phases["contact set-up"]
     return usage | {
+        "path": path, "solver": solver, "resolved": {"solver": contact.get("solver"),
+                                                      "body_solver": contact.get("body_solver")},
         "contact_status": contact["status"],
         "dofs": {name: b["num_dofs"] for name, b in bodies.items()},
         "stiffness_nnz": {name: b["solve"]["stiffness_nnz"] for name, b in bodies.items()},
         "read_mesh": phases["read mesh"],
-        "set_up": set_up, "assembly": assembly, "cholesky": cholesky,
-        "other_set_up": set_up - assembly - cholesky,
+        "set_up": set_up, "assembly": assembly, "body_setup": body_setup, "body_setup_label": label,
+        "other_set_up": set_up - assembly - body_setup,
         "steps": steps,
         "contact_total": set_up + sum(s["seconds"] for s in steps),
         "write_output": phases["write output"],
@@ -281,31 +429,45 @@ def run_dolfinx(solver: str, case: Path, output: Path) -> dict:
     return usage | json.loads(result.read_text())
 
 
-def benchmark_size(size: Size, binary: Path) -> dict:
-    """Mesh, the four runs one after the other, and the CG / MUMPS agreement."""
+def _done_line(run: dict) -> str:
+    """What a finished run of ours prints."""
+    counts = [krylov_counts(s["iterations"]) for s in run["steps"]]
+    gmres = "" if None in counts else f", {' + '.join(str(sum(c)) for c in counts)} GMRES iterations"
+    return (f"{run['wall']:.1f} s, {run['peak_mb']:.0f} MB, {run['contact_status']} "
+            f"({' + '.join(str(len(s['iterations'])) for s in run['steps'])} iterations{gmres})")
+
+
+def benchmark_size(size: Size, binary: Path, paths: list[str]) -> dict:
+    """Mesh, the runs one after the other, and the CG / MUMPS agreement."""
     generate_mesh(size)
-    cases = {run: write_case(size, run, steps or ONE_STEP) for run, (_, steps) in RUNS.items()}
+    count = 3 * mesh_nodes(size.mesh)
     runs: dict[str, dict] = {}
-    for run, (label, steps) in RUNS.items():
+    for run, (label, path, steps) in RUNS.items():
+        if path and path not in paths:
+            runs[run] = {"not_run": f"not selected (--paths {','.join(paths)})"}
+        elif path and (reason := not_run_reason(path, count)):
+            runs[run] = {"not_run": reason}
+        if "not_run" in runs.get(run, {}):
+            print(f"   {label}: not run ({runs[run]['not_run']})", flush=True)
+            continue
         print(f"   {label} ...", end=" ", flush=True)
+        case = write_case(size, run, steps or ONE_STEP, path)
         output = size.folder / run
         try:
-            if steps:
-                runs[run] = run_ours(binary, cases[run], output)
-                r = runs[run]
-                print(f"{r['wall']:.1f} s, {r['peak_mb']:.0f} MB, {r['contact_status']} "
-                      f"({' + '.join(str(len(s['iterations'])) for s in r['steps'])} iterations)", flush=True)
+            if path:
+                runs[run] = run_ours(binary, case, output, path)
+                print(_done_line(runs[run]), flush=True)
             else:
-                runs[run] = run_dolfinx(run.removeprefix("dolfinx_"), cases[run], output)
+                runs[run] = run_dolfinx(run.removeprefix("dolfinx_"), case, output)
                 print(f"{runs[run]['wall']:.1f} s, {runs[run]['peak_mb']:.0f} MB", flush=True)
-        except (RunFailed, OSError, KeyError, ValueError, IndexError) as error:
+        except (RunFailed, OSError, KeyError, ValueError, IndexError, TypeError) as error:
             runs[run] = {"error": f"{type(error).__name__}: {error}"}
             print(f"FAILED ({runs[run]['error']})", flush=True)
     if timed(runs["dolfinx_cg"]) and timed(runs["dolfinx_mumps"]):
         u_cg, u_mumps = (np.load(size.folder / f"{r}.u.npy") for r in ("dolfinx_cg", "dolfinx_mumps"))
         runs["dolfinx_cg"]["l2_vs_mumps"] = float(np.linalg.norm(u_cg - u_mumps) / np.linalg.norm(u_mumps))
     return {"name": size.name, "level": size.level, "mesh": str(size.mesh.relative_to(REPO)),
-            "nodes": mesh_nodes(size.mesh), "runs": runs}
+            "nodes": count // 3, "runs": runs}
 
 
 # ---------------------------------------------------------------------------
@@ -378,26 +540,62 @@ def all_iterations(ours: dict) -> list[float]:
     return [i["seconds"] for s in ours["steps"] for i in s["iterations"]]
 
 
-def ratios(size: dict) -> dict:
-    """The aims' ratios of one size (missing when a run did not finish).
+def dofs(size: dict) -> int:
+    """DOFs of both bodies: 3 x the mesh's nodes."""
+    return 3 * size["nodes"]
 
-    total: one-step contact solve / dolfinx best; steps_total: the load-stepped run's set-up +
-    both steps / dolfinx best; step: extra step / first step of the load-stepped run.
+
+def ratios(size: dict, path: str) -> dict:
+    """The aims' figures of one path at one size (missing when a run did not finish).
+
+    total: one-step contact total / dolfinx best; body_setup: the one-step run's body solver set-up /
+    dolfinx best; steps_total: the load-stepped run's set-up + both steps / dolfinx best; step: extra
+    step / (set-up + first step) and step_loop: extra step / first step, of the load-stepped run;
+    iterations: the most active-set iterations of a load step (both runs); memory: the larger peak of
+    the two runs / the peak of dolfinx's best run.
     """
     runs, out = size["runs"], {}
-    one, stepped, best = runs["ours_one"], runs["ours_steps"], best_dolfinx(runs)
+    one, stepped, best = runs[f"{path}_one"], runs[f"{path}_steps"], best_dolfinx(runs)
     if best:
         elastic = runs[best]["elastic_total"]
         if timed(one):
             out["total"] = one["contact_total"] / elastic
-            out["cholesky"] = one["cholesky"] / elastic
+            out["body_setup"] = one["body_setup"] / elastic
         if timed(stepped):
             out["steps_total"] = stepped["contact_total"] / elastic
+        peaks = [r["peak_mb"] for r in (one, stepped) if timed(r)]
+        if peaks:
+            out["memory"] = max(peaks) / runs[best]["peak_mb"]
     if timed(stepped) and len(stepped["steps"]) > 1:
-        first = stepped["steps"][0]["seconds"]
-        out["step"] = max(s["seconds"] for s in stepped["steps"][1:]) / first
-        out["step_with_set_up"] = max(s["seconds"] for s in stepped["steps"][1:]) / (first + stepped["set_up"])
+        first, extra = stepped["steps"][0]["seconds"], max(s["seconds"] for s in stepped["steps"][1:])
+        out["step"] = extra / (stepped["set_up"] + first)
+        out["step_loop"] = extra / first
+    counts = [len(s["iterations"]) for r in (one, stepped) if timed(r) for s in r["steps"]]
+    if counts:
+        out["iterations"] = max(counts)
     return out
+
+
+def _verdict(value: float, aim: float) -> str:
+    """"met, 0.72x the bound" or "missed, 2.2x the bound"."""
+    return ("met" if value <= aim else "missed") + f", {value / aim:.2g}x the bound"
+
+
+def _iterations_verdict(count: int) -> str:
+    """"met" or "missed by N"."""
+    return "met" if count <= AIM_ITERATIONS else f"missed by {count - AIM_ITERATIONS}"
+
+
+def _kind(run: str) -> str:
+    """"one step (1.0)" or "load steps (0.5, 1.0)"."""
+    return RUNS[run][0].split(", ", 1)[1]
+
+
+def _status_cell(run: dict) -> str:
+    """The status column: the status, and the error of a run that did not finish."""
+    if "not_run" in run:
+        return "not run (below)"
+    return f"{status(run)}: {run['error']}" if "error" in run else status(run)
 
 
 def _steps_cell(step: dict) -> str:
@@ -407,61 +605,94 @@ def _steps_cell(step: dict) -> str:
 
 
 def contact_table(sizes: list[dict]) -> list[list[str]]:
-    """Our contact solves: one row per size and run."""
-    rows = [["DOFs (sphere + block)", "run", "active primary nodes", "set-up: asm + chol + other",
+    """Our contact solves: one row per size, path and run."""
+    rows = [["DOFs (sphere + block)", "path", "run", "active primary nodes", "set-up: asm + solvers + other",
              "step 1 (its)", "step 2 (its)", "per iteration: mean / median", "compliance (est.)",
              "contact total", "wall", "peak MB", "status"]]
     for size in sizes:
         for run in OURS:
-            r, label = size["runs"][run], RUNS[run][0].removeprefix("ours, ")
+            r, path = size["runs"][run], RUNS[run][1]
             if not timed(r):
-                rows.append([f"{3 * size['nodes']:,}", label, "-", "-", "-", "-", "-", "-", "-", "-", "-", r["error"]])
+                rows.append([f"{dofs(size):,}", path, _kind(run), *["-"] * 9, _status_cell(r)])
                 continue
             steps = r["steps"]
-            compliance = sum(s["compliance_estimate"] for s in steps)
             its = all_iterations(r)
+            if path == "direct":
+                compliance = sum(s["compliance_estimate"] for s in steps)
+                compliance_cell = f"{fmt(compliance)} ({compliance / sum(s['seconds'] for s in steps):.0%} of steps)"
+            else:
+                compliance_cell = "-"
             rows.append([
-                f"{sum(r['dofs'].values()):,} ({' + '.join(f'{d:,}' for d in r['dofs'].values())})", label,
-                f"{steps[-1]['active_primary']}",
-                f"{fmt(r['set_up'])} = {fmt(r['assembly'], 2)} + {fmt(r['cholesky'])} + {fmt(r['other_set_up'], 2)}",
+                f"{sum(r['dofs'].values()):,} ({' + '.join(f'{d:,}' for d in r['dofs'].values())})", path,
+                _kind(run), f"{steps[-1]['active_primary']}",
+                f"{fmt(r['set_up'])} = {fmt(r['assembly'], 2)} + {fmt(r['body_setup'])} + {fmt(r['other_set_up'], 2)}",
                 _steps_cell(steps[0]), _steps_cell(steps[1]) if len(steps) > 1 else "-",
-                f"{fmt(statistics.mean(its))} / {fmt(statistics.median(its))}",
-                f"{fmt(compliance)} ({compliance / sum(s['seconds'] for s in steps):.0%} of steps)",
-                fmt(r["contact_total"]), fmt(r["wall"]), f"{r['peak_mb']:.0f}", status(r)])
+                f"{fmt(statistics.mean(its))} / {fmt(statistics.median(its))}", compliance_cell,
+                fmt(r["contact_total"]), fmt(r["wall"]), f"{r['peak_mb']:.0f}", _status_cell(r)])
     return rows
 
 
 def comparison_table(sizes: list[dict]) -> list[list[str]]:
-    """dolfinx's elastic solve of the same mesh and the two aims' ratios."""
+    """dolfinx's elastic solve of the same mesh and, per path, our contact total against it."""
     rows = [["DOFs", "dfx asm", "dfx CG+GAMG setup+solve (its)", "dfx MUMPS setup+solve", "dfx best total",
-             "dfx MB (CG / MUMPS)", f"one-step contact / dfx best (aim <= {AIM_TOTAL:g})",
-             "load-stepped contact / dfx best", f"step 2 / step 1 (aim < {AIM_STEP:g})"]]
+             "dfx MB (CG / MUMPS)", *[f"{path}: contact / dfx best, one step (load steps)" for path in PATHS]]]
     for size in sizes:
         runs = size["runs"]
         cg, mumps, best = runs["dolfinx_cg"], runs["dolfinx_mumps"], best_dolfinx(runs)
-        q = ratios(size)
         assembly = [r["assemble"] for r in (cg, mumps) if timed(r)]
 
-        def ratio(key: str, digits: int, run: str) -> str:
-            if key not in q:
-                return "-"
-            mark = "" if status(runs[run]) == "ok" else f" ({status(runs[run])})"
-            return f"{q[key]:.{digits}f}{mark}"
+        def ratio(path: str) -> str:
+            q, one, stepped = ratios(size, path), runs[f"{path}_one"], runs[f"{path}_steps"]
+            if "not_run" in one and "not_run" in stepped:
+                return "not run"
+            cells = []
+            for key, run in (("total", one), ("steps_total", stepped)):
+                mark = "" if status(run) == "ok" else f", {status(run)}"
+                cells.append(f"{q[key]:.1f}{mark}" if key in q else status(run) if status(run) != "ok" else "-")
+            return f"{cells[0]} ({cells[1]})"
 
         rows.append([
-            f"{3 * size['nodes']:,}", fmt(min(assembly)) if assembly else "-",
+            f"{dofs(size):,}", fmt(min(assembly)) if assembly else "-",
             f"{fmt(cg['solver_total'])} ({cg['iterations']})" if timed(cg) else status(cg),
             fmt(mumps["solver_total"]) if timed(mumps) else status(mumps),
             f"{fmt(runs[best]['elastic_total'])} ({'CG' if best == 'dolfinx_cg' else 'MUMPS'})" if best else "-",
             " / ".join(f"{r['peak_mb']:.0f}" if timed(r) else "-" for r in (cg, mumps)),
-            ratio("total", 1, "ours_one"), ratio("steps_total", 1, "ours_steps"), ratio("step", 2, "ours_steps")])
+            *[ratio(path) for path in PATHS]])
+    return rows
+
+
+def aims_table(sizes: list[dict]) -> list[list[str]]:
+    """The four aims per size and path: the figure, met or missed and by how much."""
+    rows = [["DOFs", "path", f"1. contact / dfx best (<= {AIM_TOTAL:g})",
+             f"2. step 2 / (set-up + step 1) (<= {AIM_STEP:g})",
+             f"3. most iterations in a step (<= {AIM_ITERATIONS})",
+             f"4. peak MB / dfx best's (<= {AIM_MEMORY:g} at >= {AIM_MEMORY_MIN_DOFS / 1e6:g}M DOFs)"]]
+    for size in sizes:
+        for path in PATHS:
+            runs = [size["runs"][f"{path}_{kind}"] for kind in ("one", "steps")]
+            if all("not_run" in r for r in runs):
+                rows.append([f"{dofs(size):,}", path, *["not run"] * 4])
+                continue
+            q = ratios(size, path)
+            memory = "-"
+            if "memory" in q:
+                judged = dofs(size) >= AIM_MEMORY_MIN_DOFS
+                memory = f"{q['memory']:.1f}: " + (_verdict(q["memory"], AIM_MEMORY) if judged
+                                                   else "not judged below 1M")
+            missing = [status(r) if status(r) != "ok" else "-" for r in runs]  # one step, load steps
+            rows.append([f"{dofs(size):,}", path,
+                         f"{q['total']:.1f}: {_verdict(q['total'], AIM_TOTAL)}" if "total" in q else missing[0],
+                         f"{q['step']:.2f}: {_verdict(q['step'], AIM_STEP)}" if "step" in q else missing[1],
+                         f"{q['iterations']}: {_iterations_verdict(q['iterations'])}" if "iterations" in q else "-",
+                         memory])
     return rows
 
 
 def iteration_table(sizes: list[dict]) -> list[list[str]]:
-    """Every load step of our runs: its iterations' times (first, second, the rest)."""
-    rows = [["DOFs", "run", "step (factor)", "status", "iterations", "active at the end", "1st it", "2nd it",
-             "others: median / max", "sum of its", "step", "compliance (est.)", "contact force", "Hertz a"]]
+    """Every load step of our runs: its iterations' times (first, second, the rest) and GMRES iterations."""
+    rows = [["DOFs", "path", "run", "step (factor)", "status", "iterations", "active at the end", "1st it",
+             "2nd it", "others: median / max", "step", "compliance (est.)", "GMRES its: sum / max",
+             "GMRES its per iteration", "contact force", "Hertz a"]]
     for size in sizes:
         for run in OURS:
             r = size["runs"][run]
@@ -470,108 +701,224 @@ def iteration_table(sizes: list[dict]) -> list[list[str]]:
             for k, s in enumerate(r["steps"], start=1):
                 t = [i["seconds"] for i in s["iterations"]]
                 rest = t[2:]
-                rows.append([f"{3 * size['nodes']:,}", RUNS[run][0].removeprefix("ours, "),
+                counts = krylov_counts(s["iterations"])
+                compliance = s.get("compliance_estimate")
+                rows.append([f"{dofs(size):,}", RUNS[run][1], _kind(run),
                              f"{k} ({s['load_factor']:g})", s["status"], str(len(t)),
                              f"{s['active_primary']}", fmt(t[0]),
                              fmt(t[1]) if len(t) > 1 else "-",
                              f"{fmt(statistics.median(rest))} / {fmt(max(rest))}" if rest else "-",
-                             fmt(sum(t)), fmt(s["seconds"]), fmt(s["compliance_estimate"]),
+                             fmt(s["seconds"]), fmt(compliance) if compliance is not None else "-",
+                             f"{sum(counts)} / {max(counts)}" if counts else "-",
+                             " ".join(map(str, counts)) if counts else "-",
                              f"{s['force']:.4g}", f"{s['hertz_a']:.3g}" if s["hertz_a"] else "-"])
     return rows
 
 
-def _miss(value: float, aim: float, strict: bool = False) -> str:
-    """"met" or "missed by a factor X"."""
-    met = value < aim if strict else value <= aim
-    return "met" if met else f"missed by a factor {value / aim:.1f}"
+def _breakdown(size: dict, path: str) -> str:
+    """Shares of the one-step run's contact total, by phase (from the log and summary.json)."""
+    run = size["runs"][f"{path}_one"]
+    total, elastic = run["contact_total"], size["runs"][best_dolfinx(size["runs"])]["elastic_total"]
+    loop = sum(s["seconds"] for s in run["steps"])
+    count = sum(len(s["iterations"]) for s in run["steps"])
+    if path == "direct":
+        compliance = sum(s["compliance_estimate"] for s in run["steps"])
+        return (f"{size['name']}: Cholesky of both bodies {run['body_setup'] / total:.0%} (alone "
+                f"{run['body_setup'] / elastic:.1f}x dolfinx's whole solve), compliance solves (est.) "
+                f"{compliance / total:.0%}, the other iteration work {(loop - compliance) / total:.0%} "
+                f"({count} iterations), assembly {run['assembly'] / total:.0%}")
+    its = [i for s in run["steps"] for i in s["iterations"]]
+    solve = sum(i.get("phases", {}).get("solve", 0.0) for i in its)
+    solves = [body_solves(s["iterations"]) for s in run["steps"]]
+    text = (f"{size['name']}: body solver set-up (PETSc, GAMG of both bodies) {run['body_setup'] / total:.0%}, "
+            f"the iterations' solve phase (z = K^-1 f, GMRES) {solve / total:.0%}")
+    if None not in solves and solve > 0:
+        pair = solve / sum(solves)
+        text += (f": {sum(solves)} CG + AMG solves per body at {fmt(pair)} s per pair of bodies, "
+                 f"{pair / elastic:.2f}x dolfinx's whole elastic solve (the aim's budget, {AIM_TOTAL:g}x that "
+                 f"solve, is {AIM_TOTAL * elastic / pair:.0f} such pairs)")
+    return (text + f"; the rest of the loop {(loop - solve) / total:.0%} ({count} iterations), assembly "
+            f"{run['assembly'] / total:.0%}, other set-up {run['other_set_up'] / total:.0%}")
 
 
-def _breakdown(run: dict) -> str:
-    """Shares of a run's contact total: factorization, compliance (est.), other iteration work, assembly."""
-    total = run["contact_total"]
-    compliance = sum(s["compliance_estimate"] for s in run["steps"])
-    loop = sum(s["seconds"] for s in run["steps"]) - compliance
-    return (f"Cholesky of both bodies {run['cholesky'] / total:.0%}, compliance solves (est.) "
-            f"{compliance / total:.0%}, the other iteration work {loop / total:.0%} "
-            f"({sum(len(s['iterations']) for s in run['steps'])} iterations), assembly {run['assembly'] / total:.0%}")
-
-
-def _overshoot(size: dict) -> str:
-    """Largest active set of the one-step run against its final one (sphere nodes)."""
-    its = size["runs"]["ours_one"]["steps"][0]["iterations"]
+def _overshoot(size: dict, path: str) -> str:
+    """Largest active set of the one-step run against its final one (primary nodes)."""
+    its = size["runs"][f"{path}_one"]["steps"][0]["iterations"]
     largest, final = max(i["active_primary"] for i in its), its[-1]["active_primary"]
-    return f"{size['name']}: {largest} active sphere nodes at most, {final} at the end"
+    return f"{size['name']}: {largest} active primary nodes at most, {final} at the end"
+
+
+DIRECT_BOUND = (
+    "The sparse Cholesky factorization grows faster than GAMG (factor work ~ n^2 in 3D with nested dissection, "
+    "GAMG's ~ n): once it alone exceeds twice dolfinx's solve, the aim is out of reach for this path whatever "
+    "the loop costs. The compliance solves are one forward + backward solve with each body's factor per "
+    "multiplier (per active primary node, src/contact/compliance.rs); the second iteration pays most of them, "
+    "because the unconstrained first iteration makes every geometrically overlapping node active at once, so "
+    "columns are computed for more nodes than end in contact. The other iteration work (the dense Schur "
+    "complement from the cached responses, its LU, the solves for z and the back-substitution, the interface "
+    "operators and the contact checks) is paid at every iteration.")
+ITERATIVE_BOUND = (
+    "On the iterative path every active-set iteration solves the interface equation anew: z = K^-1 f, then one "
+    "CG + AMG solve per body per GMRES iteration and per restart residual (src/contact/interface_krylov.rs), "
+    "each pair of solves the fraction of dolfinx's whole elastic solve given above. The total is about the "
+    "number of pairs times that fraction: the aim holds only if the whole loop makes no more pairs than the "
+    "budget, whatever the set-up costs.")
 
 
 def reading(sizes: list[dict]) -> list[str]:
     """A reading of the figures, derived from them (one paragraph per point)."""
     text = []
-    failed = [f"{RUNS[run][0]} at {s['name']}: {status(s['runs'][run])}"
-              + (f" ({s['runs'][run]['error']})" if "error" in s["runs"][run] else "")
-              for s in sizes for run in OURS if status(s["runs"][run]) != "ok"]
+    failed = [f"{RUNS[run][0]} at {s['name']}: {status(r)}" + (f" ({r['error']})" if "error" in r else "")
+              for s in sizes for run in RUNS if status(r := s["runs"][run]) not in ("ok", "not run")]
     if failed:
-        text.append("**Failures.** Our contact solve did not converge or did not finish: " + "; ".join(failed)
-                    + ". The times of a run that ended in a non-converged status are still reported (a step "
-                    "that cycles stops the load steps); a converged solve would have taken a different time.")
-    done = [s for s in sizes if "total" in ratios(s)]
-    if done:
+        text.append("**Failures and stopped runs.** " + "; ".join(failed) + ". The times of a run of ours that "
+                    "ended in a non-converged status are still reported (a step that does not settle stops the "
+                    "load steps); a converged solve would have taken a different time.")
+    not_run: dict[tuple, list[str]] = {}
+    for s in sizes:
+        for run in OURS:
+            if "not_run" in s["runs"][run]:
+                not_run.setdefault((s["name"], RUNS[run][1], s["runs"][run]["not_run"]), []).append(_kind(run))
+    if not_run:
+        text.append("**Not run.** " + "; ".join(f"The {path} path at {name} ({', '.join(kinds)}): {reason}"
+                                                for (name, path, reason), kinds in not_run.items()) + ".")
+    for path in PATHS:
+        done = [s for s in sizes if "total" in ratios(s, path)]
+        if not done:
+            continue
         parts = []
         for s in done:
-            one, q = s["runs"]["ours_one"], ratios(s)
+            one, q = s["runs"][f"{path}_one"], ratios(s, path)
             best = s["runs"][best_dolfinx(s["runs"])]
             parts.append(f"{s['name']}: {fmt(one['contact_total'])} s against {fmt(best['elastic_total'])} s, "
-                         f"ratio {q['total']:.1f}, {_miss(q['total'], AIM_TOTAL)}"
-                         + ("" if status(one) == "ok" else f" ({status(one)})")
-                         + (f"; the load-stepped run: ratio {q['steps_total']:.1f}" if "steps_total" in q else ""))
-        text.append(f"**Aim 1, contact total <= {AIM_TOTAL:g} x dolfinx's elastic solve** (one-step contact solve: "
-                    "set-up + its active-set loop, against dolfinx's assembly + best solver). " + "; ".join(parts)
-                    + ".")
-        shares = [f"{s['name']}: {_breakdown(s['runs']['ours_one'])}; Cholesky alone "
-                  f"{ratios(s)['cholesky']:.1f}x dolfinx's whole solve" for s in done]
-        text.append("What bounds it (shares of the one-step contact total): " + "; ".join(shares) + ". The sparse "
-                    "Cholesky factorization is a direct solver's cost (factor work ~ n^2 in 3D with nested "
-                    "dissection) where GAMG's is ~ n: once it alone exceeds twice dolfinx's solve, the aim is out "
-                    "of reach for this design whatever the loop costs. The compliance solves are one full "
-                    "forward + backward solve with each body's factor per multiplier (per active primary node, "
-                    "src/contact/compliance.rs), of which "
-                    "only the candidate-surface rows are kept; the second iteration pays most of them, because the "
-                    "unconstrained first iteration makes every geometrically overlapping node active at once ("
-                    + "; ".join(_overshoot(s) for s in done) + "), so columns are computed for more nodes than "
-                    "end in contact, and the loop then removes the nodes in tension a rim at a time. The other "
-                    "iteration work is paid at every iteration: the dense Schur complement gathered from the "
-                    "cached responses and multiplied out (s C Y: constraint rows on the read surface dofs times "
-                    "the responses there), its LU, four single-right-hand-side solves with the factors "
-                    "(z = K^-1 f and the back-substitution, per body), the interface operators and the contact "
-                    "checks; it grows with the iteration count.")
-    stepped = [s for s in sizes if "step" in ratios(s)]
-    if stepped:
+                         f"ratio {q['total']:.1f}" + ("" if status(one) == "ok" else f" ({status(one)})")
+                         + (f" (load steps: {q['steps_total']:.1f})" if "steps_total" in q else "")
+                         + f", {_verdict(q['total'], AIM_TOTAL)}")
+        text.append(f"**Aim 1, {path} path: contact total <= {AIM_TOTAL:g} x dolfinx's elastic solve** (one-step "
+                    "run: set-up + its active-set loop, against dolfinx's assembly + best solver). "
+                    + "; ".join(parts) + ". What bounds it (shares of the one-step contact total): "
+                    + "; ".join(_breakdown(s, path) for s in done) + ". "
+                    + (DIRECT_BOUND if path == "direct" else ITERATIVE_BOUND))
+    aim2 = {}
+    for path in PATHS:
         parts = []
-        for s in stepped:
-            r, q = s["runs"]["ours_steps"], ratios(s)
+        for s in [s for s in sizes if "step" in ratios(s, path)]:
+            r, q = s["runs"][f"{path}_steps"], ratios(s, path)
             first, second = r["steps"][0], r["steps"][1]
-            parts.append(f"{s['name']}: step 2 {fmt(second['seconds'])} s ({len(second['iterations'])} iterations, "
-                         f"{second['status']}) against step 1 {fmt(first['seconds'])} s ({len(first['iterations'])}),"
-                         f" ratio {q['step']:.2f}, {_miss(q['step'], AIM_STEP, strict=True)} (against set-up + "
-                         f"step 1: {q['step_with_set_up']:.2f}); compliance (est.) "
-                         f"{second['compliance_estimate'] / second['seconds']:.0%} of step 2")
-        text.append(f"**Aim 2, each extra load step < {AIM_STEP:g} x the first step.** " + "; ".join(parts) + ". "
-                    "Doubling the imposed displacement grows the contact radius by 2^(1/2) (a^2 ~ R delta) and the "
-                    "contact area twofold; step 2 starts from step 1's active set, its first iteration makes the "
-                    "whole new overlap active, so it needs compliance columns for the new nodes (its second "
-                    "iteration) and again many iterations to shed the nodes in tension, each with a larger "
-                    "interface than in step 1. What the kept factorizations and the cache save is the set-up and "
-                    "the columns of step 1's nodes, not the loop.")
-    cores = [f"{s['runs'][run]['cpu'] / s['runs'][run]['wall']:.2f}" for s in sizes for run in OURS
-             if timed(s["runs"][run])]
+            part = (f"{s['name']}: step 2 {fmt(second['seconds'])} s ({len(second['iterations'])} iterations, "
+                    f"{second['status']}) against set-up + step 1 {fmt(r['set_up'] + first['seconds'])} s "
+                    f"({fmt(r['set_up'])} + {fmt(first['seconds'])}, {len(first['iterations'])} iterations), ratio "
+                    f"{q['step']:.2f}, {_verdict(q['step'], AIM_STEP)} (loops only: {q['step_loop']:.2f})")
+            if path == "direct":
+                part += f"; compliance (est.) {second['compliance_estimate'] / second['seconds']:.0%} of step 2"
+            elif None not in (solves := [body_solves(x["iterations"]) for x in (first, second)]):
+                part += f"; {solves[1]} solves per body in step 2 against {solves[0]} in step 1"
+            parts.append(part)
+        if parts:
+            aim2[path] = f"*{path}*: " + "; ".join(parts) + "."
+    if aim2:
+        why = {"direct": "Direct: the kept factors and cached responses save the set-up and the columns of step 1's "
+                         "nodes, not the loop; step 2 needs columns for the new nodes (its second iteration).",
+               "iterative": "Iterative: step 2 keeps the set-up (AMG hierarchies, operators) and GMRES' warm start "
+                            "from the previous tractions; each of its active-set iterations still costs a full GMRES "
+                            "solve (the solves per body above)."}
+        text.append(f"**Aim 2: each extra load step <= {AIM_STEP:g} x the first, the set-up counted in the first** "
+                    "(load-stepped run: step 2 / (set-up + step 1)). " + " ".join(aim2.values()) + " What bounds it: "
+                    "doubling the imposed displacement doubles the contact area (a^2 ~ R delta); step 2 starts from "
+                    "step 1's active set, its first iteration makes the whole new overlap active and the loop again "
+                    "sheds the nodes in tension, each iteration on a larger interface than in step 1. "
+                    + " ".join(why[path] for path in aim2))
+    aim3, overshoot = [], []
+    for path in PATHS:
+        parts = []
+        for s in [s for s in sizes if "iterations" in ratios(s, path)]:
+            q = ratios(s, path)
+            per_run = [f"{_kind(run).split(' (')[0]} "
+                       + " + ".join(str(len(x["iterations"])) for x in s["runs"][run]["steps"])
+                       for run in (f"{path}_one", f"{path}_steps") if timed(s["runs"][run])]
+            parts.append(f"{s['name']}: at most {q['iterations']} ({', '.join(per_run)}), "
+                         f"{_iterations_verdict(q['iterations'])}")
+            if timed(s["runs"][f"{path}_one"]):
+                overshoot.append(f"{path} {_overshoot(s, path)}")
+        if parts:
+            aim3.append(f"*{path}*: " + "; ".join(parts) + ".")
+    if aim3:
+        text.append(f"**Aim 3: at most {AIM_ITERATIONS} active-set iterations per load step.** " + " ".join(aim3)
+                    + " What sets the count: the unconstrained first iteration makes every geometrically "
+                    "overlapping node active (one-step runs, " + "; ".join(overshoot) + "), then the loop removes "
+                    "the nodes in tension a rim at a time, one iteration per rim: the count grows with the number "
+                    "of rims between the overlap and the contact zone, i.e. with the refinement.")
+    large = [s for s in sizes if dofs(s) >= AIM_MEMORY_MIN_DOFS]
+    aim4 = []
+    for path in PATHS:
+        measured = [s for s in sizes if "memory" in ratios(s, path)]
+        parts = []
+        for s in measured:
+            q, best = ratios(s, path), s["runs"][best_dolfinx(s["runs"])]
+            peak = max(s["runs"][run]["peak_mb"] for run in (f"{path}_one", f"{path}_steps")
+                       if timed(s["runs"][run]))
+            parts.append(f"{s['name']}: {peak:.0f} MB against {best['peak_mb']:.0f} MB, ratio {q['memory']:.1f}"
+                         + (f", {_verdict(q['memory'], AIM_MEMORY)}" if dofs(s) >= AIM_MEMORY_MIN_DOFS else ""))
+        missing = [s["name"] for s in large if s not in measured]
+        if missing:
+            parts.append(f"not measured at {', '.join(missing)} (not run or not finished there)")
+        if parts:
+            aim4.append(f"*{path}*: " + "; ".join(parts) + ".")
+    if aim4:
+        judged = ("" if large else f" No size of >= {AIM_MEMORY_MIN_DOFS:,} DOFs in this run: the aim is not judged; "
+                  "the smaller sizes show the trend.")
+        text.append(f"**Aim 4: peak memory <= {AIM_MEMORY:g} x dolfinx's at >= 1M DOFs** (the larger of the path's "
+                    "two runs against dolfinx's best run). " + " ".join(aim4) + judged + " What our process holds: "
+                    "direct, the two Cholesky factors, which grow like n^(4/3) where dolfinx's CG + GAMG grows like "
+                    "n, and the cached responses to the multipliers; iterative, each body's stiffness, its copy in "
+                    "PETSc and the GAMG hierarchy, about linear in n like dolfinx's, plus the interface operators "
+                    "and GMRES' basis. dolfinx's peak includes the Python interpreter, dolfinx and the gmsh model, "
+                    "which weigh most at the small sizes.")
+    gmres = []
+    for s in sizes:
+        counts = [c for run in ("iterative_one", "iterative_steps") if timed(s["runs"][run])
+                  for x in s["runs"][run]["steps"] if (c := krylov_counts(x["iterations"]))]
+        residuals = [i["krylov"]["relative_residual"] for run in ("iterative_one", "iterative_steps")
+                     if timed(s["runs"][run]) for x in s["runs"][run]["steps"] for i in x["iterations"]
+                     if i.get("krylov") and "relative_residual" in i["krylov"]]
+        if counts:
+            flat = [k for c in counts for k in c]
+            gmres.append(f"{s['name']}: median {statistics.median(flat):g}, at most {max(flat)} per active-set "
+                         f"iteration, {min(map(sum, counts))} to {max(map(sum, counts))} per step"
+                         + (f", final relative residuals at most {max(residuals):.1e}" if residuals else ""))
+    if gmres:
+        text.append("**GMRES on the iterative path** (iterations per active-set iteration, from the log's "
+                    "`interface GMRES` lines or summary.json's `krylov_iterations`; sums and maxima of every step in "
+                    "the last table): " + "; ".join(gmres) + ".")
+    cores = [f"{s['name']} {RUNS[run][1]} {s['runs'][run]['cpu'] / s['runs'][run]['wall']:.2f}"
+             for s in sizes for run in OURS if timed(s["runs"][run])]
     if cores:
-        text.append(f"**Threads.** Our processes used {', '.join(cores)} CPU seconds per wall second (per size, "
-                    "one step then load steps); the dolfinx runs are serial (one process, one BLAS thread). On "
-                    "this shared 2-core machine a figure below 1 means the run waited for the CPU.")
+        text.append(f"**Threads.** Our processes used {', '.join(cores)} CPU seconds per wall second (per size and "
+                    "path, one step then load steps); the dolfinx runs are serial (one process, one BLAS thread). "
+                    "On this shared 2-core machine a figure below 1 means the run waited for the CPU.")
     agreement = [s["runs"]["dolfinx_cg"]["l2_vs_mumps"] for s in sizes if "l2_vs_mumps" in s["runs"]["dolfinx_cg"]]
     if agreement:
         text.append(f"**Sanity.** dolfinx's CG + GAMG and MUMPS displacements differ by at most {max(agreement):.1e} "
                     f"(relative L2; CG rtol {CG_RTOL:.0e}).")
     return text
+
+
+def _resolved(sizes: list[dict]) -> list[str]:
+    """A bullet with the solvers the runs resolved (summary.json's contact.solver and contact.body_solver,
+    where the binary writes them), or nothing."""
+    names = {}
+    for s in sizes:
+        for run in OURS:
+            resolved = s["runs"][run].get("resolved") or {}
+            for key in ("solver", "body_solver"):
+                if resolved.get(key) is not None:
+                    value = resolved[key] if isinstance(resolved[key], str) else json.dumps(resolved[key])
+                    names.setdefault(RUNS[run][1], {}).setdefault(key, set()).add(value)
+    if not names:
+        return []
+    return ["* Resolved by the runs (`summary.json`): " + "; ".join(
+        f"{path}: " + ", ".join(f"`contact.{key}` {' / '.join(sorted(values))}" for key, values in keys.items())
+        for path, keys in names.items()) + "."]
 
 
 def _load_range(sizes: list[dict]) -> str:
@@ -589,6 +936,8 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
                 ["gmsh", env["gmsh"]], ["command", f"`{COMMAND}` (this run: `{' '.join(argv)}`)"]]
     parameters = base_case()[1].get("geo_parameters", {})
     h_c = parameters.get("h_c", 1 / 15)  # the geo script's default: R / 15
+    paths = "; ".join(f"*{name}*: `[solver] body = \"{p['body']}\"`, `[contact] solver = \"{p['solver']}\"` "
+                      f"({p['label']})" for name, p in PATHS.items())
     text = [
         "# Contact benchmark: internodes against one dolfinx elastic solve",
         "",
@@ -606,11 +955,10 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "elastic block (E = 1000, nu = 0.3 both), frictionless, contact radius a ~ 0.1 R; mesh "
         "`geo/hemisphere_on_block.geo` with the case's parameters ("
         + ", ".join(f"{k} = {v:g}" for k, v in parameters.items()) + ") at levels "
-        + ", ".join(f"{s['level']} ({3 * s['nodes']:,} DOFs, h_c = R/{1 / (h_c * 2 ** -s['level']):.0f})"
-                    for s in sizes)
-        + ". Ours: `internodes solve` (Schur path), twice: the case as given (*one step*, the full "
-        f"displacement) and with `[contact] load_steps = {list(LOAD_STEPS)}` (*load steps*). dolfinx: one "
-        "linear elastic solve of the same two-body mesh (both volumes in one mesh, sphere_top displaced by "
+        + ", ".join(f"{s['level']} ({dofs(s):,} DOFs, h_c = R/{1 / (h_c * 2 ** -s['level']):.0f})" for s in sizes)
+        + f". Ours: `internodes solve`, two paths: {paths}. Each path twice: the full displacement in one step "
+        f"(*one step*) and with `[contact] load_steps = {list(LOAD_STEPS)}` (*load steps*). dolfinx: one linear "
+        "elastic solve of the same two-body mesh (both volumes in one mesh, sphere_top displaced by "
         "(0, 0, -delta), block_base clamped, no contact coupling: two independent SPD problems), assembly + its "
         "faster solver.",
         "",
@@ -620,15 +968,17 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "",
         markdown(contact_table(sizes)),
         "",
-        "* *active nodes*: at the end of the last step; the frictionless multipliers are one per active sphere "
+        *_resolved(sizes),
+        "* *active nodes*: at the end of the last step; the frictionless multipliers are one per active primary "
         "node. *status*: how the last step ended (`cycling`: the active set came back to an earlier set).",
         "* *set-up* = `contact set-up` of `summary.json`: *asm* (sparsity, stiffness, Dirichlet rows of both "
-        "bodies) + *chol* (ordering + Cholesky of both bodies, from the run's log) + *other* (interpolation "
-        "operators between the candidate surfaces).",
+        "bodies) + *solvers* (the run log's `... of both bodies` line: direct, ordering + Cholesky; iterative, "
+        "PETSc initialization + GAMG hierarchies) + *other* (interpolation operators between the candidate "
+        "surfaces).",
         "* *step k* = the active-set loop of load step k with its post-processing (iterations); "
-        "*per iteration* over the iterations of all steps; *compliance (est.)*: per step, the iteration times "
-        "above the step's median iteration, summed (the cost of new interface-compliance columns: an estimate, "
-        "the solver does not time it separately).",
+        "*per iteration* over the iterations of all steps; *compliance (est.)*, direct path only: per step, the "
+        "iteration times above the step's median iteration, summed (the cost of new interface-compliance "
+        "columns: an estimate, the solver does not time it separately; the iterative path computes no columns).",
         "* *contact total* = set-up + every step (no mesh reading, no output); *wall* = the whole process.",
         "",
         "### Against dolfinx",
@@ -639,9 +989,17 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         f"CG + GAMG (rtol {CG_RTOL:.0e}, rigid-body near-null space, iterations) or MUMPS Cholesky analysis + "
         "factorization + solve; *dfx best total* = the faster run's own assembly + setup + solve; serial, one "
         "BLAS thread. Peak memory includes the Python interpreter, dolfinx and the gmsh model.",
-        "* Aim 1 is read on the *one-step* run (the contact solve of the case as given); the *load-stepped* "
-        "run's set-up + both steps is shown beside it. Aim 2 is read on the load-stepped run: step 2 / step 1, "
-        "loops only (the set-up is not part of step 1).",
+        "* *contact / dfx best*: our contact total (set-up + every step) over dolfinx's best total, the one-step "
+        "run and in brackets the load-stepped one.",
+        "",
+        "### Aims",
+        "",
+        markdown(aims_table(sizes)),
+        "",
+        "* 1: the one-step run. 2: the load-stepped run, step 2 against set-up + step 1 (the set-up is counted in "
+        "the first step). 3: every load step of both runs. 4: the larger peak of the two runs against the peak of "
+        f"dolfinx's best run; the aim holds at >= {AIM_MEMORY_MIN_DOFS:,} DOFs. *Nx the bound*: the figure over "
+        "the aim's bound.",
         "",
         "### Reading",
         "",
@@ -650,6 +1008,9 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "",
         markdown(iteration_table(sizes)),
         "",
+        "* *GMRES its*: the interface GMRES iterations of each active-set iteration (iterative path), their sum "
+        "and largest over the step.",
+        "",
         "### Method and caveats",
         "",
         f"* {env['nproc']} cores on a machine shared with other engineers' builds and runs: wall times vary by up "
@@ -657,8 +1018,10 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "than figures across reports. Load average (1 min) just before each run: " + _load_range(sizes)
         + "; on 2 cores, above ~1 means the run shared the CPU.",
         "* Each figure is one measurement (no repetition).",
-        f"* A run is stopped beyond {MAX_SECONDS_OURS:.0f} s (ours) / {MAX_SECONDS_DOLFINX:.0f} s (dolfinx) or "
-        f"{MAX_RSS_GB:.0f} GB resident and reported as skipped.",
+        f"* A run is stopped beyond {MAX_SECONDS_OURS['direct']:.0f} s (direct) / "
+        f"{MAX_SECONDS_OURS['iterative']:.0f} s (iterative) / {MAX_SECONDS_DOLFINX:.0f} s (dolfinx) or "
+        f"{MAX_RSS_GB:.0f} GB resident and reported as skipped. The direct path is not run where its Cholesky "
+        "factors are estimated not to fit (module doc of the script).",
         "* Raw numbers: `validation/build/contact_bench/results.json` (git-ignored), with the logs of every run.",
         "",
     ]
@@ -670,11 +1033,37 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
 # ---------------------------------------------------------------------------
 
 
+def _sizes_argument(value: str) -> list[str]:
+    """--sizes: "small" (31k), "all", or names separated by commas."""
+    names = {s.name.lower(): s.name for s in SIZES}
+    if value == "small":
+        return [SIZES[0].name]
+    if value == "all":
+        return [s.name for s in SIZES]
+    chosen = [name.strip().lower() for name in value.split(",") if name.strip()]
+    unknown = [name for name in chosen if name not in names]
+    if unknown or not chosen:
+        raise argparse.ArgumentTypeError(f"unknown size {', '.join(unknown) or value!r}: small, all or names "
+                                         f"from {', '.join(names.values())}")
+    return [names[name] for name in chosen]
+
+
+def _paths_argument(value: str) -> list[str]:
+    """--paths: names of PATHS separated by commas."""
+    chosen = [name.strip() for name in value.split(",") if name.strip()]
+    if not chosen or any(name not in PATHS for name in chosen):
+        raise argparse.ArgumentTypeError(f"paths are {', '.join(PATHS)} (comma-separated), not {value!r}")
+    return [name for name in PATHS if name in chosen]
+
+
 def parse_args() -> argparse.Namespace:
-    """Command line: sizes, binary (and the hidden worker mode)."""
+    """Command line: sizes, paths, binary (and the hidden worker mode)."""
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sizes", choices=("small", "all"), default="all",
-                        help="small: the 31k-DOF mesh only (a quick check); all: 31k, 99k, 217k (default)")
+    parser.add_argument("--sizes", type=_sizes_argument, default="all",
+                        help="small: the 31k-DOF mesh only (a quick check); all: 31k, 99k, 217k, 1M (default); "
+                             "or names, e.g. 1M or 31k,99k")
+    parser.add_argument("--paths", type=_paths_argument, default="direct,iterative",
+                        help="our paths to run, comma-separated (default: direct,iterative)")
     parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes",
                         help="internodes executable (default: target/release/internodes)")
     parser.add_argument("--report-only", action="store_true",
@@ -685,21 +1074,42 @@ def parse_args() -> argparse.Namespace:
     return parser.parse_args()
 
 
+def upgrade(size: dict) -> dict:
+    """A size of a results.json written before the two paths (runs ours_one / ours_steps: the default,
+    Cholesky + Schur) in today's form: those are the direct runs, the iterative ones are not run."""
+    runs = size["runs"]
+    for old, new in (("ours_one", "direct_one"), ("ours_steps", "direct_steps")):
+        if old in runs:
+            run = runs.pop(old)
+            if "cholesky" in run:
+                run["body_setup"], run["body_setup_label"] = run.pop("cholesky"), "Cholesky"
+            runs[new] = run | {"path": "direct"} if timed(run) else run
+    for run in OURS:
+        runs.setdefault(run, {"not_run": "not in results.json (written before the iterative path was benchmarked)"})
+    return size
+
+
 def print_results(sizes: list[dict]) -> None:
     """The tables and the reading on stdout."""
-    print()
-    print(markdown(contact_table(sizes)))
-    print()
-    print(markdown(comparison_table(sizes)))
-    print()
-    print(markdown(iteration_table(sizes)))
+    for table in (contact_table, comparison_table, aims_table, iteration_table):
+        print()
+        print(markdown(table(sizes)))
     print()
     for paragraph in reading(sizes):
         print(paragraph, end="\n\n")
 
 
+def failed(sizes: list[dict], expected: int) -> bool:
+    """Whether a size is missing, a run of ours did not finish or converge, a dolfinx run failed (not stopped
+    at a limit), or no dolfinx run finished at a size. A path not run is not a failure."""
+    return len(sizes) < expected or any(
+        any(status(s["runs"][run]) not in ("ok", "not run") for run in OURS)
+        or any(status(s["runs"][run]) == "failed" for run in ("dolfinx_cg", "dolfinx_mumps"))
+        or best_dolfinx(s["runs"]) is None for s in sizes)
+
+
 def main() -> int:
-    """Environment, every size, report; exit status 1 if any run failed or did not converge."""
+    """Environment, every size, report; exit status 1 on a failure (``failed``)."""
     args = parse_args()
     if args.worker:
         dolfinx_worker(args.worker, args.case, args.output)
@@ -707,14 +1117,15 @@ def main() -> int:
 
     if args.report_only:
         results = json.loads((BENCH / "results.json").read_text())
-        print_results(results["sizes"])
-        write_report(results["environment"], results["sizes"], results["argv"])
+        sizes = [upgrade(size) for size in results["sizes"]]
+        print_results(sizes)
+        write_report(results["environment"], sizes, results["argv"])
         print(f"report: {REPORT.relative_to(REPO)}")
         return 0
 
     binary = args.binary.resolve()
     if not os.access(binary, os.X_OK):
-        print(f"error: {binary} is not an executable (cargo build --release)", file=sys.stderr)
+        print(f"error: {binary} is not an executable (cargo build --release --features petsc)", file=sys.stderr)
         return 2
     env = environment(binary)
     print(f"machine: {env['cpu']}, {env['nproc']} cores, {env['memory_gib']} GiB")
@@ -724,10 +1135,11 @@ def main() -> int:
                                     "apt-get install libopenblas0-pthread)"))
 
     sizes = []
-    for size in SIZES[:1] if args.sizes == "small" else SIZES:
+    selected = [s for s in SIZES if s.name in args.sizes]
+    for size in selected:
         print(f"== {size.name} DOFs (level {size.level})", flush=True)
         try:
-            sizes.append(benchmark_size(size, binary))
+            sizes.append(benchmark_size(size, binary, args.paths))
         except (RunFailed, OSError) as error:
             print(f"   FAILED: {error}", flush=True)
 
@@ -737,9 +1149,7 @@ def main() -> int:
     (BENCH / "results.json").write_text(json.dumps({"environment": env, "argv": argv, "sizes": sizes}, indent=2))
     write_report(env, sizes, argv)
     print(f"report: {REPORT.relative_to(REPO)}, raw numbers: {(BENCH / 'results.json').relative_to(REPO)}")
-    failed = len(sizes) < (1 if args.sizes == "small" else len(SIZES)) or any(
-        status(r) != "ok" for s in sizes for r in s["runs"].values())
-    return 1 if failed else 0
+    return 1 if failed(sizes, len(selected)) else 0
 
 
 if __name__ == "__main__":
