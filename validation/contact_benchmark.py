@@ -116,12 +116,15 @@ PATHS = {
                "label": "Cholesky factor of each body, dense Schur complement from the responses"},
     "iterative": {"body": "cg-amg", "solver": "krylov",
                   "label": "CG + AMG for each body, interface equation by GMRES"},
+    "default": {"body": "auto", "solver": "auto",
+                "label": "what `auto` picks: GMRES on the interface, Cholesky bodies below 250,000 DOFs "
+                         "in the larger body and CG + AMG above"},
 }
 
 # A run is killed (and reported as skipped) beyond these limits. An iterative run at 1M DOFs
 # may take 30 to 60 minutes.
 MAX_RSS_GB = 18.0
-MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0}
+MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0, "default": 5400.0}
 MAX_SECONDS_DOLFINX = 600.0
 
 # The aims of the module doc.
@@ -162,6 +165,8 @@ RUNS = {
     "direct_steps": ("direct, load steps (0.5, 1.0)", "direct", LOAD_STEPS),
     "iterative_one": ("iterative, one step (1.0)", "iterative", ONE_STEP),
     "iterative_steps": ("iterative, load steps (0.5, 1.0)", "iterative", LOAD_STEPS),
+    "default_one": ("default, one step (1.0)", "default", ONE_STEP),
+    "default_steps": ("default, load steps (0.5, 1.0)", "default", LOAD_STEPS),
     "dolfinx_cg": ("dolfinx, CG + GAMG", None, None),
     "dolfinx_mumps": ("dolfinx, MUMPS Cholesky", None, None),
 }
@@ -294,8 +299,9 @@ ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-
 # "  Cholesky of both bodies: 0.290 s": the body solvers' set-up (the factors, or PETSc + the AMG
 # hierarchies on the iterative path, whatever the label says).
 BODY_SETUP_LINE = re.compile(r"^\s+(\S.*?) of both bodies: ([-+0-9.eE]+) s$")
+# An active-set iteration may print two: a loose solve, then the exact one (summed).
 KRYLOV_LINE = re.compile(r"^\s+interface GMRES: (\d+) iterations \(\+(\d+) residuals\), "
-                         r"relative residual (\S+) \(start (\S+)\)\s*$")
+                         r"relative residual (\S+) \(start ([^,)]+)(?:, target [^)]+)?\)\s*$")
 
 
 def _phases(text: str | None) -> dict:
@@ -320,8 +326,10 @@ def parse_log(log: Path) -> tuple[str, float, list[list[dict]]]:
         elif LOAD_STEP_LINE.match(line):
             steps.append([])
         elif match := KRYLOV_LINE.match(line):
-            krylov = {"iterations": int(match[1]), "residuals": int(match[2]),
-                      "relative_residual": float(match[3]), "start": float(match[4])}
+            krylov = {"iterations": int(match[1]) + (krylov or {}).get("iterations", 0),
+                      "residuals": int(match[2]) + (krylov or {}).get("residuals", 0),
+                      "relative_residual": float(match[3]),
+                      "start": (krylov or {}).get("start", float(match[4]))}
         elif match := ITERATION_LINE.match(line):
             if not steps:  # a single load step prints no "load step" line
                 steps.append([])
@@ -375,8 +383,8 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
         raise RunFailed(f"exit status {usage['exit_status']}: {tail}")
     summary = json.loads(summary_file.read_text())
     contact = summary["contact"]
-    # The coupled solver asked for (contact.settings.solver); the resolved names (contact.solver,
-    # contact.body_solver) are recorded where the binary writes them.
+    # The coupled solver asked for (contact.settings.solver); the ones that ran are
+    # contact.linear_solvers (interface, body, and a GMRES failure that moved auto to schur).
     solver = contact.get("settings", {}).get("solver")
     if solver != PATHS[path]["solver"]:
         raise RunFailed(f"{summary_file}: the run used the coupled solver {solver!r}, not {PATHS[path]['solver']!r}")
@@ -389,7 +397,7 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
         raise RunFailed(f"{log}: the iterations in the log do not match summary.json (log format changed?)")
     # GMRES iterations of the last step: summary.json's krylov_iterations where the binary writes them.
     for logged, record in zip(iterations[-1], contact["iterations"]):
-        if solver == "krylov" and record.get("krylov_iterations") is not None:
+        if record.get("krylov_iterations") is not None:
             logged["krylov"] = dict(logged["krylov"] or {}, iterations=int(record["krylov_iterations"]))
     bodies = {b["name"]: b for b in summary["bodies"]}
     assembly = sum(t for b in bodies.values() for phase, t in b["solve"]["timings"]
@@ -405,8 +413,10 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
                       "force": record["force_primary"][-1], "hertz_a": record["hertz_a"]})
     set_up = phases["contact set-up"]
     return usage | {
-        "path": path, "solver": solver, "resolved": {"solver": contact.get("solver"),
-                                                      "body_solver": contact.get("body_solver")},
+        "path": path, "solver": solver,
+        "resolved": {"solver": (contact.get("linear_solvers") or {}).get("interface"),
+                     "body_solver": (contact.get("linear_solvers") or {}).get("body"),
+                     "krylov_failure": (contact.get("linear_solvers") or {}).get("krylov_failure")},
         "contact_status": contact["status"],
         "dofs": {name: b["num_dofs"] for name, b in bodies.items()},
         "stiffness_nnz": {name: b["solve"]["stiffness_nnz"] for name, b in bodies.items()},
@@ -913,11 +923,11 @@ def _resolved(sizes: list[dict]) -> list[str]:
             for key in ("solver", "body_solver"):
                 if resolved.get(key) is not None:
                     value = resolved[key] if isinstance(resolved[key], str) else json.dumps(resolved[key])
-                    names.setdefault(RUNS[run][1], {}).setdefault(key, set()).add(value)
+                    names.setdefault(RUNS[run][1], {}).setdefault(key, set()).add(f"{value} ({s['name']})")
     if not names:
         return []
-    return ["* Resolved by the runs (`summary.json`): " + "; ".join(
-        f"{path}: " + ", ".join(f"`contact.{key}` {' / '.join(sorted(values))}" for key, values in keys.items())
+    return ["* Solvers that ran (`summary.json`'s `contact.linear_solvers`): " + "; ".join(
+        f"{path}: " + ", ".join(f"{key} {' / '.join(sorted(values))}" for key, values in keys.items())
         for path, keys in names.items()) + "."]
 
 
@@ -1062,7 +1072,9 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--sizes", type=_sizes_argument, default="all",
                         help="small: the 31k-DOF mesh only (a quick check); all: 31k, 99k, 217k, 1M (default); "
                              "or names, e.g. 1M or 31k,99k")
-    parser.add_argument("--paths", type=_paths_argument, default="direct,iterative",
+    parser.add_argument("--merge", action="store_true",
+                        help="keep the sizes of results.json that this run does not measure (same commit only)")
+    parser.add_argument("--paths", type=_paths_argument, default="direct,iterative,default",
                         help="our paths to run, comma-separated (default: direct,iterative)")
     parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes",
                         help="internodes executable (default: target/release/internodes)")
@@ -1143,9 +1155,21 @@ def main() -> int:
         except (RunFailed, OSError) as error:
             print(f"   FAILED: {error}", flush=True)
 
+    argv = [Path(sys.argv[0]).name, *sys.argv[1:]]
+    if args.merge and (BENCH / "results.json").is_file():
+        earlier = json.loads((BENCH / "results.json").read_text())
+        if earlier["environment"].get("commit") != env.get("commit"):
+            print(f"error: --merge: results.json is of commit {earlier['environment'].get('commit')}, "
+                  f"this binary of {env.get('commit')}", file=sys.stderr)
+            return 2
+        measured = {s["name"] for s in sizes}
+        kept = [upgrade(s) for s in earlier["sizes"] if s["name"] not in measured]
+        order = [s.name for s in SIZES]
+        sizes = sorted(kept + sizes, key=lambda s: order.index(s["name"]))
+        argv = [*earlier["argv"], "+", *argv]
+        selected = [s for s in SIZES if s.name in {x["name"] for x in sizes}]
     print_results(sizes)
     BENCH.mkdir(parents=True, exist_ok=True)
-    argv = [Path(sys.argv[0]).name, *sys.argv[1:]]
     (BENCH / "results.json").write_text(json.dumps({"environment": env, "argv": argv, "sizes": sizes}, indent=2))
     write_report(env, sizes, argv)
     print(f"report: {REPORT.relative_to(REPO)}, raw numbers: {(BENCH / 'results.json').relative_to(REPO)}")
