@@ -1750,8 +1750,10 @@ fn assert_same_contact(a: &ContactSolution, b: &ContactSolution, tolerance: f64,
 #[test]
 fn krylov_and_schur_solves_agree() {
     // The interface GMRES against the dense Schur complement, both on Cholesky factors: 2D
-    // Hertz (a partial active set, both formulations), the 3D patch test (both formulations)
-    // and the 3D Hertz hemisphere (a partial set reached after several iterations).
+    // Hertz (a partial active set, both formulations), the 3D patch test (both formulations),
+    // the 3D Hertz hemisphere (a partial set reached after several iterations), the
+    // conservative transfer, two load steps (the second from the first's set, warm start and
+    // `K^-1 f`) and a slide (the operators paired again).
     //
     // GMRES stops early on the iterations that change the active set (`LOOSE_GAP` in
     // src/contact/solve.rs), so the next iteration's gaps are linearized at a slightly
@@ -1787,6 +1789,22 @@ fn krylov_and_schur_solves_agree() {
             "3D Hertz",
             hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, ""),
             1e-6,
+        ),
+        (
+            "2D conservative transfer",
+            narrow_blocks("primary = \"upper\"\ntransfer = \"conservative\""),
+            1e-8,
+        ),
+        (
+            "2D load steps",
+            half_disc_on_block("load_steps = [0.5, 1.0]"),
+            1e-8,
+        ),
+        (
+            "2D slid",
+            common::half_disc_on_block("half_disc_on_block.msh", "")
+                .replace("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02"),
+            1e-8,
         ),
     ];
     for (label, text, tolerance) in cases {
