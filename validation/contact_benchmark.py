@@ -447,8 +447,23 @@ def _done_line(run: dict) -> str:
             f"({' + '.join(str(len(s['iterations'])) for s in run['steps'])} iterations{gmres})")
 
 
-def benchmark_size(size: Size, binary: Path, paths: list[str]) -> dict:
-    """Mesh, the runs one after the other, and the CG / MUMPS agreement."""
+def mumps_not_run_reason(count: int, earlier: list[dict]) -> str | None:
+    """Why dolfinx's MUMPS is not run at ``count`` DOFs: its time, grown like n^2 (a 3D factorization's
+    work) from the largest size of this run where it finished, beyond its time limit (None: it is run)."""
+    done = [s for s in earlier if timed(s["runs"]["dolfinx_mumps"])]
+    if not done:
+        return None
+    largest = max(done, key=dofs)
+    seconds = largest["runs"]["dolfinx_mumps"]["wall"]
+    estimate = seconds * (count / dofs(largest)) ** 2
+    if estimate <= MAX_SECONDS_DOLFINX:
+        return None
+    return (f"MUMPS took {seconds:.0f} s at {dofs(largest):,} DOFs in this run; grown like n^2 to {count:,} DOFs, "
+            f"about {estimate:,.0f} s, beyond the {MAX_SECONDS_DOLFINX:.0f} s limit (CG + GAMG is dolfinx's best there)")
+
+
+def benchmark_size(size: Size, binary: Path, paths: list[str], earlier: list[dict]) -> dict:
+    """Mesh, the runs one after the other, and the CG / MUMPS agreement (``earlier``: the sizes done)."""
     generate_mesh(size)
     count = 3 * mesh_nodes(size.mesh)
     runs: dict[str, dict] = {}
@@ -456,6 +471,8 @@ def benchmark_size(size: Size, binary: Path, paths: list[str]) -> dict:
         if path and path not in paths:
             runs[run] = {"not_run": f"not selected (--paths {','.join(paths)})"}
         elif path and (reason := not_run_reason(path, count)):
+            runs[run] = {"not_run": reason}
+        elif run == "dolfinx_mumps" and (reason := mumps_not_run_reason(count, earlier)):
             runs[run] = {"not_run": reason}
         if "not_run" in runs.get(run, {}):
             print(f"   {label}: not run ({runs[run]['not_run']})", flush=True)
@@ -795,9 +812,10 @@ def reading(sizes: list[dict]) -> list[str]:
                     "load steps); a converged solve would have taken a different time.")
     not_run: dict[tuple, list[str]] = {}
     for s in sizes:
-        for run in OURS:
+        for run in [*OURS, "dolfinx_mumps"]:
             if "not_run" in s["runs"][run]:
-                not_run.setdefault((s["name"], RUNS[run][1], s["runs"][run]["not_run"]), []).append(_kind(run))
+                path = RUNS[run][1] or "dolfinx MUMPS"
+                not_run.setdefault((s["name"], path, s["runs"][run]["not_run"]), []).append(_kind(run))
     if not_run:
         text.append("**Not run.** " + "; ".join(f"The {path} path at {name} ({', '.join(kinds)}): {reason}"
                                                 for (name, path, reason), kinds in not_run.items()) + ".")
@@ -1162,7 +1180,7 @@ def main() -> int:
     for size in selected:
         print(f"== {size.name} DOFs (level {size.level})", flush=True)
         try:
-            sizes.append(benchmark_size(size, binary, args.paths))
+            sizes.append(benchmark_size(size, binary, args.paths, sizes))
         except (RunFailed, OSError) as error:
             print(f"   FAILED: {error}", flush=True)
 
