@@ -51,6 +51,8 @@
 //! become CG + AMG from [`crate::linalg::AUTO_CG_AMG_MIN_DOFS_CONTACT`] dofs in the larger
 //! body (`BodySolverKind::resolve_for_contact`).
 
+use std::io::IsTerminal;
+
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
@@ -172,7 +174,7 @@ impl BodyFactors {
                 false => KRYLOV_RTOL,
             };
             Interface::Krylov {
-                state: KrylovState::default(),
+                state: KrylovState::new(settings.verbose && std::io::stderr().is_terminal()),
                 tolerance,
             }
         } else {
@@ -248,8 +250,10 @@ impl BodyFactors {
         let stats = state.last;
         self.last_krylov = Some(stats);
         if self.verbose {
+            // Over a progress line, if one was shown.
+            let clear = if state.progress { "\r\x1b[2K" } else { "" };
             eprintln!(
-                "    interface GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
+                "{clear}    interface GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
                  (start {:.1e}, target {:.1e})",
                 stats.iterations,
                 stats.residual_products,

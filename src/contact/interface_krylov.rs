@@ -165,7 +165,23 @@ pub struct KrylovState {
     tractions: HashMap<MultiplierKey, f64>,
     /// The last solve's figures.
     pub last: KrylovStats,
+    /// Whether a solve over [`PROGRESS_AFTER`] rewrites a progress line on the terminal.
+    pub progress: bool,
 }
+
+impl KrylovState {
+    /// Nothing kept yet; `progress` as [`KrylovState::progress`].
+    pub fn new(progress: bool) -> Self {
+        Self {
+            progress,
+            ..Self::default()
+        }
+    }
+}
+
+/// A GMRES solve running longer than this (seconds) shows its progress (iterations, the
+/// residual estimate, the time) on one line, when [`KrylovState::progress`] is set.
+const PROGRESS_AFTER: f64 = 2.0;
 
 /// The two bodies' solvers.
 #[derive(Clone, Copy)]
@@ -412,6 +428,7 @@ pub fn solve(
             &mut lambda,
             tolerance,
             &mut stats,
+            state.progress,
         )?
     };
     state.last = stats;
@@ -434,6 +451,7 @@ pub fn solve(
 /// Restarted GMRES, right-preconditioned (so the residual it minimizes is the true one, not a
 /// preconditioned one), modified Gram-Schmidt with Givens rotations. `lambda` holds the
 /// starting guess and receives the solution; returns `K^-1 B lambda` of the solution.
+#[allow(clippy::too_many_arguments)]
 fn gmres(
     system: &CoupledSystem,
     bodies: &Bodies,
@@ -442,7 +460,20 @@ fn gmres(
     lambda: &mut [f64],
     tolerance: f64,
     stats: &mut KrylovStats,
+    progress: bool,
 ) -> Result<Vec<f64>, ContactError> {
+    let started = std::time::Instant::now();
+    let show = |stats: &KrylovStats, estimate: f64| {
+        let seconds = started.elapsed().as_secs_f64();
+        if progress && seconds > PROGRESS_AFTER {
+            // Rewrites the terminal line; the caller's summary line replaces it.
+            eprint!(
+                "\r\x1b[2K    interface GMRES: {} iterations, residual ~{estimate:.1e} (target \
+                 {tolerance:.1e}), {seconds:.1} s",
+                stats.iterations
+            );
+        }
+    };
     let m = r.len();
     let r_norm = norm(r);
     let target = tolerance * r_norm;
@@ -527,6 +558,7 @@ fn gmres(
             g[j + 1] = -sn[j] * g[j];
             g[j] *= cs[j];
             used = j + 1;
+            show(stats, g[j + 1].abs() / r_norm);
             // Half the target, so that the true residual, recomputed next, passes too.
             if g[j + 1].abs() <= 0.5 * target || next == 0.0 {
                 break;
