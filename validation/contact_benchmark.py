@@ -1175,22 +1175,25 @@ def main() -> int:
     print(f"BLAS: {env['blas']}" + ("" if env["openblas"] else "  (not OpenBLAS: dolfinx's MUMPS will be slower; "
                                     "apt-get install libopenblas0-pthread)"))
 
-    sizes = []
-    selected = [s for s in SIZES if s.name in args.sizes]
-    for size in selected:
-        print(f"== {size.name} DOFs (level {size.level})", flush=True)
-        try:
-            sizes.append(benchmark_size(size, binary, args.paths, sizes))
-        except (RunFailed, OSError) as error:
-            print(f"   FAILED: {error}", flush=True)
-
-    argv = [Path(sys.argv[0]).name, *sys.argv[1:]]
+    earlier = None
     if args.merge and (BENCH / "results.json").is_file():
         earlier = json.loads((BENCH / "results.json").read_text())
         if earlier["environment"].get("commit") != env.get("commit"):
             print(f"error: --merge: results.json is of commit {earlier['environment'].get('commit')}, "
                   f"this binary of {env.get('commit')}", file=sys.stderr)
             return 2
+    sizes = []
+    selected = [s for s in SIZES if s.name in args.sizes]
+    for size in selected:
+        print(f"== {size.name} DOFs (level {size.level})", flush=True)
+        done = sizes + [upgrade(s) for s in (earlier or {}).get("sizes", [])]
+        try:
+            sizes.append(benchmark_size(size, binary, args.paths, done))
+        except (RunFailed, OSError) as error:
+            print(f"   FAILED: {error}", flush=True)
+
+    argv = [Path(sys.argv[0]).name, *sys.argv[1:]]
+    if earlier:
         measured = {s["name"] for s in sizes}
         kept = [upgrade(s) for s in earlier["sizes"] if s["name"] not in measured]
         order = [s.name for s in SIZES]
