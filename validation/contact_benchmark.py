@@ -966,11 +966,19 @@ def _load_range(sizes: list[dict]) -> str:
     return f"{min(loads):.1f} to {max(loads):.1f}" if loads else "not measured"
 
 
+def _size_commits(sizes: list[dict], env: dict) -> str:
+    """"; sizes measured at other commits: ..." when a --merge kept sizes of an earlier commit."""
+    other = [f"{s['name']} at {s['commit']}" for s in sizes if s.get("commit", env["commit"]) != env["commit"]]
+    return f"; sizes measured at an earlier commit: {', '.join(other)} (git log between them says what changed)" \
+        if other else ""
+
+
 def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
     """validation/CONTACT_BENCHMARK.md: machine, versions, tables, reading, method."""
     env_rows = [["item", "value"], ["date", env["date"]],
                 ["machine", f"{env['cpu']}, {env['nproc']} cores, {env['memory_gib']} GiB, {env['os']}"],
-                ["internodes", f"{env['binary_version']} (commit {env['commit']}), built with {env['rustc']}"],
+                ["internodes", f"{env['binary_version']} (commit {env['commit']}), built with {env['rustc']}"
+                 + _size_commits(sizes, env)],
                 ["dolfinx / PETSc", f"{env['dolfinx']} / {env['petsc']}"], ["BLAS", env["blas"]],
                 ["gmsh", env["gmsh"]], ["command", f"`{COMMAND}` (this run: `{' '.join(argv)}`)"]]
     parameters = base_case()[1].get("geo_parameters", {})
@@ -1102,7 +1110,8 @@ def parse_args() -> argparse.Namespace:
                         help="small: the 31k-DOF mesh only (a quick check); all: 31k, 99k, 217k, 1M (default); "
                              "or names, e.g. 1M or 31k,99k")
     parser.add_argument("--merge", action="store_true",
-                        help="keep the sizes of results.json that this run does not measure (same commit only)")
+                        help="keep the sizes of results.json that this run does not measure (each keeps its commit, "
+                             "named in the report)")
     parser.add_argument("--paths", type=_paths_argument, default="direct,iterative,default",
                         help="our paths to run, comma-separated (default: direct,iterative)")
     parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes",
@@ -1198,17 +1207,18 @@ def main() -> int:
     earlier = None
     if args.merge and (BENCH / "results.json").is_file():
         earlier = json.loads((BENCH / "results.json").read_text())
-        if earlier["environment"].get("commit") != env.get("commit"):
-            print(f"error: --merge: results.json is of commit {earlier['environment'].get('commit')}, "
-                  f"this binary of {env.get('commit')}", file=sys.stderr)
+        if "modified" in env.get("commit", ""):
+            print("error: --merge: the tree has uncommitted changes", file=sys.stderr)
             return 2
+        for size in earlier["sizes"]:  # each size keeps the commit it was measured at
+            size.setdefault("commit", earlier["environment"].get("commit"))
     sizes = []
     selected = [s for s in SIZES if s.name in args.sizes]
     for size in selected:
         print(f"== {size.name} DOFs (level {size.level})", flush=True)
         done = sizes + [upgrade(s) for s in (earlier or {}).get("sizes", [])]
         try:
-            sizes.append(benchmark_size(size, binary, args.paths, done))
+            sizes.append(benchmark_size(size, binary, args.paths, done) | {"commit": env.get("commit")})
         except (RunFailed, OSError) as error:
             print(f"   FAILED: {error}", flush=True)
 
