@@ -462,7 +462,8 @@ def mumps_not_run_reason(count: int, earlier: list[dict]) -> str | None:
             f"about {estimate:,.0f} s, beyond the {MAX_SECONDS_DOLFINX:.0f} s limit (CG + GAMG is dolfinx's best there)")
 
 
-def benchmark_size(size: Size, binary: Path, paths: list[str], earlier: list[dict]) -> dict:
+def benchmark_size(size: Size, binary: Path, paths: list[str], earlier: list[dict],
+                   one_step_only: bool = False) -> dict:
     """Mesh, the runs one after the other, and the CG / MUMPS agreement (``earlier``: the sizes done)."""
     generate_mesh(size)
     count = 3 * mesh_nodes(size.mesh)
@@ -470,6 +471,8 @@ def benchmark_size(size: Size, binary: Path, paths: list[str], earlier: list[dic
     for run, (label, path, steps) in RUNS.items():
         if path and path not in paths:
             runs[run] = {"not_run": f"not selected (--paths {','.join(paths)})"}
+        elif path and steps == LOAD_STEPS and one_step_only:
+            runs[run] = {"not_run": "not selected (--one-step-only: the load-stepped run was left out for time)"}
         elif path and (reason := not_run_reason(path, count)):
             runs[run] = {"not_run": reason}
         elif run == "dolfinx_mumps" and (reason := mumps_not_run_reason(count, earlier)):
@@ -1109,6 +1112,8 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--sizes", type=_sizes_argument, default="all",
                         help="small: the 31k-DOF mesh only (a quick check); all: 31k, 99k, 217k, 1M (default); "
                              "or names, e.g. 1M or 31k,99k")
+    parser.add_argument("--one-step-only", action="store_true",
+                        help="leave out the load-stepped runs of ours (reported as not run)")
     parser.add_argument("--merge", action="store_true",
                         help="keep the sizes of results.json that this run does not measure (each keeps its commit, "
                              "named in the report)")
@@ -1218,7 +1223,8 @@ def main() -> int:
         print(f"== {size.name} DOFs (level {size.level})", flush=True)
         done = sizes + [upgrade(s) for s in (earlier or {}).get("sizes", [])]
         try:
-            sizes.append(benchmark_size(size, binary, args.paths, done) | {"commit": env.get("commit")})
+            sizes.append(benchmark_size(size, binary, args.paths, done, args.one_step_only)
+                         | {"commit": env.get("commit")})
         except (RunFailed, OSError) as error:
             print(f"   FAILED: {error}", flush=True)
 
