@@ -66,7 +66,9 @@
 //! component (a multiplier that is new starts at 0), projected on the multiplier's direction:
 //! `lambda_k = (e_k . t_node) / s`.
 //! It stops when the true residual `|r - S lambda|` (recomputed at every restart, not the
-//! Arnoldi estimate) is at most `tol |r|`. A solve that does not get there ends in a
+//! Arnoldi estimate) is at most `max(tol |r|, absolute)` ([`Target`]): `tol` is round-off
+//! ([`KRYLOV_RTOL`]), `absolute` is zero or, on a loose solve, `t` times the gap accuracy the
+//! active-set update needs (`super::solve`). A solve that does not get there ends in a
 //! [`KrylovError`] naming why: the iteration cap, a restart cycle that did not reduce the
 //! true residual (inexact products, e.g. CG's, set a floor), or a non-finite value.
 
