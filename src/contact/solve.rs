@@ -256,8 +256,10 @@ impl<'a> ContactSolver<'a> {
         let mut history = Vec::new();
         let mut status = ContactStatus::IterationLimit;
         let mut last = None;
+        // The active set `last` was solved on (`active` moves on to the next one).
+        let mut solved = active.clone();
 
-        for iteration in 1..=settings.max_iterations {
+        'iterations: for iteration in 1..=settings.max_iterations {
             let mut seconds = PhaseSeconds::default();
             // 1. The coupling of the active set: rows and columns of the fixed operators.
             let nodes: Vec<usize> = active.iter().copied().collect();
@@ -281,10 +283,24 @@ impl<'a> ContactSolver<'a> {
             let loose_gap = LOOSE_GAP * settings.penetration_tolerance * h;
             let mut krylov_iterations = None;
             let (solution, gaps, slid, update, linear) = loop {
-                let solution = timed(&mut seconds.solve, || {
+                let solved_now = timed(&mut seconds.solve, || {
                     let gap_tolerance = (loose && loose_gap.is_finite()).then_some(loose_gap);
                     self.coupled_solve(&coupling, load_factor, gap_tolerance)
-                })?;
+                });
+                let solution = match solved_now {
+                    // After a solve that left active nodes a spacing off the surface, an
+                    // interface system that cannot be solved accurately is the same diagnosis
+                    // as `Unstable`: the constraint does not control the geometry. The last
+                    // iterate is the answer, its certificate says what fails.
+                    Err(ContactError::Inaccurate { .. })
+                        if safeguard.off_surface.is_some() && last.is_some() =>
+                    {
+                        status = ContactStatus::Unstable;
+                        active = solved;
+                        break 'iterations;
+                    }
+                    solved_now => solved_now?,
+                };
                 if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
                     *krylov_iterations.get_or_insert(0) += stats.iterations;
                 }
@@ -344,6 +360,7 @@ impl<'a> ContactSolver<'a> {
             }
             history.push(record);
             last = Some((coupling, solution));
+            solved = active.clone();
             match step {
                 Step::Solve(next) => active = next,
                 Step::Stop(end) => {
