@@ -60,8 +60,9 @@
 //! changes; if that set was seen too the loop stops as [`ContactStatus::Cycling`]. It never
 //! declares convergence. A gap error that stops contracting on one active set beyond the
 //! tolerance is [`ContactStatus::Stalled`]; running out of iterations is
-//! [`ContactStatus::IterationLimit`]; an active node held a spacing or more off the other
-//! surface is [`ContactStatus::Unstable`].
+//! [`ContactStatus::IterationLimit`]; active nodes held a spacing or more off the other
+//! surface on two solves in a row, the second not contracting (or followed by an interface
+//! system that cannot be solved accurately), is [`ContactStatus::Unstable`].
 
 use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
