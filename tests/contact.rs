@@ -1823,6 +1823,49 @@ fn krylov_and_schur_solves_agree() {
 }
 
 #[test]
+fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer() {
+    // GMRES capped at one iteration cannot solve an interface problem started cold: under
+    // `auto` the failing solve and every later one go to the dense Schur complement, the
+    // answer is the Schur path's to round-off (every solve that counts is a Schur solve), and
+    // `linear_solvers` says why. Under `krylov` the same failure ends the run with an error
+    // naming it, never an answer.
+    let cases = [
+        ("2D Hertz", half_disc_on_block("krylov_max_iterations = 1")),
+        (
+            "3D Hertz",
+            hemisphere_on_block(
+                "hemisphere_on_block_hertz.msh",
+                0.01,
+                1000.0,
+                1000.0,
+                "krylov_max_iterations = 1",
+            ),
+        ),
+    ];
+    for (label, text) in cases {
+        let with =
+            |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+        let auto = solve(&with("auto")).unwrap();
+        let schur = solve(&with("schur")).unwrap();
+        assert_same_contact(&auto, &schur, 1e-10, label);
+        assert_eq!(auto.linear_solvers.interface, "schur", "{label}");
+        let failure = auto.linear_solvers.krylov_failure.as_deref();
+        assert!(
+            failure.is_some_and(|why| why.contains("iteration limit")),
+            "{label}: {failure:?}"
+        );
+        assert_eq!(schur.linear_solvers.krylov_failure, None, "{label}");
+        let message = solve(&with("krylov"))
+            .err()
+            .expect("an error, not an answer");
+        assert!(
+            message.contains("interface GMRES did not converge (iteration limit reached)"),
+            "{label}: {message}"
+        );
+    }
+}
+
+#[test]
 fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
     // With CG + AMG bodies, `schur` runs the interface GMRES (one body solve per product, no
     // per-node CG solves); each product is exact to CG's rtol (1e-10), GMRES stops at 1e-9.

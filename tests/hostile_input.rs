@@ -1115,6 +1115,11 @@ fn finite_values_that_overflow_downstream_are_rejected_naming_the_key_and_range(
             "rbf_radius",
             "<= 10",
         ),
+        (
+            common::half_disc_on_block("half_disc_on_block.msh", "krylov_max_iterations = 0"),
+            "krylov_max_iterations",
+            "between 1 and 10000",
+        ),
     ] {
         let message = case_failure(&text);
         assert!(

@@ -63,7 +63,7 @@ use super::interface_krylov::{
     self, Bodies, KRYLOV_RTOL, KRYLOV_RTOL_OVER_BODY_RTOL, KrylovState, KrylovStats, Target,
 };
 use super::system::{CoupledSystem, Coupling};
-use super::{ContactError, ContactSurface};
+use super::{ContactError, ContactSettings, ContactSurface};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
 use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
@@ -128,6 +128,8 @@ enum Interface {
         /// GMRES' relative residual target ([`KRYLOV_RTOL`], or
         /// [`KRYLOV_RTOL_OVER_BODY_RTOL`] times CG's `rtol`).
         tolerance: f64,
+        /// GMRES' iteration cap per solve (`ContactSettings::krylov_max_iterations`).
+        max_iterations: usize,
     },
 }
 
@@ -142,7 +144,8 @@ impl Interface {
 
 impl BodyFactors {
     /// Sets up both bodies' solvers (`kind`: Cholesky or CG + AMG, resolved by the caller)
-    /// for the interface solve `method`; the response caches cover the candidate surfaces.
+    /// for the interface solve `contact.solver`; the response caches cover the candidate
+    /// surfaces.
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
@@ -150,8 +153,9 @@ impl BodyFactors {
         surface2: &ContactSurface,
         settings: &SolverSettings,
         kind: BodySolverKind,
-        method: CoupledSolver,
+        contact: &ContactSettings,
     ) -> Result<Self, ContactError> {
+        let method = contact.solver;
         let dim = surface1.dim;
         let factor = |body: &AssembledBody| match kind {
             BodySolverKind::CgAmg => {
@@ -176,6 +180,7 @@ impl BodyFactors {
             Interface::Krylov {
                 state: KrylovState::new(settings.verbose && std::io::stderr().is_terminal()),
                 tolerance,
+                max_iterations: contact.krylov_max_iterations,
             }
         } else {
             Interface::dense([&surface1.nodes, &surface2.nodes], dim, sizes)
@@ -228,12 +233,16 @@ impl BodyFactors {
         gap_tolerance: Option<f64>,
     ) -> Result<Vec<f64>, ContactError> {
         self.last_krylov = None;
-        let (state, tolerance) = match &mut self.interface {
+        let (state, tolerance, max_iterations) = match &mut self.interface {
             Interface::Dense {
                 response1,
                 response2,
             } => return solve_schur(system, &self.factor1, &self.factor2, response1, response2),
-            Interface::Krylov { state, tolerance } => (state, *tolerance),
+            Interface::Krylov {
+                state,
+                tolerance,
+                max_iterations,
+            } => (state, *tolerance, *max_iterations),
         };
         let bodies = Bodies {
             solver1: &self.factor1,
@@ -243,6 +252,7 @@ impl BodyFactors {
         let target = Target {
             relative: tolerance,
             absolute: gap_tolerance.map_or(0.0, |gap| system.t * gap),
+            max_iterations,
         };
         let dim = self.dim;
         let solved =

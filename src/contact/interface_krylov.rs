@@ -100,9 +100,6 @@ pub const KRYLOV_RTOL_OVER_BODY_RTOL: f64 = 10.0;
 /// well below it (a restart only costs one extra product, the true residual).
 const RESTART: usize = 150;
 
-/// The most products with `S` (Krylov iterations) a solve may take.
-const MAX_ITERATIONS: usize = 600;
-
 /// A restart cycle must bring the true residual below this fraction of the one it started
 /// from; otherwise the iteration has stagnated.
 const STAGNATION: f64 = 0.9;
@@ -110,7 +107,7 @@ const STAGNATION: f64 = 0.9;
 /// Why the interface Krylov solve stopped without converging.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KrylovFailure {
-    /// [`MAX_ITERATIONS`] products were spent.
+    /// [`Target::max_iterations`] products were spent.
     IterationLimit,
     /// A restart cycle did not reduce the true residual (inexact body solves set a floor).
     Stagnated,
@@ -343,6 +340,9 @@ pub struct Target {
     pub relative: f64,
     /// In the units of the scaled constraint rows (`t` times a length).
     pub absolute: f64,
+    /// The most products with `S` (Krylov iterations) the solve may take
+    /// (`ContactSettings::krylov_max_iterations`).
+    pub max_iterations: usize,
 }
 
 /// Solves the coupled system by elimination with the interface problem solved by GMRES to
@@ -429,6 +429,7 @@ pub fn solve(
             &r,
             &mut lambda,
             tolerance,
+            target.max_iterations,
             &mut stats,
             state.progress,
         )?
@@ -461,6 +462,7 @@ fn gmres(
     r: &[f64],
     lambda: &mut [f64],
     tolerance: f64,
+    max_iterations: usize,
     stats: &mut KrylovStats,
     progress: bool,
 ) -> Result<Vec<f64>, ContactError> {
@@ -504,7 +506,7 @@ fn gmres(
         if beta <= target {
             return Ok(w);
         }
-        if stats.iterations >= MAX_ITERATIONS {
+        if stats.iterations >= max_iterations {
             return Err(fail(KrylovFailure::IterationLimit, stats, beta / r_norm));
         }
         if beta > STAGNATION * last_beta {
@@ -513,7 +515,7 @@ fn gmres(
         last_beta = beta;
 
         // One cycle: the Arnoldi basis V of S P^-1 from the residual, Z = P^-1 V.
-        let steps = RESTART.min(m).min(MAX_ITERATIONS - stats.iterations);
+        let steps = RESTART.min(m).min(max_iterations - stats.iterations);
         let mut basis: Vec<Vec<f64>> = vec![residual.iter().map(|x| x / beta).collect()];
         let mut directions: Vec<Vec<f64>> = Vec::new();
         let mut h = vec![vec![0.0; steps]; steps + 1];

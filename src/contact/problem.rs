@@ -63,6 +63,11 @@ pub(super) const COMPLIANT_SHARE: f64 = 0.1;
 /// The largest `max_iterations` accepted.
 const MAX_ITERATIONS_CAP: usize = 1000;
 
+/// The largest `krylov_max_iterations` accepted: GMRES keeps at most 150 vectors of the
+/// interface's size between restarts, and each iteration is one solve per body, so a cap
+/// beyond this is a run of hours waiting for a failure.
+const KRYLOV_MAX_ITERATIONS_CAP: usize = 10_000;
+
 /// Settings of the active-set loop and its certificate; every field has a documented default,
 /// and [`ContactSettings::validate`] checks them all (the solver calls it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -78,6 +83,13 @@ pub struct ContactSettings {
     pub solver: CoupledSolver,
     /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
     pub max_iterations: usize,
+    /// Cap on the interface GMRES iterations of one coupled solve (default 600; the solves
+    /// measured take 1 to 16 per active-set iteration, a few dozen when started cold).
+    /// Reaching it fails that solve: under `solver = "auto"` the solve and every later one
+    /// move to the dense Schur complement (recorded in `summary.json`), under `"krylov"` the
+    /// run ends with an error naming it. The same cap as PETSc's `ksp_max_it`: it bounds the
+    /// time a solve that is not converging may take.
+    pub krylov_max_iterations: usize,
     /// A node penetrates when its geometric gap is below `-tol * h`, `h` its distance to the
     /// nearest node of its own surface (default 1e-3); the same bound holds the active nodes
     /// on the other surface and certifies the answer.
@@ -131,6 +143,7 @@ impl Default for ContactSettings {
             transfer: Transfer::default(),
             solver: CoupledSolver::default(),
             max_iterations: 50,
+            krylov_max_iterations: 600,
             penetration_tolerance: 1e-3,
             tension_tolerance: 1e-8,
             secondary_penetration_tolerance: 0.05,
@@ -162,6 +175,13 @@ impl ContactSettings {
                 "max_iterations",
                 "between 1 and 1000",
                 self.max_iterations as f64,
+            );
+        }
+        if !(1..=KRYLOV_MAX_ITERATIONS_CAP).contains(&self.krylov_max_iterations) {
+            return error(
+                "krylov_max_iterations",
+                "between 1 and 10000",
+                self.krylov_max_iterations as f64,
             );
         }
         // A support that does not reach the nearest node interpolates nothing. One of 10

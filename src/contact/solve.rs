@@ -173,9 +173,10 @@ impl<'a> ContactSolver<'a> {
         let kind = solver.body.resolve_for_contact(s1.dim, dofs);
         let factors = match problem.settings.solver {
             CoupledSolver::MonolithicLu => None,
-            method => {
+            _ => {
                 let start = Instant::now();
-                let factors = BodyFactors::new(&body1, &body2, s1, s2, solver, kind, method)?;
+                let factors =
+                    BodyFactors::new(&body1, &body2, s1, s2, solver, kind, &problem.settings)?;
                 if solver.verbose {
                     let what = match kind {
                         BodySolverKind::CgAmg => "CG + AMG set-up",
