@@ -1,8 +1,6 @@
-//! The contact checks: the active-set update of each iteration ([`Update`]: tension of the
-//! active nodes, penetration of the inactive ones), and the checks of the answer, measured
-//! without the active-set loop's operators (`docs/method.md`, section 4). They
-//! answer two questions apart, as a convex solver's termination criteria and an error
-//! estimate do.
+//! The checks of a contact answer ([`Certificate`]), measured without the active-set loop's
+//! operators (`docs/method.md`, section 4). They answer two questions apart, as a convex
+//! solver's termination criteria and an error estimate do.
 //!
 //! **Is the discrete problem solved?** The residuals of its KKT conditions ([`CheckKind`]'s
 //! first five; [`contact_status`] turns them into the status):
@@ -53,199 +51,28 @@
 //!
 //! A failed check names the body, the gmsh node tag and the figure.
 
-use serde::Serialize;
+use std::collections::HashSet;
 
-use std::collections::{BTreeSet, HashSet};
-
-use super::interface::geometric_gaps;
-use super::linearization::gap_rows;
-use super::solution::{IterationRecord, PhaseSeconds};
+use super::certificate::{Certificate, CertificateCheck, CheckKind};
+use super::gap::{gap_rows, geometric_gaps};
+use super::solution::ContactStatus;
 use super::system::CoupledSolution;
 use super::{ContactProblem, ContactSurface, Formulation};
-
-/// What a check measures. The first five are residuals of the discrete contact problem: they
-/// decide whether it is solved (the status, `contact_status`). The others are accuracy
-/// indicators: they say whether the solved problem's answer can be trusted (the accuracy
-/// report), and never change the status.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-pub enum CheckKind {
-    /// Primal feasibility: no primary node inside the other body (over its spacing).
-    #[serde(rename = "penetration")]
-    Penetration,
-    /// Primal feasibility of the secondary's nodes, which only the transfer holds.
-    #[serde(rename = "secondary penetration")]
-    SecondaryPenetration,
-    /// Dual feasibility: no surface node of either body pulled (over the largest pressure).
-    #[serde(rename = "tension")]
-    Tension,
-    /// Complementarity: every active node on the other surface (over its spacing).
-    #[serde(rename = "complementarity")]
-    Complementarity,
-    /// Equilibrium of the interface: the contact forces on the two bodies balance.
-    #[serde(rename = "equilibrium")]
-    Equilibrium,
-    /// The secondary's sag between constrained primary nodes, over the indentation depth.
-    #[serde(rename = "secondary sag")]
-    SecondarySag,
-    /// The contact zone's width in spacings, against the minimum.
-    #[serde(rename = "resolution")]
-    Resolution,
-    /// Where the two bodies' contact forces act, over the coarser spacing.
-    #[serde(rename = "force centre")]
-    ForceCentre,
-    /// The contact force against the other primary's.
-    #[serde(rename = "primary agreement")]
-    PrimaryAgreement,
-    /// The contact force against the one with the transfer `auto` chooses.
-    #[serde(rename = "transfer agreement")]
-    TransferAgreement,
-}
-
-impl CheckKind {
-    /// The name in `summary.json` and in messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Penetration => "penetration",
-            Self::SecondaryPenetration => "secondary penetration",
-            Self::Tension => "tension",
-            Self::Complementarity => "complementarity",
-            Self::Equilibrium => "equilibrium",
-            Self::SecondarySag => "secondary sag",
-            Self::Resolution => "resolution",
-            Self::ForceCentre => "force centre",
-            Self::PrimaryAgreement => "primary agreement",
-            Self::TransferAgreement => "transfer agreement",
-        }
-    }
-
-    /// A residual of the discrete problem (the status), not an accuracy indicator.
-    pub fn is_residual(self) -> bool {
-        matches!(
-            self,
-            Self::Penetration
-                | Self::SecondaryPenetration
-                | Self::Tension
-                | Self::Complementarity
-                | Self::Equilibrium
-        )
-    }
-
-    /// The unit of the figure, for messages.
-    fn unit(self) -> &'static str {
-        match self {
-            Self::Penetration | Self::SecondaryPenetration | Self::Complementarity => " h",
-            Self::Tension => " of the largest pressure",
-            Self::SecondarySag => " of the indentation depth",
-            Self::ForceCentre => {
-                " of the coarser spacing (between the two bodies' centres of normal force)"
-            }
-            Self::Resolution => " (spacing over the contact zone's width, over the minimum's, rim)",
-            Self::PrimaryAgreement | Self::TransferAgreement | Self::Equilibrium => " of the force",
-        }
-    }
-}
-
-/// The checks of one contact answer: the residuals of the discrete problem and the accuracy
-/// indicators ([`CheckKind`]).
-#[derive(Debug, Clone)]
-pub struct Certificate {
-    pub checks: Vec<CertificateCheck>,
-}
-
-/// One check: its figure against its tolerance, and where the worst value is.
-#[derive(Debug, Clone, Serialize)]
-pub struct CertificateCheck {
-    pub name: CheckKind,
-    pub value: f64,
-    pub tolerance: f64,
-    pub passed: bool,
-    /// Body and gmsh node tag of the worst node (penetration, tension).
-    pub body: Option<String>,
-    pub node_tag: Option<u64>,
-    /// What the figure was compared with, when that is not a node (primary agreement).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub note: Option<String>,
-}
-
-impl Certificate {
-    /// Adds a check made outside [`certify`] (e.g. an [`agreement`]).
-    pub fn push(&mut self, check: CertificateCheck) {
-        self.checks.push(check);
-    }
-
-    /// Every residual check passed: the discrete problem is solved.
-    pub fn solved(&self) -> bool {
-        self.residuals().all(|c| c.passed)
-    }
-
-    /// Every accuracy indicator passed.
-    pub fn accurate(&self) -> bool {
-        self.indicators().all(|c| c.passed)
-    }
-
-    /// The residual checks.
-    pub fn residuals(&self) -> impl Iterator<Item = &CertificateCheck> {
-        self.checks.iter().filter(|c| c.name.is_residual())
-    }
-
-    /// The accuracy indicators.
-    pub fn indicators(&self) -> impl Iterator<Item = &CertificateCheck> {
-        self.checks.iter().filter(|c| !c.name.is_residual())
-    }
-
-    /// The kinds of the failed checks.
-    pub fn failed(&self) -> Vec<CheckKind> {
-        (self.checks.iter())
-            .filter(|c| !c.passed)
-            .map(|c| c.name)
-            .collect()
-    }
-
-    /// The failed checks in one line, e.g. for a status message.
-    pub fn failures(&self) -> String {
-        self.checks
-            .iter()
-            .filter(|c| !c.passed)
-            .map(CertificateCheck::describe)
-            .collect::<Vec<_>>()
-            .join("; ")
-    }
-}
 
 /// How the loop's ending and the residual checks make the status: the one place that decides
 /// it. A loop that stopped converged has solved the discrete problem only if every residual,
 /// measured independently of the loop's operators, is within its tolerance; an empty active
 /// set is then no contact. The accuracy indicators play no part.
 pub fn contact_status(
-    loop_end: super::ContactStatus,
+    loop_end: ContactStatus,
     certificate: &Certificate,
     active_is_empty: bool,
-) -> super::ContactStatus {
-    use super::ContactStatus::{Converged, NoContact, NotSolved};
+) -> ContactStatus {
+    use ContactStatus::{Converged, NoContact, NotSolved};
     match loop_end {
         Converged if !certificate.solved() => NotSolved,
         Converged if active_is_empty => NoContact,
         other => other,
-    }
-}
-
-impl CertificateCheck {
-    pub fn describe(&self) -> String {
-        let at = match (&self.body, self.node_tag) {
-            (Some(body), Some(tag)) => format!(" at node {tag} of '{body}'"),
-            _ => String::new(),
-        };
-        let unit = self.name.unit();
-        let note = self
-            .note
-            .as_ref()
-            .map_or(String::new(), |note| format!(": {note}"));
-        format!(
-            "{} {:.3e}{unit}{at} (tolerance {:.1e}){note}",
-            self.name.name(),
-            self.value,
-            self.tolerance
-        )
     }
 }
 
@@ -339,7 +166,7 @@ pub fn certify(
     );
     let centres = force_centres(&sides, &mean);
     // Complementarity: the gap each active node's constraint holds, measured again at the
-    // answer (frictionless: the gap of its linearization, `super::linearization`, which is the
+    // answer (frictionless: the gap of its linearization, `super::gap`, which is the
     // geometric gap wherever the node faces the inside of a secondary facet; tied: the
     // geometric gap).
     let held: Vec<f64> = match settings.formulation {
@@ -771,122 +598,6 @@ impl Worst {
             body,
             node_tag,
             note: None,
-        }
-    }
-}
-
-/// The active-set update of one iteration (step 4 of the module doc), in surface indices.
-pub(super) struct Update {
-    pub(super) next: BTreeSet<usize>,
-    /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
-    pub(super) tension: Vec<(usize, f64)>,
-    /// Inactive nodes with `g_i < -tol_p h_i`, with their penetration over `h_i`: every
-    /// primary candidate, as the certificate's penetration check measures them. (Only the nodes
-    /// that faced the other surface in the reference configuration were once tested, and a
-    /// block node under a punch's corner, whose line along the contact normal meets the punch's
-    /// side, was left penetrating by 1% of a spacing for the certificate to refuse.)
-    pub(super) penetrating: Vec<(usize, f64)>,
-    /// Every active node lies on the other surface: `|g_i| <= SETTLED tol_p h_i`.
-    pub(super) settled: bool,
-    /// Every active node lies on the other surface within the penetration tolerance,
-    /// `|g_i| <= tol_p h_i`: the complementarity residual passes.
-    pub(super) within_tolerance: bool,
-    pub(super) active: usize,
-    pub(super) max_gap_error_over_h: f64,
-}
-
-impl Update {
-    pub(super) fn new(
-        problem: &ContactProblem,
-        active: &[usize],
-        traction: &[[f64; 3]],
-        normals: &[[f64; 3]],
-        [gaps, held]: [&[f64]; 2],
-        pinned: &HashSet<usize>,
-    ) -> Self {
-        let settings = &problem.settings;
-        let s1 = &problem.primary_surface;
-        let pressure: Vec<f64> = traction
-            .iter()
-            .zip(normals)
-            .map(|(t, n)| -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]))
-            .collect();
-        let p_max = pressure.iter().copied().fold(0.0, f64::max);
-        // Tension is measured against the largest pressure; with no node in compression
-        // (bodies pulled apart) against the largest tension, so the worst node's is 1, not
-        // p / f64::MIN_POSITIVE, which overflowed to inf (`null` in summary.json).
-        let scale = if p_max > 0.0 {
-            p_max
-        } else {
-            -pressure.iter().copied().fold(0.0, f64::min)
-        };
-        let tension: Vec<(usize, f64)> = active
-            .iter()
-            .zip(&pressure)
-            .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
-            .map(|(&i, &p)| (i, -p / scale))
-            .collect();
-        let is_active: HashSet<usize> = active.iter().copied().collect();
-        let penetrating: Vec<(usize, f64)> = (0..s1.len())
-            .filter(|&i| !is_active.contains(&i))
-            .map(|i| (i, -gaps[i] / s1.spacing[i]))
-            .filter(|&(_, over_h)| over_h > settings.penetration_tolerance)
-            .collect();
-        let max_gap_error_over_h = active
-            .iter()
-            .map(|&i| held[i].abs() / s1.spacing[i])
-            .fold(0.0, f64::max);
-        let mut next: BTreeSet<usize> = active.iter().copied().collect();
-        for (i, _) in &tension {
-            next.remove(i);
-        }
-        next.extend(penetrating.iter().map(|&(i, _)| i));
-        Self {
-            next,
-            settled: max_gap_error_over_h <= super::solve::SETTLED * settings.penetration_tolerance,
-            within_tolerance: max_gap_error_over_h <= settings.penetration_tolerance,
-            tension,
-            penetrating,
-            active: active.len(),
-            max_gap_error_over_h,
-        }
-    }
-
-    /// The active set with only the worst violation switched, if any.
-    pub(super) fn single_switch(&self, active: &BTreeSet<usize>) -> Option<BTreeSet<usize>> {
-        let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
-        let mut next = active.clone();
-        match (worst(&self.tension), worst(&self.penetrating)) {
-            (Some(t), Some(p)) if p.1 >= t.1 => next.insert(p.0),
-            (Some(t), _) => next.remove(&t.0),
-            (None, Some(p)) => next.insert(p.0),
-            (None, None) => return None,
-        };
-        Some(next)
-    }
-
-    /// The iteration's record; `pairing_drift_over_h` is measured by the loop
-    /// (`super::solve::pairing_drift`).
-    pub(super) fn record(
-        &self,
-        iteration: usize,
-        residual: f64,
-        pairing_drift_over_h: f64,
-        seconds: PhaseSeconds,
-    ) -> IterationRecord {
-        let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
-        IterationRecord {
-            iteration,
-            active: self.active,
-            added: self.penetrating.len(),
-            removed: self.tension.len(),
-            max_penetration_over_h: max(&self.penetrating),
-            max_tension_over_p: max(&self.tension),
-            max_gap_error_over_h: self.max_gap_error_over_h,
-            pairing_drift_over_h,
-            relative_residual: residual,
-            krylov_iterations: None,
-            seconds,
         }
     }
 }

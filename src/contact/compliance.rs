@@ -11,7 +11,7 @@
 //! it is computed (one solve with the body's solver per component) the first time
 //! the node is active, and kept for every later iteration and load step, until the operators
 //! are paired again. Per component, not per multiplier: the frictionless traction acts along
-//! the normal of the secondary facet the node is held on (`super::linearization`), which
+//! the normal of the secondary facet the node is held on (`super::gap`), which
 //! turns with the displacement from one iteration to the next; the price is `dim` solves per
 //! node instead of one.
 //!

@@ -56,47 +56,17 @@ use std::io::IsTerminal;
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
-use serde::{Deserialize, Serialize};
 
 use super::compliance::SurfaceResponse;
 use super::interface_krylov::{
     self, Bodies, KRYLOV_RTOL, KRYLOV_RTOL_OVER_BODY_RTOL, KrylovState, KrylovStats, Target,
 };
+use super::settings::{ContactSettings, CoupledSolver};
 use super::system::{CoupledSystem, Coupling};
-use super::{ContactError, ContactSettings, ContactSurface};
+use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
 use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum CoupledSolver {
-    /// The default: [`Self::Krylov`], and [`Self::Schur`] from the first iteration whose GMRES
-    /// solve fails (module doc).
-    #[default]
-    Auto,
-    /// Each body's solver set up once, dense Schur complement on the multipliers per
-    /// iteration: exact whatever the conditioning of the interface problem.
-    Schur,
-    /// Sparse LU of the whole saddle-point matrix per iteration (reference).
-    MonolithicLu,
-    /// Each body's solver set up once, the interface problem solved matrix-free by
-    /// preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies); a
-    /// GMRES solve that fails ends the contact solve with that error.
-    Krylov,
-}
-
-impl CoupledSolver {
-    /// The name used in case files and summaries.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::Schur => "schur",
-            Self::MonolithicLu => "monolithic-lu",
-            Self::Krylov => "krylov",
-        }
-    }
-}
 
 /// The solvers (Cholesky factors, or CG + AMG) of both bodies' constrained stiffness matrices,
 /// and what the interface solve keeps between iterations: the bodies' responses to the

@@ -13,18 +13,19 @@
 //! ```
 //!
 //! Step 2 answers the sag of a curved secondary between the nodes of a coarse flat primary
-//! ([`PrimaryReport::other_may_retry`]); step 3 the stiff primary that passes every check of
-//! the loop's certificate with a wrong force ([`PrimaryReport::check_other`]). Both live here,
+//! ([`OtherPrimary::RetryIfUntrusted`]); step 3 the stiff primary that passes every check of
+//! the loop's certificate with a wrong force ([`OtherPrimary::CheckAgreement`]). Both live here,
 //! not in the command line, so that every caller of [`solve_contact`] gets the same answer.
 
 use std::time::Instant;
 
 use serde::Serialize;
 
-use super::checks::{CheckKind, agreement};
+use super::certificate::CheckKind;
+use super::checks::agreement;
 use super::{
     CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus,
-    Transfer,
+    OtherPrimary, Transfer,
 };
 use crate::elastic::SolverSettings;
 
@@ -111,31 +112,32 @@ pub fn solve_contact<'m>(
     // 1. The chosen primary.
     let (solution, steps) = solve_load_steps(&problem, solver, load_factors, "", &mut log)?;
     // 2. The other primary, when auto's choice between similar bodies did not settle.
-    let (problem, solution, mut steps) =
-        if problem.primary_report.other_may_retry && !solution.is_trusted() {
+    let other_primary = problem.primary_report.other_primary;
+    let (problem, mut solution, mut steps) =
+        if other_primary == OtherPrimary::RetryIfUntrusted && !solution.is_trusted() {
             retry_with_other_primary(problem, solution, steps, solver, load_factors, &mut log)
         } else {
             (problem, solution, steps)
         };
     // 3. The other primary's forces, when a stiff primary was named; 4. auto's transfer's,
     //    when another transfer was named.
-    let any_solved = steps.iter().any(|s| s.status.is_solution());
-    let (mut problem, mut solution) = (problem, solution);
-    for alternative in [Alternative::OtherPrimary, Alternative::AutoTransfer] {
-        let due = match alternative {
-            Alternative::OtherPrimary => problem.primary_report.check_other,
-            Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
-        };
-        if due && any_solved {
-            (problem, solution) = check_against(
-                problem,
-                alternative,
-                solution,
-                &mut steps,
-                solver,
-                load_factors,
-                &mut log,
-            );
+    if steps.iter().any(|s| s.status.is_solution()) {
+        for alternative in [Alternative::OtherPrimary, Alternative::AutoTransfer] {
+            let due = match alternative {
+                Alternative::OtherPrimary => other_primary == OtherPrimary::CheckAgreement,
+                Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
+            };
+            if due {
+                solution = check_against(
+                    &problem,
+                    alternative,
+                    solution,
+                    &mut steps,
+                    solver,
+                    load_factors,
+                    &mut log,
+                );
+            }
         }
     }
     // The last step's record is the answer's, checks made after the loop included.
@@ -163,7 +165,7 @@ fn retry_with_other_primary<'m>(
     log: &mut Log,
 ) -> (ContactProblem<'m>, ContactSolution, Vec<StepRecord>) {
     let (first, first_ended) = (problem.primary.body.name.clone(), solution.ending());
-    let other = problem.with_other_primary();
+    let other = problem.clone().with_other_primary();
     let other_name = other.primary.body.name.clone();
     log.say(format!(
         "primary = \"auto\": with '{first}' as primary the solve ended {first_ended}; solving \
@@ -183,7 +185,7 @@ fn retry_with_other_primary<'m>(
                 Ok((second, _)) => second.ending(),
                 Err(e) => format!("with an error ({e})"),
             };
-            let problem = other.with_other_primary().with_reason_appended(&format!(
+            let problem = problem.with_reason_appended(&format!(
                 "kept although it ended {first_ended}: '{other_name}' as primary ended \
                  {second_ended}"
             ));
@@ -205,30 +207,29 @@ enum Alternative {
 /// step's force against it (`primary agreement` or `transfer agreement`): in the last step's
 /// accuracy report, and in every step's record (the force-displacement curve is an answer
 /// too). The answer kept is the named choice's.
-fn check_against<'m>(
-    problem: ContactProblem<'m>,
+fn check_against(
+    problem: &ContactProblem,
     alternative: Alternative,
     mut solution: ContactSolution,
     steps: &mut [StepRecord],
     solver: &SolverSettings,
     load_factors: &[f64],
     log: &mut Log,
-) -> (ContactProblem<'m>, ContactSolution) {
-    let (tolerance, formulation, named) = (
+) -> ContactSolution {
+    let (tolerance, formulation) = (
         problem.settings.accuracy_tolerance,
         problem.settings.formulation,
-        problem.settings.transfer,
     );
     // The other solve's forces on [this primary body, this secondary body]: its primary is
     // this solve's secondary when the primaries are swapped.
     let (other, kind, swapped) = match alternative {
         Alternative::OtherPrimary => (
-            problem.with_other_primary(),
+            problem.clone().with_other_primary(),
             CheckKind::PrimaryAgreement,
             true,
         ),
         Alternative::AutoTransfer => (
-            problem.with_transfer(Transfer::Auto),
+            problem.clone().with_transfer(Transfer::Auto),
             CheckKind::TransferAgreement,
             false,
         ),
@@ -286,11 +287,7 @@ fn check_against<'m>(
         "contact status: {}",
         solution.describe(formulation)
     ));
-    let problem = match alternative {
-        Alternative::OtherPrimary => other.with_other_primary(),
-        Alternative::AutoTransfer => other.with_transfer(named),
-    };
-    (problem, solution)
+    solution
 }
 
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per

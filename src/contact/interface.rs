@@ -27,7 +27,7 @@
 //! geometric gap of the last iterate ([`geometric_gaps`]) and its linearized gap, so that an
 //! active node ends ON the other body's discrete surface, not on the RBF reconstruction of it.
 //! Frictionless contact constrains the geometric gap itself, linearized node to segment
-//! ([`super::linearization`]); `R12` then only measures how far the pairing has slid.
+//! ([`super::gap`]); `R12` then only measures how far the pairing has slid.
 //!
 //! **Lumped interface mass.** Node `s` stands for its area `A_s` ([`ContactSurface`]): the
 //! multiplier `lambda_i` exerts `-A_i lambda_i` on body 1 and, on body 2, either
@@ -36,7 +36,7 @@
 
 use std::collections::HashMap;
 
-use super::linearization::GapRow;
+use super::gap::GapRow;
 use super::rbf::{Interpolation, interpolation_radii};
 use super::system::Coupling;
 use super::{ContactError, ContactSurface, Formulation};
@@ -276,7 +276,7 @@ pub enum Constraint<'a> {
     /// correction `e` of the last iterate (module doc).
     Interpolated { corrections: &'a [f64] },
     /// Frictionless contact: the geometric gap linearized at the last iterate, one row per
-    /// primary candidate ([`super::linearization`]).
+    /// primary candidate ([`super::gap`]).
     Geometric { rows: &'a [GapRow] },
 }
 
@@ -295,61 +295,6 @@ pub fn contact_normal(own: &[f64; 3], other: &[f64], weights: [f64; 2]) -> [f64;
     } else {
         *own
     }
-}
-
-/// Within what distance of a contact surface a node is judged by the plane of the facet it
-/// faces, in units of that facet's longest edge. Two faces meant to end flush (equal blocks
-/// pressed together) end where each body's own P1 solution puts its edge: the two bulges
-/// differ by the discretization's error, a small fraction of a facet (1e-3 of a spacing on the
-/// 3D blocks). Measured by its distance to the other body, a node there flips from `-delta` to
-/// `+delta` as its edge crosses the other's by a hair: released, the edge of one block sagged
-/// 4% of the approach below the other's face, which the other pierced. Near the surface the
-/// plane of the facet decides, as for any node over the surface: the extension zone of
-/// node-to-surface contact (a tenth of the facet, as in the commercial codes), far below the
-/// facet's own resolution of a body's edge and far above the flush mismatch. Farther away the
-/// other body's closed boundary decides: a node on the far side of the other body is behind
-/// the plane of the facet it faces, yet outside.
-pub const NEAR_SURFACE: f64 = 0.1;
-
-/// The geometric gap of every node of `own` to the `other` body, each displaced by its body's
-/// displacement (`None`: reference geometry), the one gap measure of the loop's penetration
-/// test, the checks and the `normal_gap` output. The node's closest point `q` on the other
-/// candidate surface's P1 facets ([`super::projection`], on the facet that faces the node's own
-/// normal where several share it, as its linearization does, [`super::linearization`]) and that
-/// facet's outward normal `m` give:
-/// - within [`NEAR_SURFACE`] of the facet (beyond the surface's rim too), `g = m . (x - q)`,
-///   the distance to the facet's plane: positive outside, negative inside, exact against a
-///   flat;
-/// - farther, the distance `|x - q|`, negative when the node is inside the other body (decided
-///   on that body's closed boundary, [`super::boundary`]).
-///
-/// Defined at any distance.
-pub fn geometric_gaps(
-    own: &ContactSurface,
-    other: &ContactSurface,
-    u_own: Option<&[f64]>,
-    u_other: Option<&[f64]>,
-) -> Vec<f64> {
-    let surface = other.index(u_other);
-    let boundary = other.boundary.index(u_other);
-    (0..own.len())
-        .map(|s| {
-            let x = u_own.map_or(own.coords[s], |u| own.deformed(u, s));
-            let closest = (surface.project_facing(&x, Some(&own.normals[s])))
-                .expect("a contact surface has facets");
-            let m = surface.normal(closest.facet);
-            let offset: [f64; 3] = std::array::from_fn(|k| x[k] - closest.point[k]);
-            let plane: f64 = (0..3).map(|k| m[k] * offset[k]).sum();
-            let distance = closest.signed_distance.abs();
-            if distance <= NEAR_SURFACE * surface.facet_size(closest.facet) {
-                return plane;
-            }
-            let inside = boundary
-                .project(&x)
-                .is_some_and(|p| p.signed_distance < 0.0);
-            if inside { -distance } else { distance }
-        })
-        .collect()
 }
 
 /// The point of `other` (reference geometry) that each node of `own`, moved by `slid`, faces:

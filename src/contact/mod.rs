@@ -1,54 +1,66 @@
 //! Two elastic bodies in contact, coupled by INTERNODES.
 //!
 //! Body 1 (primary) carries the multiplier `lambda`, the contact traction on it; body 2
-//! (secondary) receives `-R21 lambda`. One solve, in the order of the files:
-//! - `problem.rs`: the two bodies, their candidate surfaces (`surface.rs`) and the settings;
-//! - `interface.rs`: the interface operators, built once over all candidates: rescaled Wendland
-//!   C2 interpolation (`rbf.rs`) evaluated at each node's closest point on the other surface
-//!   (`projection.rs`), the lumped interface mass, the contact normal and the gaps;
-//! - `solve.rs`: the active-set loop (primal-dual active set), each iteration assembling the
-//!   coupled system (`system.rs`) with the frictionless constraint linearized at the last
-//!   iterate (`linearization.rs`) and solving it (`coupled_solver.rs`, `compliance.rs`);
-//! - `checks.rs`: the active-set update of each iteration, and the checks of the answer,
-//!   measured independently of the loop's operators: the residuals that decide the status and
-//!   the accuracy report; `post.rs`: fields, forces, Hertz fit;
+//! (secondary) receives `-R21 lambda`. The files in the order of one solve; each imports only
+//! files listed before it (`tests/architecture.rs` checks that the imports have no cycle):
+//! - the geometry: `projection.rs` (closest points on a P1 surface), `boundary.rs`, `rbf.rs`
+//!   (rescaled Wendland C2 interpolation), `surface.rs` (a candidate surface: nodes, facets,
+//!   spacings, lumped interface mass), `gap.rs` (the geometric gap, and the gap linearized at
+//!   an iterate);
+//! - `settings.rs` (every setting, its default and range) and `problem.rs` (the two bodies,
+//!   their surfaces, which one is primary, which transfer);
+//! - the linear algebra of an iteration: `compliance.rs` (the bodies' responses to unit
+//!   tractions), `system.rs` (the coupled system of an active set), `interface.rs` (the
+//!   interface operators, built once over all candidates: the interpolation evaluated at each
+//!   node's closest point on the other surface, the contact normal), `interface_krylov.rs`
+//!   (the interface equation by GMRES), `coupled_solver.rs` (which solver, behind one call);
+//! - what a solve returns: `certificate.rs` (the checks of an answer), `active_set.rs` (where
+//!   the loop starts, and its primal-dual update), `solution.rs`; `checks.rs` measures the
+//!   certificate independently of the loop's operators (the residuals that decide the status,
+//!   the accuracy report), `hertz.rs` fits a Hertz profile, `post.rs` makes the fields and
+//!   forces of the last iterate;
+//! - the loop: `safeguard.rs` (when it stops) and `solve.rs` (the active-set loop);
 //! - `driver.rs`: [`solve_contact`], the solve a caller asks for: the load steps, and a second
 //!   solve with the other body as primary, or auto's transfer, when a choice made may be the
 //!   wrong one.
 //!
 //! Method, signs and the reasons behind each rule: `docs/method.md`.
 
+mod active_set;
 mod boundary;
+mod certificate;
 mod checks;
 mod compliance;
 mod coupled_solver;
 mod driver;
+mod gap;
 mod hertz;
 mod interface;
 mod interface_krylov;
-mod linearization;
 mod post;
 mod problem;
 pub mod projection;
 pub mod rbf;
+mod safeguard;
+mod settings;
 mod solution;
 mod solve;
 mod surface;
 pub mod system;
 
-pub use checks::{Certificate, CertificateCheck, CheckKind};
-pub use coupled_solver::CoupledSolver;
+pub use active_set::ActiveSet;
+pub use certificate::{Certificate, CertificateCheck, CheckKind};
 pub use driver::{ContactRun, StepRecord, solve_contact};
 pub use interface_krylov::{KrylovError, KrylovFailure};
 pub use problem::{
-    ContactProblem, ContactSettings, ContactSide, Formulation, PrimaryChoice, PrimaryReport,
-    SettingsError, Transfer, TransferReport,
+    ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,
 };
+pub use settings::{ContactSettings, CoupledSolver, Formulation, SettingsError, Transfer};
 pub use solution::{
     ContactSolution, ContactStatus, HertzFit, IterationRecord, LinearSolvers, PhaseSeconds,
     SurfaceFields,
 };
-pub use solve::{ActiveSet, ContactSolver};
+pub use solve::ContactSolver;
 pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;

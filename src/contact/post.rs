@@ -1,30 +1,50 @@
 //! Post-processing of the last iterate: each body's solution (reactions, cell strains and
 //! stresses), the interface fields of both surfaces, total forces and the Hertz fit.
 
-use super::checks::{Certificate, CheckKind};
-use super::solution::{ContactSolution, ContactStatus, IterationRecord, SurfaceFields};
-use super::solve::{ActiveSet, ContactSolver};
+use super::active_set::ActiveSet;
+use super::certificate::{Certificate, CheckKind};
+use super::solution::{
+    ContactSolution, ContactStatus, IterationRecord, LinearSolvers, SurfaceFields,
+};
 use super::system::{CoupledSolution, Coupling};
-use super::{ContactError, ContactSurface, hertz};
+use super::{ContactError, ContactProblem, ContactSurface, hertz};
 use crate::elastic::{AssembledBody, ElasticProblem, ElasticSolution, SolveStats, reactions};
 use crate::fem::stress::cell_fields;
 
-/// The solution of the last iterate, with surface fields (`gaps`: the certificate's geometric
-/// gaps of the primary and secondary surfaces), forces and the Hertz fit.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn finish(
-    solver: &ContactSolver,
-    load_factor: f64,
-    status: ContactStatus,
-    history: Vec<IterationRecord>,
-    certificate: Certificate,
-    gaps: [Vec<f64>; 2],
-    coupling: &Coupling,
-    solution: CoupledSolution,
-    active_set: ActiveSet,
-) -> Result<ContactSolution, ContactError> {
-    let problem = solver.problem;
-    let linear_solvers = solver.linear_solvers();
+/// What an active-set loop hands over: the problem with its assembled bodies, and how the loop
+/// ended with its last iterate and that iterate's certificate.
+pub(super) struct LastIterate<'a> {
+    pub problem: &'a ContactProblem<'a>,
+    /// The primary's and the secondary's assembly, with its statistics.
+    pub bodies: [(&'a AssembledBody, &'a SolveStats); 2],
+    pub linear_solvers: LinearSolvers,
+    pub load_factor: f64,
+    pub status: ContactStatus,
+    pub history: Vec<IterationRecord>,
+    pub certificate: Certificate,
+    /// The certificate's geometric gaps of the primary and secondary surfaces.
+    pub gaps: [Vec<f64>; 2],
+    pub coupling: &'a Coupling,
+    pub solution: CoupledSolution,
+    /// Where the next load step starts.
+    pub active_set: ActiveSet,
+}
+
+/// The solution of the last iterate, with surface fields, forces and the Hertz fit.
+pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError> {
+    let LastIterate {
+        problem,
+        bodies: [(body1, stats1), (body2, stats2)],
+        linear_solvers,
+        load_factor,
+        status,
+        history,
+        certificate,
+        gaps,
+        coupling,
+        solution,
+        active_set,
+    } = last;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let dim = s1.dim;
     let [gaps1, gaps2] = gaps;
@@ -88,17 +108,17 @@ pub(super) fn finish(
     };
     let primary = body(
         &problem.primary,
-        &solver.body1,
+        body1,
         solution.u1,
         &solution.contact_force1,
-        &solver.stats1,
+        stats1,
     );
     let secondary = body(
         &problem.secondary,
-        &solver.body2,
+        body2,
         solution.u2,
         &solution.contact_force2,
-        &solver.stats2,
+        stats2,
     );
     Ok(ContactSolution {
         linear_solvers,

@@ -1,231 +1,16 @@
 //! What to solve: two elastic bodies, their candidate surfaces, which one carries the
-//! multiplier, and the settings of the active-set loop.
+//! multiplier, and the settings of the active-set loop (`super::settings`).
 
 use serde::{Deserialize, Deserializer, Serialize};
-use thiserror::Error;
 
 use super::ContactSurface;
-use super::coupled_solver::CoupledSolver;
+use super::settings::{ContactSettings, Transfer};
 use crate::elastic::ElasticProblem;
-
-/// Which constraint couples the active surfaces (`docs/method.md` 1.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Formulation {
-    /// Normal constraint only, one scalar multiplier per primary node: surfaces may slide.
-    #[default]
-    Frictionless,
-    /// Vector constraint (the original INTERNODES contact system): active surfaces are glued
-    /// together.
-    Tied,
-}
-
-/// How the multiplier's force reaches the secondary body (`docs/method.md` 2.4).
-///
-/// - `Interpolation` (INTERNODES' own transfer): the secondary receives the traction
-///   interpolated at its own nodes, `lambda_2 = -R21 lambda`, integrated by its interface mass:
-///   nodal forces `-M2 R21 lambda`. A secondary coarser than the primary samples a field finer
-///   than itself there, and the total force no longer balances `M1 lambda` (the imbalance grows
-///   as the contact zone spans fewer secondary spacings).
-/// - `Conservative`: the secondary receives the primary's nodal forces distributed by the
-///   transpose of the displacement interpolation, `-R12^T M1 lambda` (the mortar method's
-///   transfer). The rows of `R12` sum to one, so the forces on the two bodies balance exactly.
-///   For tied contact the coupling is then the transpose of the constraint (the Lagrange
-///   multiplier form of `u1 - R12 u2 = d`); frictionless rows are node to segment
-///   (`super::linearization`), and the system stays unsymmetric. Onto a secondary finer than the primary it leaves the
-///   secondary nodes between the projections of primary nodes unloaded, which is why
-///   INTERNODES interpolates there.
-/// - `Auto` (default): conservative when the secondary's contact surface is coarser than the
-///   primary's near the other body ([`contact_zone_spacing`]), interpolation otherwise.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Transfer {
-    #[default]
-    Auto,
-    Interpolation,
-    Conservative,
-}
-
-/// A setting outside its range.
-#[derive(Debug, Error, PartialEq)]
-#[error("{name} must be {expected}, got {value}")]
-pub struct SettingsError {
-    pub name: &'static str,
-    pub expected: &'static str,
-    pub value: f64,
-}
 
 /// A secondary body whose share of the two bodies' compliance (`1 / E'`) is below this is
 /// nearly rigid: the contact zone need not be resolved on it (`super::checks`), and its load
 /// is best transferred conservatively ([`ContactProblem::transfer`]).
 pub(super) const COMPLIANT_SHARE: f64 = 0.1;
-
-/// The largest `max_iterations` accepted.
-const MAX_ITERATIONS_CAP: usize = 1000;
-
-/// The largest `krylov_max_iterations` accepted: GMRES keeps at most 150 vectors of the
-/// interface's size between restarts, and each iteration is one solve per body, so a cap
-/// beyond this is a run of hours waiting for a failure.
-const KRYLOV_MAX_ITERATIONS_CAP: usize = 10_000;
-
-/// Settings of the active-set loop and its certificate; every field has a documented default,
-/// and [`ContactSettings::validate`] checks them all (the solver calls it).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ContactSettings {
-    /// Default: frictionless.
-    pub formulation: Formulation,
-    /// How the multiplier's force reaches the secondary (default: auto, [`Transfer`]).
-    pub transfer: Transfer,
-    /// How each iteration's linear system is solved (default: `auto`, the interface Schur
-    /// system by GMRES on the bodies' solvers set up once, the dense Schur complement if
-    /// GMRES fails; `super::coupled_solver`).
-    pub solver: CoupledSolver,
-    /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
-    pub max_iterations: usize,
-    /// Cap on the interface GMRES iterations of one coupled solve (default 600; the solves
-    /// measured take 1 to 16 per active-set iteration, a few dozen when started cold).
-    /// Reaching it fails that solve: under `solver = "auto"` the solve and every later one
-    /// move to the dense Schur complement (recorded in `summary.json`), under `"krylov"` the
-    /// run ends with an error naming it. The same cap as PETSc's `ksp_max_it`: it bounds the
-    /// time a solve that is not converging may take.
-    pub krylov_max_iterations: usize,
-    /// A node penetrates when its geometric gap is below `-tol * h`, `h` its distance to the
-    /// nearest node of its own surface (default 1e-3); the same bound holds the active nodes
-    /// on the other surface and certifies the answer.
-    pub penetration_tolerance: f64,
-    /// An active node is in tension when its pressure is below `-tol * p_max`, `p_max` the
-    /// largest pressure of the iteration (default 1e-8).
-    pub tension_tolerance: f64,
-    /// The certificate's bound on the penetration of a SECONDARY node into the primary body,
-    /// over its spacing (default 0.05). The constraint holds the primary nodes on the
-    /// secondary surface; the secondary nodes between them can cross the primary's P1 surface
-    /// by the transfer's consistency error (measured up to 0.016 h on a 3D mesh with three
-    /// spacings across the contact zone, falling with h), far below the spacing-sized
-    /// penetration of a wrong active set.
-    pub secondary_penetration_tolerance: f64,
-    /// The accuracy report's bound on the relative error of the contact force, for each
-    /// indicator that estimates it (default 0.01): the secondary's sag, and the agreement with
-    /// the other primary or with the automatic transfer when one was named (`super::checks`).
-    /// One tolerance, because each of them answers the same question: how far the force the
-    /// user reads may be from the one of a better discretization.
-    pub accuracy_tolerance: f64,
-    /// The certificate's bound on the tensile normal force any surface node receives over its
-    /// area (along the node's own outward normal), relative to the largest pressure (default
-    /// 0.1). The secondary pressure is the RBF transfer `R21 lambda` of the multiplier, which
-    /// is not positivity preserving: it undershoots just outside the rim of the contact zone
-    /// (measured up to 0.067 on the 3D hemisphere meshes); a wrong active set leaves tensions
-    /// of the order of the peak pressure.
-    pub certificate_tension_tolerance: f64,
-    /// The certificate's lower bound on the contact zone's width, in primary spacings
-    /// (`super::checks`; default 1.5: three nodes across a 2D zone, about seven in 3D).
-    pub min_zone_width: f64,
-    /// The same bound in secondary spacings, unless the secondary is nearly rigid (default
-    /// 2.5: four nodes across a 2D zone).
-    pub secondary_min_zone_width: f64,
-    /// The certificate's bound on the distance between the centres of the normal contact
-    /// forces on the two bodies, over the coarser surface's spacing where they are loaded
-    /// (`super::checks`; default 1): equal and opposite forces must also act at the same place.
-    pub force_centre_tolerance: f64,
-    /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
-    /// is known to this fraction.
-    pub imbalance_tolerance: f64,
-    /// Support radius of each node's RBF in the transfer operators, in units of the distance
-    /// to its nearest node (default 2, the radius Algorithm 1 of `docs/method.md` starts from; see
-    /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
-    pub rbf_radius: f64,
-}
-
-impl Default for ContactSettings {
-    fn default() -> Self {
-        Self {
-            formulation: Formulation::default(),
-            transfer: Transfer::default(),
-            solver: CoupledSolver::default(),
-            max_iterations: 50,
-            krylov_max_iterations: 600,
-            penetration_tolerance: 1e-3,
-            tension_tolerance: 1e-8,
-            secondary_penetration_tolerance: 0.05,
-            accuracy_tolerance: 0.01,
-            min_zone_width: 1.5,
-            secondary_min_zone_width: 2.5,
-            certificate_tension_tolerance: 0.1,
-            imbalance_tolerance: 0.01,
-            force_centre_tolerance: 1.0,
-            rbf_radius: 2.0,
-        }
-    }
-}
-
-impl ContactSettings {
-    /// Checks every setting's range.
-    pub fn validate(&self) -> Result<(), SettingsError> {
-        let error = |name, expected, value| {
-            Err(SettingsError {
-                name,
-                expected,
-                value,
-            })
-        };
-        // The loop ends by itself within a few iterations of a repeat or a stall
-        // (`super::solve`); a cap beyond this only postpones a status that is already due.
-        if !(1..=MAX_ITERATIONS_CAP).contains(&self.max_iterations) {
-            return error(
-                "max_iterations",
-                "between 1 and 1000",
-                self.max_iterations as f64,
-            );
-        }
-        if !(1..=KRYLOV_MAX_ITERATIONS_CAP).contains(&self.krylov_max_iterations) {
-            return error(
-                "krylov_max_iterations",
-                "between 1 and 10000",
-                self.krylov_max_iterations as f64,
-            );
-        }
-        // A support that does not reach the nearest node interpolates nothing. One of 10
-        // nearest-node distances already holds about 20 nodes of a curve and 300 of a surface,
-        // where 8/3 did no better than the default 2 (`rbf::interpolation_radii`); beyond it
-        // the interpolation matrices fill up and no longer interpolate locally (on the 2D
-        // half-disc, 1e9 ended `unstable`, nodes a spacing deep, and 1e300 made Phi_MM singular).
-        if !(self.rbf_radius > 1.0 && self.rbf_radius <= 10.0) {
-            return error(
-                "rbf_radius",
-                "a number > 1 and <= 10 (units of the nearest-node distance)",
-                self.rbf_radius,
-            );
-        }
-        for (name, value) in [
-            ("min_zone_width", self.min_zone_width),
-            ("secondary_min_zone_width", self.secondary_min_zone_width),
-        ] {
-            if !(value > 0.0 && value.is_finite()) {
-                return error(name, "a finite number > 0 (spacings)", value);
-            }
-        }
-        for (name, value) in [
-            ("penetration_tolerance", self.penetration_tolerance),
-            ("tension_tolerance", self.tension_tolerance),
-            (
-                "secondary_penetration_tolerance",
-                self.secondary_penetration_tolerance,
-            ),
-            (
-                "certificate_tension_tolerance",
-                self.certificate_tension_tolerance,
-            ),
-            ("accuracy_tolerance", self.accuracy_tolerance),
-            ("imbalance_tolerance", self.imbalance_tolerance),
-            ("force_centre_tolerance", self.force_centre_tolerance),
-        ] {
-            if !(value >= 0.0 && value.is_finite()) {
-                return error(name, "a finite number >= 0", value);
-            }
-        }
-        Ok(())
-    }
-}
 
 /// Which body carries the multiplier: `"auto"` (default) or a body's name.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -263,19 +48,28 @@ pub struct PrimaryReport {
     /// "auto" or "explicit".
     pub mode: &'static str,
     pub reason: String,
-    /// Whether the other body may carry the multiplier when this choice does not end
-    /// `converged`: auto between bodies of similar stiffness. Between a compliant and a stiff
-    /// body the stiff primary is the unstable choice (`ContactProblem::new`), and a retry with
-    /// it turned uncertified answers into certified wrong ones (`docs/method.md` 3.6).
+    /// What the driver does with the other body as primary.
     #[serde(skip)]
-    pub other_may_retry: bool,
-    /// Whether the answer must agree with the one the other body gives as primary: an
-    /// explicit primary at least `SIMILAR_STIFFNESS` times stiffer than the other body, the
-    /// choice "auto" avoids as unstable. Such a primary passed every check of the certificate
-    /// with a force 3% off (a stiff block twice finer than an R/25 hemisphere, 3D), so its
-    /// certificate gets a `primary agreement` check (`super::driver`).
-    #[serde(skip)]
-    pub check_other: bool,
+    pub other_primary: OtherPrimary,
+}
+
+/// What a solve does with the other body as primary (`super::driver`), decided with the
+/// primary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OtherPrimary {
+    /// Nothing: the choice is auto's between bodies of different stiffness (the compliant body;
+    /// a stiff primary is the unstable choice, and a retry with it turned uncertified answers
+    /// into certified wrong ones, `docs/method.md` 3.6), or a named primary auto would make.
+    Unused,
+    /// Solve again with it when this answer is not trusted, and keep its answer if that one
+    /// is: auto between bodies of similar stiffness, where either choice is stable and the
+    /// coarser one (auto's, for accuracy) may be the one that fails.
+    RetryIfUntrusted,
+    /// Solve with it too, and check that the two contact forces agree: a named primary at
+    /// least [`SIMILAR_STIFFNESS`] times stiffer than the other body, the choice auto avoids.
+    /// Such a primary passed every check of the certificate with a force 3% off (a stiff block
+    /// twice finer than an R/25 hemisphere, 3D).
+    CheckAgreement,
 }
 
 /// Contact moduli within this ratio are "similar stiffness" for [`PrimaryChoice::Auto`].
@@ -286,7 +80,7 @@ pub const SIMILAR_STIFFNESS: f64 = 2.0;
 /// are graded towards the contact, so the finest spacing of a surface is one close pair of
 /// nodes somewhere there, too noisy to compare two surfaces meshed alike.
 pub fn contact_zone_spacing(surface: &ContactSurface, other: &ContactSurface) -> f64 {
-    let gaps = super::interface::geometric_gaps(surface, other, None, None);
+    let gaps = super::gap::geometric_gaps(surface, other, None, None);
     let mut order: Vec<usize> = (0..surface.len()).collect();
     order.sort_by(|&a, &b| gaps[a].abs().total_cmp(&gaps[b].abs()));
     let count = (surface.len() / 10).max(10).min(surface.len());
@@ -299,6 +93,7 @@ pub fn contact_zone_spacing(surface: &ContactSurface, other: &ContactSurface) ->
 pub type ContactSide<'m> = (ElasticProblem<'m>, ContactSurface);
 
 /// Two bodies in contact: body 1 (primary) carries the multiplier.
+#[derive(Clone)]
 pub struct ContactProblem<'m> {
     pub primary: ElasticProblem<'m>,
     pub secondary: ElasticProblem<'m>,
@@ -496,8 +291,11 @@ impl<'m> ContactProblem<'m> {
                 // Between bodies of similar stiffness either choice is stable (the coarser one
                 // is auto's for accuracy), and the other one's answer may be the one that
                 // fails; a stiff primary is the unstable choice.
-                let check_other = first != auto_first && !similar;
-                let reason = if check_other {
+                let other_primary = match first != auto_first && !similar {
+                    true => OtherPrimary::CheckAgreement,
+                    false => OtherPrimary::Unused,
+                };
+                let reason = if other_primary == OtherPrimary::CheckAgreement {
                     format!(
                         "named in the case file; \"auto\" would choose '{}' ({auto_reason}), so \
                          the answer is checked against the one with '{}' as primary",
@@ -512,8 +310,7 @@ impl<'m> ContactProblem<'m> {
                     PrimaryReport {
                         mode: "explicit",
                         reason,
-                        other_may_retry: false,
-                        check_other,
+                        other_primary,
                     },
                 )
             }
@@ -522,8 +319,10 @@ impl<'m> ContactProblem<'m> {
                 PrimaryReport {
                     mode: "auto",
                     reason: auto_reason,
-                    other_may_retry: similar,
-                    check_other: false,
+                    other_primary: match similar {
+                        true => OtherPrimary::RetryIfUntrusted,
+                        false => OtherPrimary::Unused,
+                    },
                 },
             ),
         };
@@ -539,25 +338,5 @@ impl<'m> ContactProblem<'m> {
             primary_report: report,
             contact_spacing: [spacing_near[first], spacing_near[1 - first]],
         })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::ContactSettings;
-
-    #[test]
-    fn the_iteration_cap_has_bounds() {
-        for (cap, accepted) in [(0, false), (1, true), (1000, true), (1001, false)] {
-            let settings = ContactSettings {
-                max_iterations: cap,
-                ..ContactSettings::default()
-            };
-            assert_eq!(
-                settings.validate().is_ok(),
-                accepted,
-                "max_iterations = {cap}"
-            );
-        }
     }
 }

@@ -3,8 +3,8 @@
 use serde::Serialize;
 
 use super::Formulation;
-use super::checks::Certificate;
-use super::solve::ActiveSet;
+use super::active_set::ActiveSet;
+use super::certificate::Certificate;
 use crate::elastic::ElasticSolution;
 
 /// How the active-set loop ended. Only `Converged` is a contact solution; the others carry the

@@ -24,7 +24,7 @@
 //! ```
 //!
 //! **Why it converges.** On a fixed active set, step 3 linearizes the very gap step 4 and the
-//! checks measure (`super::linearization`): steps 1-3 are Newton's method on `g_A(u) = 0`,
+//! checks measure (`super::gap`): steps 1-3 are Newton's method on `g_A(u) = 0`,
 //! exact in one step where the secondary surface is flat and quadratic where it is smooth; on
 //! a P1 surface the gap is piecewise linear, and a node on an edge can hold the error at the
 //! size of the kink, which the stall test accepts within the tolerance. Over active sets,
@@ -64,29 +64,23 @@
 //! surface on two solves in a row, the second not contracting (or followed by an interface
 //! system that cannot be solved accurately), is [`ContactStatus::Unstable`].
 
-use std::collections::{BTreeSet, HashSet};
 use std::time::Instant;
 
-use super::checks::{Update, certify, contact_status};
-use super::coupled_solver::{self, BodyFactors, CoupledSolver};
-use super::interface::{Constraint, InterfaceOperators, geometric_gaps};
-use super::linearization::{GapRow, gap_rows};
-use super::solution::{ContactSolution, ContactStatus, LinearSolvers, PhaseSeconds};
+use super::active_set::{ActiveSet, Update};
+use super::checks::{certify, contact_status};
+use super::coupled_solver::{self, BodyFactors};
+use super::gap::{gap_rows, geometric_gaps};
+use super::interface::{Constraint, InterfaceOperators};
+use super::post::{self, LastIterate};
+use super::safeguard::{Safeguard, Step};
+use super::settings::CoupledSolver;
+use super::solution::{
+    ContactSolution, ContactStatus, IterationRecord, LinearSolvers, PhaseSeconds,
+};
 use super::system::{CoupledSolution, CoupledSystem, Coupling};
-use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer, post};
+use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 use crate::linalg::BodySolverKind;
-
-/// An active node this many spacings off the other surface after two solves in a row, the second
-/// not closer by [`CONTRACTION`], means the constraint no longer controls the geometry
-/// ([`ContactStatus::Unstable`]): the stiff half-disc primary at R/500 was 1.3 to 1.8 h off at
-/// its second solve, and further off at every solve after. One solve that far off is Newton's
-/// method linearizing the gap far from the answer, which the next solve contracts: after the
-/// unconstrained first iteration the gap is linearized where the bodies overlap by the whole
-/// approach, and the error of that linearization grows with the overlap over the spacing (0.36 h
-/// after an overlap of 1.8 h on the 3D R/159 hemisphere; 1.4 h after 3.2 h at R/270, the
-/// contact benchmark's 1M DOFs).
-const UNSTABLE_GAP_OVER_H: f64 = 1.0;
 
 /// When the surfaces have slid ([`InterfaceOperators::slide`]) this many spacings of the
 /// active nodes away from the pairing of the operators, they are paired again once the active
@@ -107,24 +101,6 @@ fn pairing_drift(
         .sum::<f64>()
         .sqrt();
     if h.is_finite() { distance / h } else { 0.0 }
-}
-
-/// The active nodes count as lying on the other surface when their geometric gaps are within
-/// this fraction of the penetration tolerance. The gap corrections contract by about ten per
-/// iteration, so settling to well inside the tolerance costs a solve or two with an unchanged
-/// active set, and makes the answer independent of the path (load steps or one solve) to that
-/// precision.
-pub(super) const SETTLED: f64 = 0.01;
-
-/// Where an active-set loop starts: the active primary candidates (surface indices) and the
-/// linearization point of their constraints: the gap rows of every primary candidate
-/// (frictionless, `super::linearization`) or the gap corrections `e` (tied,
-/// `super::interface`).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ActiveSet {
-    pub nodes: BTreeSet<usize>,
-    pub rows: Vec<GapRow>,
-    pub corrections: Vec<f64>,
 }
 
 /// A contact problem set up once: both bodies assembled (and, on the Schur path, factored) and
@@ -355,7 +331,7 @@ impl<'a> ContactSolver<'a> {
                 step => step,
             };
             let residual = solution.relative_residual;
-            let mut record = update.record(iteration, residual, drift, seconds);
+            let mut record = record(&update, iteration, residual, drift, seconds);
             record.krylov_iterations = krylov_iterations;
             if self.solver.verbose {
                 eprintln!("{}", record.line());
@@ -381,17 +357,19 @@ impl<'a> ContactSolver<'a> {
             rows,
             corrections,
         };
-        post::finish(
-            self,
+        post::finish(LastIterate {
+            problem,
+            bodies: [(&self.body1, &self.stats1), (&self.body2, &self.stats2)],
+            linear_solvers: self.linear_solvers(),
             load_factor,
             status,
             history,
             certificate,
             gaps,
-            &coupling,
+            coupling: &coupling,
             solution,
-            next_start,
-        )
+            active_set: next_start,
+        })
     }
 }
 
@@ -445,143 +423,6 @@ impl ContactSolver<'_> {
 /// no answer, status or check rests on a loose solve.
 const LOOSE_GAP: f64 = 0.1;
 
-/// What the loop does after an iteration.
-enum Step {
-    /// Solve again with this active set (possibly the same, with corrected gaps).
-    Solve(BTreeSet<usize>),
-    Stop(ContactStatus),
-}
-
-/// The loop's memory against repeats (module doc): the sets seen, the nodes removed for
-/// tension, those of them added back for penetration, and those kept active for good.
-#[derive(Default)]
-struct Safeguard {
-    seen: HashSet<BTreeSet<usize>>,
-    released: HashSet<usize>,
-    readded: HashSet<usize>,
-    pinned: HashSet<usize>,
-    /// The smallest active nodes' gap error of the iterations on the current active set.
-    best_error: Option<f64>,
-    /// The active nodes' gap error (over h) of the last iteration, when beyond
-    /// [`UNSTABLE_GAP_OVER_H`].
-    off_surface: Option<f64>,
-    /// How many iterations in a row on one active set failed to contract the gap error.
-    slow: usize,
-    /// The smallest violation of the contact conditions so far ([`violation`]), and how many
-    /// iterations have passed without going below it.
-    best_violation: Option<f64>,
-    since_best: usize,
-}
-
-/// The largest violation of the nodal contact conditions an update found: penetration of an
-/// inactive node (over `h`), tension of an active one (over `p_max`), and the active nodes'
-/// distance to the other surface (over `h`).
-fn violation(update: &Update) -> f64 {
-    let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
-    max(&update.penetrating) + max(&update.tension) + update.max_gap_error_over_h
-}
-
-/// The primal-dual active set method converges superlinearly once near the solution: on the
-/// sweep the set settles in 3 to 9 iterations. An iteration that does not reduce the smallest
-/// violation found so far makes no progress; this many in a row end the loop as
-/// [`ContactStatus::Stalled`] (the active set wandering through new sets, as a stiff primary
-/// named by hand did for 50 iterations on a 3D foreign mesh), instead of running to the cap.
-const NO_PROGRESS_AFTER: usize = 10;
-
-/// On an unchanged active set the linearized constraint must shrink the active nodes' gap
-/// error (`Update::max_gap_error_over_h`) to at most this factor of the smallest error seen on
-/// that set (not of the last one: an error alternating between two values, 9.6e-5 h and
-/// 2.9e-5 h on a 3D block held by a narrower one, halves every other iteration): Newton's
-/// method on the gap ([`super::linearization`]) does far better (quadratic, exact in one step
-/// on a flat), the tied fixed-point correction by about ten. An iteration that does not is
-/// outside the regime where the iteration converges for a reason: [`STALLED_AFTER`] such
-/// iterations in a row end the loop, converged if the error is within the penetration
-/// tolerance (the complementarity residual the certificate checks), as
-/// [`ContactStatus::Stalled`] otherwise, instead of running to the iteration cap. (A node on
-/// an edge of the other P1 surface can hold the error at 1e-5 h, its closest facet changing
-/// every iteration: seen on the half-disc, whose block surface bends at each node.)
-const CONTRACTION: f64 = 0.5;
-
-/// See [`CONTRACTION`].
-const STALLED_AFTER: usize = 2;
-
-impl Safeguard {
-    fn next(&mut self, active: &BTreeSet<usize>, update: &Update) -> Step {
-        let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
-        let added_back = nodes(&update.penetrating);
-        let released = &self.released;
-        self.readded
-            .extend(added_back.into_iter().filter(|i| released.contains(i)));
-        self.released.extend(nodes(&update.tension));
-        let off = update.max_gap_error_over_h;
-        if off > UNSTABLE_GAP_OVER_H {
-            if self
-                .off_surface
-                .is_some_and(|last| off > CONTRACTION * last)
-            {
-                return Step::Stop(ContactStatus::Unstable);
-            }
-            self.off_surface = Some(off);
-        } else {
-            self.off_surface = None;
-        }
-        let v = violation(update);
-        if self.best_violation.is_none_or(|best| v < best) {
-            (self.best_violation, self.since_best) = (Some(v), 0);
-        } else {
-            self.since_best += 1;
-            if self.since_best >= NO_PROGRESS_AFTER && !update.settled {
-                return Step::Stop(ContactStatus::Stalled);
-            }
-        }
-        if update.next == *active {
-            if update.settled {
-                return Step::Stop(ContactStatus::Converged);
-            }
-            let error = update.max_gap_error_over_h;
-            let contracted = (self.best_error).is_none_or(|best| error <= CONTRACTION * best);
-            self.slow = if contracted { 0 } else { self.slow + 1 };
-            self.best_error = Some(self.best_error.map_or(error, |best| best.min(error)));
-            return if self.slow >= STALLED_AFTER {
-                // Newton's method on a piecewise linear gap stops contracting where a node sits
-                // on an edge of the other surface, its closest facet changing from one
-                // iteration to the next; within the complementarity tolerance that is an
-                // answer, beyond it a failure.
-                Step::Stop(if update.within_tolerance {
-                    ContactStatus::Converged
-                } else {
-                    ContactStatus::Stalled
-                })
-            } else {
-                Step::Solve(active.clone())
-            };
-        }
-        (self.best_error, self.slow) = (None, 0);
-        self.seen.insert(active.clone());
-        let mut next = update.next.clone();
-        if self.seen.contains(&next) {
-            // First keep active the nodes in tension that came back after an earlier removal.
-            let readded = &self.readded;
-            let alternating: Vec<usize> = nodes(&update.tension)
-                .into_iter()
-                .filter(|i| readded.contains(i))
-                .collect();
-            self.pinned.extend(alternating.iter().copied());
-            next.extend(alternating);
-            if next == *active {
-                return Step::Solve(next);
-            }
-        }
-        if self.seen.contains(&next) {
-            match update.single_switch(active) {
-                Some(switched) if !self.seen.contains(&switched) => next = switched,
-                _ => return Step::Stop(ContactStatus::Cycling),
-            }
-        }
-        Step::Solve(next)
-    }
-}
-
 /// Runs `f`, adding its wall-clock seconds to `slot`.
 fn timed<T>(slot: &mut f64, f: impl FnOnce() -> T) -> T {
     let clock = Instant::now();
@@ -590,167 +431,26 @@ fn timed<T>(slot: &mut f64, f: impl FnOnce() -> T) -> T {
     value
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// An update that keeps `active` as it is, with the active nodes' gap error `error` (over
-    /// h), settled or not.
-    fn unchanged(active: &BTreeSet<usize>, error: f64, settled: bool) -> Update {
-        Update {
-            next: active.clone(),
-            tension: Vec::new(),
-            penetrating: Vec::new(),
-            settled,
-            within_tolerance: error <= 1e-3,
-            active: active.len(),
-            max_gap_error_over_h: error,
-        }
-    }
-
-    fn status(step: Step) -> Option<ContactStatus> {
-        match step {
-            Step::Stop(status) => Some(status),
-            Step::Solve(_) => None,
-        }
-    }
-
-    #[test]
-    fn a_gap_error_that_stops_contracting_ends_stalled() {
-        let active: BTreeSet<usize> = [1, 2, 3].into();
-        let mut safeguard = Safeguard::default();
-        // The first solve of a set has nothing to compare with; then 0.9 and 0.95 of the last.
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 1e-2, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 9e-3, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 8.5e-3, false))),
-            Some(ContactStatus::Stalled)
-        );
-    }
-
-    #[test]
-    fn an_alternating_gap_error_ends_the_loop() {
-        let active: BTreeSet<usize> = [1, 2].into();
-        let mut safeguard = Safeguard::default();
-        let errors = [4.6e-4, 9.6e-5, 2.9e-5, 9.6e-5, 2.9e-5];
-        for error in &errors[..4] {
-            assert_eq!(
-                status(safeguard.next(&active, &unchanged(&active, *error, false))),
-                None
-            );
-        }
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, errors[4], false))),
-            Some(ContactStatus::Converged)
-        );
-    }
-
-    #[test]
-    fn active_nodes_off_the_surface_twice_without_contracting_end_unstable() {
-        let active: BTreeSet<usize> = [1, 2].into();
-        // Once far off, then contracting by Newton's method: goes on.
-        let mut safeguard = Safeguard::default();
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 1.4, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 0.2, false))),
-            None
-        );
-        // Far off twice, the second no closer: the constraint does not hold the geometry.
-        let mut safeguard = Safeguard::default();
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 1.3, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 1.8, false))),
-            Some(ContactStatus::Unstable)
-        );
-    }
-
-    #[test]
-    fn an_active_set_that_wanders_without_progress_ends_stalled() {
-        let mut safeguard = Safeguard::default();
-        for k in 0..NO_PROGRESS_AFTER + 1 {
-            let active: BTreeSet<usize> = [k].into();
-            let mut update = unchanged(&active, 1e-4, false);
-            update.next = [k + 1].into();
-            update.penetrating = vec![(k + 1, 0.02)];
-            let expected = (k == NO_PROGRESS_AFTER).then_some(ContactStatus::Stalled);
-            assert_eq!(
-                status(safeguard.next(&active, &update)),
-                expected,
-                "iteration {k}"
-            );
-        }
-    }
-
-    #[test]
-    fn a_stalled_gap_error_within_the_tolerance_is_converged() {
-        let active: BTreeSet<usize> = [4].into();
-        let mut safeguard = Safeguard::default();
-        for error in [1.2e-5, 1.1e-5] {
-            assert_eq!(
-                status(safeguard.next(&active, &unchanged(&active, error, false))),
-                None
-            );
-        }
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 1.2e-5, false))),
-            Some(ContactStatus::Converged)
-        );
-    }
-
-    #[test]
-    fn a_contracting_gap_error_goes_on_until_it_settles() {
-        let active: BTreeSet<usize> = [1, 2].into();
-        let mut safeguard = Safeguard::default();
-        for error in [1e-1, 4e-2, 1e-3, 1e-6] {
-            assert_eq!(
-                status(safeguard.next(&active, &unchanged(&active, error, false))),
-                None
-            );
-        }
-        assert_eq!(
-            status(safeguard.next(&active, &unchanged(&active, 1e-9, true))),
-            Some(ContactStatus::Converged)
-        );
-    }
-
-    #[test]
-    fn a_slow_iteration_on_a_new_active_set_starts_the_count_again() {
-        let (first, second): (BTreeSet<usize>, BTreeSet<usize>) = ([1, 2].into(), [1, 2, 3].into());
-        let mut safeguard = Safeguard::default();
-        assert_eq!(
-            status(safeguard.next(&first, &unchanged(&first, 1e-2, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&first, &unchanged(&first, 9e-3, false))),
-            None
-        );
-        let mut grow = unchanged(&first, 9e-3, false);
-        grow.next = second.clone();
-        assert_eq!(status(safeguard.next(&first, &grow)), None);
-        assert_eq!(
-            status(safeguard.next(&second, &unchanged(&second, 8e-3, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&second, &unchanged(&second, 7.9e-3, false))),
-            None
-        );
-        assert_eq!(
-            status(safeguard.next(&second, &unchanged(&second, 7.8e-3, false))),
-            Some(ContactStatus::Stalled)
-        );
+/// The iteration's record of `update`; `pairing_drift_over_h` as [`pairing_drift`].
+fn record(
+    update: &Update,
+    iteration: usize,
+    residual: f64,
+    pairing_drift_over_h: f64,
+    seconds: PhaseSeconds,
+) -> IterationRecord {
+    let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
+    IterationRecord {
+        iteration,
+        active: update.active,
+        added: update.penetrating.len(),
+        removed: update.tension.len(),
+        max_penetration_over_h: max(&update.penetrating),
+        max_tension_over_p: max(&update.tension),
+        max_gap_error_over_h: update.max_gap_error_over_h,
+        pairing_drift_over_h,
+        relative_residual: residual,
+        krylov_iterations: None,
+        seconds,
     }
 }

@@ -38,7 +38,7 @@ pub struct Coupling {
     pub primary_nodes: Vec<usize>,
     /// Normal at each active node (pointing out of body 1). Frictionless: the normal of the
     /// secondary facet the node is held on, the direction of both its constraint row (the
-    /// gradient of its gap, `super::linearization`) and its traction `lambda_n n`. Tied: the
+    /// gradient of its gap, `super::gap`) and its traction `lambda_n n`. Tied: the
     /// contact normal along which the gap is held.
     pub normals: Vec<[f64; 3]>,
     /// Lumped interface mass of each active node: its area `A_i`.

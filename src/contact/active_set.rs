@@ -1,0 +1,116 @@
+//! The active set of the loop (`super::solve`): where it starts, and its primal-dual update
+//! from an iterate's pressures and gaps.
+
+use std::collections::{BTreeSet, HashSet};
+
+use super::ContactProblem;
+use super::gap::GapRow;
+
+/// The active nodes count as lying on the other surface when their geometric gaps are within
+/// this fraction of the penetration tolerance. The gap corrections contract by about ten per
+/// iteration, so settling to well inside the tolerance costs a solve or two with an unchanged
+/// active set, and makes the answer independent of the path (load steps or one solve) to that
+/// precision.
+pub(super) const SETTLED: f64 = 0.01;
+
+/// Where an active-set loop starts: the active primary candidates (surface indices) and the
+/// linearization point of their constraints: the gap rows of every primary candidate
+/// (frictionless, `super::gap`) or the gap corrections `e` (tied,
+/// `super::interface`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ActiveSet {
+    pub nodes: BTreeSet<usize>,
+    pub rows: Vec<GapRow>,
+    pub corrections: Vec<f64>,
+}
+
+/// The active-set update of one iteration (step 4 of the loop, `super::solve`), in surface indices.
+pub(super) struct Update {
+    pub(super) next: BTreeSet<usize>,
+    /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
+    pub(super) tension: Vec<(usize, f64)>,
+    /// Inactive nodes with `g_i < -tol_p h_i`, with their penetration over `h_i`: every
+    /// primary candidate, as the certificate's penetration check measures them. (Only the nodes
+    /// that faced the other surface in the reference configuration were once tested, and a
+    /// block node under a punch's corner, whose line along the contact normal meets the punch's
+    /// side, was left penetrating by 1% of a spacing for the certificate to refuse.)
+    pub(super) penetrating: Vec<(usize, f64)>,
+    /// Every active node lies on the other surface: `|g_i| <= SETTLED tol_p h_i`.
+    pub(super) settled: bool,
+    /// Every active node lies on the other surface within the penetration tolerance,
+    /// `|g_i| <= tol_p h_i`: the complementarity residual passes.
+    pub(super) within_tolerance: bool,
+    pub(super) active: usize,
+    pub(super) max_gap_error_over_h: f64,
+}
+
+impl Update {
+    pub(super) fn new(
+        problem: &ContactProblem,
+        active: &[usize],
+        traction: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        [gaps, held]: [&[f64]; 2],
+        pinned: &HashSet<usize>,
+    ) -> Self {
+        let settings = &problem.settings;
+        let s1 = &problem.primary_surface;
+        let pressure: Vec<f64> = traction
+            .iter()
+            .zip(normals)
+            .map(|(t, n)| -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]))
+            .collect();
+        let p_max = pressure.iter().copied().fold(0.0, f64::max);
+        // Tension is measured against the largest pressure; with no node in compression
+        // (bodies pulled apart) against the largest tension, so the worst node's is 1, not
+        // p / f64::MIN_POSITIVE, which overflowed to inf (`null` in summary.json).
+        let scale = if p_max > 0.0 {
+            p_max
+        } else {
+            -pressure.iter().copied().fold(0.0, f64::min)
+        };
+        let tension: Vec<(usize, f64)> = active
+            .iter()
+            .zip(&pressure)
+            .filter(|&(i, &p)| p < -settings.tension_tolerance * p_max && !pinned.contains(i))
+            .map(|(&i, &p)| (i, -p / scale))
+            .collect();
+        let is_active: HashSet<usize> = active.iter().copied().collect();
+        let penetrating: Vec<(usize, f64)> = (0..s1.len())
+            .filter(|&i| !is_active.contains(&i))
+            .map(|i| (i, -gaps[i] / s1.spacing[i]))
+            .filter(|&(_, over_h)| over_h > settings.penetration_tolerance)
+            .collect();
+        let max_gap_error_over_h = active
+            .iter()
+            .map(|&i| held[i].abs() / s1.spacing[i])
+            .fold(0.0, f64::max);
+        let mut next: BTreeSet<usize> = active.iter().copied().collect();
+        for (i, _) in &tension {
+            next.remove(i);
+        }
+        next.extend(penetrating.iter().map(|&(i, _)| i));
+        Self {
+            next,
+            settled: max_gap_error_over_h <= SETTLED * settings.penetration_tolerance,
+            within_tolerance: max_gap_error_over_h <= settings.penetration_tolerance,
+            tension,
+            penetrating,
+            active: active.len(),
+            max_gap_error_over_h,
+        }
+    }
+
+    /// The active set with only the worst violation switched, if any.
+    pub(super) fn single_switch(&self, active: &BTreeSet<usize>) -> Option<BTreeSet<usize>> {
+        let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+        let mut next = active.clone();
+        match (worst(&self.tension), worst(&self.penetrating)) {
+            (Some(t), Some(p)) if p.1 >= t.1 => next.insert(p.0),
+            (Some(t), _) => next.remove(&t.0),
+            (None, Some(p)) => next.insert(p.0),
+            (None, None) => return None,
+        };
+        Some(next)
+    }
+}

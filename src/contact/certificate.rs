@@ -1,0 +1,176 @@
+//! The certificate of a contact answer: its checks, each a figure against a tolerance with the
+//! place of its worst value. The residual checks say whether the discrete problem is solved
+//! (they decide the status); the accuracy indicators say whether its answer can be trusted
+//! (a report, never the status). `super::checks` measures them and says why each is what it is.
+
+use serde::Serialize;
+
+/// What a check measures. The first five are residuals of the discrete contact problem: they
+/// decide whether it is solved (the status, `contact_status`). The others are accuracy
+/// indicators: they say whether the solved problem's answer can be trusted (the accuracy
+/// report), and never change the status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum CheckKind {
+    /// Primal feasibility: no primary node inside the other body (over its spacing).
+    #[serde(rename = "penetration")]
+    Penetration,
+    /// Primal feasibility of the secondary's nodes, which only the transfer holds.
+    #[serde(rename = "secondary penetration")]
+    SecondaryPenetration,
+    /// Dual feasibility: no surface node of either body pulled (over the largest pressure).
+    #[serde(rename = "tension")]
+    Tension,
+    /// Complementarity: every active node on the other surface (over its spacing).
+    #[serde(rename = "complementarity")]
+    Complementarity,
+    /// Equilibrium of the interface: the contact forces on the two bodies balance.
+    #[serde(rename = "equilibrium")]
+    Equilibrium,
+    /// The secondary's sag between constrained primary nodes, over the indentation depth.
+    #[serde(rename = "secondary sag")]
+    SecondarySag,
+    /// The contact zone's width in spacings, against the minimum.
+    #[serde(rename = "resolution")]
+    Resolution,
+    /// Where the two bodies' contact forces act, over the coarser spacing.
+    #[serde(rename = "force centre")]
+    ForceCentre,
+    /// The contact force against the other primary's.
+    #[serde(rename = "primary agreement")]
+    PrimaryAgreement,
+    /// The contact force against the one with the transfer `auto` chooses.
+    #[serde(rename = "transfer agreement")]
+    TransferAgreement,
+}
+
+impl CheckKind {
+    /// The name in `summary.json` and in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Penetration => "penetration",
+            Self::SecondaryPenetration => "secondary penetration",
+            Self::Tension => "tension",
+            Self::Complementarity => "complementarity",
+            Self::Equilibrium => "equilibrium",
+            Self::SecondarySag => "secondary sag",
+            Self::Resolution => "resolution",
+            Self::ForceCentre => "force centre",
+            Self::PrimaryAgreement => "primary agreement",
+            Self::TransferAgreement => "transfer agreement",
+        }
+    }
+
+    /// A residual of the discrete problem (the status), not an accuracy indicator.
+    pub fn is_residual(self) -> bool {
+        matches!(
+            self,
+            Self::Penetration
+                | Self::SecondaryPenetration
+                | Self::Tension
+                | Self::Complementarity
+                | Self::Equilibrium
+        )
+    }
+
+    /// The unit of the figure, for messages.
+    fn unit(self) -> &'static str {
+        match self {
+            Self::Penetration | Self::SecondaryPenetration | Self::Complementarity => " h",
+            Self::Tension => " of the largest pressure",
+            Self::SecondarySag => " of the indentation depth",
+            Self::ForceCentre => {
+                " of the coarser spacing (between the two bodies' centres of normal force)"
+            }
+            Self::Resolution => " (spacing over the contact zone's width, over the minimum's, rim)",
+            Self::PrimaryAgreement | Self::TransferAgreement | Self::Equilibrium => " of the force",
+        }
+    }
+}
+
+/// The checks of one contact answer: the residuals of the discrete problem and the accuracy
+/// indicators ([`CheckKind`]).
+#[derive(Debug, Clone)]
+pub struct Certificate {
+    pub checks: Vec<CertificateCheck>,
+}
+
+/// One check: its figure against its tolerance, and where the worst value is.
+#[derive(Debug, Clone, Serialize)]
+pub struct CertificateCheck {
+    pub name: CheckKind,
+    pub value: f64,
+    pub tolerance: f64,
+    pub passed: bool,
+    /// Body and gmsh node tag of the worst node (penetration, tension).
+    pub body: Option<String>,
+    pub node_tag: Option<u64>,
+    /// What the figure was compared with, when that is not a node (primary agreement).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+impl Certificate {
+    /// Adds a check made outside `super::checks::certify` (e.g. an agreement between two
+    /// discretizations).
+    pub fn push(&mut self, check: CertificateCheck) {
+        self.checks.push(check);
+    }
+
+    /// Every residual check passed: the discrete problem is solved.
+    pub fn solved(&self) -> bool {
+        self.residuals().all(|c| c.passed)
+    }
+
+    /// Every accuracy indicator passed.
+    pub fn accurate(&self) -> bool {
+        self.indicators().all(|c| c.passed)
+    }
+
+    /// The residual checks.
+    pub fn residuals(&self) -> impl Iterator<Item = &CertificateCheck> {
+        self.checks.iter().filter(|c| c.name.is_residual())
+    }
+
+    /// The accuracy indicators.
+    pub fn indicators(&self) -> impl Iterator<Item = &CertificateCheck> {
+        self.checks.iter().filter(|c| !c.name.is_residual())
+    }
+
+    /// The kinds of the failed checks.
+    pub fn failed(&self) -> Vec<CheckKind> {
+        (self.checks.iter())
+            .filter(|c| !c.passed)
+            .map(|c| c.name)
+            .collect()
+    }
+
+    /// The failed checks in one line, e.g. for a status message.
+    pub fn failures(&self) -> String {
+        self.checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(CertificateCheck::describe)
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
+impl CertificateCheck {
+    pub fn describe(&self) -> String {
+        let at = match (&self.body, self.node_tag) {
+            (Some(body), Some(tag)) => format!(" at node {tag} of '{body}'"),
+            _ => String::new(),
+        };
+        let unit = self.name.unit();
+        let note = self
+            .note
+            .as_ref()
+            .map_or(String::new(), |note| format!(": {note}"));
+        format!(
+            "{} {:.3e}{unit}{at} (tolerance {:.1e}){note}",
+            self.name.name(),
+            self.value,
+            self.tolerance
+        )
+    }
+}

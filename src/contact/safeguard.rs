@@ -1,0 +1,321 @@
+//! When the active-set loop (`super::solve`) stops, and how it avoids repeating itself: the
+//! sets seen, the nodes kept active for good, the single switch, and the tests of the gap
+//! error on one active set (converged, stalled, unstable).
+
+use std::collections::{BTreeSet, HashSet};
+
+use super::active_set::Update;
+use super::solution::ContactStatus;
+
+/// An active node this many spacings off the other surface after two solves in a row, the second
+/// not closer by [`CONTRACTION`], means the constraint no longer controls the geometry
+/// ([`ContactStatus::Unstable`]): the stiff half-disc primary at R/500 was 1.3 to 1.8 h off at
+/// its second solve, and further off at every solve after. One solve that far off is Newton's
+/// method linearizing the gap far from the answer, which the next solve contracts: after the
+/// unconstrained first iteration the gap is linearized where the bodies overlap by the whole
+/// approach, and the error of that linearization grows with the overlap over the spacing (0.36 h
+/// after an overlap of 1.8 h on the 3D R/159 hemisphere; 1.4 h after 3.2 h at R/270, the
+/// contact benchmark's 1M DOFs).
+const UNSTABLE_GAP_OVER_H: f64 = 1.0;
+
+/// What the loop does after an iteration.
+pub(super) enum Step {
+    /// Solve again with this active set (possibly the same, with corrected gaps).
+    Solve(BTreeSet<usize>),
+    Stop(ContactStatus),
+}
+
+/// The loop's memory against repeats (module doc): the sets seen, the nodes removed for
+/// tension, those of them added back for penetration, and those kept active for good.
+#[derive(Default)]
+pub(super) struct Safeguard {
+    pub(super) seen: HashSet<BTreeSet<usize>>,
+    released: HashSet<usize>,
+    readded: HashSet<usize>,
+    pub(super) pinned: HashSet<usize>,
+    /// The smallest active nodes' gap error of the iterations on the current active set.
+    best_error: Option<f64>,
+    /// The active nodes' gap error (over h) of the last iteration, when beyond
+    /// [`UNSTABLE_GAP_OVER_H`].
+    pub(super) off_surface: Option<f64>,
+    /// How many iterations in a row on one active set failed to contract the gap error.
+    slow: usize,
+    /// The smallest violation of the contact conditions so far ([`violation`]), and how many
+    /// iterations have passed without going below it.
+    best_violation: Option<f64>,
+    since_best: usize,
+}
+
+/// The largest violation of the nodal contact conditions an update found: penetration of an
+/// inactive node (over `h`), tension of an active one (over `p_max`), and the active nodes'
+/// distance to the other surface (over `h`).
+fn violation(update: &Update) -> f64 {
+    let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
+    max(&update.penetrating) + max(&update.tension) + update.max_gap_error_over_h
+}
+
+/// The primal-dual active set method converges superlinearly once near the solution: on the
+/// sweep the set settles in 3 to 9 iterations. An iteration that does not reduce the smallest
+/// violation found so far makes no progress; this many in a row end the loop as
+/// [`ContactStatus::Stalled`] (the active set wandering through new sets, as a stiff primary
+/// named by hand did for 50 iterations on a 3D foreign mesh), instead of running to the cap.
+const NO_PROGRESS_AFTER: usize = 10;
+
+/// On an unchanged active set the linearized constraint must shrink the active nodes' gap
+/// error (`Update::max_gap_error_over_h`) to at most this factor of the smallest error seen on
+/// that set (not of the last one: an error alternating between two values, 9.6e-5 h and
+/// 2.9e-5 h on a 3D block held by a narrower one, halves every other iteration): Newton's
+/// method on the gap ([`super::gap`]) does far better (quadratic, exact in one step
+/// on a flat), the tied fixed-point correction by about ten. An iteration that does not is
+/// outside the regime where the iteration converges for a reason: [`STALLED_AFTER`] such
+/// iterations in a row end the loop, converged if the error is within the penetration
+/// tolerance (the complementarity residual the certificate checks), as
+/// [`ContactStatus::Stalled`] otherwise, instead of running to the iteration cap. (A node on
+/// an edge of the other P1 surface can hold the error at 1e-5 h, its closest facet changing
+/// every iteration: seen on the half-disc, whose block surface bends at each node.)
+const CONTRACTION: f64 = 0.5;
+
+/// See [`CONTRACTION`].
+const STALLED_AFTER: usize = 2;
+
+impl Safeguard {
+    pub(super) fn next(&mut self, active: &BTreeSet<usize>, update: &Update) -> Step {
+        let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
+        let added_back = nodes(&update.penetrating);
+        let released = &self.released;
+        self.readded
+            .extend(added_back.into_iter().filter(|i| released.contains(i)));
+        self.released.extend(nodes(&update.tension));
+        let off = update.max_gap_error_over_h;
+        if off > UNSTABLE_GAP_OVER_H {
+            if self
+                .off_surface
+                .is_some_and(|last| off > CONTRACTION * last)
+            {
+                return Step::Stop(ContactStatus::Unstable);
+            }
+            self.off_surface = Some(off);
+        } else {
+            self.off_surface = None;
+        }
+        let v = violation(update);
+        if self.best_violation.is_none_or(|best| v < best) {
+            (self.best_violation, self.since_best) = (Some(v), 0);
+        } else {
+            self.since_best += 1;
+            if self.since_best >= NO_PROGRESS_AFTER && !update.settled {
+                return Step::Stop(ContactStatus::Stalled);
+            }
+        }
+        if update.next == *active {
+            if update.settled {
+                return Step::Stop(ContactStatus::Converged);
+            }
+            let error = update.max_gap_error_over_h;
+            let contracted = (self.best_error).is_none_or(|best| error <= CONTRACTION * best);
+            self.slow = if contracted { 0 } else { self.slow + 1 };
+            self.best_error = Some(self.best_error.map_or(error, |best| best.min(error)));
+            return if self.slow >= STALLED_AFTER {
+                // Newton's method on a piecewise linear gap stops contracting where a node sits
+                // on an edge of the other surface, its closest facet changing from one
+                // iteration to the next; within the complementarity tolerance that is an
+                // answer, beyond it a failure.
+                Step::Stop(if update.within_tolerance {
+                    ContactStatus::Converged
+                } else {
+                    ContactStatus::Stalled
+                })
+            } else {
+                Step::Solve(active.clone())
+            };
+        }
+        (self.best_error, self.slow) = (None, 0);
+        self.seen.insert(active.clone());
+        let mut next = update.next.clone();
+        if self.seen.contains(&next) {
+            // First keep active the nodes in tension that came back after an earlier removal.
+            let readded = &self.readded;
+            let alternating: Vec<usize> = nodes(&update.tension)
+                .into_iter()
+                .filter(|i| readded.contains(i))
+                .collect();
+            self.pinned.extend(alternating.iter().copied());
+            next.extend(alternating);
+            if next == *active {
+                return Step::Solve(next);
+            }
+        }
+        if self.seen.contains(&next) {
+            match update.single_switch(active) {
+                Some(switched) if !self.seen.contains(&switched) => next = switched,
+                _ => return Step::Stop(ContactStatus::Cycling),
+            }
+        }
+        Step::Solve(next)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An update that keeps `active` as it is, with the active nodes' gap error `error` (over
+    /// h), settled or not.
+    fn unchanged(active: &BTreeSet<usize>, error: f64, settled: bool) -> Update {
+        Update {
+            next: active.clone(),
+            tension: Vec::new(),
+            penetrating: Vec::new(),
+            settled,
+            within_tolerance: error <= 1e-3,
+            active: active.len(),
+            max_gap_error_over_h: error,
+        }
+    }
+
+    fn status(step: Step) -> Option<ContactStatus> {
+        match step {
+            Step::Stop(status) => Some(status),
+            Step::Solve(_) => None,
+        }
+    }
+
+    #[test]
+    fn a_gap_error_that_stops_contracting_ends_stalled() {
+        let active: BTreeSet<usize> = [1, 2, 3].into();
+        let mut safeguard = Safeguard::default();
+        // The first solve of a set has nothing to compare with; then 0.9 and 0.95 of the last.
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1e-2, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 9e-3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 8.5e-3, false))),
+            Some(ContactStatus::Stalled)
+        );
+    }
+
+    #[test]
+    fn an_alternating_gap_error_ends_the_loop() {
+        let active: BTreeSet<usize> = [1, 2].into();
+        let mut safeguard = Safeguard::default();
+        let errors = [4.6e-4, 9.6e-5, 2.9e-5, 9.6e-5, 2.9e-5];
+        for error in &errors[..4] {
+            assert_eq!(
+                status(safeguard.next(&active, &unchanged(&active, *error, false))),
+                None
+            );
+        }
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, errors[4], false))),
+            Some(ContactStatus::Converged)
+        );
+    }
+
+    #[test]
+    fn active_nodes_off_the_surface_twice_without_contracting_end_unstable() {
+        let active: BTreeSet<usize> = [1, 2].into();
+        // Once far off, then contracting by Newton's method: goes on.
+        let mut safeguard = Safeguard::default();
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1.4, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 0.2, false))),
+            None
+        );
+        // Far off twice, the second no closer: the constraint does not hold the geometry.
+        let mut safeguard = Safeguard::default();
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1.3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1.8, false))),
+            Some(ContactStatus::Unstable)
+        );
+    }
+
+    #[test]
+    fn an_active_set_that_wanders_without_progress_ends_stalled() {
+        let mut safeguard = Safeguard::default();
+        for k in 0..NO_PROGRESS_AFTER + 1 {
+            let active: BTreeSet<usize> = [k].into();
+            let mut update = unchanged(&active, 1e-4, false);
+            update.next = [k + 1].into();
+            update.penetrating = vec![(k + 1, 0.02)];
+            let expected = (k == NO_PROGRESS_AFTER).then_some(ContactStatus::Stalled);
+            assert_eq!(
+                status(safeguard.next(&active, &update)),
+                expected,
+                "iteration {k}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_stalled_gap_error_within_the_tolerance_is_converged() {
+        let active: BTreeSet<usize> = [4].into();
+        let mut safeguard = Safeguard::default();
+        for error in [1.2e-5, 1.1e-5] {
+            assert_eq!(
+                status(safeguard.next(&active, &unchanged(&active, error, false))),
+                None
+            );
+        }
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1.2e-5, false))),
+            Some(ContactStatus::Converged)
+        );
+    }
+
+    #[test]
+    fn a_contracting_gap_error_goes_on_until_it_settles() {
+        let active: BTreeSet<usize> = [1, 2].into();
+        let mut safeguard = Safeguard::default();
+        for error in [1e-1, 4e-2, 1e-3, 1e-6] {
+            assert_eq!(
+                status(safeguard.next(&active, &unchanged(&active, error, false))),
+                None
+            );
+        }
+        assert_eq!(
+            status(safeguard.next(&active, &unchanged(&active, 1e-9, true))),
+            Some(ContactStatus::Converged)
+        );
+    }
+
+    #[test]
+    fn a_slow_iteration_on_a_new_active_set_starts_the_count_again() {
+        let (first, second): (BTreeSet<usize>, BTreeSet<usize>) = ([1, 2].into(), [1, 2, 3].into());
+        let mut safeguard = Safeguard::default();
+        assert_eq!(
+            status(safeguard.next(&first, &unchanged(&first, 1e-2, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&first, &unchanged(&first, 9e-3, false))),
+            None
+        );
+        let mut grow = unchanged(&first, 9e-3, false);
+        grow.next = second.clone();
+        assert_eq!(status(safeguard.next(&first, &grow)), None);
+        assert_eq!(
+            status(safeguard.next(&second, &unchanged(&second, 8e-3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&second, &unchanged(&second, 7.9e-3, false))),
+            None
+        );
+        assert_eq!(
+            status(safeguard.next(&second, &unchanged(&second, 7.8e-3, false))),
+            Some(ContactStatus::Stalled)
+        );
+    }
+}
