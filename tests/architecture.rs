@@ -13,10 +13,9 @@ fn documented_order(mod_rs: &str) -> Vec<String> {
     for line in mod_rs.lines().take_while(|l| l.starts_with("//!")) {
         for (i, piece) in line.split('`').enumerate() {
             let name = piece.strip_suffix(".rs");
-            if let Some(name) = name.filter(|n| i % 2 == 1 && !n.contains('/')) {
-                if !order.iter().any(|o| o == name) {
-                    order.push(name.to_string());
-                }
+            let name = name.filter(|n| i % 2 == 1 && !n.contains('/'));
+            if let Some(name) = name.filter(|n| !order.iter().any(|o| o == n)) {
+                order.push(name.to_string());
             }
         }
     }
