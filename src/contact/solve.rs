@@ -64,12 +64,13 @@
 //! surface on two solves in a row, the second not contracting (or followed by an interface
 //! system that cannot be solved accurately), is [`ContactStatus::Unstable`].
 
+use std::collections::BTreeSet;
 use std::time::Instant;
 
 use super::active_set::{ActiveSet, Update};
 use super::checks::{certify, contact_status};
 use super::coupled_solver::{self, BodyFactors};
-use super::gap::{gap_rows, geometric_gaps};
+use super::gap::{GapRow, gap_rows, geometric_gaps};
 use super::interface::{Constraint, InterfaceOperators};
 use super::post::{self, LastIterate};
 use super::safeguard::{Safeguard, Step};
@@ -237,80 +238,42 @@ impl<'a> ContactSolver<'a> {
         // The active set `last` was solved on (`active` moves on to the next one).
         let mut solved = active.clone();
 
-        'iterations: for iteration in 1..=settings.max_iterations {
+        for iteration in 1..=settings.max_iterations {
             let mut seconds = PhaseSeconds::default();
             // 1. The coupling of the active set: rows and columns of the fixed operators.
             let nodes: Vec<usize> = active.iter().copied().collect();
             let coupling = timed(&mut seconds.operators, || {
-                let formulation = settings.formulation;
-                let constraint = match formulation {
-                    Formulation::Frictionless => Constraint::Geometric { rows: &rows },
-                    Formulation::Tied => Constraint::Interpolated {
-                        corrections: &corrections,
-                    },
-                };
-                (self.operators).coupling(s1, s2, formulation, &nodes, constraint)
+                self.coupling(&nodes, &rows, &corrections)
             });
-            // 2-4. The coupled solve; the gaps of every primary candidate, geometric (the
-            //    search) and linearized at this iterate, and how far the active nodes' pairing
-            //    has slid; the primal-dual active set update. On the Krylov path the solve is
-            //    first loose (`LOOSE_GAP`) and solved again exactly when its update would keep
-            //    the active set or return to one seen before.
-            let mut loose = self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
-            let h = (nodes.iter().map(|&i| s1.spacing[i])).fold(f64::INFINITY, f64::min);
-            let loose_gap = LOOSE_GAP * settings.penetration_tolerance * h;
-            let mut krylov_iterations = None;
-            let (solution, gaps, slid, update, linear) = loop {
-                let solved_now = timed(&mut seconds.solve, || {
-                    let gap_tolerance = (loose && loose_gap.is_finite()).then_some(loose_gap);
-                    self.coupled_solve(&coupling, load_factor, gap_tolerance)
-                });
-                let solution = match solved_now {
-                    // After a solve that left active nodes a spacing off the surface, an
-                    // interface system that cannot be solved accurately is the same diagnosis
-                    // as `Unstable`: the constraint does not control the geometry. The last
-                    // iterate is the answer, its certificate says what fails.
-                    Err(ContactError::Inaccurate { .. })
-                        if safeguard.off_surface.is_some() && last.is_some() =>
-                    {
-                        status = ContactStatus::Unstable;
-                        active = solved;
-                        break 'iterations;
-                    }
-                    solved_now => solved_now?,
-                };
-                if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
-                    *krylov_iterations.get_or_insert(0) += stats.iterations;
+            // 2-4. The coupled solve, the gaps at the iterate, the active set update.
+            let iterate = self.iterate(
+                &coupling,
+                &active,
+                load_factor,
+                &safeguard,
+                &mut rows,
+                &mut seconds,
+            );
+            let Iterate {
+                solution,
+                gaps,
+                linear,
+                slid,
+                update,
+                krylov_iterations,
+            } = match iterate {
+                // After a solve that left active nodes a spacing off the surface, an interface
+                // system that cannot be solved accurately is the same diagnosis as `Unstable`:
+                // the constraint does not control the geometry. The last iterate is the
+                // answer, its certificate says what fails.
+                Err(ContactError::Inaccurate { .. })
+                    if safeguard.off_surface.is_some() && last.is_some() =>
+                {
+                    status = ContactStatus::Unstable;
+                    active = solved;
+                    break;
                 }
-                let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
-                let (gaps, linear, slid) = timed(&mut seconds.search, || {
-                    let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                    rows = gap_rows(s1, s2, Some(u1), Some(u2));
-                    let jumps = self.operators.jumps(s1, s2, u1, u2);
-                    let slid = self.operators.slide(s1, &jumps, &nodes);
-                    (gaps, self.operators.linearized_gaps(&jumps), slid)
-                });
-                // The gap each active node's constraint holds: the gap of its linearization.
-                let held: Vec<f64> = match settings.formulation {
-                    Formulation::Frictionless => rows.iter().map(|r| r.gap).collect(),
-                    Formulation::Tied => gaps.clone(),
-                };
-                let update = timed(&mut seconds.checks, || {
-                    let (traction, normals) = (&solution.traction, &coupling.normals);
-                    Update::new(
-                        problem,
-                        &nodes,
-                        traction,
-                        normals,
-                        [&gaps, &held],
-                        &safeguard.pinned,
-                    )
-                });
-                if loose && (update.next == active || safeguard.seen.contains(&update.next)) {
-                    loose = false;
-                    continue;
-                }
-                break (solution, gaps, slid, update, linear);
+                iterate => iterate?,
             };
             let drift = pairing_drift(&self.operators.slid, &slid, s1, &nodes);
             if settings.formulation == Formulation::Tied {
@@ -349,16 +312,119 @@ impl<'a> ContactSolver<'a> {
         }
 
         let (coupling, solution) = last.expect("max_iterations >= 1 is validated");
-        let nodes: Vec<usize> = active.iter().copied().collect();
-        let (certificate, gaps) = certify(problem, &solution, &nodes);
-        let status = contact_status(status, &certificate, active.is_empty());
         let next_start = ActiveSet {
             nodes: active,
             rows,
             corrections,
         };
+        self.finish(
+            load_factor,
+            status,
+            history,
+            &coupling,
+            solution,
+            next_start,
+        )
+    }
+}
+
+impl ContactSolver<'_> {
+    /// The coupling of the active primary nodes `nodes` (surface indices): rows and columns of
+    /// the fixed operators, the constraint linearized by `rows` (frictionless) or corrected by
+    /// `corrections` (tied).
+    fn coupling(&mut self, nodes: &[usize], rows: &[GapRow], corrections: &[f64]) -> Coupling {
+        let problem = self.problem;
+        let formulation = problem.settings.formulation;
+        let constraint = match formulation {
+            Formulation::Frictionless => Constraint::Geometric { rows },
+            Formulation::Tied => Constraint::Interpolated { corrections },
+        };
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        (self.operators).coupling(s1, s2, formulation, nodes, constraint)
+    }
+
+    /// Steps 2-4 of the loop on the active set `active` with its `coupling`: the coupled
+    /// solve; the gaps of every primary candidate, geometric (the search) and linearized at
+    /// the iterate (into `rows`), and how far the active nodes' pairing has slid; the
+    /// primal-dual active set update. On the Krylov path the solve is first loose
+    /// ([`LOOSE_GAP`]) and solved again exactly when its update would keep the active set or
+    /// return to one seen before. The time of each phase is added to `seconds`.
+    #[allow(clippy::too_many_arguments)]
+    fn iterate(
+        &mut self,
+        coupling: &Coupling,
+        active: &BTreeSet<usize>,
+        load_factor: f64,
+        safeguard: &Safeguard,
+        rows: &mut Vec<GapRow>,
+        seconds: &mut PhaseSeconds,
+    ) -> Result<Iterate, ContactError> {
+        let problem = self.problem;
+        let settings = &problem.settings;
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let nodes: Vec<usize> = active.iter().copied().collect();
+        let mut loose = self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
+        let h = (nodes.iter().map(|&i| s1.spacing[i])).fold(f64::INFINITY, f64::min);
+        let loose_gap = LOOSE_GAP * settings.penetration_tolerance * h;
+        let mut krylov_iterations = None;
+        loop {
+            let solution = timed(&mut seconds.solve, || {
+                let gap_tolerance = (loose && loose_gap.is_finite()).then_some(loose_gap);
+                self.coupled_solve(coupling, load_factor, gap_tolerance)
+            })?;
+            if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
+                *krylov_iterations.get_or_insert(0) += stats.iterations;
+            }
+            let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+            let (gaps, linear, slid) = timed(&mut seconds.search, || {
+                let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
+                *rows = gap_rows(s1, s2, Some(u1), Some(u2));
+                let jumps = self.operators.jumps(s1, s2, u1, u2);
+                let slid = self.operators.slide(s1, &jumps, &nodes);
+                (gaps, self.operators.linearized_gaps(&jumps), slid)
+            });
+            // The gap each active node's constraint holds: the gap of its linearization.
+            let held: Vec<f64> = match settings.formulation {
+                Formulation::Frictionless => rows.iter().map(|r| r.gap).collect(),
+                Formulation::Tied => gaps.clone(),
+            };
+            let update = timed(&mut seconds.checks, || {
+                let (traction, normals) = (&solution.traction, &coupling.normals);
+                let pinned = &safeguard.pinned;
+                Update::new(problem, &nodes, traction, normals, [&gaps, &held], pinned)
+            });
+            if loose && (update.next == *active || safeguard.seen.contains(&update.next)) {
+                loose = false;
+                continue;
+            }
+            return Ok(Iterate {
+                solution,
+                gaps,
+                linear,
+                slid,
+                update,
+                krylov_iterations,
+            });
+        }
+    }
+
+    /// The answer of a loop that ended `loop_end` with `solution` on the active set of
+    /// `next_start`: certified without the loop's operators (`super::checks`), which decides
+    /// the status, with the fields and forces of `super::post`.
+    fn finish(
+        &self,
+        load_factor: f64,
+        loop_end: ContactStatus,
+        history: Vec<IterationRecord>,
+        coupling: &Coupling,
+        solution: CoupledSolution,
+        next_start: ActiveSet,
+    ) -> Result<ContactSolution, ContactError> {
+        let nodes: Vec<usize> = next_start.nodes.iter().copied().collect();
+        let (certificate, gaps) = certify(self.problem, &solution, &nodes);
+        let status = contact_status(loop_end, &certificate, nodes.is_empty());
         post::finish(LastIterate {
-            problem,
+            problem: self.problem,
             bodies: [(&self.body1, &self.stats1), (&self.body2, &self.stats2)],
             linear_solvers: self.linear_solvers(),
             load_factor,
@@ -366,14 +432,12 @@ impl<'a> ContactSolver<'a> {
             history,
             certificate,
             gaps,
-            coupling: &coupling,
+            coupling,
             solution,
             active_set: next_start,
         })
     }
-}
 
-impl ContactSolver<'_> {
     /// Builds the interface operators again, paired with the primary surface slid by `slid`;
     /// the bodies' responses computed with the old ones are forgotten.
     fn pair_again(&mut self, slid: [f64; 3]) -> Result<(), ContactError> {
@@ -412,6 +476,20 @@ impl ContactSolver<'_> {
         }
         Ok(system.solution(&x, coupling, dim, residual))
     }
+}
+
+/// What steps 2-4 of one iteration found.
+struct Iterate {
+    solution: CoupledSolution,
+    /// The geometric gap of every primary candidate at the iterate.
+    gaps: Vec<f64>,
+    /// Their gaps through the interpolation operators (tied contact's corrections).
+    linear: Vec<f64>,
+    /// The slide of the active nodes' pairing ([`InterfaceOperators::slide`]).
+    slid: [f64; 3],
+    update: Update,
+    /// GMRES iterations of the solves (Krylov path).
+    krylov_iterations: Option<usize>,
 }
 
 /// A loose interface solve holds every active node's gap to this fraction of the penetration
