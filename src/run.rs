@@ -10,7 +10,7 @@ use crate::contact::{
     ContactError, ContactProblem, ContactRun, ContactSolution, StepRecord, SurfaceFields,
     solve_contact,
 };
-use crate::elastic::{ElasticSolution, SolveError, solve};
+use crate::elastic::{DirichletCondition, ElasticSolution, SolveError, solve};
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
 use crate::mesh::BodyMesh;
 use crate::mesh::{Mesh, MeshError, mesh_geo, read_msh, read_msh_bytes};
@@ -273,14 +273,32 @@ fn solve_contact_case<'m>(
     // Warned even with --quiet, since a file the user expects is missing.
     let png = output_dir.join("force_displacement.png");
     let title = format!(
-        "{}: contact force on '{}' against load factor",
+        "{}: contact of '{}' (primary) and '{}'",
         case_name(case),
-        run.problem.primary.body.name
+        run.problem.primary.body.name,
+        run.problem.secondary.body.name
     );
-    if let Err(e) = write_force_displacement_png(&png, &title, &run.steps) {
+    let approach = imposed_approach(&run.problem);
+    if let Err(e) = write_force_displacement_png(&png, &title, &run.steps, approach) {
         eprintln!("warning: {} not written: {e}", png.display());
     }
     Ok(run)
+}
+
+/// The approach the two bodies' prescribed displacements impose at load factor 1: the largest
+/// `|u1 - u2|` over a Dirichlet condition of each body (components not prescribed count as
+/// 0). A hemisphere pushed down by 0.01 onto a clamped block: 0.01.
+fn imposed_approach(problem: &ContactProblem) -> f64 {
+    let vector = |c: &DirichletCondition| c.components.map(|u| u.unwrap_or(0.0));
+    let mut largest = 0.0f64;
+    for a in &problem.primary.dirichlet {
+        for b in &problem.secondary.dirichlet {
+            let (u1, u2) = (vector(a), vector(b));
+            let d = (0..3).map(|k| (u1[k] - u2[k]).powi(2)).sum::<f64>().sqrt();
+            largest = largest.max(d);
+        }
+    }
+    largest
 }
 
 /// The case file's name without its extension (the plot title).

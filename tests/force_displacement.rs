@@ -26,7 +26,7 @@ fn stepped_contact_writes_the_csv_and_a_png_plot_of_it() {
     assert_eq!(&bytes[12..16], b"IHDR", "the first chunk is the header");
     let width = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
     let height = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
-    assert_eq!((width, height), (900, 600));
+    assert_eq!((width, height), internodes::output::PLOT_SIZE);
     let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes))
         .read_info()
         .expect("a decodable PNG header");

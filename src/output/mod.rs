@@ -11,7 +11,7 @@ pub use folder::{
     FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, mark_failed_folder, unsaid_causes,
 };
 pub use matrix_market::write_matrix_market;
-pub use plot::{PlotError, write_force_displacement_png};
+pub use plot::{PLOT_SIZE, PlotError, write_force_displacement_png};
 pub use summary::{
     BodySummary, CaseSummary, ContactSummary, force_displacement_csv, peak_memory_mb,
 };

@@ -1,5 +1,5 @@
-//! `force_displacement.png`: the contact force of each load step against its load factor, the
-//! picture of `force_displacement.csv`.
+//! `force_displacement.png`: the contact force and the contact radius of each load step
+//! against the imposed approach, the picture of `force_displacement.csv`.
 //!
 //! plotters draws text with a font it is given at run time (its pure-Rust `ab_glyph` backend,
 //! so no fontconfig or freetype): DejaVu Sans from Debian's `fonts-dejavu-core`, or the file
@@ -37,66 +37,99 @@ pub enum PlotError {
     Draw { path: PathBuf, message: String },
 }
 
-/// Draws `steps` into the PNG file `path`: one line with markers per force component (named
-/// as the CSV columns), load factor on x, contact force on the primary body on y.
+/// Width and height of the picture in pixels: two panels side by side.
+pub const PLOT_SIZE: (u32, u32) = (1200, 540);
+
+/// Draws `steps` into the PNG file `path`, two panels against the imposed approach, each from
+/// the origin: the magnitude of the contact force on the primary body, and the contact radius
+/// (half-width in 2D) of each step's Hertz fit. `approach` is the imposed approach at load
+/// factor 1 (the largest difference between the two bodies' prescribed displacements); where
+/// no displacement is imposed (0: the bodies are loaded by forces) the x axis is the load
+/// factor.
 pub fn write_force_displacement_png(
     path: &Path,
     title: &str,
     steps: &[StepRecord],
+    approach: f64,
 ) -> Result<(), PlotError> {
     register_font()?;
     let draw_error = |e: &dyn std::fmt::Display| PlotError::Draw {
         path: path.to_owned(),
         message: e.to_string(),
     };
-    let dim = steps.first().map_or(0, |s| s.force_primary.len());
-    let x_range = padded_range(steps.iter().map(|s| s.load_factor));
-    let y_range = padded_range(steps.iter().flat_map(|s| s.force_primary.iter().copied()));
+    let (scale, x_desc) = if approach > 0.0 {
+        (
+            approach,
+            format!("imposed approach (load factor x {approach})"),
+        )
+    } else {
+        (1.0, "load factor (no displacement imposed)".to_string())
+    };
+    let norm = |f: &[f64]| f.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let origin = std::iter::once((0.0, 0.0));
+    let force: Vec<(f64, f64)> = origin
+        .clone()
+        .chain(
+            steps
+                .iter()
+                .map(|s| (scale * s.load_factor, norm(&s.force_primary))),
+        )
+        .collect();
+    let radius: Vec<(f64, f64)> = origin
+        .chain(
+            steps
+                .iter()
+                .filter_map(|s| s.hertz_a.map(|a| (scale * s.load_factor, a))),
+        )
+        .collect();
 
-    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    let root = BitMapBackend::new(path, PLOT_SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| draw_error(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, (FAMILY, 22))
-        .margin(20)
-        .x_label_area_size(50)
-        .y_label_area_size(90)
-        .build_cartesian_2d(x_range, y_range)
+    let root = root
+        .titled(title, (FAMILY, 22))
         .map_err(|e| draw_error(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("load factor (load_factor: scales every load and imposed displacement)")
-        .y_desc("contact force on the primary body (contact_force_*)")
-        .axis_desc_style((FAMILY, 16))
-        .label_style((FAMILY, 14))
-        .y_label_formatter(&|v| tick_label(*v))
-        .draw()
-        .map_err(|e| draw_error(&e))?;
-    for (component, axis) in ["x", "y", "z"].iter().enumerate().take(dim) {
-        let color = Palette99::pick(component).to_rgba();
-        let points: Vec<(f64, f64)> = steps
-            .iter()
-            .map(|s| (s.load_factor, s.force_primary[component]))
-            .collect();
+    let (left, right) = root.split_horizontally(PLOT_SIZE.0 / 2);
+    let panels = [
+        (&left, &force, "contact force |F| on the primary body", 0),
+        (
+            &right,
+            &radius,
+            "contact radius a (Hertz fit of the pressure)",
+            1,
+        ),
+    ];
+    for (area, points, y_desc, colour) in panels {
+        let x_range = padded_range(points.iter().map(|p| p.0));
+        let y_range = padded_range(points.iter().map(|p| p.1));
+        let mut chart = ChartBuilder::on(area)
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x_range, y_range)
+            .map_err(|e| draw_error(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc.as_str())
+            .y_desc(y_desc)
+            .axis_desc_style((FAMILY, 16))
+            .label_style((FAMILY, 14))
+            .x_labels(6)
+            .y_labels(8)
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .draw()
+            .map_err(|e| draw_error(&e))?;
+        let color = Palette99::pick(colour).to_rgba();
         chart
             .draw_series(LineSeries::new(
                 points.iter().copied(),
                 color.stroke_width(2),
             ))
-            .map_err(|e| draw_error(&e))?
-            .label(format!("contact_force_{axis}"))
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+            .map_err(|e| draw_error(&e))?;
         chart
             .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
             .map_err(|e| draw_error(&e))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font((FAMILY, 14))
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| draw_error(&e))?;
     root.present().map_err(|e| draw_error(&e))
 }
 
