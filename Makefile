@@ -8,7 +8,7 @@ LEVELS  ?= 0 1 2
 # builds and tests without it.
 FEATURES ?= petsc
 
-.PHONY: deps build demo test validate meshes bench clean
+.PHONY: deps build demo picture test validate foreign-meshes outside-check meshes bench clean
 
 deps:
 	bash .ci/install-deps.sh
@@ -32,6 +32,18 @@ test: build
 # The full validation: every suite at every level; writes validation/report/ (committed).
 validate: build
 	$(PYTHON) validation/run.py
+
+# The README's picture (docs/demo.png), drawn from the demo's output files.
+picture: demo
+	$(PYTHON) validation/render_demo.py
+
+# The held-out checks, on meshes made without geo/ (about 40 and 15 minutes; reports in
+# validation/report/foreign_meshes.md and validation/report/outside_check.md).
+foreign-meshes: build
+	$(PYTHON) validation/foreign_meshes.py
+
+outside-check: build
+	$(PYTHON) validation/outside_check.py
 
 # Every geo/ script at the refinement levels $(LEVELS), into meshes/.
 meshes: deps
