@@ -91,20 +91,10 @@ pub fn certify(
         (s1, s2, u1, u2, &solution.contact_force1[..]),
         (s2, s1, u2, u1, &solution.contact_force2[..]),
     ];
-
     let gaps = sides.map(|(own, other, u_own, u_other, _)| {
         geometric_gaps(own, other, Some(u_own), Some(u_other))
     });
     let held = held_by_primary([s1, s2], [u1, u2], active);
-    let mut penetration = [Worst::default(), Worst::default()];
-    for (b, (worst, &(own, ..))) in penetration.iter_mut().zip(&sides).enumerate() {
-        for (s, g) in gaps[b].iter().enumerate() {
-            if b == 0 || held[s] == Held::Not {
-                worst.offer(-g / own.spacing[s], own, s);
-            }
-        }
-    }
-
     let mean: Vec<Vec<f64>> = sides
         .iter()
         .map(|&(own, _, _, _, force)| {
@@ -113,6 +103,49 @@ pub fn certify(
                 .collect()
         })
         .collect();
+
+    let [penetration1, penetration2] = penetration(&sides, &gaps, &held);
+    let indentation = indentation_depth(s1, s2, [u1, u2], &gaps[0], &mean[0])
+        .max(elastic_approach(s1, &mean[0], problem.contact_modulus()));
+    // A nearly rigid secondary's spacing does not bound the answer: only its position does.
+    let secondary_width =
+        (!problem.secondary_is_nearly_rigid()).then_some(settings.secondary_min_zone_width);
+    let checks = vec![
+        penetration1.check(CheckKind::Penetration, settings.penetration_tolerance),
+        penetration2.check(
+            CheckKind::SecondaryPenetration,
+            settings.secondary_penetration_tolerance,
+        ),
+        tension(problem, &sides, &mean),
+        complementarity(problem, solution, &gaps[0], active),
+        equilibrium(solution, s1.dim, settings.imbalance_tolerance),
+        secondary_sag(s2, &held, &gaps[1], &mean[1], indentation, settings),
+        zone_resolution(
+            [(s1, Some(settings.min_zone_width)), (s2, secondary_width)],
+            &mean,
+            &held,
+        ),
+        force_centres(&sides, &mean).check(settings.force_centre_tolerance),
+    ];
+    (Certificate { checks }, gaps)
+}
+
+/// The deepest penetration over the node's spacing on each surface: every primary node, and
+/// the secondary nodes no active primary node holds ([`Held::Not`]).
+fn penetration(sides: &[Side; 2], gaps: &[Vec<f64>; 2], held: &[Held]) -> [Worst; 2] {
+    let mut worst = [Worst::default(), Worst::default()];
+    for (b, (worst, &(own, ..))) in worst.iter_mut().zip(sides).enumerate() {
+        for (s, g) in gaps[b].iter().enumerate() {
+            if b == 0 || held[s] == Held::Not {
+                worst.offer(-g / own.spacing[s], own, s);
+            }
+        }
+    }
+    worst
+}
+
+/// The largest tension (negative mean pressure) of a surface node over the largest pressure.
+fn tension(problem: &ContactProblem, sides: &[Side; 2], mean: &[Vec<f64>]) -> CertificateCheck {
     let p_max = mean.iter().flatten().copied().fold(0.0, f64::max);
     // A nearly rigid secondary's nodal forces are the transfer's spreading of the multiplier,
     // of which only the resultant acts on it (`ContactProblem::transfer` chooses the
@@ -124,15 +157,45 @@ pub fn certify(
     };
     let mut tension = Worst::default();
     if p_max > 0.0 {
-        for (&(own, ..), pressures) in sides.iter().zip(&mean).take(judged) {
+        for (&(own, ..), pressures) in sides.iter().zip(mean).take(judged) {
             for (s, p) in pressures.iter().enumerate() {
                 tension.offer(-p / p_max, own, s);
             }
         }
     }
+    let tolerance = problem.settings.certificate_tension_tolerance;
+    tension.check(CheckKind::Tension, tolerance)
+}
 
+/// Complementarity: the gap each active node's constraint holds, measured again at the
+/// answer (frictionless: the gap of its linearization, `super::gap`, which is the geometric
+/// gap wherever the node faces the inside of a secondary facet; tied: the geometric gap
+/// `gaps1`), over the node's spacing.
+fn complementarity(
+    problem: &ContactProblem,
+    solution: &CoupledSolution,
+    gaps1: &[f64],
+    active: &[usize],
+) -> CertificateCheck {
+    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+    let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+    let held: Vec<f64> = match problem.settings.formulation {
+        Formulation::Frictionless => (gap_rows(s1, s2, Some(u1), Some(u2)).into_iter())
+            .map(|row| row.gap)
+            .collect(),
+        Formulation::Tied => gaps1.to_vec(),
+    };
+    let mut worst = Worst::default();
+    for &i in active {
+        worst.offer(held[i].abs() / s1.spacing[i], s1, i);
+    }
+    let tolerance = problem.settings.penetration_tolerance;
+    worst.check(CheckKind::Complementarity, tolerance)
+}
+
+/// Equilibrium: `|F1 + F2| / |F1|`, the total contact forces on the two bodies.
+fn equilibrium(solution: &CoupledSolution, dim: usize, tolerance: f64) -> CertificateCheck {
     let total = |force: &[f64]| -> [f64; 3] {
-        let dim = s1.dim;
         std::array::from_fn(|c| {
             if c < dim {
                 force.iter().skip(c).step_by(dim).sum()
@@ -151,57 +214,15 @@ pub fn certify(
     } else {
         norm(f2)
     };
-
-    let indentation = indentation_depth(s1, s2, [u1, u2], &gaps[0], &mean[0])
-        .max(elastic_approach(s1, &mean[0], problem.contact_modulus()));
-    let secondary_sag = secondary_sag(s2, &held, &gaps[1], &mean[1], indentation, settings);
-
-    // A nearly rigid secondary's spacing does not bound the answer: only its position does.
-    let secondary_width =
-        (!problem.secondary_is_nearly_rigid()).then_some(settings.secondary_min_zone_width);
-    let resolution = zone_resolution(
-        [(s1, Some(settings.min_zone_width)), (s2, secondary_width)],
-        &mean,
-        &held,
-    );
-    let centres = force_centres(&sides, &mean);
-    // Complementarity: the gap each active node's constraint holds, measured again at the
-    // answer (frictionless: the gap of its linearization, `super::gap`, which is the
-    // geometric gap wherever the node faces the inside of a secondary facet; tied: the
-    // geometric gap).
-    let held: Vec<f64> = match settings.formulation {
-        Formulation::Frictionless => (gap_rows(s1, s2, Some(u1), Some(u2)).into_iter())
-            .map(|row| row.gap)
-            .collect(),
-        Formulation::Tied => gaps[0].clone(),
-    };
-    let mut complementarity = Worst::default();
-    for &i in active {
-        complementarity.offer(held[i].abs() / s1.spacing[i], s1, i);
+    CertificateCheck {
+        name: CheckKind::Equilibrium,
+        value: imbalance,
+        tolerance,
+        passed: imbalance <= tolerance,
+        body: None,
+        node_tag: None,
+        note: None,
     }
-    let [penetration1, penetration2] = penetration;
-    let checks = vec![
-        penetration1.check(CheckKind::Penetration, settings.penetration_tolerance),
-        penetration2.check(
-            CheckKind::SecondaryPenetration,
-            settings.secondary_penetration_tolerance,
-        ),
-        tension.check(CheckKind::Tension, settings.certificate_tension_tolerance),
-        complementarity.check(CheckKind::Complementarity, settings.penetration_tolerance),
-        CertificateCheck {
-            name: CheckKind::Equilibrium,
-            value: imbalance,
-            tolerance: settings.imbalance_tolerance,
-            passed: imbalance <= settings.imbalance_tolerance,
-            body: None,
-            node_tag: None,
-            note: None,
-        },
-        secondary_sag,
-        resolution,
-        centres.check(settings.force_centre_tolerance),
-    ];
-    (Certificate { checks }, gaps)
 }
 
 /// An agreement check (`kind`: primary or transfer agreement): the total contact force on
