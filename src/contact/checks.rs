@@ -195,19 +195,7 @@ fn complementarity(
 
 /// Equilibrium: `|F1 + F2| / |F1|`, the total contact forces on the two bodies.
 fn equilibrium(solution: &CoupledSolution, dim: usize, tolerance: f64) -> CertificateCheck {
-    let total = |force: &[f64]| -> [f64; 3] {
-        std::array::from_fn(|c| {
-            if c < dim {
-                force.iter().skip(c).step_by(dim).sum()
-            } else {
-                0.0
-            }
-        })
-    };
-    let (f1, f2) = (
-        total(&solution.contact_force1),
-        total(&solution.contact_force2),
-    );
+    let [f1, f2] = solution.total_forces(dim);
     let norm = |f: [f64; 3]| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
     let imbalance = if norm(f1) > 0.0 {
         norm(std::array::from_fn(|c| f1[c] + f2[c])) / norm(f1)

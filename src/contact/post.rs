@@ -61,17 +61,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
                 && secondary_fields.normal_gap[j].abs() <= touching * s2.spacing[j]
         })
         .collect();
-    let total = |force: &[f64]| -> [f64; 3] {
-        std::array::from_fn(|c| {
-            if c < dim {
-                force.iter().skip(c).step_by(dim).sum()
-            } else {
-                0.0
-            }
-        })
-    };
-    let force_primary = total(&solution.contact_force1);
-    let force_secondary = total(&solution.contact_force2);
+    let [force_primary, force_secondary] = solution.total_forces(dim);
     let force_imbalance = certificate
         .checks
         .iter()
@@ -91,34 +81,21 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         })
         .fold(0.0, f64::max);
     let residual = solution.relative_residual;
-    let body = |p: &ElasticProblem,
-                body: &AssembledBody,
-                u: Vec<f64>,
-                force: &[f64],
-                stats: &SolveStats| {
-        ElasticSolution {
-            reactions: reactions(p, body, &u, load_factor, force),
-            cell_fields: cell_fields(p.body, &p.material, &u),
-            displacement: u,
-            stats: SolveStats {
-                relative_residual: residual,
-                ..stats.clone()
-            },
-        }
-    };
-    let primary = body(
+    let primary = body_solution(
         &problem.primary,
-        body1,
+        (body1, stats1),
         solution.u1,
         &solution.contact_force1,
-        stats1,
+        load_factor,
+        residual,
     );
-    let secondary = body(
+    let secondary = body_solution(
         &problem.secondary,
-        body2,
+        (body2, stats2),
         solution.u2,
         &solution.contact_force2,
-        stats2,
+        load_factor,
+        residual,
     );
     Ok(ContactSolution {
         linear_solvers,
@@ -137,6 +114,28 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         load_factor,
         active_set,
     })
+}
+
+/// One body's part of the answer: displacement `u`, the reactions of its Dirichlet groups
+/// (with the interface's `contact_force` on it), cell strains and stresses; the coupled
+/// system's `residual` replaces the body's own.
+fn body_solution(
+    problem: &ElasticProblem,
+    (body, stats): (&AssembledBody, &SolveStats),
+    u: Vec<f64>,
+    contact_force: &[f64],
+    load_factor: f64,
+    residual: f64,
+) -> ElasticSolution {
+    ElasticSolution {
+        reactions: reactions(problem, body, &u, load_factor, contact_force),
+        cell_fields: cell_fields(problem.body, &problem.material, &u),
+        displacement: u,
+        stats: SolveStats {
+            relative_residual: residual,
+            ..stats.clone()
+        },
+    }
 }
 
 /// The interface fields of a surface from the nodal forces the interface puts on its body:

@@ -66,6 +66,19 @@ pub struct CoupledSolution {
     pub relative_residual: f64,
 }
 
+impl CoupledSolution {
+    /// The total contact force on each body, `[F1, F2]` (components beyond `dim` are 0).
+    pub fn total_forces(&self, dim: usize) -> [[f64; 3]; 2] {
+        let total = |force: &[f64]| -> [f64; 3] {
+            std::array::from_fn(|c| match c < dim {
+                true => force.iter().skip(c).step_by(dim).sum(),
+                false => 0.0,
+            })
+        };
+        [total(&self.contact_force1), total(&self.contact_force2)]
+    }
+}
+
 impl Coupling {
     fn num_multipliers(&self, dim: usize) -> usize {
         match self.formulation {
