@@ -237,95 +237,11 @@ impl<'m> ContactProblem<'m> {
         choice: &PrimaryChoice,
         settings: ContactSettings,
     ) -> Result<Self, String> {
-        let modulus = |side: &ContactSide| {
-            let m = &side.0.material;
-            m.youngs_modulus() / (1.0 - m.poisson_ratio().powi(2))
-        };
         let spacing_near = [
             contact_zone_spacing(&sides[0].1, &sides[1].1),
             contact_zone_spacing(&sides[1].1, &sides[0].1),
         ];
-        let name = |side: &ContactSide| side.0.body.name.clone();
-        // What "auto" chooses (module doc of `PrimaryChoice::Auto`); an explicit choice is
-        // compared with it.
-        let stiffness = modulus(&sides[1]) / modulus(&sides[0]);
-        // Symmetric in the two bodies: at a ratio of exactly 2 the order they are listed in
-        // must not decide.
-        let similar = stiffness.max(1.0 / stiffness) < SIMILAR_STIFFNESS;
-        let (auto_first, auto_reason) = if !similar {
-            let first = usize::from(stiffness < 1.0);
-            (
-                first,
-                format!(
-                    "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
-                    modulus(&sides[first]),
-                    modulus(&sides[1 - first]),
-                    name(&sides[1 - first])
-                ),
-            )
-        } else {
-            let first = usize::from(spacing_near[1] > spacing_near[0]);
-            (
-                first,
-                format!(
-                    "similar stiffness (ratio {:.2}); the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
-                    stiffness.max(1.0 / stiffness),
-                    spacing_near[first],
-                    spacing_near[1 - first],
-                    name(&sides[1 - first])
-                ),
-            )
-        };
-        let (first, report) = match choice {
-            PrimaryChoice::Body(body) => {
-                let first = sides
-                    .iter()
-                    .position(|s| &s.0.body.name == body)
-                    .ok_or_else(|| {
-                        format!(
-                            "primary = '{body}' is neither of the contact bodies '{}' and '{}' (or \"auto\")",
-                            name(&sides[0]),
-                            name(&sides[1])
-                        )
-                    })?;
-                // Between bodies of similar stiffness either choice is stable (the coarser one
-                // is auto's for accuracy), and the other one's answer may be the one that
-                // fails; a stiff primary is the unstable choice.
-                let other_primary = match first != auto_first && !similar {
-                    true => OtherPrimary::CheckAgreement,
-                    false => OtherPrimary::Unused,
-                };
-                let reason = if other_primary == OtherPrimary::CheckAgreement {
-                    format!(
-                        "named in the case file; \"auto\" would choose '{}' ({auto_reason}), so \
-                         the answer is checked against the one with '{}' as primary",
-                        name(&sides[auto_first]),
-                        name(&sides[auto_first])
-                    )
-                } else {
-                    format!("named in the case file (as \"auto\" would: {auto_reason})")
-                };
-                (
-                    first,
-                    PrimaryReport {
-                        mode: "explicit",
-                        reason,
-                        other_primary,
-                    },
-                )
-            }
-            PrimaryChoice::Auto => (
-                auto_first,
-                PrimaryReport {
-                    mode: "auto",
-                    reason: auto_reason,
-                    other_primary: match similar {
-                        true => OtherPrimary::RetryIfUntrusted,
-                        false => OtherPrimary::Unused,
-                    },
-                },
-            ),
-        };
+        let (first, report) = choose_primary(choice, &sides, spacing_near)?;
         let [a, b] = sides;
         let ((primary, primary_surface), (secondary, secondary_surface)) =
             if first == 0 { (a, b) } else { (b, a) };
@@ -339,4 +255,88 @@ impl<'m> ContactProblem<'m> {
             contact_spacing: [spacing_near[first], spacing_near[1 - first]],
         })
     }
+}
+
+/// The contact modulus `E / (1 - nu^2)` of a side's body.
+fn contact_modulus(side: &ContactSide) -> f64 {
+    let m = &side.0.material;
+    m.youngs_modulus() / (1.0 - m.poisson_ratio().powi(2))
+}
+
+/// Which of `sides` carries the multiplier (its index) under `choice`, and the report of why;
+/// `spacing_near` is [`contact_zone_spacing`] of each side. An explicit choice is compared with
+/// what "auto" would choose (module doc of [`PrimaryChoice::Auto`]).
+fn choose_primary(
+    choice: &PrimaryChoice,
+    sides: &[ContactSide; 2],
+    spacing_near: [f64; 2],
+) -> Result<(usize, PrimaryReport), String> {
+    let name = |side: &ContactSide| side.0.body.name.clone();
+    let stiffness = contact_modulus(&sides[1]) / contact_modulus(&sides[0]);
+    // Symmetric in the two bodies: at a ratio of exactly 2 the order they are listed in must
+    // not decide.
+    let similar = stiffness.max(1.0 / stiffness) < SIMILAR_STIFFNESS;
+    let (auto_first, auto_reason) = if !similar {
+        let first = usize::from(stiffness < 1.0);
+        (
+            first,
+            format!(
+                "the more compliant body: contact modulus E/(1-nu^2) {:.3e} against {:.3e} for '{}'",
+                contact_modulus(&sides[first]),
+                contact_modulus(&sides[1 - first]),
+                name(&sides[1 - first])
+            ),
+        )
+    } else {
+        let first = usize::from(spacing_near[1] > spacing_near[0]);
+        (
+            first,
+            format!(
+                "similar stiffness (ratio {:.2}); the coarser contact surface: spacing near the other body {:.3e} against {:.3e} for '{}'",
+                stiffness.max(1.0 / stiffness),
+                spacing_near[first],
+                spacing_near[1 - first],
+                name(&sides[1 - first])
+            ),
+        )
+    };
+    let PrimaryChoice::Body(body) = choice else {
+        let other_primary = match similar {
+            true => OtherPrimary::RetryIfUntrusted,
+            false => OtherPrimary::Unused,
+        };
+        let report = PrimaryReport {
+            mode: "auto",
+            reason: auto_reason,
+            other_primary,
+        };
+        return Ok((auto_first, report));
+    };
+    let first = (sides.iter().position(|s| &s.0.body.name == body)).ok_or_else(|| {
+        format!(
+            "primary = '{body}' is neither of the contact bodies '{}' and '{}' (or \"auto\")",
+            name(&sides[0]),
+            name(&sides[1])
+        )
+    })?;
+    // Between bodies of similar stiffness either choice is stable (the coarser one is auto's
+    // for accuracy), and the other one's answer may be the one that fails; a stiff primary is
+    // the unstable choice.
+    let (other_primary, reason) = if first != auto_first && !similar {
+        let auto = name(&sides[auto_first]);
+        let reason = format!(
+            "named in the case file; \"auto\" would choose '{auto}' ({auto_reason}), so the \
+             answer is checked against the one with '{auto}' as primary"
+        );
+        (OtherPrimary::CheckAgreement, reason)
+    } else {
+        let reason = format!("named in the case file (as \"auto\" would: {auto_reason})");
+        (OtherPrimary::Unused, reason)
+    };
+    let report = PrimaryReport {
+        mode: "explicit",
+        reason,
+        other_primary,
+    };
+    Ok((first, report))
 }
