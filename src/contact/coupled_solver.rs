@@ -290,18 +290,65 @@ fn solve_schur(
     response1: &mut SurfaceResponse,
     response2: &mut SurfaceResponse,
 ) -> Result<Vec<f64>, ContactError> {
-    let (n1, n2, m, s) = (system.n1, system.n2, system.m, system.s);
+    let (n1, n2, m) = (system.n1, system.n2, system.m);
 
-    // z = K^-1 f. The bodies are independent: solved side by side.
+    // z = K^-1 f.
     let mut z1 = system.f[..n1].to_vec();
     let mut z2 = system.f[n1..].to_vec();
-    let (done1, done2) = rayon::join(
-        || factor1.solve_in_place(&mut z1, 1),
-        || factor2.solve_in_place(&mut z2, 1),
-    );
-    done1.and(done2).map_err(body_solve_error)?;
+    solve_both([factor1, factor2], [&mut z1, &mut z2])?;
 
-    // The responses to the unit forces not seen before (`super::compliance`).
+    // S = D - s C Y from the responses Y (the new ones computed first), and r = g - C z.
+    extend_responses(
+        system,
+        [factor1, factor2],
+        [&mut *response1, &mut *response2],
+    )?;
+    let schur = schur_complement(system, [&*response1, &*response2]);
+    let mut r = DVector::from_column_slice(&system.g);
+    for &(k, col, value) in &system.c {
+        r[k] -= value * if col < n1 { z1[col] } else { z2[col - n1] };
+    }
+    let lambda = if m > 0 {
+        schur.lu().solve(&r).ok_or_else(|| {
+            ContactError::Linalg("the interface Schur complement is singular".into())
+        })?
+    } else {
+        DVector::zeros(0)
+    };
+
+    // u = z - K^-1 (B lambda).
+    let mut w1 = vec![0.0; n1];
+    let mut w2 = vec![0.0; n2];
+    for &(row, k, value) in &system.b {
+        if row < n1 {
+            w1[row] += value * lambda[k];
+        } else {
+            w2[row - n1] += value * lambda[k];
+        }
+    }
+    solve_both([factor1, factor2], [&mut w1, &mut w2])?;
+    let mut x: Vec<f64> = z1.iter().zip(&w1).map(|(z, w)| z - w).collect();
+    x.extend(z2.iter().zip(&w2).map(|(z, w)| z - w));
+    x.extend(lambda.iter());
+    Ok(x)
+}
+
+/// `K1^-1 w1` and `K2^-1 w2` in place; the bodies are independent, so side by side.
+fn solve_both(factors: [&BodySolver; 2], [w1, w2]: [&mut Vec<f64>; 2]) -> Result<(), ContactError> {
+    let (done1, done2) = rayon::join(
+        || factors[0].solve_in_place(w1, 1),
+        || factors[1].solve_in_place(w2, 1),
+    );
+    done1.and(done2).map(|_| ()).map_err(body_solve_error)
+}
+
+/// Each body's responses to the unit forces of `system` not seen before (`super::compliance`).
+fn extend_responses(
+    system: &CoupledSystem,
+    factors: [&BodySolver; 2],
+    [response1, response2]: [&mut SurfaceResponse; 2],
+) -> Result<(), ContactError> {
+    let n1 = system.n1;
     let new = |response: &SurfaceResponse, body: usize| {
         (system.unit_loads.iter())
             .filter(|(key, _)| !response.contains(key))
@@ -317,14 +364,18 @@ fn solve_schur(
     };
     let (new1, new2) = (new(response1, 0), new(response2, 1));
     let (done1, done2) = rayon::join(
-        || response1.extend(factor1, &new1),
-        || response2.extend(factor2, &new2),
+        || response1.extend(factors[0], &new1),
+        || response2.extend(factors[1], &new2),
     );
-    done1.and(done2)?;
+    done1.and(done2)
+}
 
-    // S = D - s C Y, and r = g - C z; C and Y as dense blocks on the dofs C reads.
+/// The interface Schur complement `S = D - s C Y`, with `C` and each body's responses `Y` as
+/// dense blocks on the dofs `C` reads.
+fn schur_complement(system: &CoupledSystem, responses: [&SurfaceResponse; 2]) -> DMatrix<f64> {
+    let (n1, n2, m, s) = (system.n1, system.n2, system.m, system.s);
     let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
-    for (response, dofs) in [(&*response1, 0..n1), (&*response2, n1..n1 + n2)] {
+    for (response, dofs) in responses.into_iter().zip([0..n1, n1..n1 + n2]) {
         let mut read: Vec<usize> = (system.c.iter())
             .filter(|e| dofs.contains(&e.1))
             .map(|e| e.1 - dofs.start)
@@ -356,35 +407,5 @@ fn solve_schur(
         }
         schur -= (c * y) * s;
     }
-    let mut r = DVector::from_column_slice(&system.g);
-    for &(k, col, value) in &system.c {
-        r[k] -= value * if col < n1 { z1[col] } else { z2[col - n1] };
-    }
-    let lambda = if m > 0 {
-        schur.lu().solve(&r).ok_or_else(|| {
-            ContactError::Linalg("the interface Schur complement is singular".into())
-        })?
-    } else {
-        DVector::zeros(0)
-    };
-
-    // u = z - K^-1 (B lambda).
-    let mut w1 = vec![0.0; n1];
-    let mut w2 = vec![0.0; n2];
-    for &(row, k, value) in &system.b {
-        if row < n1 {
-            w1[row] += value * lambda[k];
-        } else {
-            w2[row - n1] += value * lambda[k];
-        }
-    }
-    let (done1, done2) = rayon::join(
-        || factor1.solve_in_place(&mut w1, 1),
-        || factor2.solve_in_place(&mut w2, 1),
-    );
-    done1.and(done2).map_err(body_solve_error)?;
-    let mut x: Vec<f64> = z1.iter().zip(&w1).map(|(z, w)| z - w).collect();
-    x.extend(z2.iter().zip(&w2).map(|(z, w)| z - w));
-    x.extend(lambda.iter());
-    Ok(x)
+    schur
 }
