@@ -105,6 +105,7 @@ from petsc4py import PETSc
 VALIDATION = Path(__file__).resolve().parent
 sys.path.insert(0, str(VALIDATION))
 
+import hertz_theory  # noqa: E402
 from dolfinx_reference import (  # noqa: E402
     ReferenceFailure,
     _gmsh_elements,
@@ -501,13 +502,9 @@ def facet_measure(x: np.ndarray) -> float:
 
 
 def hertz(force: float, radius: float, youngs_modulus: float, poisson_ratio: float, dim: int) -> dict:
-    """Hertz contact radius / half-width and peak pressure for load P on a rigid flat."""
-    e_star = youngs_modulus / (1 - poisson_ratio**2)
-    if dim == 3:
-        a = (3 * force * radius / (4 * e_star)) ** (1 / 3)
-        return {"a": a, "p0": 3 * force / (2 * math.pi * a**2), "delta": a**2 / radius, "E_star": e_star}
-    a = math.sqrt(4 * force * radius / (math.pi * e_star))
-    return {"a": a, "p0": 2 * force / (math.pi * a), "E_star": e_star}
+    """Hertz contact radius / half-width and peak pressure for load P on a rigid flat (``hertz_theory``)."""
+    e_star = hertz_theory.contact_modulus([(youngs_modulus, poisson_ratio)])
+    return hertz_theory.contact(force, radius, e_star, dim) | {"E_star": e_star}
 
 
 def ellipse_fit(r: np.ndarray, p: np.ndarray) -> dict | None:
@@ -851,10 +848,10 @@ def run_reference(msh: Path, output: Path, delta: float | None = None, youngs_mo
 
 
 def hertz_force(delta: float, radius: float, youngs_modulus: float, poisson_ratio: float, dim: int) -> float | None:
-    """3D Hertz load for approach delta, P = 4/3 E* sqrt(R) delta^(3/2); None in 2D (no closed form)."""
+    """3D Hertz load for approach delta on a rigid flat (``hertz_theory.force_3d``); None in 2D (no closed form)."""
     if dim != 3:
         return None
-    return 4 / 3 * youngs_modulus / (1 - poisson_ratio**2) * math.sqrt(radius) * delta**1.5
+    return hertz_theory.force_3d(delta, radius, hertz_theory.contact_modulus([(youngs_modulus, poisson_ratio)]))
 
 
 # ---------------------------------------------------------------------------

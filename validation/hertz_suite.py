@@ -59,13 +59,14 @@ VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
+import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
 from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing, json_safe  # noqa: E402
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
 POISSON_RATIO = 0.3
-E_STAR = YOUNGS_MODULUS / (2 * (1 - POISSON_RATIO**2))  # two identical bodies
+E_STAR = hertz_theory.contact_modulus([(YOUNGS_MODULUS, POISSON_RATIO)] * 2)  # two identical bodies
 LEVELS = (0, 1, 2)
 LOAD_STEPS = (0.25, 0.5, 0.75, 1.0)
 FORMULATIONS = ("frictionless", "tied")
@@ -128,25 +129,6 @@ CASES = (
 
 class RunFailed(RuntimeError):
     """Meshing or solving failed without usable output; the message says which and why."""
-
-
-# ---------------------------------------------------------------------------
-# Hertz theory
-# ---------------------------------------------------------------------------
-
-
-def hertz(force: float, radius: float, dim: int) -> dict:
-    """Hertz half-width / radius a and peak pressure p0 for the contact force P (docs/method.md, section 5)."""
-    if dim == 3:
-        a = (3 * force * radius / (4 * E_STAR)) ** (1 / 3)
-        return {"a": a, "p0": 3 * force / (2 * math.pi * a**2)}
-    a = math.sqrt(4 * force * radius / (math.pi * E_STAR))
-    return {"a": a, "p0": 2 * force / (math.pi * a)}
-
-
-def hertz_approach_3d(force: np.ndarray, radius: float) -> np.ndarray:
-    """Hertz's half-space law P = 4/3 E* R^1/2 delta^3/2, solved for delta."""
-    return (3 * force / (4 * E_STAR * math.sqrt(radius))) ** (2 / 3)
 
 
 def boussinesq_correction(force: np.ndarray, depths: tuple) -> np.ndarray:
@@ -246,7 +228,7 @@ def analyse(case: HertzCase, msh: Path, output: Path, formulation: str) -> dict:
         active = h5["fields/contact_active"][()] == 1
         gap = h5["fields/normal_gap"][()]
     force = abs(contact["force_primary"][v])
-    theory = hertz(force, case.radius, case.dim)
+    theory = hertz_theory.contact(force, case.radius, E_STAR, case.dim)
     fit = contact.get("hertz_fit") or {"a": math.nan, "p0": math.nan}
     h_primary = surface_spacing(msh, case.primary_surface, case.dim, SPACING_RADIUS)
     h_secondary = surface_spacing(msh, case.secondary_surface, case.dim, SPACING_RADIUS)
@@ -467,7 +449,7 @@ def plot_force_approach(cases: list, results: dict, path: Path) -> None:
         if case.dim == 3:
             largest = max((s["force"] for r in runs.values() for s in r.get("steps", [])), default=1.0)
             force = np.linspace(0, largest, 101)
-            delta = hertz_approach_3d(force, case.radius)
+            delta = hertz_theory.approach_3d(force, case.radius, E_STAR)
             ax.plot(delta, force, "k--", lw=1, label="Hertz half-space 4/3 E* R^1/2 d^3/2")
             ax.plot(delta - boussinesq_correction(force, case.support_depths), force, "k:", lw=1,
                     label="Hertz, supports at finite depth (estimate)")
@@ -589,7 +571,7 @@ def force_table(cases: list, results: dict) -> str:
         level = max(runs)
         for step in runs[level]["steps"]:
             if case.dim == 3:
-                delta_h = hertz_approach_3d(step["force"], case.radius)
+                delta_h = hertz_theory.approach_3d(step["force"], case.radius, E_STAR)
                 estimate = delta_h - boussinesq_correction(step["force"], case.support_depths)
                 ratios = f"{(delta_h / step['delta']) ** 1.5:.3f} | {estimate / step['delta']:.3f}"
             else:

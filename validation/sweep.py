@@ -139,6 +139,7 @@ REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
+import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
 from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, report_rows,  # noqa: E402
                    solver_reports, surface_spacing, vouched)
@@ -434,19 +435,9 @@ def spacings(case: Case, msh: Path) -> dict:
 
 
 def e_star(case: Case) -> float:
-    """1/E* = (1 - nu^2) (1/E1 + 1/E2)."""
+    """The contact modulus of the case's two bodies (``hertz_theory.contact_modulus``)."""
     e2 = YOUNGS_MODULUS * (1.0 if case.two_equal else case.e_ratio)
-    return 1.0 / ((1 - POISSON_RATIO**2) * (1 / YOUNGS_MODULUS + 1 / e2))
-
-
-def hertz(case: Case, force: float) -> dict:
-    """Hertz half-width / radius and peak pressure for the force P (docs/method.md, section 5)."""
-    es, r = e_star(case), case.radius_eff
-    if case.dim == 3:
-        a = (3 * force * r / (4 * es)) ** (1 / 3)
-        return {"a": a, "p0": 3 * force / (2 * math.pi * a**2)}
-    a = math.sqrt(4 * force * r / (math.pi * es))
-    return {"a": a, "p0": 2 * force / (math.pi * a)}
+    return hertz_theory.contact_modulus([(YOUNGS_MODULUS, POISSON_RATIO), (e2, POISSON_RATIO)])
 
 
 def read_output(output: Path) -> dict:
@@ -597,7 +588,7 @@ def hertz_checks(case: Case, out: dict, h: dict, msh: Path) -> tuple[list[Check]
         raise RunFailed("summary.json contact has no 'primary'")
     role = next(r for r, (b, _, _) in case.bodies().items() if b == primary)
     force = vertical_force(out, primary, case.dim)
-    theory = hertz(case, force)
+    theory = hertz_theory.contact(force, case.radius_eff, e_star(case), case.dim)
     # Slid: the curved body's nodes move with it, the block's contact zone is centred where it
     # was pushed to.
     fit = hertz_fit(out, primary, case.dim, case.lateral if role in ("block", "lower") else 0.0)
