@@ -52,8 +52,6 @@ from pathlib import Path
 import h5py
 import numpy as np
 from dolfinx import fem
-from dolfinx.fem import petsc
-from petsc4py import PETSc
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent

@@ -78,7 +78,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass, replace
@@ -93,7 +92,7 @@ sys.path.insert(0, str(VALIDATION))
 import flat_reference  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ReferenceFailure  # noqa: E402
-from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, report_rows,  # noqa: E402
+from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, report_rows, run_solve,  # noqa: E402
                    solver_reports, surface_spacing, vouched)
 from sweep import plot_summary, read_output, solved_primary, vertical_force  # noqa: E402
 
@@ -327,22 +326,12 @@ def solve(binary: Path, case: FlatCase, msh: Path, label: str = "", primary: str
     folder = BUILD / (case.name + (f"-{label}" if label else ""))
     folder.mkdir(parents=True, exist_ok=True)
     output = folder / "internodes"
-    for stale in ("summary.json", "solution.h5"):
-        (output / stale).unlink(missing_ok=True)
     toml = folder / "case.toml"
     toml.write_text(case_text(case, msh, output, primary, transfer))
-    start = time.perf_counter()
-    try:
-        result = subprocess.run([str(binary), "solve", str(toml), "--output", str(output)], capture_output=True,
-                                text=True, timeout=case.timeout)
-        log, code = result.stdout + result.stderr, result.returncode
-    except subprocess.TimeoutExpired as error:
-        log, code = f"{error.stdout or ''}{error.stderr or ''}\ntimeout after {case.timeout:g} s", "timeout"
-    seconds = time.perf_counter() - start
-    (folder / "log.txt").write_text(log if isinstance(log, str) else log.decode(errors="replace"))
+    run = run_solve(binary, toml, output, case.timeout, folder / "log.txt")
+    code, seconds = run.exit, run.seconds
     if not (output / "summary.json").is_file() or not (output / "solution.h5").is_file():
-        tail = " | ".join(str(log).strip().splitlines()[-3:])
-        raise RunFailed(f"internodes wrote no solution (exit {code}, {seconds:.1f} s): {tail}")
+        raise RunFailed(f"internodes wrote no solution (exit {code}, {seconds:.1f} s): {run.tail()}")
     return output, {"seconds": seconds, "exit": code}
 
 

@@ -53,7 +53,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 import rigid_flat  # noqa: E402
-from suite import contact_table, failed_report_names, vouched  # noqa: E402
+from suite import failed_report_names, run_solve, vouched  # noqa: E402
 
 BUILD = VALIDATION / "build" / "foreign_meshes"
 REPORT = VALIDATION / "report" / "foreign_meshes.md"
@@ -362,12 +362,12 @@ def run(binary: Path, m: Mesh, approach: float, primaries: tuple[str, ...]) -> l
         case = output.parent / f"{output.name}.toml"
         case.parent.mkdir(parents=True, exist_ok=True)
         case.write_text(case_text(m, msh, primary, approach, output))
-        done = subprocess.run([str(binary), "solve", str(case), "--quiet"], capture_output=True, text=True)
+        done = run_solve(binary, case, output)
         row = {"mesh": m.name, "dim": m.dim, "field": m.field, "h_c": f"R/{1 / m.h_c:.0f}",
                "block_ratio": m.block_ratio, "gap": m.gap, "approach": approach, "asked": primary}
         summary_path = output / "summary.json"
         if not summary_path.is_file():
-            row.update(verdict="FAILED TO RUN", message=(done.stderr or done.stdout).strip().splitlines()[-1:])
+            row.update(verdict="FAILED TO RUN", message=done.log.strip().splitlines()[-1:])
             rows.append(row)
             continue
         contact = json.loads(summary_path.read_text())["contact"]

@@ -46,7 +46,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass, field
@@ -61,7 +60,8 @@ sys.path.insert(0, str(VALIDATION))
 
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, MeshFailed, SuiteResult, contact_table, mesh_geo, surface_spacing, json_safe  # noqa: E402
+from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, run_solve,  # noqa: E402
+                   surface_spacing)
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
@@ -194,16 +194,10 @@ def solve(binary: Path, case: HertzCase, level: int, formulation: str) -> tuple[
             return msh, output, previous["seconds"]
     done.unlink(missing_ok=True)
     toml.write_text(text)
-    for stale in ("summary.json", "solution.h5", "force_displacement.csv"):
-        (output / stale).unlink(missing_ok=True)
-    start = time.perf_counter()
-    result = subprocess.run([str(binary), "solve", str(toml), "--output", str(output)], capture_output=True,
-                            text=True)
-    seconds = time.perf_counter() - start
-    (folder / "log.txt").write_text(result.stdout + result.stderr)
+    run = run_solve(binary, toml, output, log=folder / "log.txt")
+    seconds = run.seconds
     if not (output / "summary.json").is_file() or not (output / "solution.h5").is_file():
-        tail = "\n".join((result.stdout + result.stderr).strip().splitlines()[-4:])
-        raise RunFailed(f"internodes solve {toml} (exit {result.returncode}) wrote no solution: {tail}")
+        raise RunFailed(f"internodes solve {toml} (exit {run.exit}) wrote no solution: {run.tail(4)}")
     done.write_text(json.dumps({"stamp": stamp, "seconds": seconds}))
     return msh, output, seconds
 

@@ -35,7 +35,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 import rigid_flat  # noqa: E402
-from suite import MeshFailed, failed_report_names, mesh_geo, vouched  # noqa: E402
+from suite import MeshFailed, failed_report_names, mesh_geo, run_solve, vouched  # noqa: E402
 
 BUILD = VALIDATION / "build" / "outside_check"
 REPORT = VALIDATION / "report" / "outside_check.md"
@@ -78,7 +78,7 @@ def run(binary: Path, dim: int, geo: str, h_c: float, block_ratio: float, delta:
     case = BUILD / "runs" / f"{name}.toml"
     case.parent.mkdir(parents=True, exist_ok=True)
     case.write_text(case_text(msh, dim, delta, output))
-    subprocess.run([str(binary), "solve", str(case)], capture_output=True, text=True)
+    run_solve(binary, case, output)
     contact = json.loads((output / "summary.json").read_text())["contact"]
     curved = CURVED[dim][0]
     force = abs(contact["force_primary" if contact["primary"] == curved else "force_secondary"][dim - 1])

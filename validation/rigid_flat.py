@@ -32,7 +32,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import subprocess
 import sys
 from pathlib import Path
 
@@ -42,7 +41,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, SuiteResult, contact_table, mesh_geo  # noqa: E402
+from suite import Figure, SuiteResult, contact_table, mesh_geo, run_solve  # noqa: E402
 
 BUILD = VALIDATION / "build" / "rigid_flat"
 STIFFNESS_RATIO = 1e4
@@ -129,7 +128,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
                 folders[fraction] = run_dir / f"{primary}_{fraction:g}"
                 case = run_dir / f"{primary}_{fraction:g}.toml"
                 case.write_text(case_text(msh, dim, primary, folders[fraction], fraction))
-                subprocess.run([str(binary), "solve", str(case), "--quiet"], capture_output=True)
+                run_solve(binary, case, folders[fraction])
             try:
                 checks = contact_reference.compare_with_internodes(reference_json, folders[1.0],
                                                                    out_dir / f"{slug}_{primary}_overlay.png")

@@ -16,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import json
 import subprocess
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -39,6 +40,45 @@ class SuiteResult:
     figures: list[Figure] = field(default_factory=list)
     text: str = ""
     data: dict = field(default_factory=dict)
+
+
+@dataclass
+class SolveRun:
+    """One ``internodes solve``: its combined output, exit status (``"timeout"`` when stopped) and
+    wall time."""
+
+    log: str
+    exit: int | str
+    seconds: float
+
+    def tail(self, lines: int = 3) -> str:
+        """The last lines of the log, on one line."""
+        return " | ".join(self.log.strip().splitlines()[-lines:])
+
+
+def run_solve(binary: Path, case: Path, output: Path | None = None, timeout: float | None = None,
+              log: Path | None = None) -> SolveRun:
+    """``internodes solve case`` (into ``output`` with ``--output`` when given, whose stale answer files
+    are removed first, so that a run that writes nothing is never read as the last one's answer):
+    the one way the validation runs the solver. The log goes to ``log`` when given."""
+    command = [str(binary), "solve", str(case)]
+    if output is not None:
+        command += ["--output", str(output)]
+        for stale in ("summary.json", "solution.h5", "force_displacement.csv"):
+            (output / stale).unlink(missing_ok=True)
+    start = time.perf_counter()
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, timeout=timeout)
+        text, code = result.stdout + result.stderr, result.returncode
+    except subprocess.TimeoutExpired as error:
+        def decoded(part):
+            return part.decode(errors="replace") if isinstance(part, bytes) else (part or "")
+        text = f"{decoded(error.stdout)}{decoded(error.stderr)}\ntimeout after {timeout:g} s"
+        code = "timeout"
+    run = SolveRun(text, code, time.perf_counter() - start)
+    if log is not None:
+        log.write_text(text)
+    return run
 
 
 GEO = Path(__file__).resolve().parent.parent / "geo"
