@@ -42,7 +42,6 @@ import argparse
 import json
 import math
 import shutil
-import subprocess
 import sys
 import time
 import tomllib
@@ -59,7 +58,7 @@ sys.path.insert(0, str(VALIDATION))
 
 from compare import ERRORS, Check, InternodesOutput, cell_order, failure, pad3, reaction_check, relative_max  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case  # noqa: E402
-from suite import SuiteResult, contact_sides, modern_contact  # noqa: E402
+from suite import MeshFailed, SuiteResult, contact_sides, mesh_geo, modern_contact, run_solve  # noqa: E402
 
 BUILD = VALIDATION / "build" / "body_by_body"
 # Fields go through one linear solve on each side: round-off times cond(K_FF).
@@ -153,22 +152,12 @@ def write_cases(case: ContactCase, formulation: str, mesh: Path, folder: Path) -
     return case_file, bodies_file, data["contact"]
 
 
-def run(command: list, what: str) -> None:
-    """Run a command; on failure raise StepFailed with the end of its output."""
-    result = subprocess.run([str(c) for c in command], capture_output=True, text=True)
-    if result.returncode != 0:
-        tail = "\n".join((result.stdout + result.stderr).strip().splitlines()[-5:])
-        raise StepFailed(f"{what} failed (exit {result.returncode}): {tail}")
-
-
 def generate_mesh(case: ContactCase) -> Path:
-    """gmsh -dim geo/<geo>.geo -setnumber ... -> build/body_by_body/meshes/<name>.msh (MSH 4.1)."""
-    mesh = BUILD / "meshes" / f"{case.name}.msh"
-    mesh.parent.mkdir(parents=True, exist_ok=True)
-    settings = [x for k, v in case.parameters.items() for x in ("-setnumber", k, v)]
-    run(["gmsh", f"-{case.dim}", REPO / "geo" / f"{case.geo}.geo", *settings, "-format", "msh41",
-         "-o", mesh, "-v", "1"], f"gmsh {case.geo}.geo")
-    return mesh
+    """geo/<geo>.geo with the case's parameters -> build/body_by_body/meshes/<name>.msh (``suite.mesh_geo``)."""
+    try:
+        return mesh_geo(case.geo, case.dim, case.parameters, BUILD / "meshes" / f"{case.name}.msh")
+    except MeshFailed as error:
+        raise StepFailed(str(error)) from error
 
 
 # ---------------------------------------------------------------------------
@@ -278,7 +267,9 @@ def check_case(binary: Path, case: ContactCase, mesh: Path, formulation: str) ->
     output = folder / "internodes"
     shutil.rmtree(output, ignore_errors=True)  # never compare stale output
     start = time.perf_counter()
-    run([binary, "solve", case_file, "--output", output], f"internodes solve {case_file}")
+    solved = run_solve(binary, case_file, output)
+    if solved.exit != 0:
+        raise StepFailed(f"internodes solve {case_file} failed (exit {solved.exit}): {solved.tail(5)}")
     record = {"case": case.name, "mesh": case.description(), "formulation": formulation,
               "internodes_seconds": time.perf_counter() - start}
 

@@ -51,7 +51,7 @@ import importlib  # noqa: E402
 import report  # noqa: E402
 from compare import Check, compare_case, failure  # noqa: E402
 from dolfinx_reference import ReferenceFailure, read_case  # noqa: E402
-from suite import SuiteResult  # noqa: E402
+from suite import MeshFailed, SuiteResult, mesh_geo, run_solve  # noqa: E402
 
 BUILD = VALIDATION / "build"
 # The full run's report is committed; the quick run (make test) writes its own under build/.
@@ -148,12 +148,11 @@ def geo_script(case_file: Path) -> str:
 
 
 def generate_mesh(script: str, level: int) -> Path:
-    """gmsh -3 geo/<script>.geo -setnumber level L -> build/meshes/<script>_l<L>.msh (MSH 4.1)."""
-    mesh = BUILD / "meshes" / f"{script}_l{level}.msh"
-    mesh.parent.mkdir(parents=True, exist_ok=True)
-    run(["gmsh", "-3", REPO / "geo" / f"{script}.geo", "-setnumber", "level", level,
-         "-format", "msh41", "-o", mesh, "-v", "1"], f"gmsh {script}.geo level {level}")
-    return mesh
+    """geo/<script>.geo at ``level`` -> build/meshes/<script>_l<L>.msh (``suite.mesh_geo``)."""
+    try:
+        return mesh_geo(script, 3, {"level": level}, BUILD / "meshes" / f"{script}_l{level}.msh")
+    except MeshFailed as error:
+        raise StepFailed(str(error)) from error
 
 
 def write_level_case(case_file: Path, mesh: Path, folder: Path) -> Path:
@@ -182,7 +181,9 @@ def validate_level(binary: Path, case_file: Path, script: str, level: int, timin
     level_case = write_level_case(case_file, mesh, folder)
     output = folder / "internodes"
     shutil.rmtree(output, ignore_errors=True)  # never compare stale output
-    run([binary, "solve", level_case, "--output", output, "--export-matrices"], f"internodes solve {level_case}")
+    solved = run_solve(binary, level_case, output, extra=("--export-matrices",))
+    if solved.exit != 0:
+        raise StepFailed(f"internodes solve {level_case} failed (exit {solved.exit}): {solved.tail(5)}")
     timings["internodes"] = time.perf_counter() - start
 
     # 3. dolfinx reference from the same mesh and case file, and comparison.

@@ -57,11 +57,12 @@ class SolveRun:
 
 
 def run_solve(binary: Path, case: Path, output: Path | None = None, timeout: float | None = None,
-              log: Path | None = None) -> SolveRun:
+              log: Path | None = None, extra: tuple[str, ...] = ()) -> SolveRun:
     """``internodes solve case`` (into ``output`` with ``--output`` when given, whose stale answer files
     are removed first, so that a run that writes nothing is never read as the last one's answer):
-    the one way the validation runs the solver. The log goes to ``log`` when given."""
-    command = [str(binary), "solve", str(case)]
+    the one way the validation runs the solver. ``extra`` are further flags (``--export-matrices``);
+    the log goes to ``log`` when given."""
+    command = [str(binary), "solve", str(case), *extra]
     if output is not None:
         command += ["--output", str(output)]
         for stale in ("summary.json", "solution.h5", "force_displacement.csv"):
