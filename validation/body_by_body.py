@@ -58,7 +58,8 @@ sys.path.insert(0, str(VALIDATION))
 
 from compare import ERRORS, Check, InternodesOutput, cell_order, failure, pad3, reaction_check, relative_max  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case  # noqa: E402
-from suite import MeshFailed, SuiteResult, contact_sides, mesh_geo, modern_contact, run_solve  # noqa: E402
+from suite import (MeshFailed, SuiteResult, contact_sides, mesh_geo, modern_contact, run_solve,  # noqa: E402
+                   toml_text)
 
 BUILD = VALIDATION / "build" / "body_by_body"
 # Fields go through one linear solve on each side: round-off times cond(K_FF).
@@ -102,32 +103,6 @@ class StepFailed(RuntimeError):
 # ---------------------------------------------------------------------------
 # Case files
 # ---------------------------------------------------------------------------
-
-
-def toml_text(table: dict, prefix: str = "") -> str:
-    """A TOML document for nested dicts / lists of dicts / scalars (enough for case files)."""
-    def value(v) -> str:
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, (int, float)):
-            return repr(v)
-        if isinstance(v, str):
-            return json.dumps(v)
-        if isinstance(v, list):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        raise TypeError(f"no TOML form for {v!r}")
-
-    def is_table_array(v) -> bool:
-        return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
-
-    lines = [f"{k} = {value(v)}" for k, v in table.items() if not isinstance(v, dict) and not is_table_array(v)]
-    for k, v in table.items():
-        if isinstance(v, dict):
-            lines += ["", f"[{prefix}{k}]", toml_text(v, f"{prefix}{k}.")]
-        elif is_table_array(v):
-            for item in v:
-                lines += ["", f"[[{prefix}{k}]]", toml_text(item, f"{prefix}{k}.")]
-    return "\n".join(lines).strip() + "\n"
 
 
 def write_cases(case: ContactCase, formulation: str, mesh: Path, folder: Path) -> tuple[Path, Path, dict]:

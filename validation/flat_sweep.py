@@ -92,7 +92,8 @@ sys.path.insert(0, str(VALIDATION))
 import flat_reference  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ReferenceFailure  # noqa: E402
-from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, report_rows, run_solve,  # noqa: E402
+from suite import (Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
+                   report_rows, run_solve,  # noqa: E402
                    solver_reports, surface_spacing, vouched)
 from sweep import plot_summary, read_output, solved_primary, vertical_force  # noqa: E402
 
@@ -309,14 +310,10 @@ def case_text(case: FlatCase, msh: Path, output: Path, primary: str | None = Non
     primary = case.primary if primary is None else primary
     extra = {"transfer": transfer} if transfer else {}
     contact = contact_table((moving, fixed), (moving_surface, fixed_surface), primary, **extra)
-    text = f"# {case.name}: {case.parameters_text()} (written by validation/flat_sweep.py)\n"
-    text += f"mesh = {json.dumps(str(msh))}\noutput = {json.dumps(str(output))}\n\n{contact}"
     moduli = case.moduli()
-    for body, rows in dirichlet(case).items():
-        text += f'\n[[body]]\nname = "{body}"\nyoungs_modulus = {moduli[body]!r}\npoisson_ratio = {POISSON_RATIO}\n'
-        for group, values in rows:
-            text += f'\n[[body.dirichlet]]\ngroup = "{group}"\n' + "".join(f"{k} = {x!r}\n" for k, x in values.items())
-    return text
+    bodies = [body_table(body, moduli[body], POISSON_RATIO, rows) for body, rows in dirichlet(case).items()]
+    comment = f"{case.name}: {case.parameters_text()} (written by validation/flat_sweep.py)"
+    return case_toml(msh, output, contact, bodies, comment)
 
 
 def solve(binary: Path, case: FlatCase, msh: Path, label: str = "", primary: str | None = None,

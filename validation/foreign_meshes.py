@@ -335,13 +335,8 @@ def lifted(msh: Path, lift: float, dim: int) -> Path:
 def case_text(m: Mesh, msh: Path, primary: str, approach: float, output: Path) -> str:
     """rigid_flat's case (curved body on a block 1e4 times stiffer), with our primary and the top
     displacement that brings the total approach (initial overlap included) to ``approach``."""
-    curved = CURVED[m.dim]
-    full = {2: "uy = -0.02", 3: "uz = -0.01"}[m.dim]
-    text = rigid_flat.case_text(msh, m.dim, curved, output, 1.0)
-    if f'primary = "{curved}"' not in text or full not in text:
-        raise RuntimeError("rigid_flat.case_text changed: its primary or approach line was not found")
-    return (text.replace(f'primary = "{curved}"', f'primary = "{primary}"')
-            .replace(full, f"{full.split('=')[0]}= {-(approach + m.gap):.12g}"))
+    top = float(f"{approach + m.gap:.12g}")
+    return rigid_flat.case_text(msh, m.dim, primary, output, 1.0, top, listed_first=CURVED[m.dim])
 
 
 def run(binary: Path, m: Mesh, approach: float, primaries: tuple[str, ...]) -> list[dict]:

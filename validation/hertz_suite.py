@@ -60,8 +60,8 @@ sys.path.insert(0, str(VALIDATION))
 
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, run_solve,  # noqa: E402
-                   surface_spacing)
+from suite import (Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe,  # noqa: E402
+                   mesh_geo, run_solve, surface_spacing)
 
 BUILD = VALIDATION / "build" / "hertz_suite"
 YOUNGS_MODULUS = 1000.0
@@ -159,18 +159,15 @@ def mesh(case: HertzCase, level: int) -> Path:
 
 def case_file(case: HertzCase, msh: Path, formulation: str) -> str:
     """The TOML case of one run: primary support pushed down by delta, secondary support clamped."""
-    zero = ["ux = 0.0", "uy = 0.0", "uz = 0.0"][: case.dim]
-    push = zero[:-1] + [f"{'uz' if case.dim == 3 else 'uy'} = {-case.delta!r}"]
-    steps = f"load_steps = {list(LOAD_STEPS)}\n" if formulation == "frictionless" else ""
-    bodies = ""
-    for body, support, values in ((case.primary, case.primary_support, push),
-                                  (case.secondary, case.secondary_support, zero)):
-        bodies += (f'\n[[body]]\nname = "{body}"\nyoungs_modulus = {YOUNGS_MODULUS}\n'
-                   f'poisson_ratio = {POISSON_RATIO}\n\n[[body.dirichlet]]\ngroup = "{support}"\n'
-                   + "\n".join(values) + "\n")
+    components = ["ux", "uy", "uz"][: case.dim]
+    zero = dict.fromkeys(components, 0.0)
+    push = zero | {components[-1]: -case.delta}
+    steps = {"load_steps": list(LOAD_STEPS)} if formulation == "frictionless" else {}
     contact = contact_table((case.primary, case.secondary), (case.primary_surface, case.secondary_surface),
-                            case.primary, formulation)
-    return f'mesh = "{msh}"\noutput = "internodes"\n\n{contact}{steps}' + bodies
+                            case.primary, formulation, **steps)
+    bodies = [body_table(case.primary, YOUNGS_MODULUS, POISSON_RATIO, [(case.primary_support, push)]),
+              body_table(case.secondary, YOUNGS_MODULUS, POISSON_RATIO, [(case.secondary_support, zero)])]
+    return case_toml(msh, "internodes", contact, bodies)
 
 
 def solve(binary: Path, case: HertzCase, level: int, formulation: str) -> tuple[Path, Path, float]:

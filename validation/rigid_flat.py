@@ -41,7 +41,7 @@ sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import Figure, SuiteResult, contact_table, mesh_geo, run_solve  # noqa: E402
+from suite import Figure, SuiteResult, body_table, case_toml, contact_table, mesh_geo, run_solve  # noqa: E402
 
 BUILD = VALIDATION / "build" / "rigid_flat"
 STIFFNESS_RATIO = 1e4
@@ -57,12 +57,10 @@ MESHES = {
     "3D hemisphere, R/67": ("hemisphere_on_block", 3, {"h_c": 0.015, "r_c": 0.16, "h_far": 0.5, "d_far": 1.0}),
 }
 QUICK = ("2D half-disc, R/80", "3D hemisphere, R/33")
-BODIES = {
-    2: {"curved": "disc", "top": "disc_top", "top_displacement": "ux = 0.0\nuy = -0.02",
-        "block_base": "ux = 0.0\nuy = 0.0"},
-    3: {"curved": "sphere", "top": "sphere_top", "top_displacement": "ux = 0.0\nuy = 0.0\nuz = -0.01",
-        "block_base": "ux = 0.0\nuy = 0.0\nuz = 0.0"},
-}
+# The curved body and its top (pushed down by the full approach), per dimension.
+BODIES = {2: {"curved": "disc", "top": "disc_top"}, 3: {"curved": "sphere", "top": "sphere_top"}}
+#: The full approach: the curved body's top moves down by it, the block's base is clamped.
+APPROACH = {2: 0.02, 3: 0.01}
 
 
 def mesh(script: str, dim: int, parameters: dict) -> Path:
@@ -71,33 +69,23 @@ def mesh(script: str, dim: int, parameters: dict) -> Path:
     return mesh_geo(script, dim, parameters, BUILD / name)
 
 
-def case_text(msh: Path, dim: int, primary: str, output: Path, fraction: float) -> str:
-    """Our case: the curved body (E = 1e3) on a block 1e4 times stiffer, `primary` carrying lambda,
-    at `fraction` of the full approach (one load step from the reference configuration)."""
-    b = BODIES[dim]
-    secondary = "block" if primary == b["curved"] else b["curved"]
-    contact = contact_table((primary, secondary), (f"{primary}_contact", f"{secondary}_contact"), primary,
+def case_text(msh: Path, dim: int, primary: str, output: Path, fraction: float, approach: float | None = None,
+              listed_first: str | None = None) -> str:
+    """Our case: the curved body (E = 1e3) on a block 1e4 times stiffer, ``primary`` (a body, or "auto")
+    carrying lambda, at ``fraction`` of the ``approach`` (default the full one, ``APPROACH``) in one load
+    step from the reference configuration. The contact bodies are listed ``listed_first`` first (default:
+    the primary, or the curved body under "auto")."""
+    curved, top = BODIES[dim]["curved"], BODIES[dim]["top"]
+    first = listed_first or (curved if primary == "auto" else primary)
+    second = "block" if first == curved else curved
+    contact = contact_table((first, second), (f"{first}_contact", f"{second}_contact"), primary,
                             load_steps=[fraction])
-    return f"""mesh = {json.dumps(str(msh))}
-output = {json.dumps(str(output))}
-
-{contact}
-[[body]]
-name = "{b['curved']}"
-youngs_modulus = {YOUNGS_MODULUS}
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "{b['top']}"
-{b['top_displacement']}
-
-[[body]]
-name = "block"
-youngs_modulus = {YOUNGS_MODULUS * STIFFNESS_RATIO}
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "block_base"
-{b['block_base']}
-"""
+    components = ["ux", "uy", "uz"][:dim]
+    zero = dict.fromkeys(components, 0.0)
+    push = zero | {components[-1]: -(APPROACH[dim] if approach is None else approach)}
+    bodies = [body_table(curved, YOUNGS_MODULUS, 0.3, [(top, push)]),
+              body_table("block", YOUNGS_MODULUS * STIFFNESS_RATIO, 0.3, [("block_base", zero)])]
+    return case_toml(msh, output, contact, bodies)
 
 
 def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:

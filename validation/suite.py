@@ -120,19 +120,60 @@ OLD_CONTACT_KEYS = ("primary_surface", "secondary", "secondary_surface")
 
 
 def contact_table(bodies: tuple[str, str], surfaces: tuple[str, str], primary: str = "auto",
-                  formulation: str = "frictionless", **extra) -> str:
-    """The ``[contact]`` table of a case file, in the form of the rewritten solver.
+                  formulation: str = "frictionless", **extra) -> dict:
+    """The ``[contact]`` table of a case file (for ``case_toml``).
 
     ``bodies`` are the two bodies in contact, ``surfaces`` their candidate surfaces in the same
     order, ``primary`` "auto" or one of the two body names (an explicit choice). ``extra`` are
-    further keys written verbatim as TOML values (``load_steps = [...]``, ``max_iterations``...).
+    further keys (``load_steps = [...]``, ``transfer``...).
     """
     if primary != "auto" and primary not in bodies:
         raise ValueError(f"primary '{primary}' is neither 'auto' nor one of the bodies {bodies}")
-    lines = ["[contact]", f"bodies = {json.dumps(list(bodies))}", f"surfaces = {json.dumps(list(surfaces))}",
-             f'primary = "{primary}"', f'formulation = "{formulation}"']
-    lines += [f"{key} = {json.dumps(value)}" for key, value in extra.items()]
-    return "\n".join(lines) + "\n"
+    return {"bodies": list(bodies), "surfaces": list(surfaces), "primary": primary,
+            "formulation": formulation, **extra}
+
+
+def body_table(name: str, youngs_modulus: float, poisson_ratio: float,
+               dirichlet: list[tuple[str, dict]]) -> dict:
+    """A ``[[body]]`` table: material and Dirichlet conditions (group, {component: value})."""
+    return {"name": name, "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
+            "dirichlet": [{"group": group, **values} for group, values in dirichlet]}
+
+
+def case_toml(mesh: Path | str, output: Path | str, contact: dict | None, bodies: list[dict],
+              comment: str = "") -> str:
+    """A case file: the one writer of the validation's cases (the keys of ``docs/case-file.md``)."""
+    case = {"mesh": str(mesh), "output": str(output)}
+    if contact is not None:
+        case["contact"] = contact
+    case["body"] = bodies
+    return (f"# {comment}\n" if comment else "") + toml_text(case)
+
+
+def toml_text(table: dict, prefix: str = "") -> str:
+    """A TOML document for nested dicts / lists of dicts / scalars (enough for case files)."""
+    def value(v) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, (int, float)):
+            return repr(v)
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, list):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        raise TypeError(f"no TOML form for {v!r}")
+
+    def is_table_array(v) -> bool:
+        return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+    lines = [f"{k} = {value(v)}" for k, v in table.items() if not isinstance(v, dict) and not is_table_array(v)]
+    for k, v in table.items():
+        if isinstance(v, dict):
+            lines += ["", f"[{prefix}{k}]", toml_text(v, f"{prefix}{k}.")]
+        elif is_table_array(v):
+            for item in v:
+                lines += ["", f"[[{prefix}{k}]]", toml_text(item, f"{prefix}{k}.")]
+    return "\n".join(lines).strip() + "\n"
 
 
 def modern_contact(table: dict) -> dict:

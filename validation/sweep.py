@@ -140,7 +140,8 @@ sys.path.insert(0, str(VALIDATION))
 import contact_reference  # noqa: E402
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import (Figure, MeshFailed, SuiteResult, contact_table, json_safe, mesh_geo, report_rows, run_solve,  # noqa: E402
+from suite import (Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
+                   report_rows, run_solve,  # noqa: E402
                    solver_reports, surface_spacing, vouched)
 
 BUILD = VALIDATION / "build" / "sweep"
@@ -378,16 +379,14 @@ def case_text(case: Case, msh: Path, output: Path, lateral: float | None = None)
     roles = case.bodies()
     (moving, moving_surface, moving_support), (fixed, fixed_surface, fixed_support) = roles.values()
     contact = contact_table((moving, fixed), (moving_surface, fixed_surface), primary_body(case))
-    zero = ["ux = 0.0", "uy = 0.0", "uz = 0.0"][: case.dim]
-    push = [f"ux = {lateral!r}"] + zero[1:-1] + [f"{'uz' if case.dim == 3 else 'uy'} = {-case.imposed!r}"]
+    components = ["ux", "uy", "uz"][: case.dim]
+    zero = dict.fromkeys(components, 0.0)
+    push = zero | {"ux": lateral, components[-1]: -case.imposed}
     e_fixed = YOUNGS_MODULUS * (1.0 if case.two_equal else case.e_ratio)
-    text = f"# {case.name}: {case.parameters_text()} (written by validation/sweep.py)\n"
-    text += f"mesh = {json.dumps(str(msh))}\noutput = {json.dumps(str(output))}\n\n{contact}"
-    for body, support, e, values in ((moving, moving_support, YOUNGS_MODULUS, push),
-                                     (fixed, fixed_support, e_fixed, zero)):
-        text += (f'\n[[body]]\nname = "{body}"\nyoungs_modulus = {e!r}\npoisson_ratio = {POISSON_RATIO}\n'
-                 f'\n[[body.dirichlet]]\ngroup = "{support}"\n' + "\n".join(values) + "\n")
-    return text
+    bodies = [body_table(moving, YOUNGS_MODULUS, POISSON_RATIO, [(moving_support, push)]),
+              body_table(fixed, e_fixed, POISSON_RATIO, [(fixed_support, zero)])]
+    comment = f"{case.name}: {case.parameters_text()} (written by validation/sweep.py)"
+    return case_toml(msh, output, contact, bodies, comment)
 
 
 def solve(binary: Path, case: Case, msh: Path, straight: bool = False) -> tuple[Path, dict]:
