@@ -58,8 +58,7 @@ sys.path.insert(0, str(VALIDATION))
 
 from compare import ERRORS, Check, InternodesOutput, cell_order, failure, pad3, reaction_check, relative_max  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case  # noqa: E402
-from suite import (MeshFailed, SuiteResult, contact_sides, mesh_geo, modern_contact, run_solve,  # noqa: E402
-                   toml_text)
+from suite import MeshFailed, SuiteResult, contact_sides, mesh_geo, run_solve, toml_text  # noqa: E402
 
 BUILD = VALIDATION / "build" / "body_by_body"
 # Fields go through one linear solve on each side: round-off times cond(K_FF).
@@ -117,7 +116,7 @@ def write_cases(case: ContactCase, formulation: str, mesh: Path, folder: Path) -
     data.pop("geo_parameters", None)
     data["mesh"] = str(mesh)
     data["output"] = str(folder / "internodes")
-    data["contact"] = modern_contact(data["contact"]) | {"formulation": formulation}
+    data["contact"] = data["contact"] | {"formulation": formulation}
     folder.mkdir(parents=True, exist_ok=True)
     case_file, bodies_file = folder / "case.toml", folder / "bodies.toml"
     case_file.write_text(f"# {case.description()}, {formulation} (written by body_by_body.py)\n"

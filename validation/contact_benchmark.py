@@ -95,7 +95,6 @@ import numpy as np
 VALIDATION = Path(__file__).resolve().parent
 sys.path.insert(0, str(VALIDATION))
 
-from suite import OLD_CONTACT_KEYS, modern_contact  # noqa: E402
 from benchmark import (CG_RTOL, SERIAL_ENV, RunFailed, environment, fmt,  # noqa: E402
                        markdown, measure, mesh_nodes)
 
@@ -193,20 +192,9 @@ def timed(run: dict) -> bool:
 
 
 def base_case() -> tuple[str, dict]:
-    """The text of geo/hemisphere_on_block.toml and its parsed contents, its ``[contact]`` table in the
-    form of the rewritten solver (``bodies``, ``surfaces``, ``primary``: suite.modern_contact) whichever
-    form the template is in; the other keys of the table follow verbatim."""
+    """The text of geo/hemisphere_on_block.toml and its parsed contents."""
     text = BASE_CASE.read_text()
-    data = tomllib.loads(text)
-    if any(key in data.get("contact", {}) for key in OLD_CONTACT_KEYS):
-        table = modern_contact(data["contact"])
-        new = ["[contact]"] + [f"{key} = {json.dumps(value)}" for key, value in table.items()]
-        # the old table: its header and key lines up to the next table header
-        text, count = re.subn(r"(?ms)^\[contact\]\s*\n.*?(?=^\[)", "\n".join(new) + "\n\n", text)
-        if count != 1:
-            raise RunFailed(f"{BASE_CASE}: could not rewrite its [contact] table")
-        data = tomllib.loads(text)
-    return text, data
+    return text, tomllib.loads(text)
 
 
 def generate_mesh(size: Size) -> None:

@@ -115,10 +115,6 @@ def mesh_geo(script: str, dim: int, parameters: dict, path: Path) -> Path:
 # The [contact] table of a case file
 # ---------------------------------------------------------------------------
 
-# Keys of the [contact] table before the solver rewrite, replaced by bodies / surfaces / primary.
-OLD_CONTACT_KEYS = ("primary_surface", "secondary", "secondary_surface")
-
-
 def contact_table(bodies: tuple[str, str], surfaces: tuple[str, str], primary: str = "auto",
                   formulation: str = "frictionless", **extra) -> dict:
     """The ``[contact]`` table of a case file (for ``case_toml``).
@@ -176,24 +172,8 @@ def toml_text(table: dict, prefix: str = "") -> str:
     return "\n".join(lines).strip() + "\n"
 
 
-def modern_contact(table: dict) -> dict:
-    """A ``[contact]`` table (parsed TOML) in the rewritten form: the old ``primary`` /
-    ``primary_surface`` / ``secondary`` / ``secondary_surface`` keys become ``bodies``, ``surfaces``
-    and an explicit ``primary``; a table already in the new form is returned unchanged.
-
-    Lets the suites that take their case from ``geo/*.toml`` write the new form whichever form
-    those templates are in."""
-    if not any(key in table for key in OLD_CONTACT_KEYS):
-        return dict(table)
-    new = {k: v for k, v in table.items() if k not in OLD_CONTACT_KEYS + ("primary",)}
-    return {"bodies": [table["primary"], table["secondary"]],
-            "surfaces": [table["primary_surface"], table["secondary_surface"]],
-            "primary": table["primary"], **new}
-
-
 def contact_sides(table: dict) -> dict[str, str]:
-    """Body name -> candidate surface of a ``[contact]`` table (either form)."""
-    table = modern_contact(table)
+    """Body name -> candidate surface of a ``[contact]`` table."""
     return dict(zip(table["bodies"], table["surfaces"]))
 
 
