@@ -286,7 +286,6 @@ def dolfinx_worker(solver: str, case: Path, coordinates: Path, output: Path) -> 
     from dolfinx import fem
     from petsc4py import PETSc
 
-    sys.path.insert(0, str(VALIDATION))
     from dolfinx_reference import ReferenceModel, read_case
 
     timings = {}
@@ -366,7 +365,6 @@ def _krylov_solver(solver: str, A, model):
     """PETSc KSP: "cg" (CG + GAMG with the rigid-body near-null space, rtol CG_RTOL) or "mumps"."""
     from petsc4py import PETSc
 
-    sys.path.insert(0, str(VALIDATION))
     from dolfinx_reference import rigid_body_modes
 
     ksp = PETSc.KSP().create(A.getComm())

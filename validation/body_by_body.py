@@ -54,7 +54,6 @@ from dolfinx import fem
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
-sys.path.insert(0, str(VALIDATION))
 
 from compare import ERRORS, Check, InternodesOutput, cell_order, failure, pad3, reaction_check, relative_max  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case  # noqa: E402

@@ -37,7 +37,6 @@ from pathlib import Path
 import numpy as np
 
 VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 import benchmark as bm  # noqa: E402  (the shared helpers: meshes, measure, dolfinx worker)
 
 REPO = VALIDATION.parent

@@ -93,7 +93,6 @@ from pathlib import Path
 import numpy as np
 
 VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 
 from benchmark import (CG_RTOL, SERIAL_ENV, RunFailed, environment, fmt,  # noqa: E402
                        markdown, measure, mesh_nodes)

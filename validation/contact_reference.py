@@ -103,7 +103,6 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 
 import hertz_theory  # noqa: E402
 from dolfinx_reference import (  # noqa: E402

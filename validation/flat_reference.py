@@ -44,8 +44,6 @@ from pathlib import Path
 
 import numpy as np
 
-VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 
 from contact_reference import RigidFlatContact, obstacle_below, read_body, turned_mesh  # noqa: E402
 from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, solve_constrained  # noqa: E402

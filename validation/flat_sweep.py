@@ -87,7 +87,6 @@ import numpy as np
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
-sys.path.insert(0, str(VALIDATION))
 
 import flat_reference  # noqa: E402
 from compare import Check  # noqa: E402

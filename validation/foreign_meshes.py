@@ -49,7 +49,6 @@ from pathlib import Path
 import numpy as np
 
 VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 import rigid_flat  # noqa: E402

@@ -56,7 +56,6 @@ import numpy as np
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
-sys.path.insert(0, str(VALIDATION))
 
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402

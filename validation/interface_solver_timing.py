@@ -29,8 +29,6 @@ import sys
 import time
 from pathlib import Path
 
-VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 
 from contact_benchmark import BENCH, ONE_STEP, REPO, Size, generate_mesh, write_case  # noqa: E402
 

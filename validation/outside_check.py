@@ -31,7 +31,6 @@ import sys
 from pathlib import Path
 
 VALIDATION = Path(__file__).resolve().parent
-sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 import rigid_flat  # noqa: E402

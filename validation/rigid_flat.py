@@ -37,7 +37,6 @@ from pathlib import Path
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
-sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 from compare import Check  # noqa: E402

@@ -44,7 +44,6 @@ from pathlib import Path
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
-sys.path.insert(0, str(VALIDATION))
 
 import importlib  # noqa: E402
 

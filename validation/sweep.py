@@ -135,7 +135,6 @@ import numpy as np
 
 VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
-sys.path.insert(0, str(VALIDATION))
 
 import contact_reference  # noqa: E402
 import hertz_theory  # noqa: E402
