@@ -39,6 +39,7 @@ VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
 
 import contact_reference  # noqa: E402
+import rigid_flat_comparison  # noqa: E402
 from compare import Check  # noqa: E402
 from suite import Figure, SuiteResult, body_table, case_toml, contact_table, mesh_geo, run_solve  # noqa: E402
 
@@ -117,7 +118,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
                 case.write_text(case_text(msh, dim, primary, folders[fraction], fraction))
                 run_solve(binary, case, folders[fraction])
             try:
-                checks = contact_reference.compare_with_internodes(reference_json, folders[1.0],
+                checks = rigid_flat_comparison.compare_with_internodes(reference_json, folders[1.0],
                                                                    out_dir / f"{slug}_{primary}_overlay.png")
             except (contact_reference.ReferenceFailure, OSError, KeyError) as error:
                 result.checks.append(Check("rigid flat: run", name, float("nan"), 0.0, str(error)))

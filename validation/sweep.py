@@ -137,6 +137,7 @@ VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
 
 import contact_reference  # noqa: E402
+import rigid_flat_comparison  # noqa: E402
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
 from suite import (Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
@@ -676,7 +677,7 @@ def rigid_flat_checks(case: Case, msh: Path, output: Path, out_dir: Path, ref: d
                     f"dolfinx VI: reason {sol['snes']['converged_reason']}, {sol['snes']['iterations']} its, KKT "
                     + ", ".join(f"{k} {v:.1e}" for k, v in sol["kkt"].items() if k != "passed"))]
     reference_json = BUILD / "references" / f"{msh.stem}_delta{case.delta:g}" / "contact_reference.json"
-    compared = contact_reference.compare_with_internodes(reference_json, output, out_dir / f"{case.name}_overlay.png")
+    compared = rigid_flat_comparison.compare_with_internodes(reference_json, output, out_dir / f"{case.name}_overlay.png")
     primary = compared["role"] == "secondary"  # the curved body is secondary: the block is primary
     tol_radius = RADIUS_TOLERANCE * (max(1.0, case.block_ratio) if primary else 1.0)
     f, a = compared["force"], compared["contact_radius"]
