@@ -238,7 +238,7 @@ fn a_single_body_run_is_identical_for_any_thread_count() {
 #[test]
 fn a_contact_run_is_identical_for_any_thread_count() {
     // Two stacked 3D blocks with non-matching meshes, the upper one pressed down, each pinned at
-    // corners only (the frictionless patch test of tests/contact.rs), in two load steps.
+    // corners only (the frictionless patch test of tests/contact_accuracy.rs), in two load steps.
     let pins = |body: &str| {
         format!(
             "[[body.dirichlet]]\ngroup = \"{body}_corner_a\"\nux = 0.0\nuy = 0.0\n\

@@ -87,7 +87,7 @@ use crate::linalg::BodySolver;
 /// Relative residual `|r - S lambda| / |r|` the GMRES solve stops at with exact (Cholesky)
 /// body solves. Why 1e-12: the answer then matches the dense Schur solve's to 1e-14 to 1e-12
 /// (forces, displacements) and 1e-12 to 7e-11 (pressures) relative on the fixtures of
-/// `tests/contact.rs`, two orders and more below the 1e-8 the tests ask; the error is about
+/// `tests/contact_solvers.rs`, two orders and more below the 1e-8 the tests ask; the error is about
 /// `cond(S)` times the residual, so 1e-10 would leave pressures near that bound.
 pub const KRYLOV_RTOL: f64 = 1e-12;
 

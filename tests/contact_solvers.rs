@@ -1,0 +1,236 @@
+//! The linear solvers of a contact iteration give the same answer: the dense Schur
+//! complement, sparse LU of the whole system, GMRES on the interface, CG + AMG bodies.
+
+mod common;
+
+use common::contact::{
+    half_disc_on_block, hemisphere_on_block, narrow_blocks, rollers, solve, two_blocks,
+};
+use internodes::contact::ContactSolution;
+
+/// The largest `|a - b|` over the largest `|b|`.
+fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
+    let max = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0f64, |m, x| m.max(x.abs()));
+    let diff = max(&mut a.iter().zip(b).map(|(x, y)| x - y));
+    let scale = max(&mut b.iter().copied());
+    if scale > 0.0 { diff / scale } else { diff }
+}
+
+/// `a` (a solve through the interface GMRES) against `b` (the dense Schur path): the same
+/// active-set history and status, and displacements, pressures and forces within `tolerance`.
+fn assert_same_contact(a: &ContactSolution, b: &ContactSolution, tolerance: f64, label: &str) {
+    assert_eq!(a.status, b.status, "{label}: status");
+    assert_eq!(a.history.len(), b.history.len(), "{label}: iterations");
+    for (x, y) in a.history.iter().zip(&b.history) {
+        assert_eq!(
+            (x.active, x.added, x.removed),
+            (y.active, y.added, y.removed),
+            "{label}: active sets"
+        );
+    }
+    let pairs = [
+        (
+            "primary displacement",
+            &a.primary.displacement,
+            &b.primary.displacement,
+        ),
+        (
+            "secondary displacement",
+            &a.secondary.displacement,
+            &b.secondary.displacement,
+        ),
+        (
+            "pressure",
+            &a.primary_fields.pressure,
+            &b.primary_fields.pressure,
+        ),
+    ];
+    for (name, x, y) in pairs {
+        let difference = relative_difference(x, y);
+        eprintln!("{label}: {name} differs by {difference:.1e} relative");
+        assert!(
+            difference <= tolerance,
+            "{label}: {name} differs by {difference:.2e}"
+        );
+    }
+    let force = relative_difference(&a.force_primary, &b.force_primary);
+    eprintln!("{label}: force differs by {force:.1e} relative");
+    assert!(force <= tolerance, "{label}: force differs by {force:.2e}");
+}
+
+#[test]
+fn schur_and_monolithic_solves_agree() {
+    // The factor-once Schur path against the sparse LU of the whole system, on a case with a
+    // partial active set (2D Hertz) and on the 3D patch test, both formulations.
+    let cases = [
+        half_disc_on_block(""),
+        half_disc_on_block("formulation = \"tied\""),
+        two_blocks(
+            3,
+            "frictionless",
+            &rollers("lower", 3),
+            &rollers("upper", 3),
+        ),
+        two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
+    ];
+    for text in cases {
+        let schur = solve(&text.replace("[contact]", "[contact]\nsolver = \"schur\"")).unwrap();
+        let lu =
+            solve(&text.replace("[contact]", "[contact]\nsolver = \"monolithic-lu\"")).unwrap();
+        assert_eq!(schur.history.len(), lu.history.len());
+        let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (a, b) in [
+            (&schur.primary, &lu.primary),
+            (&schur.secondary, &lu.secondary),
+        ] {
+            let diff: Vec<f64> = a
+                .displacement
+                .iter()
+                .zip(&b.displacement)
+                .map(|(x, y)| x - y)
+                .collect();
+            assert!(
+                max(&diff) <= 1e-8 * max(&b.displacement),
+                "displacement differs by {:.2e}",
+                max(&diff)
+            );
+        }
+        let (pa, pb) = (&schur.primary_fields.pressure, &lu.primary_fields.pressure);
+        let diff: Vec<f64> = pa.iter().zip(pb).map(|(x, y)| x - y).collect();
+        assert!(
+            max(&diff) <= 1e-8 * max(pb),
+            "pressure differs by {:.2e}",
+            max(&diff)
+        );
+        assert!(schur.history.iter().all(|h| h.relative_residual < 1e-10));
+    }
+}
+
+#[test]
+fn krylov_and_schur_solves_agree() {
+    // The interface GMRES against the dense Schur complement, both on Cholesky factors: 2D
+    // Hertz (a partial active set, both formulations), the 3D patch test (both formulations),
+    // the 3D Hertz hemisphere (a partial set reached after several iterations), the
+    // conservative transfer, two load steps (the second from the first's set, warm start and
+    // `K^-1 f`) and a slide (the operators paired again).
+    //
+    // GMRES stops early on the iterations that change the active set (`LOOSE_GAP` in
+    // src/contact/solve.rs), so the next iteration's gaps are linearized at a slightly
+    // different point. Where the active set is right from the first solve (the patch tests,
+    // the 2D cases here) the two paths solve the same systems and agree to round-off. On the
+    // 3D hemisphere they reach the same active sets and each final iterate holds its active
+    // gaps within the settled tolerance (`SETTLED` = 0.01 of the penetration tolerance 1e-3
+    // h, 1e-5 h), so the answers may differ by that much: 1e-5 h / delta = 1.5e-5 relative
+    // for h = R/67, delta = 0.01 R. 1e-6 asks for fifteen times less.
+    let cases = [
+        ("2D frictionless", half_disc_on_block(""), 1e-8),
+        (
+            "2D tied",
+            half_disc_on_block("formulation = \"tied\""),
+            1e-8,
+        ),
+        (
+            "3D patch frictionless",
+            two_blocks(
+                3,
+                "frictionless",
+                &rollers("lower", 3),
+                &rollers("upper", 3),
+            ),
+            1e-8,
+        ),
+        (
+            "3D patch tied",
+            two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
+            1e-8,
+        ),
+        (
+            "3D Hertz",
+            hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, ""),
+            1e-6,
+        ),
+        (
+            "2D conservative transfer",
+            narrow_blocks("primary = \"upper\"\ntransfer = \"conservative\""),
+            1e-8,
+        ),
+        (
+            "2D load steps",
+            half_disc_on_block("load_steps = [0.5, 1.0]"),
+            1e-8,
+        ),
+        (
+            "2D slid",
+            common::half_disc_on_block("half_disc_on_block.msh", "")
+                .replace("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02"),
+            1e-8,
+        ),
+    ];
+    for (label, text, tolerance) in cases {
+        let with =
+            |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+        let krylov = solve(&with("krylov")).unwrap();
+        let schur = solve(&with("schur")).unwrap();
+        assert_same_contact(&krylov, &schur, tolerance, label);
+        // Iterations that change the active set may stop GMRES early (a loose solve); the
+        // answer is the last iteration's, solved to round-off.
+        let last = krylov.history.last().unwrap();
+        assert!(last.relative_residual < 1e-10, "{label}: {last:?}");
+        assert_eq!(krylov.linear_solvers.interface, "krylov");
+        assert_eq!(schur.linear_solvers.interface, "schur");
+    }
+}
+
+#[test]
+fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer() {
+    // GMRES capped at one iteration cannot solve an interface problem started cold: under
+    // `auto` the failing solve and every later one go to the dense Schur complement, the
+    // answer is the Schur path's to round-off (every solve that counts is a Schur solve), and
+    // `linear_solvers` says why. Under `krylov` the same failure ends the run with an error
+    // naming it, never an answer.
+    let cases = [
+        ("2D Hertz", half_disc_on_block("krylov_max_iterations = 1")),
+        (
+            "3D Hertz",
+            hemisphere_on_block(
+                "hemisphere_on_block_hertz.msh",
+                0.01,
+                1000.0,
+                1000.0,
+                "krylov_max_iterations = 1",
+            ),
+        ),
+    ];
+    for (label, text) in cases {
+        let with =
+            |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+        let auto = solve(&with("auto")).unwrap();
+        let schur = solve(&with("schur")).unwrap();
+        assert_same_contact(&auto, &schur, 1e-10, label);
+        assert_eq!(auto.linear_solvers.interface, "schur", "{label}");
+        let failure = auto.linear_solvers.krylov_failure.as_deref();
+        assert!(
+            failure.is_some_and(|why| why.contains("iteration limit")),
+            "{label}: {failure:?}"
+        );
+        assert_eq!(schur.linear_solvers.krylov_failure, None, "{label}");
+        let message = solve(&with("krylov"))
+            .err()
+            .expect("an error, not an answer");
+        assert!(
+            message.contains("interface GMRES did not converge (iteration limit reached)"),
+            "{label}: {message}"
+        );
+    }
+}
+
+#[test]
+fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
+    // With CG + AMG bodies, `schur` runs the interface GMRES (one body solve per product, no
+    // per-node CG solves); each product is exact to CG's rtol (1e-10), GMRES stops at 1e-9.
+    let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
+    let cholesky =
+        solve(&text.replace("[contact]", "[solver]\nbody = \"cholesky\"\n\n[contact]")).unwrap();
+    let cg = solve(&text.replace("[contact]", "[solver]\nbody = \"cg-amg\"\n\n[contact]")).unwrap();
+    assert_same_contact(&cg, &cholesky, 1e-6, "CG + AMG");
+}
