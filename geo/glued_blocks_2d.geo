@@ -8,7 +8,7 @@
 //          each body on its own, so `lower` and `upper` are two bodies with
 //          duplicated interface nodes, while `union` is the single body made of
 //          both: tied contact between lower and upper must give the solution of
-//          union (tests/contact.rs).
+//          union (tests/contact_accuracy.rs).
 //
 // Parameters (override with -setnumber name value):
 //   level  refinement level; the mesh size is h * 2^-level             [0]
