@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{block_3d_case, fixture, write_case};
+use common::{Edit, block_3d_case, fixture, write_case};
 use internodes::case::CaseError;
 use internodes::elastic::{ProblemError, SolveError};
 use internodes::fem::MaterialError;
@@ -112,7 +112,7 @@ fn info_prints_groups_and_counts() {
 
 #[test]
 fn cli_reports_errors_with_a_failure_status() {
-    let (_dir, path) = write_case(&block_3d_case().replace("youngs_modulus", "youngs_modulu"));
+    let (_dir, path) = write_case(&block_3d_case().edit("youngs_modulus", "youngs_modulu"));
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap()])
         .output()
@@ -128,7 +128,7 @@ fn cli_reports_errors_with_a_failure_status() {
 
 #[test]
 fn misspelled_key_names_the_key_and_line() {
-    let (e, message) = failure(&block_3d_case().replace("poisson_ratio", "poison_ratio"));
+    let (e, message) = failure(&block_3d_case().edit("poisson_ratio", "poison_ratio"));
     assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
     assert!(
         message.contains("poison_ratio") && message.contains("line 7"),
@@ -138,7 +138,7 @@ fn misspelled_key_names_the_key_and_line() {
 
 #[test]
 fn missing_key_is_named() {
-    let (e, message) = failure(&block_3d_case().replace("poisson_ratio = 0.3\n", ""));
+    let (e, message) = failure(&block_3d_case().edit("poisson_ratio = 0.3\n", ""));
     assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
     assert!(message.contains("poisson_ratio"), "{message}");
 }
@@ -146,7 +146,7 @@ fn missing_key_is_named() {
 #[test]
 fn non_physical_materials_are_rejected() {
     let (e, message) =
-        failure(&block_3d_case().replace("youngs_modulus = 1000.0", "youngs_modulus = 0.0"));
+        failure(&block_3d_case().edit("youngs_modulus = 1000.0", "youngs_modulus = 0.0"));
     assert!(
         matches!(
             e,
@@ -158,8 +158,7 @@ fn non_physical_materials_are_rejected() {
         "{message}"
     );
     assert!(message.contains("body 'block'"));
-    let (e, message) =
-        failure(&block_3d_case().replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
+    let (e, message) = failure(&block_3d_case().edit("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
     assert!(
         matches!(
             e,
@@ -170,14 +169,14 @@ fn non_physical_materials_are_rejected() {
         ),
         "{message}"
     );
-    let (e, _) = failure(&block_3d_case().replace("poisson_ratio = 0.3", "poisson_ratio = -1.2"));
+    let (e, _) = failure(&block_3d_case().edit("poisson_ratio = 0.3", "poisson_ratio = -1.2"));
     assert!(matches!(e, RunError::Case(CaseError::Material { .. })));
 }
 
 #[test]
 fn unknown_group_lists_the_groups_of_the_body() {
     let (e, message) =
-        failure(&block_3d_case().replace("group = \"block_top\"", "group = \"block_tpo\""));
+        failure(&block_3d_case().edit("group = \"block_top\"", "group = \"block_tpo\""));
     assert!(matches!(
         e,
         RunError::Case(CaseError::Problem {
@@ -193,7 +192,7 @@ fn unknown_group_lists_the_groups_of_the_body() {
 
 #[test]
 fn unknown_body_lists_the_bodies_of_the_mesh() {
-    let (e, message) = failure(&block_3d_case().replace("name = \"block\"", "name = \"sphere\""));
+    let (e, message) = failure(&block_3d_case().edit("name = \"block\"", "name = \"sphere\""));
     assert!(matches!(e, RunError::Case(CaseError::UnknownBody { .. })));
     assert!(
         message.contains("'sphere'") && message.contains("its bodies: block"),
@@ -223,7 +222,7 @@ fn a_body_without_dirichlet_condition_is_singular() {
 #[test]
 fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
     // Only uz = 0 on the flat base: translations in x, y and the rotation about z are free.
-    let (e, message) = failure(&block_3d_case().replace("ux = 0.0\nuy = 0.0\n", ""));
+    let (e, message) = failure(&block_3d_case().edit("ux = 0.0\nuy = 0.0\n", ""));
     assert!(
         matches!(
             e,
@@ -239,7 +238,7 @@ fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
 #[test]
 fn a_load_must_have_exactly_one_kind() {
     let (e, message) =
-        failure(&block_3d_case().replace("hertz_pressure =", "pressure = 1.0\nhertz_pressure ="));
+        failure(&block_3d_case().edit("hertz_pressure =", "pressure = 1.0\nhertz_pressure ="));
     assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
     assert!(
         message.contains("exactly one of") && message.contains("load on 'block_top'"),
@@ -250,14 +249,14 @@ fn a_load_must_have_exactly_one_kind() {
 #[test]
 fn vectors_must_match_the_mesh_dimension() {
     let (e, message) =
-        failure(&block_3d_case().replace("center = [0.0, 0.0, 0.0]", "center = [0.0, 0.0]"));
+        failure(&block_3d_case().edit("center = [0.0, 0.0, 0.0]", "center = [0.0, 0.0]"));
     assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
     assert!(message.contains("expected 3 components"), "{message}");
 }
 
 #[test]
 fn a_bad_mesh_is_reported_through_the_case() {
-    let (e, message) = failure(&block_3d_case().replace("block_3d.msh", "no_such.msh"));
+    let (e, message) = failure(&block_3d_case().edit("block_3d.msh", "no_such.msh"));
     assert!(matches!(e, RunError::Case(CaseError::Mesh { .. })));
     assert!(message.contains("no_such.msh"), "{message}");
 }
@@ -265,7 +264,7 @@ fn a_bad_mesh_is_reported_through_the_case() {
 #[test]
 fn inaccurate_solves_are_errors_not_results() {
     // A residual tolerance below round-off cannot be met: the solve must say so.
-    let text = block_3d_case().replace(
+    let text = block_3d_case().edit(
         "[[body]]",
         "[solver]\nresidual_tolerance = 1e-30\n\n[[body]]",
     );
@@ -285,7 +284,7 @@ fn inaccurate_solves_are_errors_not_results() {
 #[test]
 fn the_output_folder_may_come_from_the_flag_alone() {
     // `output` used to be required in the case file even with --output.
-    let (dir, path) = write_case(&block_3d_case().replace("output = \"out\"\n", ""));
+    let (dir, path) = write_case(&block_3d_case().edit("output = \"out\"\n", ""));
     let out = dir.path().join("elsewhere");
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap(), "--quiet", "--output"])
@@ -302,7 +301,7 @@ fn the_output_folder_may_come_from_the_flag_alone() {
 
 #[test]
 fn without_the_output_key_or_flag_the_error_names_both() {
-    let (e, message) = failure(&block_3d_case().replace("output = \"out\"\n", ""));
+    let (e, message) = failure(&block_3d_case().edit("output = \"out\"\n", ""));
     assert!(
         matches!(e, RunError::Case(CaseError::Invalid { .. })),
         "{message}"

@@ -7,7 +7,7 @@ use common::contact::{
     flat_punch, footprint_force, half_disc_on_block, hemisphere_on_block, one_body_reaction,
     rollers, solve, solve_cli, two_blocks,
 };
-use common::{fixture, write_case};
+use common::{Edit, fixture, write_case};
 use internodes::case::Case;
 use internodes::contact::{ContactSolution, ContactStatus, ContactSurface};
 use internodes::elastic::SolverSettings;
@@ -23,7 +23,7 @@ const PATCH_SOLVERS: [(&str, f64); 2] = [("schur", 1e-12), ("auto", 1e-10)];
 
 /// `text` with `[contact] solver = solver`.
 fn with_solver(text: &str, solver: &str) -> String {
-    text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""))
+    text.edit("[contact]", &format!("[contact]\nsolver = \"{solver}\""))
 }
 
 /// What converged means: the certificate passed (geometric penetration of every candidate of
@@ -316,11 +316,11 @@ fn bodies_meshed_overlapping_are_pushed_apart_into_hertz_contact() {
     eprintln!("3D overlap: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
 
     let text = half_disc_on_block("")
-        .replace(
+        .edit(
             "half_disc_on_block_hertz.msh",
             "half_disc_on_block_overlap.msh",
         )
-        .replace("uy = -0.02", "uy = 0.0");
+        .edit("uy = -0.02", "uy = 0.0");
     let solution = solve(&text).unwrap();
     assert_eq!(solution.status, ContactStatus::Converged);
     assert_contact_conditions(&solution, 0.03, "2D overlap");
@@ -575,11 +575,11 @@ fn flat_blocks_clamped_at_both_ends_match_their_union() {
             ("uz", "ux = 0.0\nuy = 0.0")
         };
         let clamp = |text: String| {
-            text.replace(
+            text.edit(
                 &format!("group = \"lower_base\"\n{vertical} = 0.0"),
                 &format!("group = \"lower_base\"\n{vertical} = 0.0\n{lateral}"),
             )
-            .replace(
+            .edit(
                 &format!("group = \"upper_top\"\n{vertical} = -0.01"),
                 &format!("group = \"upper_top\"\n{vertical} = -0.01\n{lateral}"),
             )
@@ -595,7 +595,7 @@ fn flat_blocks_clamped_at_both_ends_match_their_union() {
             .abs();
         for primary in ["upper", "lower", "auto"] {
             let text = clamp(two_blocks(dim, "frictionless", "", ""))
-                .replace("primary = \"upper\"", &format!("primary = \"{primary}\""));
+                .edit("primary = \"upper\"", &format!("primary = \"{primary}\""));
             assert!(text.matches(lateral).count() >= 2, "{text}");
             let solution = solve(&text).unwrap();
             let label = format!("{dim}D, primary {primary}");

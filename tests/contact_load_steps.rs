@@ -4,7 +4,7 @@
 mod common;
 
 use common::contact::{half_disc_on_block, solve, solve_cli, stiff_block};
-use common::{fixture, run_solve, write_case};
+use common::{Edit, fixture, run_solve, write_case};
 use internodes::case::Case;
 use internodes::contact::{ContactSolver, ContactStatus};
 use internodes::elastic::SolverSettings;
@@ -59,7 +59,7 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     assert!(full.force_primary[1].abs() > half.force_primary[1].abs());
 
     // From the command line: one CSV row per step.
-    let stepped_text = text.replace("[contact]", "[contact]\nload_steps = [0.5, 1.0]");
+    let stepped_text = text.edit("[contact]", "[contact]\nload_steps = [0.5, 1.0]");
     std::fs::write(&path, &stepped_text).unwrap();
     let output = run_solve(&path);
     assert!(
@@ -82,7 +82,7 @@ fn a_not_certified_load_step_does_not_stop_the_later_ones() {
     // steps: at 5% of the load the zone spans about two block spacings and the disc's sag fails
     // the certificate; the full load resolves the zone and is certified. Both steps run, each
     // with its own status, and the run ends with the last one's.
-    let text = stiff_block("half_disc_on_block_coarse_block.msh", "block").replace(
+    let text = stiff_block("half_disc_on_block_coarse_block.msh", "block").edit(
         "primary = \"block\"",
         "primary = \"block\"\nload_steps = [0.05, 1.0]",
     );
@@ -107,7 +107,7 @@ fn a_body_slid_sideways_is_paired_where_it_touches() {
     // much. Paired where the contact began, the block received its reaction four spacings from
     // where the disc touched it and the run was certified 3.1% high.
     let straight = common::half_disc_on_block("half_disc_on_block.msh", "");
-    let slid = straight.replace("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02");
+    let slid = straight.edit("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02");
     assert!(slid.contains("ux = 0.1"), "{slid}");
     let (straight, slid) = (solve(&straight).unwrap(), solve(&slid).unwrap());
     assert_eq!(straight.status, ContactStatus::Converged);

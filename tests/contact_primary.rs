@@ -7,7 +7,7 @@ use common::contact::{
     failed_checks, failed_in_summary, flat_punch, footprint_force, narrow_blocks, solve, solve_cli,
     stiff_block,
 };
-use common::{run_solve, write_case};
+use common::{Edit, run_solve, write_case};
 use internodes::case::Case;
 use internodes::contact::{ContactStatus, solve_contact};
 use internodes::elastic::SolverSettings;
@@ -189,8 +189,8 @@ fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
     // The block 1e4 times stiffer than the disc and the primary body, its contact surface meshed
     // twice coarser: the loop converges, without the warning, to the dolfinx rigid-flat force.
     let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
-        .replace("primary = \"disc\"", "primary = \"block\"")
-        .replace(
+        .edit("primary = \"disc\"", "primary = \"block\"")
+        .edit(
             "name = \"block\"\nyoungs_modulus = 1000.0",
             "name = \"block\"\nyoungs_modulus = 1.0e7",
         );
@@ -246,9 +246,9 @@ fn a_coarser_secondary_receives_the_conservative_transfer() {
     // through R12^T instead: certified, and the disc force is dolfinx's rigid flat on the same
     // disc mesh to 1%.
     let text = stiff_block("half_disc_on_block_coarse_block.msh", "disc")
-        .replace("uy = -0.02", "uy = -0.004");
+        .edit("uy = -0.02", "uy = -0.004");
     assert!(text.contains("uy = -0.004"), "{text}");
-    let interpolated = solve(&text.replace(
+    let interpolated = solve(&text.edit(
         "primary = \"disc\"",
         "primary = \"disc\"\ntransfer = \"interpolation\"",
     ))
@@ -279,12 +279,12 @@ fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {
     // sag (its force is 2% below the disc primary's); the disc as primary is certified, and
     // that answer is the one kept, with the reason.
     let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
-        .replace("uy = -0.02", "uy = -0.004");
+        .edit("uy = -0.02", "uy = -0.004");
     assert!(text.contains("uy = -0.004"), "{text}");
-    let block_first = solve(&text.replace("primary = \"disc\"", "primary = \"block\"")).unwrap();
+    let block_first = solve(&text.edit("primary = \"disc\"", "primary = \"block\"")).unwrap();
     assert!(!block_first.is_trusted());
 
-    let (code, summary) = solve_cli(&text.replace("primary = \"disc\"", "primary = \"auto\""));
+    let (code, summary) = solve_cli(&text.edit("primary = \"disc\"", "primary = \"auto\""));
     let contact = &summary["contact"];
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["status"], "converged", "{contact}");

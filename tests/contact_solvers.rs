@@ -3,6 +3,8 @@
 
 mod common;
 
+use common::Edit;
+
 use common::contact::{
     half_disc_on_block, hemisphere_on_block, narrow_blocks, rollers, solve, two_blocks,
 };
@@ -74,9 +76,8 @@ fn schur_and_monolithic_solves_agree() {
         two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
     ];
     for text in cases {
-        let schur = solve(&text.replace("[contact]", "[contact]\nsolver = \"schur\"")).unwrap();
-        let lu =
-            solve(&text.replace("[contact]", "[contact]\nsolver = \"monolithic-lu\"")).unwrap();
+        let schur = solve(&text.edit("[contact]", "[contact]\nsolver = \"schur\"")).unwrap();
+        let lu = solve(&text.edit("[contact]", "[contact]\nsolver = \"monolithic-lu\"")).unwrap();
         assert_eq!(schur.history.len(), lu.history.len());
         let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for (a, b) in [
@@ -162,13 +163,13 @@ fn krylov_and_schur_solves_agree() {
         (
             "2D slid",
             common::half_disc_on_block("half_disc_on_block.msh", "")
-                .replace("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02"),
+                .edit("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02"),
             1e-8,
         ),
     ];
     for (label, text, tolerance) in cases {
         let with =
-            |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+            |solver: &str| text.edit("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
         let krylov = solve(&with("krylov")).unwrap();
         let schur = solve(&with("schur")).unwrap();
         assert_same_contact(&krylov, &schur, tolerance, label);
@@ -203,7 +204,7 @@ fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer
     ];
     for (label, text) in cases {
         let with =
-            |solver: &str| text.replace("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+            |solver: &str| text.edit("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
         let auto = solve(&with("auto")).unwrap();
         let schur = solve(&with("schur")).unwrap();
         assert_same_contact(&auto, &schur, 1e-10, label);
@@ -230,7 +231,7 @@ fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
     // per-node CG solves); each product is exact to CG's rtol (1e-10), GMRES stops at 1e-9.
     let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
     let cholesky =
-        solve(&text.replace("[contact]", "[solver]\nbody = \"cholesky\"\n\n[contact]")).unwrap();
-    let cg = solve(&text.replace("[contact]", "[solver]\nbody = \"cg-amg\"\n\n[contact]")).unwrap();
+        solve(&text.edit("[contact]", "[solver]\nbody = \"cholesky\"\n\n[contact]")).unwrap();
+    let cg = solve(&text.edit("[contact]", "[solver]\nbody = \"cg-amg\"\n\n[contact]")).unwrap();
     assert_same_contact(&cg, &cholesky, 1e-6, "CG + AMG");
 }

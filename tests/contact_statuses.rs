@@ -7,7 +7,7 @@ use common::contact::{
     failed_checks, failed_in_summary, half_disc_on_block, hemisphere_on_block, rollers, solve,
     stiff_block, two_blocks,
 };
-use common::{run_solve, write_case};
+use common::{Edit, run_solve, write_case};
 use internodes::case::{Case, CaseError};
 use internodes::contact::{CheckKind, ContactStatus, solve_contact};
 use internodes::mesh::read_msh;
@@ -20,8 +20,8 @@ const FOREIGN_RIGID_FLAT_FORCE_2D: f64 = 1.3839070125526174;
 #[test]
 fn bodies_pulled_apart_end_with_no_contact() {
     let text = two_blocks(2, "frictionless", "", "")
-        .replace("uy = -0.01", "uy = 0.01\nux = 0.0")
-        .replace(
+        .edit("uy = -0.01", "uy = 0.01\nux = 0.0")
+        .edit(
             "group = \"lower_base\"\nuy = 0.0",
             "group = \"lower_base\"\nuy = 0.0\nux = 0.0",
         );
@@ -40,7 +40,7 @@ fn surfaces_that_do_not_face_each_other_end_with_no_contact() {
         &rollers("lower", 2),
         &rollers("upper", 2),
     )
-    .replace(
+    .edit(
         "surfaces = [\"upper_contact\", \"lower_contact\"]",
         "surfaces = [\"upper_top\", \"lower_base\"]",
     );
@@ -58,7 +58,7 @@ fn the_iteration_cap_is_a_status() {
 
 #[test]
 fn a_missing_candidate_group_is_named() {
-    let text = two_blocks(2, "frictionless", "", "").replace(
+    let text = two_blocks(2, "frictionless", "", "").edit(
         "surfaces = [\"upper_contact\"",
         "surfaces = [\"upper_contct\"",
     );
@@ -73,7 +73,7 @@ fn a_missing_candidate_group_is_named() {
 #[test]
 fn a_candidate_group_empty_on_its_body_is_named() {
     // "lower_contact" exists, but has no facet on the upper body.
-    let text = two_blocks(2, "frictionless", "", "").replace(
+    let text = two_blocks(2, "frictionless", "", "").edit(
         "surfaces = [\"upper_contact\"",
         "surfaces = [\"lower_contact\"",
     );
@@ -102,7 +102,7 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_trusted() {
     // constrained nodes there is no sag to measure: the disc's penetration is at the zone's
     // rim, whose place the resolution bounds.
     let text = stiff_block("half_disc_on_block_coarse_block.msh", "block")
-        .replace("uy = -0.02", "uy = -0.001");
+        .edit("uy = -0.02", "uy = -0.001");
     assert!(text.contains("uy = -0.001"), "{text}");
     let coarse = solve(&text).unwrap();
     assert_eq!(coarse.status, ContactStatus::Converged);
@@ -115,7 +115,7 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_trusted() {
     );
 
     // The premise: constraining the disc's nodes instead changes the force by several percent.
-    let fine = solve(&text.replace("primary = \"block\"", "primary = \"disc\"")).unwrap();
+    let fine = solve(&text.edit("primary = \"block\"", "primary = \"disc\"")).unwrap();
     let (on_disc_coarse, on_disc_fine) = (coarse.force_secondary[1], fine.force_primary[1]);
     let change = (on_disc_coarse - on_disc_fine).abs() / on_disc_fine.abs();
     assert!(change > 0.03, "{on_disc_coarse} against {on_disc_fine}");
@@ -129,8 +129,8 @@ fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
     // penetration, tension, sag and balance all pass, yet the force on the disc is more than
     // 1% off dolfinx's rigid flat on the same disc mesh. It must not be called converged, and
     // the resolution must be named, at that block node.
-    let text = stiff_block("foreign_disc_on_coarse_block.msh", "block")
-        .replace("uy = -0.02", "uy = -0.003");
+    let text =
+        stiff_block("foreign_disc_on_coarse_block.msh", "block").edit("uy = -0.02", "uy = -0.003");
     assert!(text.contains("uy = -0.003"), "{text}");
     let solution = solve(&text).unwrap();
     let error = solution.force_secondary[1] / FOREIGN_RIGID_FLAT_FORCE_2D - 1.0;
@@ -158,7 +158,7 @@ fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
     // Auto makes the compliant disc primary, whose three nodes in contact resolve the zone
     // (the coarse stiff block, nearly rigid, need not):
     // certified, and dolfinx's force to 1%.
-    let auto = solve(&text.replace("primary = \"block\"", "primary = \"auto\"")).unwrap();
+    let auto = solve(&text.edit("primary = \"block\"", "primary = \"auto\"")).unwrap();
     assert_eq!(
         auto.status,
         ContactStatus::Converged,
@@ -233,7 +233,7 @@ fn a_contact_body_needs_a_body_table() {
         &rollers("lower", 2),
         &rollers("upper", 2),
     )
-    .replace(
+    .edit(
         "bodies = [\"upper\", \"lower\"]",
         "bodies = [\"upper\", \"base\"]",
     );
@@ -248,7 +248,7 @@ fn a_contact_body_needs_a_body_table() {
 #[test]
 fn misspelled_contact_keys_are_rejected() {
     let (_dir, path) =
-        write_case(&two_blocks(2, "frictionless", "", "").replace("formulation", "formulatoin"));
+        write_case(&two_blocks(2, "frictionless", "", "").edit("formulation", "formulatoin"));
     let error = Case::load(&path).unwrap_err();
     assert!(matches!(error, CaseError::Syntax { .. }));
     assert!(error.to_string().contains("formulatoin"));

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use common::hostile::{
     assert_failed_without_results, case_failure, run_error, run_quiet, square_case, two_blocks_case,
 };
-use common::{fixture, write_case};
+use common::{Edit, fixture, write_case};
 
 /// A case on `geo/block_2d.geo` with `parameters` as its `geo_parameters`.
 fn geo_case(geo: &str, parameters: &str) -> String {
@@ -109,7 +109,7 @@ fn non_finite_geo_parameters_are_errors() {
 
 #[test]
 fn geo_parameters_beside_a_msh_are_errors() {
-    let text = square_case("square_sorted.msh", "[1.0, 0.0]").replace(
+    let text = square_case("square_sorted.msh", "[1.0, 0.0]").edit(
         "output = \"out\"",
         "output = \"out\"\ngeo_parameters = { level = 1 }",
     );
@@ -141,14 +141,14 @@ fn non_finite_loads_are_errors_naming_the_load() {
         "hertz_pressure = { p0 = nan, a = 0.5, center = [0.0, 0.0] }",
     ] {
         let text =
-            square_case("square_sorted.msh", "[1.0, 0.0]").replace("traction = [1.0, 0.0]", load);
+            square_case("square_sorted.msh", "[1.0, 0.0]").edit("traction = [1.0, 0.0]", load);
         let message = case_failure(&text);
         assert!(
             message.contains("body 'square', load on 'right'") && message.contains("finite"),
             "{load}: {message}"
         );
     }
-    let text = square_case("square_sorted.msh", "[1.0, 0.0]").replace(
+    let text = square_case("square_sorted.msh", "[1.0, 0.0]").edit(
         "poisson_ratio = 0.25",
         "poisson_ratio = 0.25\nbody_force = [0.0, nan]",
     );
@@ -166,7 +166,7 @@ fn finite_values_that_overflow_downstream_are_rejected_naming_the_key_and_range(
     let square = |from: &str, to: &str| {
         let text = square_case("square_sorted.msh", "[1.0, 0.0]");
         assert!(text.contains(from), "{from}");
-        text.replace(from, to)
+        text.edit(from, to)
     };
     let range = "of magnitude at most 1e40";
     for (text, key, expected) in [
@@ -243,7 +243,7 @@ fn finite_values_that_overflow_downstream_are_rejected_naming_the_key_and_range(
 #[test]
 fn a_load_on_a_point_group_says_a_boundary_group_is_needed() {
     let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", "")
-        .replace("group = \"lower_contact\"", "group = \"lower_corner\"");
+        .edit("group = \"lower_contact\"", "group = \"lower_corner\"");
     let message = case_failure(&text);
     assert!(
         message.contains("load on 'lower_corner'")

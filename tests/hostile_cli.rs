@@ -6,7 +6,7 @@ mod common;
 use std::process::Command;
 
 use common::hostile::{BINARY, run_quiet, square_case, two_blocks_case};
-use common::{fixture, write_case};
+use common::{Edit, fixture, write_case};
 
 #[test]
 fn info_into_a_closed_pipe_does_not_panic() {
@@ -63,7 +63,7 @@ fn exporting_matrices_with_a_dirichlet_point_group_does_not_panic() {
 fn an_error_and_its_causes_are_printed_once() {
     // The case error quotes the mesh error, which quotes the I/O error: each once on stderr and
     // in the failure mark (every cause used to be printed again under its own message).
-    let (dir, case) = write_case(&square_case("square_sorted.msh", "[1.0, 0.0]").replace(
+    let (dir, case) = write_case(&square_case("square_sorted.msh", "[1.0, 0.0]").edit(
         &fixture("square_sorted.msh").display().to_string(),
         "missing.msh",
     ));
@@ -91,7 +91,7 @@ fn bodies_pulled_apart_leave_no_null_in_the_iteration_history() {
     // in tension and none compressed, and its tension over the largest pressure was
     // p / f64::MIN_POSITIVE = inf, written as `null` into summary.json.
     let contact = "[contact]\nbodies = [\"upper\", \"lower\"]\nsurfaces = [\"upper_contact\", \"lower_contact\"]\n";
-    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", contact).replace(
+    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", contact).edit(
         "group = \"upper_top\"\nux = 0.0\nuy = 0.0",
         "group = \"upper_top\"\nux = 0.0\nuy = 0.01",
     );

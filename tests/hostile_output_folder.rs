@@ -10,7 +10,7 @@ use common::hostile::{
     BINARY, assert_failed_without_results, case_failure, displacement_by_tag, exists, run_error,
     run_quiet, square_case, two_blocks_case,
 };
-use common::{fixture, write_case};
+use common::{Edit, fixture, write_case};
 use internodes::run::{RunOptions, solve_case};
 
 /// A folder holding `two_blocks_2d.msh` as `mesh` and the case `case` reading it, with the output
@@ -20,7 +20,7 @@ fn case_beside_its_outputs(mesh: &str, case: &str) -> (tempfile::TempDir, PathBu
     let mesh_path = dir.path().join(mesh);
     std::fs::copy(fixture("two_blocks_2d.msh"), &mesh_path).unwrap();
     let text =
-        two_blocks_case(Path::new(mesh), "upper", "").replace("output = \"out\"", "output = \".\"");
+        two_blocks_case(Path::new(mesh), "upper", "").edit("output = \"out\"", "output = \".\"");
     let case_path = dir.path().join(case);
     std::fs::write(&case_path, text).unwrap();
     (dir, mesh_path, case_path)
@@ -56,7 +56,7 @@ fn a_failed_run_removes_earlier_results_and_marks_the_folder() {
 
     // The same case, now failing in the solve of its second body.
     let bad = dir.path().join("bad.toml");
-    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", "").replace(
+    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", "").edit(
         "[[body]]\nname = \"lower\"",
         "[solver]\nresidual_tolerance = 1e-300\n\n[[body]]\nname = \"lower\"",
     );
@@ -84,11 +84,7 @@ fn runs_remove_only_their_own_files_from_the_output_folder() {
     run_quiet(&good).unwrap();
     assert!(exists(&out, "matrices/lower_stiffness.mtx"));
     let text = std::fs::read_to_string(&good).unwrap();
-    std::fs::write(
-        &good,
-        text.replace("name = \"upper\"", "name = \"nowhere\""),
-    )
-    .unwrap();
+    std::fs::write(&good, text.edit("name = \"upper\"", "name = \"nowhere\"")).unwrap();
     run_error(&good, "no body 'nowhere'");
     assert!(!exists(&out, "matrices/lower_stiffness.mtx"));
     assert!(exists(&out, "notes.txt") && exists(&out, "matrices/notes.txt"));
@@ -99,7 +95,7 @@ fn a_case_file_that_does_not_parse_marks_the_folder_it_names() {
     let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
     run_quiet(&good).unwrap();
     let text = std::fs::read_to_string(&good).unwrap();
-    std::fs::write(&good, text.replace("poisson_ratio", "poison_ratio")).unwrap();
+    std::fs::write(&good, text.edit("poisson_ratio", "poison_ratio")).unwrap();
     let e = run_error(&good, "misspelled key");
     assert_failed_without_results(&dir.path().join("out"), "poison_ratio");
     assert!(e.to_string().contains("poison_ratio"));
@@ -136,8 +132,8 @@ fn concurrent_runs_into_one_folder_leave_one_runs_complete_results() {
         .map(|e| {
             let path = dir.path().join(format!("e{e}.toml"));
             let text = square_case("square_sorted.msh", "[1.0, 0.0]")
-                .replace("youngs_modulus = 100.0", &format!("youngs_modulus = {e}"))
-                .replace("output = \"out\"", "output = \"shared\"");
+                .edit("youngs_modulus = 100.0", &format!("youngs_modulus = {e}"))
+                .edit("output = \"out\"", "output = \"shared\"");
             std::fs::write(&path, text).unwrap();
             path
         })
@@ -195,7 +191,7 @@ fn an_input_mesh_named_mesh_msh_in_the_output_folder_is_never_removed() {
 
     // A case file that does not parse marks the folder, and the mesh stays.
     let text = std::fs::read_to_string(&case).unwrap();
-    std::fs::write(&case, text.replace("youngs_modulus", "young_modulus")).unwrap();
+    std::fs::write(&case, text.edit("youngs_modulus", "young_modulus")).unwrap();
     run_error(&case, "misspelled key");
     assert_failed_without_results(dir.path(), "young_modulus");
     assert_eq!(
@@ -243,7 +239,7 @@ fn an_output_folder_holding_an_input_under_a_result_name_is_refused() {
     let (dir, _, case) = case_beside_its_outputs("lower.msh", "FAILED.txt");
     let broken = std::fs::read_to_string(&case)
         .unwrap()
-        .replace("youngs_modulus", "young_modulus");
+        .edit("youngs_modulus", "young_modulus");
     std::fs::write(&case, &broken).unwrap();
     run_error(&case, "misspelled key");
     assert_eq!(
@@ -324,7 +320,7 @@ fn names_with_a_slash_are_refused_before_solving_when_matrices_are_exported() {
     .unwrap();
     let with_group = |extra: &str| {
         two_blocks_case(&group_mesh, "upper", extra)
-            .replace("group = \"lower_base\"", "group = \"../../base\"")
+            .edit("group = \"lower_base\"", "group = \"../../base\"")
     };
     let message = case_failure(&with_group("export_matrices = true"));
     assert!(

@@ -1,7 +1,7 @@
 //! Helpers of the contact tests: solving a case given as TOML text, and the committed
 //! fixtures' cases (two blocks, the half-disc and the hemisphere on a block, a flat punch).
 
-use super::{fixture, run_solve, write_case};
+use super::{Edit, fixture, run_solve, write_case};
 use internodes::case::Case;
 use internodes::contact::{ContactSolution, ContactSolver, solve_contact};
 use internodes::elastic::SolverSettings;
@@ -90,8 +90,8 @@ pub fn half_disc_on_block(extra: &str) -> String {
 /// primary body `primary` ("auto", "disc" or "block").
 pub fn stiff_block(mesh: &str, primary: &str) -> String {
     super::half_disc_on_block(mesh, "")
-        .replace("primary = \"disc\"", &format!("primary = \"{primary}\""))
-        .replace(
+        .edit("primary = \"disc\"", &format!("primary = \"{primary}\""))
+        .edit(
             "name = \"block\"\nyoungs_modulus = 1000.0",
             "name = \"block\"\nyoungs_modulus = 1.0e7",
         )

@@ -56,6 +56,23 @@ pub fn without_physical_tags(text: &str, dim: usize) -> String {
     format!("{}{}\n{}", &text[..start], lines.join("\n"), &text[end..])
 }
 
+/// Edits of a case's text that must apply: a replacement that matches nothing would leave the
+/// case as it was, and the test would check something else than it says.
+pub trait Edit {
+    /// The text with every `from` replaced by `to`; panics when `from` does not occur.
+    fn edit(&self, from: &str, to: &str) -> String;
+}
+
+impl Edit for str {
+    fn edit(&self, from: &str, to: &str) -> String {
+        assert!(
+            self.contains(from),
+            "the case has no {from:?} to replace:\n{self}"
+        );
+        self.replace(from, to)
+    }
+}
+
 /// A case file with `text`, written to a fresh temporary folder (kept alive by the returned
 /// guard; relative output paths land inside it).
 pub fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
