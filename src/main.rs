@@ -59,7 +59,14 @@ fn main() -> ExitCode {
     // solves guarantee it themselves; faer's sparse LUs (RBF interpolation, the monolithic
     // reference solver) take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
-    let result: Result<u8, Box<dyn Error>> = match Cli::parse().command {
+    let cli = Cli::parse();
+    let quiet = matches!(cli.command, Command::Solve { quiet: true, .. });
+    StderrLogger::install(if quiet {
+        log::LevelFilter::Warn
+    } else {
+        log::LevelFilter::Info
+    });
+    let result: Result<u8, Box<dyn Error>> = match cli.command {
         Command::Solve {
             case,
             output,
@@ -119,6 +126,37 @@ fn failures(checks: &[internodes::contact::CertificateCheck]) -> String {
         .map(|c| c.describe())
         .collect::<Vec<_>>()
         .join("; ")
+}
+
+/// Prints the library's progress messages on stderr as they are, and its warnings prefixed
+/// with `warning: `. Hand-written: the `log` facade needs a logger, and the ones on crates.io
+/// add timestamps, levels and colours the CLI's output has never had.
+struct StderrLogger;
+
+impl StderrLogger {
+    fn install(level: log::LevelFilter) {
+        static LOGGER: StderrLogger = StderrLogger;
+        // Only fails when a logger is already installed, which nothing else in the CLI does.
+        let _ = log::set_logger(&LOGGER);
+        log::set_max_level(level);
+    }
+}
+
+impl log::Log for StderrLogger {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        metadata.level() <= log::max_level()
+    }
+
+    fn log(&self, record: &log::Record) {
+        if self.enabled(record.metadata()) {
+            match record.level() {
+                log::Level::Error | log::Level::Warn => eprintln!("warning: {}", record.args()),
+                _ => eprintln!("{}", record.args()),
+            }
+        }
+    }
+
+    fn flush(&self) {}
 }
 
 /// Writes `text` to stdout. A reader that stops early (`internodes info m.msh | head`) closes

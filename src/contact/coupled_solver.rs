@@ -232,7 +232,7 @@ impl BodyFactors {
         if self.verbose {
             // Over a progress line, if one was shown.
             let clear = if state.progress { "\r\x1b[2K" } else { "" };
-            eprintln!(
+            log::info!(
                 "{clear}    interface GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
                  (start {:.1e}, target {:.1e})",
                 stats.iterations,
@@ -245,7 +245,7 @@ impl BodyFactors {
         match (solved, self.fallback.take()) {
             (Err(ContactError::Krylov(failure)), Some([nodes1, nodes2])) => {
                 if self.verbose {
-                    eprintln!("    {failure}: the dense Schur complement from here on");
+                    log::info!("    {failure}: the dense Schur complement from here on");
                 }
                 let sizes = [system.n1, system.n2];
                 self.interface = Interface::dense([&nodes1, &nodes2], dim, sizes);

@@ -95,8 +95,8 @@ pub struct ContactRun<'m> {
 }
 
 /// Solves `problem` at each of `load_factors` in turn (each step starting from the previous
-/// active set), with the retry and the agreement check of the module doc. Progress goes to
-/// standard error when `solver.verbose`.
+/// active set), with the retry and the agreement check of the module doc. Progress goes to the
+/// `log` crate (level info) when `solver.verbose`.
 pub fn solve_contact<'m>(
     problem: ContactProblem<'m>,
     solver: &SolverSettings,
@@ -371,7 +371,7 @@ struct Log {
 impl Log {
     fn say(&self, message: impl AsRef<str>) {
         if self.verbose {
-            eprintln!("{}", message.as_ref());
+            log::info!("{}", message.as_ref());
         }
     }
 

@@ -160,7 +160,7 @@ impl<'a> ContactSolver<'a> {
                         _ => "Cholesky",
                     };
                     let seconds = start.elapsed().as_secs_f64();
-                    eprintln!("  {what} of both bodies: {seconds:.3} s");
+                    log::info!("  {what} of both bodies: {seconds:.3} s");
                 }
                 Some(factors)
             }
@@ -297,7 +297,7 @@ impl<'a> ContactSolver<'a> {
             let mut record = record(&update, iteration, residual, drift, seconds);
             record.krylov_iterations = krylov_iterations;
             if self.solver.verbose {
-                eprintln!("{}", record.line());
+                log::info!("{}", record.line());
             }
             history.push(record);
             last = Some((coupling, solution));

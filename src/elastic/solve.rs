@@ -38,7 +38,9 @@ pub struct SolverSettings {
     pub ordering: Ordering,
     /// A solve whose relative residual exceeds this is reported as failed (default 1e-8).
     pub residual_tolerance: f64,
-    /// Print each phase and its time on stderr (default: true; the CLI's `--quiet` clears it).
+    /// Report each phase and its time (`log` messages at level info), and show the live progress
+    /// line of long interface solves when stderr is a terminal (default: true; the CLI's
+    /// `--quiet` and the Python module clear it).
     #[serde(skip)]
     pub verbose: bool,
 }
@@ -125,7 +127,7 @@ pub(crate) fn timed<T>(
     let value = f();
     let seconds = start.elapsed().as_secs_f64();
     if verbose {
-        eprintln!("    {name:<28} {seconds:>8.3} s");
+        log::info!("    {name:<28} {seconds:>8.3} s");
     }
     stats.timings.push((name.to_string(), seconds));
     value

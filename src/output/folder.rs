@@ -158,7 +158,7 @@ impl ResultFolder {
 
     /// Removes this run's staged files and results, and writes [`FAILURE_MARK`] with `error`.
     /// Best effort: the error itself is what the caller reports, so a folder that cannot be
-    /// cleaned is reported on stderr only.
+    /// cleaned is only logged as a warning.
     pub fn fail(&self, command: &str, error: &dyn std::error::Error) {
         let wait = if self.lock_timed_out.load(Ordering::Relaxed) {
             Duration::ZERO
@@ -168,7 +168,7 @@ impl ResultFolder {
         match mark_failed(&self.dir, Some(&self.staging), command, error, wait) {
             // The run's own error names the lock: no mark can be written without it.
             Err(OutputError::LockTimeout { .. }) if wait.is_zero() => {}
-            Err(e) => eprintln!("warning: {e}"),
+            Err(e) => log::warn!("{e}"),
             Ok(()) => {}
         }
     }
@@ -178,7 +178,7 @@ impl ResultFolder {
 /// [`ResultFolder`] (a case file that does not parse): earlier results are removed and
 /// [`FAILURE_MARK`] written. `mesh.msh` stays: whether this run would have generated it is not
 /// known, and it may be the mesh the case reads. Nothing is done if `dir` does not exist, or if
-/// it holds `case_file` under a result file's name (said on stderr).
+/// it holds `case_file` under a result file's name (logged as a warning).
 pub fn mark_failed_folder(
     dir: &Path,
     origin: &str,
@@ -192,7 +192,7 @@ pub fn mark_failed_folder(
     let marked = check_inputs(dir, origin, &[case_file], false)
         .and_then(|()| mark_failed(dir, None, command, error, MAX_LOCK_WAIT));
     if let Err(e) = marked {
-        eprintln!("warning: {e}");
+        log::warn!("{e}");
     }
 }
 
@@ -443,7 +443,7 @@ impl CommitLock {
                         });
                     }
                     if !said && waited >= LOCK_WAIT_NOTICE {
-                        eprintln!(
+                        log::warn!(
                             "waiting for the commit lock {} (another run into this folder is \
                              moving its results into place; a lock older than {} s is removed, \
                              and the wait ends with an error after {} s)",

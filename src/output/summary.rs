@@ -13,7 +13,7 @@ use crate::contact::{
 };
 use crate::elastic::SolveStats;
 
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct CaseSummary {
     pub case: String,
     pub mesh: String,
@@ -37,7 +37,7 @@ pub fn peak_memory_mb() -> Option<f64> {
     Some(kb / 1024.0)
 }
 
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct BodySummary {
     pub name: String,
     pub youngs_modulus: f64,
@@ -55,7 +55,7 @@ pub struct BodySummary {
 }
 
 /// How the contact solve ended, its forces and the iteration history.
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct ContactSummary {
     pub status: ContactStatus,
     pub primary: String,
@@ -90,7 +90,7 @@ pub struct ContactSummary {
 }
 
 /// The residual checks of the discrete problem (`status` is `converged` only if all passed).
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct SolvedChecks {
     pub passed: bool,
     pub checks: Vec<CertificateCheck>,
@@ -98,7 +98,7 @@ pub struct SolvedChecks {
 
 /// The accuracy indicators of the answer (a failure leaves the status as it is, and makes the
 /// run exit with status 3).
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct AccuracyReport {
     pub passed: bool,
     pub indicators: Vec<CertificateCheck>,

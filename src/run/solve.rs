@@ -1,0 +1,270 @@
+//! A case solved in memory: the contact solve of the two bodies in contact, and each other body
+//! alone. Nothing is written here: the command line ([`super::solve_case`]) and the Python
+//! module write the result files from a [`CaseSolution`] with [`super::write_results`].
+
+use std::time::Instant;
+
+use crate::case::Case;
+use crate::contact::{ContactProblem, ContactRun, ContactSolution, SurfaceFields, solve_contact};
+use crate::elastic::{DirichletCondition, ElasticSolution, solve};
+use crate::mesh::Mesh;
+use crate::output::{BodySummary, CaseSummary, ContactSummary, peak_memory_mb};
+
+use super::RunError;
+
+/// Wall-clock seconds of each phase of a run, in order, from its start.
+#[derive(Debug, Clone)]
+pub struct Timings {
+    started: Instant,
+    phases: Vec<(String, f64)>,
+}
+
+impl Timings {
+    /// A run that starts now.
+    pub fn start() -> Self {
+        Self {
+            started: Instant::now(),
+            phases: Vec::new(),
+        }
+    }
+
+    /// Records the seconds since `since` under `name`, and returns them.
+    pub fn record(&mut self, name: impl Into<String>, since: Instant) -> f64 {
+        let seconds = since.elapsed().as_secs_f64();
+        self.phases.push((name.into(), seconds));
+        seconds
+    }
+
+    /// The phases so far, then `"total"`: the seconds since the run started.
+    pub fn with_total(&self) -> Vec<(String, f64)> {
+        let mut phases = self.phases.clone();
+        phases.push(("total".to_string(), self.started.elapsed().as_secs_f64()));
+        phases
+    }
+
+    /// The seconds since the run started.
+    pub fn elapsed(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+}
+
+/// Every body of a case, solved.
+pub struct CaseSolution {
+    /// In the case file's order of bodies.
+    pub bodies: Vec<SolvedBody>,
+    /// The contact solve's outcome, when the case has a `[contact]` table.
+    pub contact: Option<SolvedContact>,
+    pub timings: Timings,
+}
+
+/// One body's solution and, in contact runs, its contact surface's fields.
+pub struct SolvedBody {
+    pub name: String,
+    pub solution: ElasticSolution,
+    pub surface: Option<SurfaceFields>,
+}
+
+/// What a contact solve leaves besides the two bodies' fields.
+pub struct SolvedContact {
+    /// Status, certificate, accuracy report, forces and one record per load step: the
+    /// `contact` part of `summary.json`.
+    pub summary: ContactSummary,
+    /// The title of `force_displacement.png`.
+    pub plot_title: String,
+    /// The approach the prescribed displacements impose at load factor 1 (the plot's x axis).
+    pub imposed_approach: f64,
+}
+
+/// Solves every body of `case` on `mesh`. Every body's problem is built first, so that bad
+/// input is an error before anything is solved.
+pub fn solve_case_on(
+    case: &Case,
+    mesh: &Mesh,
+    mut timings: Timings,
+) -> Result<CaseSolution, RunError> {
+    case.check_bodies(mesh)?;
+    if case.export_matrices {
+        case.check_export_names(mesh)?;
+    }
+    let mut bodies = Vec::new();
+    let mut contact = None;
+    if let Some(problem) = case.contact_problem(mesh)? {
+        log::info!(
+            "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
+            problem.primary.body.name,
+            problem.primary_surface.group,
+            problem.primary_surface.len(),
+            problem.secondary.body.name,
+            problem.secondary_surface.group,
+            problem.secondary_surface.len(),
+            serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
+        );
+        log::info!(
+            "primary body '{}' ({}): {}",
+            problem.primary.body.name,
+            problem.primary_report.mode,
+            problem.primary_report.reason
+        );
+        let run = solve_contact(problem, &case.solver, &case.load_steps()).map_err(|source| {
+            RunError::Contact {
+                path: case.path.clone(),
+                source,
+            }
+        })?;
+        let ContactRun {
+            problem,
+            solution,
+            steps,
+            timings: contact_timings,
+        } = run;
+        timings.phases.extend(contact_timings);
+        contact = Some(SolvedContact {
+            summary: summarize_contact(&problem, &solution, steps),
+            plot_title: format!(
+                "{}: contact of '{}' (primary) and '{}'",
+                case_name(case),
+                problem.primary.body.name,
+                problem.secondary.body.name
+            ),
+            imposed_approach: imposed_approach(&problem),
+        });
+        bodies.push(SolvedBody {
+            name: problem.primary.body.name.clone(),
+            solution: solution.primary,
+            surface: Some(solution.primary_fields),
+        });
+        bodies.push(SolvedBody {
+            name: problem.secondary.body.name.clone(),
+            solution: solution.secondary,
+            surface: Some(solution.secondary_fields),
+        });
+    }
+    for spec in &case.bodies {
+        if bodies.iter().any(|s| s.name == spec.name) {
+            continue;
+        }
+        let body = case.body_mesh(mesh, spec)?;
+        let problem = case.elastic_problem(body, spec)?;
+        log::info!(
+            "body '{}': {} nodes, {} cells, {} dofs",
+            body.name,
+            body.num_nodes(),
+            body.num_cells(),
+            body.num_dofs()
+        );
+        let phase = Instant::now();
+        let solution = solve(&problem, &case.solver).map_err(|source| RunError::Solve {
+            path: case.path.clone(),
+            source,
+        })?;
+        timings.record(format!("solve {}", body.name), phase);
+        bodies.push(SolvedBody {
+            name: spec.name.clone(),
+            solution,
+            surface: None,
+        });
+    }
+    bodies.sort_by_key(|s| case.bodies.iter().position(|b| b.name == s.name));
+    Ok(CaseSolution {
+        bodies,
+        contact,
+        timings,
+    })
+}
+
+impl CaseSolution {
+    /// The contents of `summary.json`, with the timings recorded so far.
+    pub fn summary(&self, case: &Case, mesh: &Mesh) -> CaseSummary {
+        let (mut node_offset, mut cell_offset) = (0, 0);
+        let bodies = (self.bodies.iter())
+            .map(|solved| {
+                let spec = (case.bodies.iter())
+                    .find(|b| b.name == solved.name)
+                    .expect("solved bodies come from the case");
+                let body = mesh
+                    .body(&solved.name)
+                    .expect("solved bodies are mesh bodies");
+                let s = &solved.solution;
+                let summary = BodySummary {
+                    name: body.name.clone(),
+                    youngs_modulus: spec.youngs_modulus,
+                    poisson_ratio: spec.poisson_ratio,
+                    num_nodes: body.num_nodes(),
+                    num_cells: body.num_cells(),
+                    num_dofs: body.num_dofs(),
+                    node_offset,
+                    cell_offset,
+                    reactions: s.reactions.iter().cloned().collect(),
+                    solve: s.stats.clone(),
+                };
+                node_offset += body.num_nodes();
+                cell_offset += body.num_cells();
+                summary
+            })
+            .collect();
+        CaseSummary {
+            case: case.path.display().to_string(),
+            mesh: mesh.path.display().to_string(),
+            dimension: mesh.dim,
+            bodies,
+            contact: self.contact.as_ref().map(|c| c.summary.clone()),
+            timings: self.timings.with_total(),
+            peak_memory_mb: peak_memory_mb(),
+        }
+    }
+}
+
+fn summarize_contact(
+    problem: &ContactProblem,
+    solution: &ContactSolution,
+    steps: Vec<crate::contact::StepRecord>,
+) -> ContactSummary {
+    let dim = problem.primary_surface.dim;
+    let (solved, accuracy) = ContactSummary::checks(&solution.certificate);
+    let active = |fields: &SurfaceFields| fields.active.iter().filter(|&&a| a).count();
+    ContactSummary {
+        status: solution.status,
+        primary: problem.primary.body.name.clone(),
+        secondary: problem.secondary.body.name.clone(),
+        primary_choice: problem.primary_report.clone(),
+        transfer: problem.transfer(),
+        solved,
+        accuracy,
+        settings: problem.settings,
+        linear_solvers: solution.linear_solvers.clone(),
+        force_primary: solution.force_primary[..dim].to_vec(),
+        force_secondary: solution.force_secondary[..dim].to_vec(),
+        force_imbalance: solution.force_imbalance,
+        active_primary: active(&solution.primary_fields),
+        active_secondary: active(&solution.secondary_fields),
+        max_pressure: (solution.primary_fields.pressure.iter().cloned()).fold(0.0, f64::max),
+        max_tangential_traction: solution.max_tangential_traction,
+        hertz_fit: solution.hertz_primary,
+        iterations: solution.history.clone(),
+        steps,
+    }
+}
+
+/// The approach the two bodies' prescribed displacements impose at load factor 1: the largest
+/// `|u1 - u2|` over a Dirichlet condition of each body (components not prescribed count as
+/// 0). A hemisphere pushed down by 0.01 onto a clamped block: 0.01.
+fn imposed_approach(problem: &ContactProblem) -> f64 {
+    let vector = |c: &DirichletCondition| c.components.map(|u| u.unwrap_or(0.0));
+    let mut largest = 0.0f64;
+    for a in &problem.primary.dirichlet {
+        for b in &problem.secondary.dirichlet {
+            let (u1, u2) = (vector(a), vector(b));
+            let d = (0..3).map(|k| (u1[k] - u2[k]).powi(2)).sum::<f64>().sqrt();
+            largest = largest.max(d);
+        }
+    }
+    largest
+}
+
+/// The case file's name without its extension (the plot title).
+fn case_name(case: &Case) -> String {
+    case.path.file_stem().map_or_else(
+        || case.path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    )
+}

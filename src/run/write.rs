@@ -1,0 +1,89 @@
+//! The result files of a solved case: `solution.xdmf` and `solution.h5` (every body's fields),
+//! `summary.json`, and in contact runs `force_displacement.csv` and `.png`; `matrices/` when the
+//! case asks for them.
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::case::Case;
+use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
+use crate::mesh::{BodyMesh, Mesh};
+use crate::output::{
+    BodyFields, CaseSummary, OutputError, force_displacement_csv, write_force_displacement_png,
+    write_matrix_market, write_xdmf,
+};
+
+use super::{CaseSolution, RunError};
+
+/// Writes the result files of `solution` into `dir` and returns the summary it wrote (its
+/// timings include the writing).
+pub fn write_results(
+    solution: &mut CaseSolution,
+    case: &Case,
+    mesh: &Mesh,
+    dir: &Path,
+) -> Result<CaseSummary, RunError> {
+    let phase = Instant::now();
+    if let Some(contact) = &solution.contact {
+        let csv = dir.join("force_displacement.csv");
+        std::fs::write(&csv, force_displacement_csv(&contact.summary.steps))
+            .map_err(|source| OutputError::Io { path: csv, source })?;
+        // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
+        // A warning, since a file the user expects is missing.
+        let png = dir.join("force_displacement.png");
+        let steps = &contact.summary.steps;
+        if let Err(e) =
+            write_force_displacement_png(&png, &contact.plot_title, steps, contact.imposed_approach)
+        {
+            log::warn!("{} not written: {e}", png.display());
+        }
+    }
+    let meshes: Vec<&BodyMesh> = (solution.bodies.iter())
+        .map(|s| mesh.body(&s.name).expect("solved bodies are mesh bodies"))
+        .collect();
+    let fields: Vec<BodyFields> = (solution.bodies.iter().zip(&meshes))
+        .map(|(s, body)| BodyFields {
+            mesh: body,
+            displacement: &s.solution.displacement,
+            cell_fields: &s.solution.cell_fields,
+            surface: s.surface.as_ref(),
+        })
+        .collect();
+    write_xdmf(dir, "solution", &fields)?;
+    if case.export_matrices {
+        export_matrices(case, mesh, dir)?;
+    }
+    solution.timings.record("write output", phase);
+    let summary = solution.summary(case, mesh);
+    summary.write(&dir.join("summary.json"))?;
+    Ok(summary)
+}
+
+/// Writes `matrices/<body>_stiffness.mtx` (unconstrained `K`) and
+/// `matrices/<body>__<group>_mass.mtx` for every boundary group the case uses (not for point
+/// groups, which have no surface).
+fn export_matrices(case: &Case, mesh: &Mesh, output_dir: &Path) -> Result<(), RunError> {
+    let dir = output_dir.join("matrices");
+    std::fs::create_dir_all(&dir).map_err(|source| OutputError::Io {
+        path: dir.clone(),
+        source,
+    })?;
+    for spec in &case.bodies {
+        let body = case.body_mesh(mesh, spec)?;
+        let problem = case.elastic_problem(body, spec)?;
+        let k = assemble_stiffness(body, &problem.material, &stiffness_pattern(body));
+        write_matrix_market(&dir.join(format!("{}_stiffness.mtx", body.name)), &k)?;
+        let mut groups: Vec<&String> = (problem.dirichlet.iter().map(|d| &d.group))
+            .chain(problem.loads.iter().map(|l| &l.group))
+            .collect();
+        groups.sort();
+        groups.dedup();
+        for name in groups {
+            if let Some(group) = body.boundary_group(name) {
+                let m = assemble_surface_mass(body, group);
+                write_matrix_market(&dir.join(format!("{}__{}_mass.mtx", body.name, name)), &m)?;
+            }
+        }
+    }
+    Ok(())
+}
