@@ -167,14 +167,34 @@ impl Case {
             path: path.to_owned(),
             source,
         })?;
-        let mut case: Case = toml::from_str(&text).map_err(|e| CaseError::Syntax {
+        let case: Case = toml::from_str(&text).map_err(|e| CaseError::Syntax {
             path: path.to_owned(),
             message: e.to_string(),
         })?;
         let folder = path.parent().unwrap_or(Path::new(""));
-        case.mesh = folder.join(&case.mesh);
-        case.output = case.output.map(|output| folder.join(output));
-        case.path = path.to_owned();
+        case.checked(path, folder)
+    }
+
+    /// A case given as a table of the case file's keys rather than as a file (the Python
+    /// module's `Case.from_dict`), with the same checks as [`Case::load`]. `name` stands for the
+    /// case file in error messages and the plot title; relative paths are relative to `folder`.
+    pub fn from_table(table: toml::Table, name: &str, folder: &Path) -> Result<Self, CaseError> {
+        let path = Path::new(name);
+        let case = Case::deserialize(toml::Value::Table(table)).map_err(|e| CaseError::Syntax {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        case.checked(path, folder)
+    }
+
+    /// Resolves the case's paths against `folder` and checks what the schema alone cannot.
+    fn checked(self, path: &Path, folder: &Path) -> Result<Self, CaseError> {
+        let case = Case {
+            mesh: folder.join(&self.mesh),
+            output: self.output.map(|output| folder.join(output)),
+            path: path.to_owned(),
+            ..self
+        };
         if case.bodies.is_empty() {
             return Err(case.invalid("[[body]]", "the case names no body"));
         }

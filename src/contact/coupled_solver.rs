@@ -148,7 +148,9 @@ impl BodyFactors {
                 false => KRYLOV_RTOL,
             };
             Interface::Krylov {
-                state: KrylovState::new(settings.verbose && std::io::stderr().is_terminal()),
+                state: KrylovState::new(
+                    settings.verbose && settings.progress_line && std::io::stderr().is_terminal(),
+                ),
                 tolerance,
                 max_iterations: contact.krylov_max_iterations,
             }

@@ -38,11 +38,15 @@ pub struct SolverSettings {
     pub ordering: Ordering,
     /// A solve whose relative residual exceeds this is reported as failed (default 1e-8).
     pub residual_tolerance: f64,
-    /// Report each phase and its time (`log` messages at level info), and show the live progress
-    /// line of long interface solves when stderr is a terminal (default: true; the CLI's
-    /// `--quiet` and the Python module clear it).
+    /// Report each phase and its time as `log` messages at level info (default: true; the
+    /// CLI's `--quiet` clears it).
     #[serde(skip)]
     pub verbose: bool,
+    /// With `verbose`, rewrite a live progress line of long interface solves on stderr when it
+    /// is a terminal (default: true; the Python module clears it: its messages go to Python's
+    /// `logging`, never to the terminal).
+    #[serde(skip)]
+    pub progress_line: bool,
 }
 
 impl SolverSettings {
@@ -66,6 +70,7 @@ impl Default for SolverSettings {
             ordering: Ordering::default(),
             residual_tolerance: 1e-8,
             verbose: true,
+            progress_line: true,
         }
     }
 }

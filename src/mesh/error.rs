@@ -94,6 +94,9 @@ pub enum MeshError {
          partitioned too"
     )]
     Partitioned { path: PathBuf, line: usize },
+    /// A mesh handed over in memory ([`super::GmshModel`]) whose parts do not fit together.
+    #[error("{path}: {message}")]
+    Model { path: PathBuf, message: String },
     #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
     EmptyBody { path: PathBuf, body: String },
 }

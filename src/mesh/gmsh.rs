@@ -6,7 +6,7 @@ use std::fs;
 use std::path::Path;
 
 use super::msh41::{self, MshContents, element_type_name};
-use super::{BodyMesh, Dim, FacetGroup, Mesh, MeshError, PhysicalGroup, check_cells};
+use super::{BodyMesh, Dim, FacetGroup, GmshModel, Mesh, MeshError, PhysicalGroup, check_cells};
 
 /// gmsh element types: 1 the 2-node line, 2 the 3-node triangle, 4 the 4-node tetrahedron, 15
 /// the point.
@@ -35,7 +35,17 @@ pub fn read_msh(path: &Path) -> Result<Mesh, MeshError> {
 /// [`read_msh`] on the bytes of a file already read; `path` names it in the mesh and in errors.
 /// Any bytes give a mesh or an error, never a panic (the fuzz target in `fuzz/` checks this).
 pub fn read_msh_bytes(path: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
-    let msh = msh41::parse(path, bytes)?;
+    split(path, msh41::parse(path, bytes)?)
+}
+
+/// A mesh handed over in memory (see [`GmshModel`]), checked and split into bodies as a file
+/// is; `label` names it in the mesh and in errors.
+pub fn mesh_from_model(label: &Path, model: GmshModel) -> Result<Mesh, MeshError> {
+    split(label, model.into_contents(label)?)
+}
+
+/// Splits the contents of a file (or model) into bodies, boundary groups and point groups.
+fn split(path: &Path, msh: MshContents) -> Result<Mesh, MeshError> {
     let physical_names: BTreeMap<(Dim, i32), String> = msh
         .physical_names
         .iter()

@@ -11,13 +11,15 @@
 mod error;
 mod generate;
 mod gmsh;
+mod model;
 mod msh41;
 mod quality;
 mod summary;
 
 pub use error::MeshError;
 pub use generate::mesh_geo;
-pub use gmsh::{read_msh, read_msh_bytes};
+pub use gmsh::{mesh_from_model, read_msh, read_msh_bytes};
+pub use model::{GmshModel, ModelElements, ModelGroup};
 pub use quality::{check_cells, signed_measure};
 pub use summary::MeshSummary;
 

@@ -401,7 +401,7 @@ fn entity_dim(cursor: &Cursor, dim: i32, what: &str) -> Result<Dim, MeshError> {
 
 /// Nodes per element of a gmsh element type (the types of gmsh's `GmshDefines.h` up to order
 /// 4), or `None` for a type we do not know: in a binary file its elements could not be skipped.
-fn nodes_per_element(element_type: i32) -> Option<usize> {
+pub(super) fn nodes_per_element(element_type: i32) -> Option<usize> {
     const NODES: [usize; 31] = [
         2, 3, 4, 4, 8, 6, 5, 3, 6, 9, 10, 27, 18, 14, 1, 8, 20, 15, 13, 9, 10, 12, 15, 15, 21, 4,
         5, 6, 20, 35, 56,

@@ -141,10 +141,10 @@ fn solve_into(
     );
 
     // 2. Every body solved: the two in contact together, the others alone.
-    let mut solution = solve_case_on(&case, &mesh, timings)?;
+    let solution = solve_case_on(&case, &mesh, timings)?;
 
     // 3. The result files, into the staging folder.
-    let summary = write_results(&mut solution, &case, &mesh, results.staging())?;
+    let summary = write_results(&solution, &case, &mesh, results.staging())?;
     log::info!(
         "wrote {} (solution.xdmf, solution.h5, summary.json) in {:.3} s total",
         results.dir().display(),

@@ -175,6 +175,11 @@ pub fn solve_case_on(
 impl CaseSolution {
     /// The contents of `summary.json`, with the timings recorded so far.
     pub fn summary(&self, case: &Case, mesh: &Mesh) -> CaseSummary {
+        self.summary_with(case, mesh, &self.timings)
+    }
+
+    /// [`CaseSolution::summary`] with `timings` (this solve's, and more phases after it).
+    pub(super) fn summary_with(&self, case: &Case, mesh: &Mesh, timings: &Timings) -> CaseSummary {
         let (mut node_offset, mut cell_offset) = (0, 0);
         let bodies = (self.bodies.iter())
             .map(|solved| {
@@ -208,7 +213,7 @@ impl CaseSolution {
             dimension: mesh.dim,
             bodies,
             contact: self.contact.as_ref().map(|c| c.summary.clone()),
-            timings: self.timings.with_total(),
+            timings: timings.with_total(),
             peak_memory_mb: peak_memory_mb(),
         }
     }

@@ -18,7 +18,7 @@ use super::{CaseSolution, RunError};
 /// Writes the result files of `solution` into `dir` and returns the summary it wrote (its
 /// timings include the writing).
 pub fn write_results(
-    solution: &mut CaseSolution,
+    solution: &CaseSolution,
     case: &Case,
     mesh: &Mesh,
     dir: &Path,
@@ -53,8 +53,9 @@ pub fn write_results(
     if case.export_matrices {
         export_matrices(case, mesh, dir)?;
     }
-    solution.timings.record("write output", phase);
-    let summary = solution.summary(case, mesh);
+    let mut timings = solution.timings.clone();
+    timings.record("write output", phase);
+    let summary = solution.summary_with(case, mesh, &timings);
     summary.write(&dir.join("summary.json"))?;
     Ok(summary)
 }
