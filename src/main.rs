@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use internodes::mesh::{MeshSummary, read_msh};
-use internodes::output::unsaid_causes;
+use internodes::output::{Verdict, unsaid_causes};
 use internodes::run::{RunOptions, solve_case};
 
 #[derive(Parser)]
@@ -39,12 +39,6 @@ enum Command {
         mesh: PathBuf,
     },
 }
-
-/// Exit status of a solve whose contact problem was not solved (a status other than
-/// `converged` or `no-contact`).
-const EXIT_NOT_SOLVED: u8 = 2;
-/// Exit status of a solve whose contact problem was solved but whose accuracy report failed.
-const EXIT_INACCURATE: u8 = 3;
 
 fn main() -> ExitCode {
     // A closed pipe on stdout or stderr (`internodes solve case 2>&1 | head -1`) ends the
@@ -83,25 +77,15 @@ fn main() -> ExitCode {
         .map_err(Into::into)
         .map(|report| {
             let folder = report.output_dir.display();
-            match report.summary.contact.as_ref() {
-                Some(contact) if !contact.status.is_solution() => {
-                    let failed = failures(&contact.solved.checks);
-                    eprintln!(
-                        "error: the contact problem was not solved: status \"{}\"{} (see {folder}/summary.json); the last iterate was written for inspection",
-                        contact.status.name(),
-                        if failed.is_empty() { String::new() } else { format!(", failed: {failed}") },
-                    );
-                    EXIT_NOT_SOLVED
-                }
-                Some(contact) if !contact.accuracy.passed => {
-                    eprintln!(
-                        "error: the contact problem was solved, but its accuracy report failed: {} (see {folder}/summary.json)",
-                        failures(&contact.accuracy.indicators)
-                    );
-                    EXIT_INACCURATE
-                }
-                _ => 0,
+            let verdict = report.summary.verdict();
+            match &verdict {
+                Verdict::NotSolved(why) => eprintln!(
+                    "error: {why} (see {folder}/summary.json); the last iterate was written for inspection"
+                ),
+                Verdict::Inaccurate(why) => eprintln!("error: {why} (see {folder}/summary.json)"),
+                Verdict::Solved => {}
             }
+            verdict.exit_status()
         }),
         Command::Info { mesh } => read_msh(&mesh)
             .map_err(Into::into)
@@ -118,14 +102,6 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// The failed checks among `checks`, in one line.
-fn failures(checks: &[internodes::contact::CertificateCheck]) -> String {
-    (checks.iter().filter(|c| !c.passed))
-        .map(|c| c.describe())
-        .collect::<Vec<_>>()
-        .join("; ")
 }
 
 /// Prints the library's progress messages on stderr as they are, and its warnings prefixed

@@ -13,7 +13,7 @@ pub use folder::{
 pub use matrix_market::write_matrix_market;
 pub use plot::{PLOT_SIZE, PlotError, write_force_displacement_png};
 pub use summary::{
-    BodySummary, CaseSummary, ContactSummary, force_displacement_csv, peak_memory_mb,
+    BodySummary, CaseSummary, ContactSummary, Verdict, force_displacement_csv, peak_memory_mb,
 };
 pub use xdmf::{BodyFields, write_xdmf};
 

@@ -104,6 +104,63 @@ pub struct AccuracyReport {
     pub indicators: Vec<CertificateCheck>,
 }
 
+/// How a solved case ended, as the command line's exit status tells it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Verdict {
+    /// Every body solved; a contact problem, if any, solved and its accuracy report passed
+    /// (exit status 0).
+    Solved,
+    /// The contact problem was not solved (a status other than `converged` or `no-contact`;
+    /// exit status 2): why, in one line.
+    NotSolved(String),
+    /// The contact problem was solved but its accuracy report failed (exit status 3): why.
+    Inaccurate(String),
+}
+
+impl Verdict {
+    /// The command line's exit status for this verdict.
+    pub fn exit_status(&self) -> u8 {
+        match self {
+            Verdict::Solved => 0,
+            Verdict::NotSolved(_) => 2,
+            Verdict::Inaccurate(_) => 3,
+        }
+    }
+}
+
+impl CaseSummary {
+    /// Whether the case was solved, and accurately.
+    pub fn verdict(&self) -> Verdict {
+        match &self.contact {
+            Some(contact) if !contact.status.is_solution() => {
+                let failed = failures(&contact.solved.checks);
+                Verdict::NotSolved(format!(
+                    "the contact problem was not solved: status \"{}\"{}",
+                    contact.status.name(),
+                    if failed.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", failed: {failed}")
+                    },
+                ))
+            }
+            Some(contact) if !contact.accuracy.passed => Verdict::Inaccurate(format!(
+                "the contact problem was solved, but its accuracy report failed: {}",
+                failures(&contact.accuracy.indicators)
+            )),
+            _ => Verdict::Solved,
+        }
+    }
+}
+
+/// The failed checks among `checks`, in one line.
+fn failures(checks: &[CertificateCheck]) -> String {
+    (checks.iter().filter(|c| !c.passed))
+        .map(|c| c.describe())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 impl ContactSummary {
     /// The two parts of a certificate.
     pub fn checks(certificate: &Certificate) -> (SolvedChecks, AccuracyReport) {

@@ -1,0 +1,45 @@
+"""Frictionless contact between elastic bodies with non-matching meshes (INTERNODES).
+
+The Python face of the ``internodes`` solver: the same case keys, checks, solve and result files
+as the command line ``internodes solve CASE``, with results as NumPy arrays.
+
+    import internodes
+    case = internodes.Case.from_toml("geo/hemisphere_on_block.toml")
+    result = internodes.solve(case)
+    result.raise_for_status()
+    print(result.summary["contact"]["force_primary"])
+
+Progress goes to the ``logging`` logger ``internodes`` (silent unless configured, e.g.
+``logging.basicConfig(level=logging.INFO)``). See docs/python.md.
+"""
+
+import logging
+
+from ._internodes import (
+    BodyResult,
+    Case,
+    InputError,
+    Mesh,
+    NotSolvedError,
+    Result,
+    SolveError,
+    SurfaceResult,
+    WriteError,
+    solve,
+)
+
+# A library's logger stays silent until the application configures logging.
+logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+__all__ = [
+    "BodyResult",
+    "Case",
+    "InputError",
+    "Mesh",
+    "NotSolvedError",
+    "Result",
+    "SolveError",
+    "SurfaceResult",
+    "WriteError",
+    "solve",
+]

@@ -1,0 +1,44 @@
+"""Reads a gmsh model's mesh through the gmsh Python API, for ``Mesh.from_gmsh``.
+
+Only gathers arrays: the checks and the split into bodies are the solver's own, the same as for
+a file.
+"""
+
+import numpy as np
+
+
+def model_arrays(model=None):
+    """The physical groups, nodes and element blocks of gmsh's current model (or ``model``)."""
+    import gmsh
+
+    if not gmsh.isInitialized():
+        raise RuntimeError("gmsh is not initialized: call gmsh.initialize() and build a model first")
+    if model is not None:
+        gmsh.model.setCurrent(model)
+    name = gmsh.model.getCurrent()
+    groups = []
+    for dim, tag in gmsh.model.getPhysicalGroups():
+        entities = [int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(dim, tag)]
+        groups.append((int(dim), int(tag), gmsh.model.getPhysicalName(dim, tag), entities))
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    blocks = []
+    for dim, entity in gmsh.model.getEntities():
+        types, element_tags, element_nodes = gmsh.model.mesh.getElements(dim, entity)
+        for kind, tags, nodes in zip(types, element_tags, element_nodes):
+            blocks.append(
+                (
+                    int(dim),
+                    int(entity),
+                    int(kind),
+                    np.ascontiguousarray(tags, dtype=np.uint64),
+                    np.ascontiguousarray(nodes, dtype=np.uint64),
+                )
+            )
+    return {
+        "label": f"gmsh model '{name}'",
+        "groups": groups,
+        "num_volumes": len(gmsh.model.getEntities(3)),
+        "node_tags": np.ascontiguousarray(node_tags, dtype=np.uint64),
+        "coords": np.ascontiguousarray(coords, dtype=np.float64),
+        "blocks": blocks,
+    }

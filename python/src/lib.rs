@@ -1,0 +1,635 @@
+//! `internodes._internodes`: the native part of the `internodes` Python package.
+//!
+//! A thin layer over the Rust library: a case is read and checked by `internodes::case`, a mesh
+//! by `internodes::mesh`, the solve is `internodes::run::solve_case_on` and the result files are
+//! `internodes::run::write_results`, exactly as the command line runs them. This module only
+//! converts: Python values in, NumPy arrays and the summary's JSON out, Rust errors into Python
+//! exceptions. `docs/python.md` is the user's page.
+
+use std::collections::BTreeMap;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyList};
+
+use internodes::case::Case as CaseFile;
+use internodes::mesh::{
+    GmshModel, Mesh as BodyMeshes, ModelElements, ModelGroup, mesh_from_model, mesh_geo, read_msh,
+    read_msh_bytes,
+};
+use internodes::output::{
+    CaseSummary, GENERATED_MESH, OutputError, ResultFolder, Verdict, unsaid_causes,
+};
+use internodes::run::{CaseSolution, RunError, Timings, solve_case_on, write_results};
+
+create_exception!(
+    internodes,
+    InputError,
+    PyValueError,
+    "A case or a mesh that cannot be used; the message is the command line's."
+);
+create_exception!(
+    internodes,
+    SolveError,
+    PyRuntimeError,
+    "A solve that failed: a body's linear solve, or the contact solve, named in the message."
+);
+create_exception!(
+    internodes,
+    NotSolvedError,
+    PyRuntimeError,
+    "Raised by Result.raise_for_status: the contact problem was not solved, or its accuracy \
+     report failed."
+);
+create_exception!(
+    internodes,
+    WriteError,
+    PyOSError,
+    "The result files could not be written."
+);
+
+/// An error's message and the causes its message does not already say, as the command line
+/// prints them.
+fn message(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    for cause in unsaid_causes(error) {
+        text += &format!("\n  caused by: {cause}");
+    }
+    text
+}
+
+/// The Python exception of a run's error.
+fn run_error(error: RunError) -> PyErr {
+    let text = message(&error);
+    match error {
+        RunError::Case(_) => InputError::new_err(text),
+        RunError::Solve { .. } | RunError::Contact { .. } => SolveError::new_err(text),
+        RunError::Output(_) => WriteError::new_err(text),
+    }
+}
+
+/// Runs `f`; a panic (a bug of the solver) becomes a `SolveError` instead of crossing into
+/// Python as pyo3's `PanicException`, which derives from `BaseException` and escapes
+/// `except Exception`.
+fn guarded<T>(what: &str, f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|panic| {
+        let why = (panic.downcast_ref::<String>().cloned())
+            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_else(|| "unknown".to_string());
+        Err(SolveError::new_err(format!(
+            "internal error of the solver during {what} (a bug; please report it with the \
+             case): {why}"
+        )))
+    })
+}
+
+/// A case: bodies, materials, boundary conditions, loads, and the contact settings, with the
+/// keys of a case file (`docs/case-file.md`) and the same checks.
+#[pyclass(module = "internodes", frozen)]
+struct Case {
+    file: CaseFile,
+    /// Whether the case names a mesh (a case built in code may leave it to `solve(mesh=...)`).
+    names_mesh: bool,
+}
+
+#[pymethods]
+impl Case {
+    /// Reads a case file. Relative paths in it are relative to its folder.
+    #[staticmethod]
+    fn from_toml(path: PathBuf) -> PyResult<Self> {
+        let file = CaseFile::load(&path).map_err(|e| InputError::new_err(message(&e)))?;
+        Ok(Case {
+            file,
+            names_mesh: true,
+        })
+    }
+
+    /// A case from a dict with the case file's keys (`{"mesh": ..., "body": [...], "contact":
+    /// {...}}`). `mesh` may be left out when a `Mesh` is passed to `solve`. `name` stands for
+    /// the case file in messages and the plot title; relative paths are relative to `folder`
+    /// (default: the current directory).
+    #[staticmethod]
+    #[pyo3(signature = (table, name = "case", folder = None))]
+    fn from_dict(
+        py: Python<'_>,
+        table: &Bound<'_, PyAny>,
+        name: &str,
+        folder: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        // The dict goes through JSON (its values may be path objects: `os.fspath` turns them
+        // into strings), then into the same schema as a file.
+        let os = py.import("os")?;
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("default", os.getattr("fspath")?)?;
+        let text: String = (py.import("json")?)
+            .call_method("dumps", (table,), Some(&kwargs))
+            .map_err(|e| InputError::new_err(format!("case '{name}': {e}")))?
+            .extract()?;
+        let mut value: toml::Table = serde_json::from_str(&text).map_err(|e| {
+            InputError::new_err(format!(
+                "case '{name}': expected a dict of case-file keys ({e})"
+            ))
+        })?;
+        let names_mesh = value.contains_key("mesh");
+        if !names_mesh {
+            value.insert("mesh".to_string(), toml::Value::String(String::new()));
+        }
+        let folder = folder.unwrap_or_default();
+        let file = CaseFile::from_table(value, name, &folder)
+            .map_err(|e| InputError::new_err(message(&e)))?;
+        Ok(Case { file, names_mesh })
+    }
+
+    /// The case file, or the name given to `from_dict`.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.file.path.clone()
+    }
+
+    /// The mesh the case names (`None` if it names none).
+    #[getter]
+    fn mesh(&self) -> Option<PathBuf> {
+        self.names_mesh.then(|| self.file.mesh.clone())
+    }
+
+    /// The bodies' names, in the case's order.
+    #[getter]
+    fn bodies(&self) -> Vec<String> {
+        self.file.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+
+    /// The load factors of the contact solve (`[1.0]` unless the case lists steps).
+    #[getter]
+    fn load_steps(&self) -> Vec<f64> {
+        self.file.load_steps()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Case('{}', bodies={:?}, contact={})",
+            self.file.path.display(),
+            self.bodies(),
+            self.file.contact.is_some()
+        )
+    }
+}
+
+/// A mesh: the bodies (physical surfaces in 2D, volumes in 3D), their boundary groups and point
+/// groups, as `docs/meshes.md` describes.
+#[pyclass(module = "internodes", frozen)]
+#[derive(Clone)]
+struct Mesh {
+    mesh: Arc<BodyMeshes>,
+    /// The MSH file gmsh made of a `.geo`: written as `mesh.msh` with the results, as the
+    /// command line does.
+    generated: Option<Arc<Vec<u8>>>,
+}
+
+#[pymethods]
+impl Mesh {
+    /// Reads a gmsh MSH 4.1 file.
+    #[staticmethod]
+    fn from_msh(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let mesh = py
+            .detach(|| read_msh(&path))
+            .map_err(|e| InputError::new_err(message(&e)))?;
+        Ok(Mesh {
+            mesh: Arc::new(mesh),
+            generated: None,
+        })
+    }
+
+    /// Meshes a `.geo` script with gmsh (the `gmsh` program), with `parameters` as gmsh's
+    /// `-setnumber` values.
+    #[staticmethod]
+    #[pyo3(signature = (path, parameters = None))]
+    fn from_geo(
+        py: Python<'_>,
+        path: PathBuf,
+        parameters: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Self> {
+        let parameters: Vec<(String, f64)> = parameters.unwrap_or_default().into_iter().collect();
+        py.detach(|| generate(&path, &parameters))
+    }
+
+    /// The current model of the `gmsh` Python module (or the model named `model`), meshed,
+    /// without a file: its physical groups, nodes and elements are read through gmsh's API.
+    #[staticmethod]
+    #[pyo3(signature = (model = None))]
+    fn from_gmsh(py: Python<'_>, model: Option<String>) -> PyResult<Self> {
+        let arrays = (py.import("internodes._gmsh")?).call_method1("model_arrays", (model,))?;
+        let label: String = arrays.get_item("label")?.extract()?;
+        let model = gmsh_model(&arrays)?;
+        let mesh = py
+            .detach(|| mesh_from_model(Path::new(&label), model))
+            .map_err(|e| InputError::new_err(message(&e)))?;
+        Ok(Mesh {
+            mesh: Arc::new(mesh),
+            generated: None,
+        })
+    }
+
+    /// The file (or model) the mesh came from.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.mesh.path.clone()
+    }
+
+    /// 2 or 3.
+    #[getter]
+    fn dim(&self) -> usize {
+        self.mesh.dim
+    }
+
+    /// The bodies' names.
+    #[getter]
+    fn bodies(&self) -> Vec<String> {
+        self.mesh.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+
+    /// The names of every physical group.
+    #[getter]
+    fn groups(&self) -> Vec<String> {
+        self.mesh
+            .physical_groups
+            .iter()
+            .map(|g| g.name.clone())
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Mesh('{}', dim={}, bodies={:?})",
+            self.mesh.path.display(),
+            self.mesh.dim,
+            self.bodies()
+        )
+    }
+}
+
+/// Meshes `geo` with gmsh into a temporary folder and reads the mesh; the mesh is named after
+/// the `.geo`.
+fn generate(geo: &Path, parameters: &[(String, f64)]) -> PyResult<Mesh> {
+    let folder = tempfile::tempdir().map_err(|e| WriteError::new_err(e.to_string()))?;
+    let msh = folder.path().join(GENERATED_MESH);
+    mesh_geo(geo, &msh, parameters).map_err(|e| {
+        InputError::new_err(format!("cannot mesh {} with gmsh: {e}", geo.display()))
+    })?;
+    let bytes = std::fs::read(&msh).map_err(|e| WriteError::new_err(e.to_string()))?;
+    let mesh = read_msh_bytes(geo, &bytes).map_err(|e| InputError::new_err(message(&e)))?;
+    Ok(Mesh {
+        mesh: Arc::new(mesh),
+        generated: Some(Arc::new(bytes)),
+    })
+}
+
+/// The model that `internodes._gmsh.model_arrays` read from gmsh's API.
+fn gmsh_model(arrays: &Bound<'_, PyAny>) -> PyResult<GmshModel> {
+    let vector_u64 = |value: Bound<'_, PyAny>| -> PyResult<Vec<u64>> {
+        Ok(value
+            .cast_into::<PyArray1<u64>>()?
+            .readonly()
+            .as_slice()?
+            .to_vec())
+    };
+    let mut model = GmshModel {
+        num_volumes: arrays.get_item("num_volumes")?.extract()?,
+        node_tags: vector_u64(arrays.get_item("node_tags")?)?,
+        coords: (arrays.get_item("coords")?.cast_into::<PyArray1<f64>>()?)
+            .readonly()
+            .as_slice()?
+            .to_vec(),
+        ..GmshModel::default()
+    };
+    for group in arrays.get_item("groups")?.cast_into::<PyList>()?.iter() {
+        let (dim, tag, name, entities): (usize, i32, String, Vec<i32>) = group.extract()?;
+        model.physical_groups.push(ModelGroup {
+            dim,
+            tag,
+            name,
+            entities,
+        });
+    }
+    for block in arrays.get_item("blocks")?.cast_into::<PyList>()?.iter() {
+        let (entity_dim, entity_tag, element_type, element_tags, node_tags): (
+            usize,
+            i32,
+            i32,
+            Bound<'_, PyAny>,
+            Bound<'_, PyAny>,
+        ) = block.extract()?;
+        model.element_blocks.push(ModelElements {
+            entity_dim,
+            entity_tag,
+            element_type,
+            element_tags: vector_u64(element_tags)?,
+            node_tags: vector_u64(node_tags)?,
+        });
+    }
+    Ok(model)
+}
+
+/// Solves a case, on `mesh` or on the mesh the case names (read, or meshed with gmsh when it
+/// is a `.geo`). The solve runs without the GIL.
+///
+/// Raises `InputError` for a case or mesh that cannot be used and `SolveError` when a solve
+/// fails; a contact problem that was not solved, or whose accuracy report failed, is a result
+/// with that status (see `Result.exit_code` and `Result.raise_for_status`), as the command line
+/// writes its results and says so in its exit status.
+#[pyfunction]
+#[pyo3(signature = (case, mesh = None))]
+fn solve(py: Python<'_>, case: &Case, mesh: Option<PyRef<'_, Mesh>>) -> PyResult<Result> {
+    let mesh = match mesh {
+        Some(mesh) => mesh.clone(),
+        None if !case.names_mesh => {
+            return Err(InputError::new_err(format!(
+                "case '{}' names no mesh: give it the `mesh` key, or pass mesh= to solve()",
+                case.file.path.display()
+            )));
+        }
+        None if case.file.generates_mesh() => {
+            let parameters: Vec<(String, f64)> = (case.file.geo_parameters.iter())
+                .map(|(k, v)| (k.clone(), *v))
+                .collect();
+            py.detach(|| generate(&case.file.mesh, &parameters))?
+        }
+        None => Mesh::from_msh(py, case.file.mesh.clone())?,
+    };
+    let mut file = case.file.clone();
+    file.solver.verbose = true;
+    file.solver.progress_line = false;
+    let solution = py.detach(|| {
+        guarded("the solve", || {
+            solve_case_on(&file, &mesh.mesh, Timings::start()).map_err(run_error)
+        })
+    })?;
+    let summary = solution.summary(&file, &mesh.mesh);
+    Ok(Result {
+        case: file,
+        mesh,
+        solution,
+        summary,
+        bodies: PyOnceLock::new(),
+    })
+}
+
+/// A solved case: the summary (`summary.json`'s contents), every body's fields as NumPy
+/// arrays, and the result files on request.
+#[pyclass(module = "internodes", frozen)]
+struct Result {
+    case: CaseFile,
+    mesh: Mesh,
+    solution: CaseSolution,
+    summary: CaseSummary,
+    bodies: PyOnceLock<Py<PyDict>>,
+}
+
+#[pymethods]
+impl Result {
+    /// What `summary.json` holds: status, certificate and accuracy report, forces, Hertz fit,
+    /// iteration history and load-step records, per-body sizes and reactions, timings.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = serde_json::to_string(&self.summary)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
+    /// The contact status (`"converged"`, `"no-contact"`, `"iteration-limit"`, ...), or `None`
+    /// when the case has no contact.
+    #[getter]
+    fn status(&self) -> Option<&'static str> {
+        self.summary.contact.as_ref().map(|c| c.status.name())
+    }
+
+    /// Whether every body was solved and the contact problem, if any, was solved.
+    #[getter]
+    fn solved(&self) -> bool {
+        !matches!(self.summary.verdict(), Verdict::NotSolved(_))
+    }
+
+    /// Whether the answer passed its accuracy report too (the command line's exit status 0).
+    #[getter]
+    fn accurate(&self) -> bool {
+        self.summary.verdict() == Verdict::Solved
+    }
+
+    /// The command line's exit status for this result: 0 solved, 2 not solved, 3 solved but
+    /// inaccurate.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.summary.verdict().exit_status()
+    }
+
+    /// Raises `NotSolvedError`, with the command line's message, unless `exit_code` is 0.
+    fn raise_for_status(&self) -> PyResult<()> {
+        match self.summary.verdict() {
+            Verdict::Solved => Ok(()),
+            Verdict::NotSolved(why) | Verdict::Inaccurate(why) => Err(NotSolvedError::new_err(why)),
+        }
+    }
+
+    /// Each body's fields by name (a `dict` of `BodyResult`), built on first access.
+    #[getter]
+    fn bodies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let bodies = self
+            .bodies
+            .get_or_try_init(py, || -> PyResult<Py<PyDict>> {
+                let dict = PyDict::new(py);
+                for solved in &self.solution.bodies {
+                    let body = BodyResult::new(py, &self.mesh.mesh, solved)?;
+                    dict.set_item(&solved.name, Py::new(py, body)?)?;
+                }
+                Ok(dict.unbind())
+            })?;
+        Ok(bodies.bind(py).clone())
+    }
+
+    /// Writes the command line's result files into `folder` (`solution.xdmf` and `.h5`,
+    /// `summary.json`, `force_displacement.csv` and `.png`, `matrices/` when the case exports
+    /// them, and `mesh.msh` when the mesh was made from a `.geo`), replacing earlier results
+    /// there, and returns the folder.
+    fn write(&self, py: Python<'_>, folder: PathBuf) -> PyResult<PathBuf> {
+        py.detach(|| guarded("writing the results", || self.write_into(&folder)))?;
+        Ok(folder)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Result(status={}, exit_code={}, bodies={:?})",
+            self.status().unwrap_or("solved"),
+            self.exit_code(),
+            (self.solution.bodies.iter())
+                .map(|b| &b.name)
+                .collect::<Vec<_>>()
+        )
+    }
+}
+
+impl Result {
+    fn write_into(&self, folder: &Path) -> PyResult<()> {
+        let write_error = |e: OutputError| WriteError::new_err(message(&e));
+        let mut inputs = vec![self.mesh.mesh.path.as_path()];
+        if self.case.path.is_file() {
+            inputs.push(self.case.path.as_path());
+        }
+        let origin = format!("Result.write({})", folder.display());
+        let generated = self.mesh.generated.as_deref();
+        let results = ResultFolder::create(folder, &origin, &inputs, generated.is_some())
+            .map_err(write_error)?;
+        let written = (|| {
+            if let Some(bytes) = generated {
+                let staged = results.staging().join(GENERATED_MESH);
+                std::fs::write(&staged, bytes.as_slice()).map_err(|source| OutputError::Io {
+                    path: staged,
+                    source,
+                })?;
+                results.publish(GENERATED_MESH)?;
+            }
+            write_results(
+                &self.solution,
+                &self.case,
+                &self.mesh.mesh,
+                results.staging(),
+            )?;
+            results.commit()?;
+            Ok::<(), RunError>(())
+        })();
+        written.map_err(|e| {
+            results.fail("Result.write", &e);
+            run_error(e)
+        })
+    }
+}
+
+/// One body's fields: node-wise arrays in the body's local numbering, cell-wise arrays in its
+/// cell order.
+#[pyclass(module = "internodes", frozen, get_all)]
+struct BodyResult {
+    name: String,
+    /// `(n, dim)` node coordinates.
+    coordinates: Py<PyAny>,
+    /// `(n,)` gmsh node tags.
+    node_tags: Py<PyAny>,
+    /// `(n, dim)` displacement.
+    displacement: Py<PyAny>,
+    /// `(m, dim + 1)` cell connectivity (local node indices).
+    cells: Py<PyAny>,
+    /// `(m,)` gmsh element tags.
+    cell_tags: Py<PyAny>,
+    /// `(m, 3, 3)` strain and Cauchy stress per cell (plane strain in 2D: the zz component).
+    strain: Py<PyAny>,
+    stress: Py<PyAny>,
+    /// `(m,)` von Mises stress per cell.
+    von_mises: Py<PyAny>,
+    /// The contact surface's fields in contact runs, else `None`.
+    surface: Option<Py<SurfaceResult>>,
+}
+
+/// Interface fields on a body's contact candidate surface.
+#[pyclass(module = "internodes", frozen, get_all)]
+struct SurfaceResult {
+    /// `(k,)` body-local node index of each surface node.
+    nodes: Py<PyAny>,
+    /// `(k,)` contact pressure (positive in compression).
+    pressure: Py<PyAny>,
+    /// `(k,)` normal contact force over the node's area.
+    mean_pressure: Py<PyAny>,
+    /// `(k, dim)` contact traction.
+    traction: Py<PyAny>,
+    /// `(k,)` signed distance to the other body in the deformed configuration (negative
+    /// inside it).
+    gap: Py<PyAny>,
+    /// `(k,)` whether the node is in contact.
+    active: Py<PyAny>,
+}
+
+/// A flat vector as a NumPy array of shape `shape`.
+fn array<T: numpy::Element>(py: Python<'_>, data: Vec<T>, shape: &[usize]) -> PyResult<Py<PyAny>> {
+    Ok(PyArray1::from_vec(py, data)
+        .reshape(shape)?
+        .into_any()
+        .unbind())
+}
+
+impl BodyResult {
+    fn new(
+        py: Python<'_>,
+        mesh: &BodyMeshes,
+        solved: &internodes::run::SolvedBody,
+    ) -> PyResult<Self> {
+        let body = mesh
+            .body(&solved.name)
+            .expect("solved bodies are mesh bodies");
+        let (n, m, dim) = (body.num_nodes(), body.num_cells(), body.dim);
+        let fields = &solved.solution.cell_fields;
+        let coordinates = body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect();
+        let tensors = |t: &[[f64; 9]]| t.iter().flatten().copied().collect::<Vec<f64>>();
+        let surface = match &solved.surface {
+            None => None,
+            Some(s) => {
+                let k = s.nodes.len();
+                let traction = s.traction.iter().flat_map(|t| t[..dim].to_vec()).collect();
+                Some(Py::new(
+                    py,
+                    SurfaceResult {
+                        nodes: array(py, s.nodes.clone(), &[k])?,
+                        pressure: array(py, s.pressure.clone(), &[k])?,
+                        mean_pressure: array(py, s.mean_pressure.clone(), &[k])?,
+                        traction: array(py, traction, &[k, dim])?,
+                        gap: array(py, s.normal_gap.clone(), &[k])?,
+                        active: array(py, s.active.clone(), &[k])?,
+                    },
+                )?)
+            }
+        };
+        Ok(BodyResult {
+            name: solved.name.clone(),
+            coordinates: array(py, coordinates, &[n, dim])?,
+            node_tags: array(py, body.node_tags.clone(), &[n])?,
+            displacement: array(py, solved.solution.displacement.clone(), &[n, dim])?,
+            cells: array(py, body.cells.clone(), &[m, dim + 1])?,
+            cell_tags: array(py, body.cell_tags.clone(), &[m])?,
+            strain: array(py, tensors(&fields.strain), &[m, 3, 3])?,
+            stress: array(py, tensors(&fields.stress), &[m, 3, 3])?,
+            von_mises: array(py, fields.von_mises.clone(), &[m])?,
+            surface,
+        })
+    }
+}
+
+#[pymethods]
+impl BodyResult {
+    fn __repr__(&self) -> String {
+        format!("BodyResult('{}')", self.name)
+    }
+}
+
+#[pymodule]
+fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Results must not depend on the number of threads, as in the command line: faer's sparse
+    // LUs take faer's global setting, whose default splits work by thread count.
+    faer::set_global_parallelism(faer::Par::Seq);
+    // The solver's messages go to the Python logger named after their Rust module
+    // (`internodes.contact.driver`, ...), read afresh at each message so that a logging
+    // configuration made after the import holds.
+    let _ = pyo3_log::Logger::new(m.py(), pyo3_log::Caching::Nothing)?.install();
+    m.add_class::<Case>()?;
+    m.add_class::<Mesh>()?;
+    m.add_class::<Result>()?;
+    m.add_class::<BodyResult>()?;
+    m.add_class::<SurfaceResult>()?;
+    m.add_function(wrap_pyfunction!(solve, m)?)?;
+    let py = m.py();
+    m.add("InputError", py.get_type::<InputError>())?;
+    m.add("SolveError", py.get_type::<SolveError>())?;
+    m.add("NotSolvedError", py.get_type::<NotSolvedError>())?;
+    m.add("WriteError", py.get_type::<WriteError>())?;
+    Ok(())
+}
