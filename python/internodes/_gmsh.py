@@ -6,16 +6,22 @@ a file.
 
 import numpy as np
 
+from ._internodes import InputError
+
 
 def model_arrays(model=None):
     """The physical groups, nodes and element blocks of gmsh's current model (or ``model``)."""
     import gmsh
 
-    if not gmsh.isInitialized():
-        raise RuntimeError("gmsh is not initialized: call gmsh.initialize() and build a model first")
-    if model is not None:
-        gmsh.model.setCurrent(model)
-    name = gmsh.model.getCurrent()
+    try:
+        if model is not None:
+            gmsh.model.setCurrent(model)
+        name = gmsh.model.getCurrent()
+    except Exception as error:
+        raise InputError(
+            f"no gmsh model to read ({error}): call gmsh.initialize(), build and mesh a model, "
+            "then Mesh.from_gmsh() before gmsh.finalize()"
+        ) from error
     groups = []
     for dim, tag in gmsh.model.getPhysicalGroups():
         entities = [int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(dim, tag)]
@@ -35,7 +41,7 @@ def model_arrays(model=None):
                 )
             )
     return {
-        "label": f"gmsh model '{name}'",
+        "label": f"gmsh model '{name}'" if name else "gmsh model",
         "groups": groups,
         "num_volumes": len(gmsh.model.getEntities(3)),
         "node_tags": np.ascontiguousarray(node_tags, dtype=np.uint64),

@@ -18,10 +18,10 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
 
-use internodes::case::Case as CaseFile;
+use internodes::case::{Case as CaseFile, CaseError};
 use internodes::mesh::{
-    GmshModel, Mesh as BodyMeshes, ModelElements, ModelGroup, mesh_from_model, mesh_geo, read_msh,
-    read_msh_bytes,
+    GmshModel, Mesh as BodyMeshes, MeshError, ModelElements, ModelGroup, mesh_from_model, mesh_geo,
+    read_msh, read_msh_bytes,
 };
 use internodes::output::{
     CaseSummary, GENERATED_MESH, OutputError, ResultFolder, Verdict, unsaid_causes,
@@ -57,7 +57,8 @@ create_exception!(
 /// An error's message and the causes its message does not already say, as the command line
 /// prints them.
 fn message(error: &dyn std::error::Error) -> String {
-    let mut text = error.to_string();
+    // The TOML parser's messages end with a newline, which an exception's text does not need.
+    let mut text = error.to_string().trim_end().to_string();
     for cause in unsaid_causes(error) {
         text += &format!("\n  caused by: {cause}");
     }
@@ -131,7 +132,15 @@ impl Case {
             .call_method("dumps", (table,), Some(&kwargs))
             .map_err(|e| InputError::new_err(format!("case '{name}': {e}")))?
             .extract()?;
-        let mut value: toml::Table = serde_json::from_str(&text).map_err(|e| {
+        let json: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| InputError::new_err(e.to_string()))?;
+        if let Some(key) = first_none(&json, String::new()) {
+            return Err(InputError::new_err(format!(
+                "case '{name}': {key} is None: a case file has no null; leave the key out to \
+                 take its default"
+            )));
+        }
+        let mut value: toml::Table = serde_json::from_value(json).map_err(|e| {
             InputError::new_err(format!(
                 "case '{name}': expected a dict of case-file keys ({e})"
             ))
@@ -180,6 +189,27 @@ impl Case {
     }
 }
 
+/// The place of the first `None` in a case's dict (`body[0].youngs_modulus`), if any.
+fn first_none(value: &serde_json::Value, at: String) -> Option<String> {
+    match value {
+        serde_json::Value::Null => Some(at),
+        serde_json::Value::Array(items) => {
+            (items.iter().enumerate()).find_map(|(k, item)| first_none(item, format!("{at}[{k}]")))
+        }
+        serde_json::Value::Object(table) => table.iter().find_map(|(key, item)| {
+            first_none(
+                item,
+                if at.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{at}.{key}")
+                },
+            )
+        }),
+        _ => None,
+    }
+}
+
 /// A mesh: the bodies (physical surfaces in 2D, volumes in 3D), their boundary groups and point
 /// groups, as `docs/meshes.md` describes.
 #[pyclass(module = "internodes", frozen)]
@@ -198,7 +228,7 @@ impl Mesh {
     fn from_msh(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let mesh = py
             .detach(|| read_msh(&path))
-            .map_err(|e| InputError::new_err(message(&e)))?;
+            .map_err(|e| mesh_error(e, None))?;
         Ok(Mesh {
             mesh: Arc::new(mesh),
             generated: None,
@@ -215,7 +245,7 @@ impl Mesh {
         parameters: Option<BTreeMap<String, f64>>,
     ) -> PyResult<Self> {
         let parameters: Vec<(String, f64)> = parameters.unwrap_or_default().into_iter().collect();
-        py.detach(|| generate(&path, &parameters))
+        py.detach(|| generate(&path, &parameters, None))
     }
 
     /// The current model of the `gmsh` Python module (or the model named `model`), meshed,
@@ -228,7 +258,7 @@ impl Mesh {
         let model = gmsh_model(&arrays)?;
         let mesh = py
             .detach(|| mesh_from_model(Path::new(&label), model))
-            .map_err(|e| InputError::new_err(message(&e)))?;
+            .map_err(|e| mesh_error(e, None))?;
         Ok(Mesh {
             mesh: Arc::new(mesh),
             generated: None,
@@ -273,20 +303,38 @@ impl Mesh {
     }
 }
 
-/// Meshes `geo` with gmsh into a temporary folder and reads the mesh; the mesh is named after
-/// the `.geo`.
-fn generate(geo: &Path, parameters: &[(String, f64)]) -> PyResult<Mesh> {
+/// Meshes `geo` with gmsh into a temporary folder and reads the mesh, which is named after the
+/// `.geo`. Errors name `case` when the case named the `.geo`, as the command line's do.
+fn generate(geo: &Path, parameters: &[(String, f64)], case: Option<&Path>) -> PyResult<Mesh> {
     let folder = tempfile::tempdir().map_err(|e| WriteError::new_err(e.to_string()))?;
     let msh = folder.path().join(GENERATED_MESH);
-    mesh_geo(geo, &msh, parameters).map_err(|e| {
-        InputError::new_err(format!("cannot mesh {} with gmsh: {e}", geo.display()))
-    })?;
+    if let Err(e) = mesh_geo(geo, &msh, parameters) {
+        return Err(InputError::new_err(match case {
+            Some(path) => message(&CaseError::Gmsh {
+                path: path.to_owned(),
+                geo: geo.to_owned(),
+                message: e,
+            }),
+            None => format!("cannot mesh {} with gmsh: {e}", geo.display()),
+        }));
+    }
     let bytes = std::fs::read(&msh).map_err(|e| WriteError::new_err(e.to_string()))?;
-    let mesh = read_msh_bytes(geo, &bytes).map_err(|e| InputError::new_err(message(&e)))?;
+    let mesh = read_msh_bytes(geo, &bytes).map_err(|e| mesh_error(e, case))?;
     Ok(Mesh {
         mesh: Arc::new(mesh),
         generated: Some(Arc::new(bytes)),
     })
+}
+
+/// A mesh error as an `InputError`, naming `case` when the case named the mesh.
+fn mesh_error(error: MeshError, case: Option<&Path>) -> PyErr {
+    match case {
+        Some(path) => InputError::new_err(message(&CaseError::Mesh {
+            path: path.to_owned(),
+            source: error,
+        })),
+        None => InputError::new_err(message(&error)),
+    }
 }
 
 /// The model that `internodes._gmsh.model_arrays` read from gmsh's API.
@@ -357,9 +405,15 @@ fn solve(py: Python<'_>, case: &Case, mesh: Option<PyRef<'_, Mesh>>) -> PyResult
             let parameters: Vec<(String, f64)> = (case.file.geo_parameters.iter())
                 .map(|(k, v)| (k.clone(), *v))
                 .collect();
-            py.detach(|| generate(&case.file.mesh, &parameters))?
+            py.detach(|| generate(&case.file.mesh, &parameters, Some(&case.file.path)))?
         }
-        None => Mesh::from_msh(py, case.file.mesh.clone())?,
+        None => Mesh {
+            mesh: Arc::new(
+                py.detach(|| read_msh(&case.file.mesh))
+                    .map_err(|e| mesh_error(e, Some(&case.file.path)))?,
+            ),
+            generated: None,
+        },
     };
     let mut file = case.file.clone();
     file.solver.verbose = true;

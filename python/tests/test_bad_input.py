@@ -1,0 +1,119 @@
+"""Bad input raises an exception with the command line's message; nothing crashes the
+interpreter."""
+
+import pytest
+
+import internodes
+from conftest import REPO, hertz_2d_case
+
+MESH = REPO / "tests" / "fixtures" / "half_disc_on_block.msh"
+
+
+def cli_error(cli, case_file, tmp_path):
+    """The message the command line prints after `error: ` (with its `caused by` lines)."""
+    code, stderr = cli(case_file, tmp_path / "cli-out")
+    assert code == 1, stderr
+    assert stderr.startswith("error: "), stderr
+    return stderr[len("error: "):].rstrip("\n")
+
+
+@pytest.mark.parametrize("fault", [
+    ("mesh = \"{mesh}\"\n[contact\n", "a syntax error"),
+    ("mesh = \"{mesh}\"\ncolour = 1\n[[body]]\nname = \"disc\"\nyoungs_modulus = 1.0\npoisson_ratio = 0.3\n", "an unknown key"),
+    ("mesh = \"{mesh}\"\n[[body]]\nname = \"disc\"\nyoungs_modulus = \"stiff\"\npoisson_ratio = 0.3\n", "a string for a number"),
+    ("mesh = \"{mesh}\"\n[[body]]\nname = \"disc\"\nyoungs_modulus = -1.0\npoisson_ratio = 0.3\n", "a negative modulus"),
+    ("mesh = \"{mesh}\"\n[[body]]\nname = \"ball\"\nyoungs_modulus = 1.0\npoisson_ratio = 0.3\n", "a body the mesh lacks"),
+    ("mesh = \"missing.msh\"\n[[body]]\nname = \"disc\"\nyoungs_modulus = 1.0\npoisson_ratio = 0.3\n", "a missing mesh"),
+], ids=lambda fault: fault[1])
+def test_a_bad_case_file_raises_the_cli_message(cli, tmp_path, fault):
+    case_file = tmp_path / "bad.toml"
+    case_file.write_text(fault[0].format(mesh=MESH))
+    expected = cli_error(cli, case_file, tmp_path)
+    with pytest.raises(internodes.InputError) as raised:
+        internodes.solve(internodes.Case.from_toml(case_file))
+    assert str(raised.value) == expected
+    assert isinstance(raised.value, ValueError)
+
+
+def test_a_missing_case_file_names_it():
+    with pytest.raises(internodes.InputError, match="cannot read case file .*nowhere.toml"):
+        internodes.Case.from_toml("nowhere.toml")
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"body": []}, "the case names no body"),
+    ({"body": [{"name": "disc", "youngs_modulus": None, "poisson_ratio": 0.3}]},
+     r"body\[0\].youngs_modulus is None"),
+    ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}], "solver": {"rtol": 2.0}},
+     r"rtol must be in \(0, 1\)"),
+    ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}],
+      "contact": {"bodies": ["disc", "block"], "surfaces": ["a", "b"], "load_steps": []}},
+     "load_steps"),
+    ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}], "mesh": object()},
+     "not JSON serializable|expected str"),
+], ids=["no body", "null modulus", "rtol", "empty load steps", "an object for a path"])
+def test_a_bad_dict_raises_input_error(table, match):
+    with pytest.raises(internodes.InputError, match=match):
+        internodes.Case.from_dict(table, name="study")
+
+
+def test_a_case_without_mesh_needs_one_at_solve():
+    case = internodes.Case.from_dict({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}]})
+    assert case.mesh is None
+    with pytest.raises(internodes.InputError, match="names no mesh: .* pass mesh= to solve"):
+        internodes.solve(case)
+
+
+@pytest.mark.parametrize("content, match", [
+    (b"", "the file is empty"),
+    (b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", "MSH format version 2.2 is not supported"),
+    (b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n", r"bad.msh:\d+"),
+])
+def test_a_bad_mesh_file_raises_input_error(tmp_path, content, match):
+    (tmp_path / "bad.msh").write_bytes(content)
+    with pytest.raises(internodes.InputError, match=match):
+        internodes.Mesh.from_msh(tmp_path / "bad.msh")
+
+
+def test_an_empty_gmsh_model_raises_input_error():
+    gmsh = pytest.importorskip("gmsh")
+    gmsh.initialize()
+    try:
+        with pytest.raises(internodes.InputError, match="^gmsh model.*: no body found"):
+            internodes.Mesh.from_gmsh()
+    finally:
+        gmsh.finalize()
+
+
+def test_gmsh_after_finalize_raises_input_error():
+    gmsh = pytest.importorskip("gmsh")
+    gmsh.initialize()
+    gmsh.finalize()
+    with pytest.raises(internodes.InputError, match="no gmsh model to read .*gmsh.initialize()"):
+        internodes.Mesh.from_gmsh()
+
+
+def test_a_gmsh_model_without_bodies_raises_input_error():
+    gmsh = pytest.importorskip("gmsh")
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+        gmsh.model.occ.synchronize()
+        gmsh.model.mesh.generate(2)
+        with pytest.raises(internodes.InputError, match="gmsh model.*no .*surface"):
+            internodes.Mesh.from_gmsh()
+    finally:
+        gmsh.finalize()
+
+
+def test_a_contact_problem_not_solved_is_a_status_as_in_the_cli(cli, tmp_path):
+    # One iteration cannot settle the active set: the CLI writes the last iterate and exits 2.
+    case_file = hertz_2d_case(tmp_path, MESH, max_iterations=1)
+    code, stderr = cli(case_file, tmp_path / "cli")
+    result = internodes.solve(internodes.Case.from_toml(case_file))
+    assert (result.exit_code, code) == (2, 2)
+    assert (result.status, result.solved, result.accurate) == ("iteration-limit", False, False)
+    with pytest.raises(internodes.NotSolvedError) as raised:
+        result.raise_for_status()
+    assert stderr.startswith(f"error: {raised.value} (see ")
