@@ -3,18 +3,30 @@
 
 PYTHON  := /usr/bin/python3
 BINARY  := target/release/internodes
+# The Python module is installed into this virtual environment, which sees Debian's numpy, gmsh,
+# h5py and matplotlib (--system-site-packages).
+VENV    := build/venv
 LEVELS  ?= 0 1 2
 # Cargo features: petsc = the CG + AMG body solver (links the system's PETSc). `make FEATURES=`
 # builds and tests without it.
 FEATURES ?= petsc
 
-.PHONY: deps build demo picture test validate foreign-meshes outside-check meshes bench clean
+.PHONY: deps build python demo picture test validate foreign-meshes outside-check meshes bench clean
 
 deps:
 	bash .ci/install-deps.sh
 
 build: deps
 	cargo build --release --features "$(FEATURES)"
+
+# The Python module (python/): `import internodes` in $(VENV), built from this repository by
+# maturin, with mypy for its stub test. Use it with $(VENV)/bin/python, or install it anywhere
+# with `pip install ./python`.
+python: build
+	test -x $(VENV)/bin/python || $(PYTHON) -m venv --system-site-packages $(VENV)
+	$(VENV)/bin/pip install --quiet "maturin>=1.5,<2" mypy
+	MATURIN_PEP517_ARGS="$(if $(findstring petsc,$(FEATURES)),,--no-default-features)" \
+	    $(VENV)/bin/pip install --quiet ./python
 
 # Mesh geo/hemisphere_on_block.geo with gmsh and solve the 3D Hertz contact of an elastic
 # hemisphere pressed onto an elastic block (INTERNODES, frictionless).
@@ -23,10 +35,12 @@ build: deps
 demo: build
 	$(BINARY) solve geo/hemisphere_on_block.toml --output out/demo
 
-# Unit and integration tests (no gmsh or Python needed), then the quick validation: the
-# coarsest level of every suite, same thresholds (report in validation/build/report-quick/).
-test: build
+# Unit and integration tests, the Python module's tests and examples, then the quick
+# validation: the coarsest level of every suite, same thresholds (report in
+# validation/build/report-quick/).
+test: build python
 	cargo test --release --features "$(FEATURES)"
+	$(VENV)/bin/python -m pytest python/tests
 	$(PYTHON) validation/run.py --quick
 
 # The full validation: every suite at every level; writes validation/report/ (committed).
@@ -56,4 +70,4 @@ bench: build
 
 clean:
 	cargo clean
-	rm -rf out meshes validation/build
+	rm -rf out meshes validation/build build
