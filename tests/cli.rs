@@ -25,6 +25,11 @@ fn run_quiet(case: &Path) -> Result<internodes::run::RunReport, RunError> {
     )
 }
 
+/// The `block_3d` case with `change` applied to its body.
+fn block_with(change: impl FnOnce(Body) -> Body) -> CaseFile {
+    block_3d_case().with_body("block", change)
+}
+
 /// Runs a case that must fail and returns the error and its message.
 fn failure(case: &CaseFile) -> (RunError, String) {
     text_failure(&case.to_toml())
@@ -160,7 +165,7 @@ fn missing_key_is_named() {
 
 #[test]
 fn non_physical_materials_are_rejected() {
-    let (e, message) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, message) = failure(&block_with(|b| Body {
         youngs_modulus: 0.0,
         ..b
     }));
@@ -175,7 +180,7 @@ fn non_physical_materials_are_rejected() {
         "{message}"
     );
     assert!(message.contains("body 'block'"));
-    let (e, message) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, message) = failure(&block_with(|b| Body {
         poisson_ratio: 0.5,
         ..b
     }));
@@ -189,7 +194,7 @@ fn non_physical_materials_are_rejected() {
         ),
         "{message}"
     );
-    let (e, _) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, _) = failure(&block_with(|b| Body {
         poisson_ratio: -1.2,
         ..b
     }));
@@ -198,7 +203,7 @@ fn non_physical_materials_are_rejected() {
 
 #[test]
 fn unknown_group_lists_the_groups_of_the_body() {
-    let (e, message) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, message) = failure(&block_with(|b| Body {
         loads: vec![Load::hertz("block_tpo", 10.0, 0.5, &[0.0, 0.0, 0.0])],
         ..b
     }));
@@ -217,7 +222,7 @@ fn unknown_group_lists_the_groups_of_the_body() {
 
 #[test]
 fn unknown_body_lists_the_bodies_of_the_mesh() {
-    let (e, message) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, message) = failure(&block_with(|b| Body {
         name: "sphere".to_string(),
         ..b
     }));
@@ -230,7 +235,7 @@ fn unknown_body_lists_the_bodies_of_the_mesh() {
 
 #[test]
 fn a_body_without_dirichlet_condition_is_singular() {
-    let (e, message) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, message) = failure(&block_with(|b| Body {
         dirichlet: Vec::new(),
         ..b
     }));
@@ -279,7 +284,7 @@ fn a_load_must_have_exactly_one_kind() {
 
 #[test]
 fn vectors_must_match_the_mesh_dimension() {
-    let (e, message) = failure(&block_3d_case().with_body("block", |b| Body {
+    let (e, message) = failure(&block_with(|b| Body {
         loads: vec![Load::hertz("block_top", 10.0, 0.5, &[0.0, 0.0])],
         ..b
     }));
