@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{block_3d_case, fixture, read_fixture, write_case};
+use common::{block_3d_case, read_fixture};
 use internodes::case::{Case, CaseError};
 use internodes::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use internodes::fem::Material;
@@ -62,15 +62,10 @@ fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
     max_abs(&diff) / max_abs(b)
 }
 
-/// The `block_3d` case with `solver` as its `[solver]` table.
-fn block_case(solver: &str) -> String {
-    format!("{}\n[solver]\n{solver}\n", block_3d_case())
-}
-
 #[test]
 fn rtol_outside_zero_one_is_rejected() {
-    for rtol in ["0.0", "1.0", "-1e-10", "nan"] {
-        let (_dir, path) = write_case(&block_case(&format!("rtol = {rtol}")));
+    for rtol in [0.0, 1.0, -1e-10, f64::NAN] {
+        let (_dir, path) = block_3d_case().rtol(rtol).write();
         let e = Case::load(&path).unwrap_err();
         assert!(
             matches!(e, CaseError::Invalid { .. }) && e.to_string().contains("rtol"),
@@ -81,15 +76,20 @@ fn rtol_outside_zero_one_is_rejected() {
 
 #[test]
 fn rtol_above_the_residual_tolerance_is_rejected_for_cg_amg_and_makes_auto_cholesky() {
-    let solver = |body: &str| format!("body = \"{body}\"\nrtol = 1e-6\nresidual_tolerance = 1e-8");
-    let (_dir, path) = write_case(&block_case(&solver("cg-amg")));
+    let solver = |body: &str| {
+        block_3d_case()
+            .body_solver(body)
+            .rtol(1e-6)
+            .residual_tolerance(1e-8)
+    };
+    let (_dir, path) = solver("cg-amg").write();
     let e = Case::load(&path).unwrap_err();
     assert!(
         e.to_string().contains("rtol") && e.to_string().contains("residual_tolerance"),
         "{e}"
     );
     for body in ["auto", "cholesky"] {
-        let (_dir, path) = write_case(&block_case(&solver(body)));
+        let (_dir, path) = solver(body).write();
         let case = Case::load(&path).unwrap();
         assert_eq!(
             case.solver.body_solver(3, 10_000_000),
@@ -130,7 +130,7 @@ mod without_petsc {
 
     #[test]
     fn a_case_asking_for_cg_amg_names_the_key_and_petsc() {
-        let (_dir, path) = write_case(&block_case("body = \"cg-amg\""));
+        let (_dir, path) = block_3d_case().body_solver("cg-amg").write();
         let e = Case::load(&path).unwrap_err();
         let message = e.to_string();
         assert!(matches!(e, CaseError::Invalid { .. }), "{message}");
@@ -219,7 +219,7 @@ mod with_petsc {
 
     #[test]
     fn summary_records_the_solver_and_its_iterations() {
-        let (dir, path) = write_case(&block_case("body = \"cg-amg\""));
+        let (dir, path) = block_3d_case().body_solver("cg-amg").write();
         let output = common::run_solve(&path);
         assert!(output.status.success(), "{output:?}");
         let text = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
@@ -432,42 +432,8 @@ mod with_petsc {
     fn contact_with_cg_amg_agrees_with_cholesky() {
         use internodes::contact::{ContactStatus, solve_contact};
         use internodes::mesh::read_msh;
-        let text = format!(
-            r#"mesh = "{}"
-output = "out"
-
-[contact]
-bodies = ["upper", "lower"]
-surfaces = ["upper_contact", "lower_contact"]
-primary = "upper"
-
-[[body]]
-name = "lower"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "lower_base"
-uz = 0.0
-[[body.dirichlet]]
-group = "lower_sides"
-ux = 0.0
-uy = 0.0
-
-[[body]]
-name = "upper"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "upper_top"
-uz = -0.01
-[[body.dirichlet]]
-group = "upper_sides"
-ux = 0.0
-uy = 0.0
-"#,
-            fixture("two_blocks_3d.msh").display()
-        );
-        let (_dir, path) = write_case(&text);
+        let (_dir, path) =
+            common::contact::with_rollers(common::contact::stacked_blocks(3), 3).write();
         let case = Case::load(&path).unwrap();
         let mesh = read_msh(&case.mesh).unwrap();
         let run = |body| {

@@ -6,6 +6,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
+use common::case_builder::{Body, CaseFile, Dirichlet, Load};
 use common::{Edit, block_3d_case, fixture, write_case};
 use internodes::case::CaseError;
 use internodes::elastic::{ProblemError, SolveError};
@@ -24,8 +25,18 @@ fn run_quiet(case: &Path) -> Result<internodes::run::RunReport, RunError> {
     )
 }
 
+/// The `block_3d` case with `change` applied to its body.
+fn block_with(change: impl FnOnce(Body) -> Body) -> CaseFile {
+    block_3d_case().with_body("block", change)
+}
+
 /// Runs a case that must fail and returns the error and its message.
-fn failure(text: &str) -> (RunError, String) {
+fn failure(case: &CaseFile) -> (RunError, String) {
+    text_failure(&case.to_toml())
+}
+
+/// [`failure`] of a case file given as text.
+fn text_failure(text: &str) -> (RunError, String) {
     let (_dir, path) = write_case(text);
     let e = match run_quiet(&path) {
         Ok(_) => panic!("the case should fail:\n{text}"),
@@ -41,7 +52,7 @@ fn failure(text: &str) -> (RunError, String) {
 
 #[test]
 fn solve_writes_xdmf_hdf5_and_summary() {
-    let (dir, path) = write_case(&block_3d_case());
+    let (dir, path) = block_3d_case().write();
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap(), "--export-matrices"])
         .output()
@@ -112,7 +123,12 @@ fn info_prints_groups_and_counts() {
 
 #[test]
 fn cli_reports_errors_with_a_failure_status() {
-    let (_dir, path) = write_case(&block_3d_case().edit("youngs_modulus", "youngs_modulu"));
+    // A misspelled key is no case the builder can describe: its text is edited.
+    let (_dir, path) = write_case(
+        &block_3d_case()
+            .to_toml()
+            .edit("youngs_modulus", "youngs_modulu"),
+    );
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap()])
         .output()
@@ -128,7 +144,11 @@ fn cli_reports_errors_with_a_failure_status() {
 
 #[test]
 fn misspelled_key_names_the_key_and_line() {
-    let (e, message) = failure(&block_3d_case().edit("poisson_ratio", "poison_ratio"));
+    let (e, message) = text_failure(
+        &block_3d_case()
+            .to_toml()
+            .edit("poisson_ratio", "poison_ratio"),
+    );
     assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
     assert!(
         message.contains("poison_ratio") && message.contains("line 7"),
@@ -138,15 +158,17 @@ fn misspelled_key_names_the_key_and_line() {
 
 #[test]
 fn missing_key_is_named() {
-    let (e, message) = failure(&block_3d_case().edit("poisson_ratio = 0.3\n", ""));
+    let (e, message) = text_failure(&block_3d_case().to_toml().edit("poisson_ratio = 0.3\n", ""));
     assert!(matches!(e, RunError::Case(CaseError::Syntax { .. })));
     assert!(message.contains("poisson_ratio"), "{message}");
 }
 
 #[test]
 fn non_physical_materials_are_rejected() {
-    let (e, message) =
-        failure(&block_3d_case().edit("youngs_modulus = 1000.0", "youngs_modulus = 0.0"));
+    let (e, message) = failure(&block_with(|b| Body {
+        youngs_modulus: 0.0,
+        ..b
+    }));
     assert!(
         matches!(
             e,
@@ -158,7 +180,10 @@ fn non_physical_materials_are_rejected() {
         "{message}"
     );
     assert!(message.contains("body 'block'"));
-    let (e, message) = failure(&block_3d_case().edit("poisson_ratio = 0.3", "poisson_ratio = 0.5"));
+    let (e, message) = failure(&block_with(|b| Body {
+        poisson_ratio: 0.5,
+        ..b
+    }));
     assert!(
         matches!(
             e,
@@ -169,14 +194,19 @@ fn non_physical_materials_are_rejected() {
         ),
         "{message}"
     );
-    let (e, _) = failure(&block_3d_case().edit("poisson_ratio = 0.3", "poisson_ratio = -1.2"));
+    let (e, _) = failure(&block_with(|b| Body {
+        poisson_ratio: -1.2,
+        ..b
+    }));
     assert!(matches!(e, RunError::Case(CaseError::Material { .. })));
 }
 
 #[test]
 fn unknown_group_lists_the_groups_of_the_body() {
-    let (e, message) =
-        failure(&block_3d_case().edit("group = \"block_top\"", "group = \"block_tpo\""));
+    let (e, message) = failure(&block_with(|b| Body {
+        loads: vec![Load::hertz("block_tpo", 10.0, 0.5, &[0.0, 0.0, 0.0])],
+        ..b
+    }));
     assert!(matches!(
         e,
         RunError::Case(CaseError::Problem {
@@ -192,7 +222,10 @@ fn unknown_group_lists_the_groups_of_the_body() {
 
 #[test]
 fn unknown_body_lists_the_bodies_of_the_mesh() {
-    let (e, message) = failure(&block_3d_case().edit("name = \"block\"", "name = \"sphere\""));
+    let (e, message) = failure(&block_with(|b| Body {
+        name: "sphere".to_string(),
+        ..b
+    }));
     assert!(matches!(e, RunError::Case(CaseError::UnknownBody { .. })));
     assert!(
         message.contains("'sphere'") && message.contains("its bodies: block"),
@@ -202,10 +235,10 @@ fn unknown_body_lists_the_bodies_of_the_mesh() {
 
 #[test]
 fn a_body_without_dirichlet_condition_is_singular() {
-    let text = block_3d_case();
-    let start = text.find("[[body.dirichlet]]").unwrap();
-    let end = text.find("[[body.load]]").unwrap();
-    let (e, message) = failure(&format!("{}{}", &text[..start], &text[end..]));
+    let (e, message) = failure(&block_with(|b| Body {
+        dirichlet: Vec::new(),
+        ..b
+    }));
     assert!(
         matches!(
             e,
@@ -222,7 +255,9 @@ fn a_body_without_dirichlet_condition_is_singular() {
 #[test]
 fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
     // Only uz = 0 on the flat base: translations in x, y and the rotation about z are free.
-    let (e, message) = failure(&block_3d_case().edit("ux = 0.0\nuy = 0.0\n", ""));
+    let (e, message) = failure(&block_3d_case().with_support("block", "block_base", |_| {
+        Dirichlet::on("block_base").uz(0.0)
+    }));
     assert!(
         matches!(
             e,
@@ -237,8 +272,9 @@ fn dirichlet_conditions_that_leave_rigid_motions_free_are_singular() {
 
 #[test]
 fn a_load_must_have_exactly_one_kind() {
-    let (e, message) =
-        failure(&block_3d_case().edit("hertz_pressure =", "pressure = 1.0\nhertz_pressure ="));
+    let mut case = block_3d_case();
+    case.bodies[0].loads[0].pressure = Some(1.0);
+    let (e, message) = failure(&case);
     assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
     assert!(
         message.contains("exactly one of") && message.contains("load on 'block_top'"),
@@ -248,15 +284,19 @@ fn a_load_must_have_exactly_one_kind() {
 
 #[test]
 fn vectors_must_match_the_mesh_dimension() {
-    let (e, message) =
-        failure(&block_3d_case().edit("center = [0.0, 0.0, 0.0]", "center = [0.0, 0.0]"));
+    let (e, message) = failure(&block_with(|b| Body {
+        loads: vec![Load::hertz("block_top", 10.0, 0.5, &[0.0, 0.0])],
+        ..b
+    }));
     assert!(matches!(e, RunError::Case(CaseError::Invalid { .. })));
     assert!(message.contains("expected 3 components"), "{message}");
 }
 
 #[test]
 fn a_bad_mesh_is_reported_through_the_case() {
-    let (e, message) = failure(&block_3d_case().edit("block_3d.msh", "no_such.msh"));
+    let mut case = block_3d_case();
+    case.mesh = fixture("no_such.msh");
+    let (e, message) = failure(&case);
     assert!(matches!(e, RunError::Case(CaseError::Mesh { .. })));
     assert!(message.contains("no_such.msh"), "{message}");
 }
@@ -264,11 +304,7 @@ fn a_bad_mesh_is_reported_through_the_case() {
 #[test]
 fn inaccurate_solves_are_errors_not_results() {
     // A residual tolerance below round-off cannot be met: the solve must say so.
-    let text = block_3d_case().edit(
-        "[[body]]",
-        "[solver]\nresidual_tolerance = 1e-30\n\n[[body]]",
-    );
-    let (e, message) = failure(&text);
+    let (e, message) = failure(&block_3d_case().residual_tolerance(1e-30));
     assert!(
         matches!(
             e,
@@ -284,7 +320,7 @@ fn inaccurate_solves_are_errors_not_results() {
 #[test]
 fn the_output_folder_may_come_from_the_flag_alone() {
     // `output` used to be required in the case file even with --output.
-    let (dir, path) = write_case(&block_3d_case().edit("output = \"out\"\n", ""));
+    let (dir, path) = block_3d_case().without_output().write();
     let out = dir.path().join("elsewhere");
     let output = Command::new(BINARY)
         .args(["solve", path.to_str().unwrap(), "--quiet", "--output"])
@@ -301,7 +337,7 @@ fn the_output_folder_may_come_from_the_flag_alone() {
 
 #[test]
 fn without_the_output_key_or_flag_the_error_names_both() {
-    let (e, message) = failure(&block_3d_case().edit("output = \"out\"\n", ""));
+    let (e, message) = failure(&block_3d_case().without_output());
     assert!(
         matches!(e, RunError::Case(CaseError::Invalid { .. })),
         "{message}"

@@ -3,11 +3,12 @@
 
 mod common;
 
+use common::case_builder::{Body, CaseFile, Dirichlet};
 use common::contact::{
     flat_punch, footprint_force, half_disc_on_block, hemisphere_on_block, one_body_reaction,
-    rollers, solve, solve_cli, two_blocks,
+    pinned_at_corners, solve, solve_cli, two_blocks, two_blocks_on_rollers,
 };
-use common::{Edit, fixture, write_case};
+use common::fixture;
 use internodes::case::Case;
 use internodes::contact::{ContactSolution, ContactStatus, ContactSurface};
 use internodes::elastic::SolverSettings;
@@ -20,11 +21,6 @@ use internodes::mesh::read_msh;
 /// of the interface equation, which left errors of 1e-13 to 3e-12 in the pressure over runs
 /// (its sums run in parallel, in varying order).
 const PATCH_SOLVERS: [(&str, f64); 2] = [("schur", 1e-12), ("auto", 1e-10)];
-
-/// `text` with `[contact] solver = solver`.
-fn with_solver(text: &str, solver: &str) -> String {
-    text.edit("[contact]", &format!("[contact]\nsolver = \"{solver}\""))
-}
 
 /// What converged means: the certificate passed (geometric penetration of every candidate of
 /// both bodies within 1e-3 h, tension on every surface node, force balance), and the force
@@ -107,16 +103,9 @@ fn contact_patch_test_gives_the_uniform_applied_pressure() {
     for (solver, tolerance) in PATCH_SOLVERS {
         for dim in [2, 3] {
             for formulation in ["frictionless", "tied"] {
-                let text = with_solver(
-                    &two_blocks(
-                        dim,
-                        formulation,
-                        &rollers("lower", dim),
-                        &rollers("upper", dim),
-                    ),
-                    solver,
-                );
-                let solution = solve(&text).unwrap();
+                let case =
+                    two_blocks_on_rollers(dim, formulation).contact_setting("solver", solver);
+                let solution = solve(&case).unwrap();
                 let label = format!("{dim}D {formulation}, {solver}");
                 assert_eq!(
                     solution.status,
@@ -176,21 +165,9 @@ fn frictionless_patch_test_without_rollers_gives_the_uniaxial_stress() {
     // interpolation does not reproduce.
     for (solver, tolerance) in PATCH_SOLVERS {
         for dim in [2, 3] {
-            let (lower_pins, upper_pins) = if dim == 2 {
-                (
-                    "[[body.dirichlet]]\ngroup = \"lower_corner\"\nux = 0.0".to_string(),
-                    "[[body.dirichlet]]\ngroup = \"upper_corner\"\nux = 0.0".to_string(),
-                )
-            } else {
-                let pins = |body: &str| {
-                    format!(
-                        "[[body.dirichlet]]\ngroup = \"{body}_corner_a\"\nux = 0.0\nuy = 0.0\n[[body.dirichlet]]\ngroup = \"{body}_corner_b\"\nuy = 0.0"
-                    )
-                };
-                (pins("lower"), pins("upper"))
-            };
-            let text = two_blocks(dim, "frictionless", &lower_pins, &upper_pins);
-            let solution = solve(&with_solver(&text, solver)).unwrap();
+            let case = pinned_at_corners(two_blocks(dim, "frictionless"), dim)
+                .contact_setting("solver", solver);
+            let solution = solve(&case).unwrap();
             assert_eq!(solution.status, ContactStatus::Converged, "{dim}D");
             let e_prime = if dim == 2 {
                 1000.0 / (1.0 - 0.09)
@@ -216,7 +193,7 @@ fn frictionless_patch_test_without_rollers_gives_the_uniaxial_stress() {
 
 #[test]
 fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
-    let solution = solve(&half_disc_on_block("")).unwrap();
+    let solution = solve(&half_disc_on_block()).unwrap();
     assert_eq!(solution.status, ContactStatus::Converged);
     let fields = &solution.primary_fields;
 
@@ -289,8 +266,8 @@ fn hertz_half_disc_on_block_matches_theory_in_plane_strain() {
 fn hertz_hemisphere_on_block_matches_theory() {
     // Identical materials, E = 1000, nu = 0.3, pressed by 0.01 (a / R about 0.1); the contact
     // zone is meshed at R/67. 1/E* = 2 (1 - nu^2) / E.
-    let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
-    let solution = solve(&text).unwrap();
+    let case = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0);
+    let solution = solve(&case).unwrap();
     let (error_a, error_p0) = assert_hertz_3d(
         &solution,
         "hemisphere_on_block_hertz.msh",
@@ -305,8 +282,8 @@ fn bodies_meshed_overlapping_are_pushed_apart_into_hertz_contact() {
     // The set-up of earlier INTERNODES contact tests: no imposed displacement, the bodies
     // meshed overlapping (pole 0.01 below the block top in 3D, 0.02 in 2D, the same overlaps
     // as the pressed cases), the sphere's top held and the block's base clamped.
-    let text = hemisphere_on_block("hemisphere_on_block_overlap.msh", 0.0, 1000.0, 1000.0, "");
-    let solution = solve(&text).unwrap();
+    let case = hemisphere_on_block("hemisphere_on_block_overlap.msh", 0.0, 1000.0, 1000.0);
+    let solution = solve(&case).unwrap();
     let (error_a, error_p0) = assert_hertz_3d(
         &solution,
         "hemisphere_on_block_overlap.msh",
@@ -315,13 +292,12 @@ fn bodies_meshed_overlapping_are_pushed_apart_into_hertz_contact() {
     );
     eprintln!("3D overlap: a {error_a:+.4}, p0 {error_p0:+.4} against Hertz");
 
-    let text = half_disc_on_block("")
-        .edit(
-            "half_disc_on_block_hertz.msh",
-            "half_disc_on_block_overlap.msh",
-        )
-        .edit("uy = -0.02", "uy = 0.0");
-    let solution = solve(&text).unwrap();
+    let case = common::half_disc_on_block("half_disc_on_block_overlap.msh").with_support(
+        "disc",
+        "disc_top",
+        |d| d.uy(0.0),
+    );
+    let solution = solve(&case).unwrap();
     assert_eq!(solution.status, ContactStatus::Converged);
     assert_contact_conditions(&solution, 0.03, "2D overlap");
     let e_star = 1000.0 / (2.0 * (1.0 - 0.09));
@@ -345,7 +321,6 @@ fn hertz_with_dissimilar_materials_uses_the_combined_modulus() {
         0.01,
         1000.0,
         10000.0,
-        "",
     ))
     .unwrap();
     let (error_a, error_p0) = assert_hertz_3d(
@@ -358,13 +333,10 @@ fn hertz_with_dissimilar_materials_uses_the_combined_modulus() {
 
     // Glued, the dissimilar surfaces cannot slide: the same case runs and the shear it carries
     // is reported (it is not Hertz's problem any more, so only its presence is checked).
-    let tied = solve(&hemisphere_on_block(
-        "hemisphere_on_block_hertz.msh",
-        0.01,
-        1000.0,
-        10000.0,
-        "formulation = \"tied\"",
-    ))
+    let tied = solve(
+        &hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 10000.0)
+            .contact_setting("formulation", "tied"),
+    )
     .unwrap();
     assert_eq!(tied.status, ContactStatus::Converged);
     let p0 = tied.hertz_primary.unwrap().p0;
@@ -385,36 +357,15 @@ fn equal_half_discs_with_different_meshes_meet_on_a_flat_symmetric_surface() {
     // Two identical half-discs (R = 1), the upper one meshed 1.5 times coarser, pressed together
     // by 0.02: by symmetry the contact surface is the plane y = -0.01 and the pressure is
     // symmetric about x = 0.
-    let text = format!(
-        r#"mesh = "{mesh}"
-output = "out"
-
-[contact]
-bodies = ["upper", "lower"]
-surfaces = ["upper_contact", "lower_contact"]
-primary = "upper"
-
-[[body]]
-name = "lower"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "lower_support"
-ux = 0.0
-uy = 0.0
-
-[[body]]
-name = "upper"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "upper_support"
-ux = 0.0
-uy = -0.02
-"#,
-        mesh = fixture("two_half_discs.msh").display()
-    );
-    let solution = solve(&text).unwrap();
+    let case = CaseFile::on_fixture("two_half_discs.msh")
+        .contact(["upper", "lower"], ["upper_contact", "lower_contact"])
+        .primary("upper")
+        .body(Body::new("lower", 1000.0, 0.3).dirichlet(Dirichlet::clamped("lower_support", 2)))
+        .body(
+            Body::new("upper", 1000.0, 0.3)
+                .dirichlet(Dirichlet::on("upper_support").ux(0.0).uy(-0.02)),
+        );
+    let solution = solve(&case).unwrap();
     assert_eq!(solution.status, ContactStatus::Converged);
     let mesh = read_msh(&fixture("two_half_discs.msh")).unwrap();
     // The interface spacing: the smallest nodal spacing of the two contact surfaces.
@@ -481,30 +432,18 @@ fn tied_conforming_blocks_give_the_solution_of_their_union() {
     for dim in [2, 3] {
         let mesh_path = fixture(&format!("glued_blocks_{dim}d.msh"));
         let top = if dim == 2 {
-            "ux = 0.002\nuy = -0.02"
+            Dirichlet::on("upper_top").ux(0.002).uy(-0.02)
         } else {
-            "ux = 0.002\nuy = 0.001\nuz = -0.02"
+            Dirichlet::on("upper_top").ux(0.002).uy(0.001).uz(-0.02)
         };
-        let base = if dim == 2 {
-            "ux = 0.0\nuy = 0.0"
-        } else {
-            "ux = 0.0\nuy = 0.0\nuz = 0.0"
-        };
-        let body = |name: &str, groups: &[(&str, &str)]| {
-            let mut text = format!(
-                "[[body]]\nname = \"{name}\"\nyoungs_modulus = 1000.0\npoisson_ratio = 0.3\n"
-            );
-            for (group, values) in groups {
-                text += &format!("[[body.dirichlet]]\ngroup = \"{group}\"\n{values}\n");
-            }
-            text
-        };
-        let header = format!("mesh = \"{}\"\noutput = \"out\"\n", mesh_path.display());
-        let tied = format!(
-            "{header}[contact]\nbodies = [\"upper\", \"lower\"]\nsurfaces = [\"interface\", \"interface\"]\nprimary = \"upper\"\nformulation = \"tied\"\n{}{}",
-            body("lower", &[("lower_base", base)]),
-            body("upper", &[("upper_top", top)])
-        );
+        let base = Dirichlet::clamped("lower_base", dim);
+        let body = |name: &str| Body::new(name, 1000.0, 0.3);
+        let tied = CaseFile::new(&mesh_path)
+            .contact(["upper", "lower"], ["interface", "interface"])
+            .primary("upper")
+            .contact_setting("formulation", "tied")
+            .body(body("lower").dirichlet(base.clone()))
+            .body(body("upper").dirichlet(top.clone()));
         let solution = solve(&tied).unwrap();
         assert_eq!(solution.status, ContactStatus::Converged, "{dim}D");
         assert!(
@@ -513,10 +452,9 @@ fn tied_conforming_blocks_give_the_solution_of_their_union() {
         );
 
         // The union, solved as one body.
-        let (_dir, path) = write_case(&format!(
-            "{header}{}",
-            body("union", &[("lower_base", base), ("upper_top", top)])
-        ));
+        let (_dir, path) = CaseFile::new(&mesh_path)
+            .body(body("union").dirichlet(base).dirichlet(top))
+            .write();
         let case = Case::load(&path).unwrap();
         let mesh = read_msh(&mesh_path).unwrap();
         let union_mesh = mesh.body("union").unwrap();
@@ -569,35 +507,30 @@ fn flat_blocks_clamped_at_both_ends_match_their_union() {
     // doubling every iteration) and the 3D one ended cycling; the linearized geometric gap is
     // exact on a flat: one iteration, then the stop test.
     for dim in [2, 3] {
-        let (vertical, lateral) = if dim == 2 {
-            ("uy", "ux = 0.0")
-        } else {
-            ("uz", "ux = 0.0\nuy = 0.0")
-        };
-        let clamp = |text: String| {
-            text.edit(
-                &format!("group = \"lower_base\"\n{vertical} = 0.0"),
-                &format!("group = \"lower_base\"\n{vertical} = 0.0\n{lateral}"),
-            )
-            .edit(
-                &format!("group = \"upper_top\"\n{vertical} = -0.01"),
-                &format!("group = \"upper_top\"\n{vertical} = -0.01\n{lateral}"),
-            )
-        };
+        let base = Dirichlet::clamped("lower_base", dim);
+        let top = Dirichlet::on("upper_top")
+            .lateral(dim, 0.0)
+            .vertical(dim, -0.01);
         let union = one_body_reaction(
             &format!("glued_blocks_{dim}d.msh"),
             "union",
-            &format!(
-                "[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n{lateral}\n[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = -0.01\n{lateral}\n"
-            ),
+            &[base.clone(), top.clone()],
             "lower_base",
         )[dim - 1]
             .abs();
         for primary in ["upper", "lower", "auto"] {
-            let text = clamp(two_blocks(dim, "frictionless", "", ""))
-                .edit("primary = \"upper\"", &format!("primary = \"{primary}\""));
+            let case = two_blocks(dim, "frictionless")
+                .with_support("lower", "lower_base", |_| base.clone())
+                .with_support("upper", "upper_top", |_| top.clone())
+                .primary(primary);
+            let text = case.to_toml();
+            let lateral = if dim == 2 {
+                "ux = 0.0"
+            } else {
+                "ux = 0.0\nuy = 0.0"
+            };
             assert!(text.matches(lateral).count() >= 2, "{text}");
-            let solution = solve(&text).unwrap();
+            let solution = solve(&case).unwrap();
             let label = format!("{dim}D, primary {primary}");
             assert_eq!(
                 solution.status,

@@ -4,7 +4,7 @@
 mod common;
 
 use common::contact::{half_disc_on_block, solve, solve_cli, stiff_block};
-use common::{Edit, fixture, run_solve, write_case};
+use common::{fixture, run_solve};
 use internodes::case::Case;
 use internodes::contact::{ContactSolver, ContactStatus};
 use internodes::elastic::SolverSettings;
@@ -14,8 +14,8 @@ use internodes::mesh::read_msh;
 fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     // Stepping 0.5 -> 1 from the previous active set (one set-up, one factorization) must give,
     // at each step, what an independent solve at that load factor gives.
-    let text = half_disc_on_block("");
-    let (dir, path) = write_case(&text);
+    let case_file = half_disc_on_block();
+    let (dir, path) = case_file.write();
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
     let problem = case.contact_problem(&mesh).unwrap().unwrap();
@@ -59,8 +59,7 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     assert!(full.force_primary[1].abs() > half.force_primary[1].abs());
 
     // From the command line: one CSV row per step.
-    let stepped_text = text.edit("[contact]", "[contact]\nload_steps = [0.5, 1.0]");
-    std::fs::write(&path, &stepped_text).unwrap();
+    case_file.load_steps(&[0.5, 1.0]).write_to(&path);
     let output = run_solve(&path);
     assert!(
         output.status.success(),
@@ -82,12 +81,10 @@ fn a_not_certified_load_step_does_not_stop_the_later_ones() {
     // steps: at 5% of the load the zone spans about two block spacings and the disc's sag fails
     // the certificate; the full load resolves the zone and is certified. Both steps run, each
     // with its own status, and the run ends with the last one's.
-    let text = stiff_block("half_disc_on_block_coarse_block.msh", "block").edit(
-        "primary = \"block\"",
-        "primary = \"block\"\nload_steps = [0.05, 1.0]",
-    );
+    let case = stiff_block("half_disc_on_block_coarse_block.msh", "block").load_steps(&[0.05, 1.0]);
+    let text = case.to_toml();
     assert!(text.contains("load_steps = [0.05, 1.0]"), "{text}");
-    let (code, summary) = solve_cli(&text);
+    let (code, summary) = solve_cli(&case);
     let contact = &summary["contact"];
     let steps = contact["steps"].as_array().unwrap();
     assert_eq!(steps.len(), 2, "{contact}");
@@ -106,9 +103,12 @@ fn a_body_slid_sideways_is_paired_where_it_touches() {
     // pressed straight down: sliding over a flat changes where the block is loaded, not how
     // much. Paired where the contact began, the block received its reaction four spacings from
     // where the disc touched it and the run was certified 3.1% high.
-    let straight = common::half_disc_on_block("half_disc_on_block.msh", "");
-    let slid = straight.edit("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02");
-    assert!(slid.contains("ux = 0.1"), "{slid}");
+    let straight = common::half_disc_on_block("half_disc_on_block.msh");
+    let slid = straight
+        .clone()
+        .with_support("disc", "disc_top", |d| d.ux(0.1));
+    let slid_text = slid.to_toml();
+    assert!(slid_text.contains("ux = 0.1"), "{slid_text}");
     let (straight, slid) = (solve(&straight).unwrap(), solve(&slid).unwrap());
     assert_eq!(straight.status, ContactStatus::Converged);
     assert_eq!(slid.status, ContactStatus::Converged);

@@ -3,11 +3,12 @@
 
 mod common;
 
+use common::case_builder::{Body, CaseFile, Dirichlet};
 use common::contact::{
     failed_checks, failed_in_summary, flat_punch, footprint_force, narrow_blocks, solve, solve_cli,
     stiff_block,
 };
-use common::{Edit, run_solve, write_case};
+use common::run_solve;
 use internodes::case::Case;
 use internodes::contact::{ContactStatus, solve_contact};
 use internodes::elastic::SolverSettings;
@@ -15,39 +16,19 @@ use internodes::mesh::read_msh;
 
 /// The hemisphere of `foreign_hemisphere_on_fine_block.msh` (R/25, E = 1000) pressed by 0.004
 /// onto the block 1e4 times stiffer and twice finer, the block primary by hand.
-fn foreign_stiff_block_primary() -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-
-[contact]
-bodies = ["sphere", "block"]
-surfaces = ["sphere_contact", "block_contact"]
-primary = "block"
-
-[[body]]
-name = "sphere"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "sphere_top"
-ux = 0.0
-uy = 0.0
-uz = -0.004
-
-[[body]]
-name = "block"
-youngs_modulus = 1.0e7
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-uz = 0.0
-"#,
-        common::fixture("foreign_hemisphere_on_fine_block.msh").display()
-    )
+fn foreign_stiff_block_primary() -> CaseFile {
+    CaseFile::on_fixture("foreign_hemisphere_on_fine_block.msh")
+        .contact(["sphere", "block"], ["sphere_contact", "block_contact"])
+        .primary("block")
+        .body(
+            Body::new("sphere", 1000.0, 0.3)
+                .dirichlet(Dirichlet::on("sphere_top").lateral(3, 0.0).uz(-0.004)),
+        )
+        .body(Body::new("block", 1.0e7, 0.3).dirichlet(Dirichlet::clamped("block_base", 3)))
 }
+
+/// How the written case spells the stiff block's Young's modulus, 1e7.
+const STIFF_MODULUS: &str = "youngs_modulus = 10000000.0";
 
 /// The hemisphere of `tests/fixtures/foreign_hemisphere_on_fine_block.msh` pressed by 0.004
 /// onto a rigid flat: contact force computed by dolfinx (PETSc VI solver, exact node-to-plane
@@ -73,12 +54,13 @@ const COARSE_BLOCK_RIGID_FLAT_FORCE_2D_AT_0_004: f64 = 1.829546778705095;
 
 #[test]
 fn auto_primary_is_the_more_compliant_body() {
-    let text = stiff_block("half_disc_on_block.msh", "auto");
+    let case = stiff_block("half_disc_on_block.msh", "auto");
+    let text = case.to_toml();
     assert!(
-        text.contains("1.0e7") && text.contains("\"auto\""),
+        text.contains(STIFF_MODULUS) && text.contains("\"auto\""),
         "{text}"
     );
-    let (code, summary) = solve_cli(&text);
+    let (code, summary) = solve_cli(&case);
     let contact = &summary["contact"];
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["primary"], "disc", "{contact}");
@@ -120,8 +102,8 @@ fn an_explicit_stiff_primary_is_right_or_named() {
     // the gap's own linearization the loop ends `unstable` (a fine stiff multiplier surface
     // on a coarse compliant one: the inf-sup condition). Either way the answer must be right
     // or named, for a library caller and on the command line.
-    let text = foreign_stiff_block_primary();
-    let library = solve(&text).unwrap();
+    let case = foreign_stiff_block_primary();
+    let library = solve(&case).unwrap();
     let error = library.force_secondary[2] / FOREIGN_RIGID_FLAT_FORCE_3D - 1.0;
     if library.is_trusted() {
         assert!(error.abs() <= 0.01, "trusted, but {error:+.4} off dolfinx");
@@ -131,7 +113,7 @@ fn an_explicit_stiff_primary_is_right_or_named() {
         library.ending()
     );
 
-    let (code, summary) = solve_cli(&text);
+    let (code, summary) = solve_cli(&case);
     let contact = &summary["contact"];
     assert_eq!(contact["primary"], "block", "{contact}");
     let reason = contact["primary_choice"]["reason"].as_str().unwrap();
@@ -153,8 +135,7 @@ fn every_load_step_of_an_explicit_stiff_primary_is_right_or_named() {
     // block primary's loop with the RBF constraint rows certified steps whose force was more
     // than 1% off dolfinx. Every step's record must be right or say why it is not trusted.
     let factors = [0.25, 0.5, 0.75, 1.0];
-    let text = foreign_stiff_block_primary();
-    let (_dir, path) = write_case(&text);
+    let (_dir, path) = foreign_stiff_block_primary().write();
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
     let settings = SolverSettings {
@@ -188,17 +169,18 @@ fn every_load_step_of_an_explicit_stiff_primary_is_right_or_named() {
 fn a_stiff_primary_on_a_coarser_surface_matches_the_rigid_flat_reference() {
     // The block 1e4 times stiffer than the disc and the primary body, its contact surface meshed
     // twice coarser: the loop converges, without the warning, to the dolfinx rigid-flat force.
-    let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
-        .edit("primary = \"disc\"", "primary = \"block\"")
-        .edit(
-            "name = \"block\"\nyoungs_modulus = 1000.0",
-            "name = \"block\"\nyoungs_modulus = 1.0e7",
-        );
+    let case = common::half_disc_on_block("half_disc_on_block_coarse_block.msh")
+        .primary("block")
+        .with_body("block", |b| Body {
+            youngs_modulus: 1.0e7,
+            ..b
+        });
+    let text = case.to_toml();
     assert!(
-        text.contains("1.0e7") && text.contains("primary = \"block\""),
+        text.contains(STIFF_MODULUS) && text.contains("primary = \"block\""),
         "{text}"
     );
-    let (dir, path) = write_case(&text);
+    let (dir, path) = case.write();
     let output = run_solve(&path);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
@@ -245,18 +227,18 @@ fn a_coarser_secondary_receives_the_conservative_transfer() {
     // the disc, and the answer is not certified. The auto transfer sends the disc's nodal forces
     // through R12^T instead: certified, and the disc force is dolfinx's rigid flat on the same
     // disc mesh to 1%.
-    let text = stiff_block("half_disc_on_block_coarse_block.msh", "disc")
-        .edit("uy = -0.02", "uy = -0.004");
+    let case = stiff_block("half_disc_on_block_coarse_block.msh", "disc").with_support(
+        "disc",
+        "disc_top",
+        |d| d.uy(-0.004),
+    );
+    let text = case.to_toml();
     assert!(text.contains("uy = -0.004"), "{text}");
-    let interpolated = solve(&text.edit(
-        "primary = \"disc\"",
-        "primary = \"disc\"\ntransfer = \"interpolation\"",
-    ))
-    .unwrap();
+    let interpolated = solve(&case.clone().contact_setting("transfer", "interpolation")).unwrap();
     assert_eq!(interpolated.status, ContactStatus::NotSolved);
     assert_eq!(failed_checks(&interpolated), ["equilibrium"]);
 
-    let (code, summary) = solve_cli(&text);
+    let (code, summary) = solve_cli(&case);
     let contact = &summary["contact"];
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["status"], "converged", "{contact}");
@@ -278,13 +260,17 @@ fn auto_tries_the_other_primary_when_its_first_choice_is_not_certified() {
     // 0.004: auto picks the coarser block, whose answer fails the certificate on the disc's
     // sag (its force is 2% below the disc primary's); the disc as primary is certified, and
     // that answer is the one kept, with the reason.
-    let text = common::half_disc_on_block("half_disc_on_block_coarse_block.msh", "")
-        .edit("uy = -0.02", "uy = -0.004");
+    let case = common::half_disc_on_block("half_disc_on_block_coarse_block.msh").with_support(
+        "disc",
+        "disc_top",
+        |d| d.uy(-0.004),
+    );
+    let text = case.to_toml();
     assert!(text.contains("uy = -0.004"), "{text}");
-    let block_first = solve(&text.edit("primary = \"disc\"", "primary = \"block\"")).unwrap();
+    let block_first = solve(&case.clone().primary("block")).unwrap();
     assert!(!block_first.is_trusted());
 
-    let (code, summary) = solve_cli(&text.edit("primary = \"disc\"", "primary = \"auto\""));
+    let (code, summary) = solve_cli(&case.primary("auto"));
     let contact = &summary["contact"];
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["status"], "converged", "{contact}");
@@ -332,13 +318,15 @@ fn a_named_transfer_is_checked_against_the_automatic_one() {
     // primary's nodes: 2.3% softer, and every residual and the sag pass. The answer is then
     // compared with auto's transfer (interpolation here, which does not balance the forces on
     // this pair: nothing trusted to compare with), and the accuracy report names it.
-    let (code, summary) = solve_cli(&narrow_blocks(""));
+    let (code, summary) = solve_cli(&narrow_blocks());
     let contact = &summary["contact"];
     assert_eq!(code, Some(0), "{contact}");
     let trusted = contact["force_primary"][1].as_f64().unwrap().abs();
 
-    let text = narrow_blocks("primary = \"upper\"\ntransfer = \"conservative\"");
-    let solution = solve(&text).unwrap();
+    let case = narrow_blocks()
+        .primary("upper")
+        .contact_setting("transfer", "conservative");
+    let solution = solve(&case).unwrap();
     let error = solution.force_primary[1].abs() / trusted - 1.0;
     assert!(
         error < -0.01,
@@ -346,6 +334,6 @@ fn a_named_transfer_is_checked_against_the_automatic_one() {
     );
     assert_eq!(solution.status, ContactStatus::Converged);
     assert_eq!(failed_checks(&solution), ["transfer agreement"]);
-    let (code, summary) = solve_cli(&text);
+    let (code, summary) = solve_cli(&case);
     assert_eq!(code, Some(3), "{}", summary["contact"]);
 }

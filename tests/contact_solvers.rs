@@ -3,10 +3,8 @@
 
 mod common;
 
-use common::Edit;
-
 use common::contact::{
-    half_disc_on_block, hemisphere_on_block, narrow_blocks, rollers, solve, two_blocks,
+    half_disc_on_block, hemisphere_on_block, narrow_blocks, solve, two_blocks_on_rollers,
 };
 use internodes::contact::ContactSolution;
 
@@ -65,19 +63,14 @@ fn schur_and_monolithic_solves_agree() {
     // The factor-once Schur path against the sparse LU of the whole system, on a case with a
     // partial active set (2D Hertz) and on the 3D patch test, both formulations.
     let cases = [
-        half_disc_on_block(""),
-        half_disc_on_block("formulation = \"tied\""),
-        two_blocks(
-            3,
-            "frictionless",
-            &rollers("lower", 3),
-            &rollers("upper", 3),
-        ),
-        two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
+        half_disc_on_block(),
+        half_disc_on_block().contact_setting("formulation", "tied"),
+        two_blocks_on_rollers(3, "frictionless"),
+        two_blocks_on_rollers(3, "tied"),
     ];
-    for text in cases {
-        let schur = solve(&text.edit("[contact]", "[contact]\nsolver = \"schur\"")).unwrap();
-        let lu = solve(&text.edit("[contact]", "[contact]\nsolver = \"monolithic-lu\"")).unwrap();
+    for case in cases {
+        let schur = solve(&case.clone().contact_setting("solver", "schur")).unwrap();
+        let lu = solve(&case.contact_setting("solver", "monolithic-lu")).unwrap();
         assert_eq!(schur.history.len(), lu.history.len());
         let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for (a, b) in [
@@ -124,52 +117,47 @@ fn krylov_and_schur_solves_agree() {
     // h, 1e-5 h), so the answers may differ by that much: 1e-5 h / delta = 1.5e-5 relative
     // for h = R/67, delta = 0.01 R. 1e-6 asks for fifteen times less.
     let cases = [
-        ("2D frictionless", half_disc_on_block(""), 1e-8),
+        ("2D frictionless", half_disc_on_block(), 1e-8),
         (
             "2D tied",
-            half_disc_on_block("formulation = \"tied\""),
+            half_disc_on_block().contact_setting("formulation", "tied"),
             1e-8,
         ),
         (
             "3D patch frictionless",
-            two_blocks(
-                3,
-                "frictionless",
-                &rollers("lower", 3),
-                &rollers("upper", 3),
-            ),
+            two_blocks_on_rollers(3, "frictionless"),
             1e-8,
         ),
-        (
-            "3D patch tied",
-            two_blocks(3, "tied", &rollers("lower", 3), &rollers("upper", 3)),
-            1e-8,
-        ),
+        ("3D patch tied", two_blocks_on_rollers(3, "tied"), 1e-8),
         (
             "3D Hertz",
-            hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, ""),
+            hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0),
             1e-6,
         ),
         (
             "2D conservative transfer",
-            narrow_blocks("primary = \"upper\"\ntransfer = \"conservative\""),
+            narrow_blocks()
+                .primary("upper")
+                .contact_setting("transfer", "conservative"),
             1e-8,
         ),
         (
             "2D load steps",
-            half_disc_on_block("load_steps = [0.5, 1.0]"),
+            half_disc_on_block().load_steps(&[0.5, 1.0]),
             1e-8,
         ),
         (
             "2D slid",
-            common::half_disc_on_block("half_disc_on_block.msh", "")
-                .edit("ux = 0.0\nuy = -0.02", "ux = 0.1\nuy = -0.02"),
+            common::half_disc_on_block("half_disc_on_block.msh").with_support(
+                "disc",
+                "disc_top",
+                |d| d.ux(0.1),
+            ),
             1e-8,
         ),
     ];
-    for (label, text, tolerance) in cases {
-        let with =
-            |solver: &str| text.edit("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+    for (label, case, tolerance) in cases {
+        let with = |solver: &str| case.clone().contact_setting("solver", solver);
         let krylov = solve(&with("krylov")).unwrap();
         let schur = solve(&with("schur")).unwrap();
         assert_same_contact(&krylov, &schur, tolerance, label);
@@ -190,21 +178,18 @@ fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer
     // `linear_solvers` says why. Under `krylov` the same failure ends the run with an error
     // naming it, never an answer.
     let cases = [
-        ("2D Hertz", half_disc_on_block("krylov_max_iterations = 1")),
+        (
+            "2D Hertz",
+            half_disc_on_block().contact_setting("krylov_max_iterations", 1),
+        ),
         (
             "3D Hertz",
-            hemisphere_on_block(
-                "hemisphere_on_block_hertz.msh",
-                0.01,
-                1000.0,
-                1000.0,
-                "krylov_max_iterations = 1",
-            ),
+            hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
+                .contact_setting("krylov_max_iterations", 1),
         ),
     ];
-    for (label, text) in cases {
-        let with =
-            |solver: &str| text.edit("[contact]", &format!("[contact]\nsolver = \"{solver}\""));
+    for (label, case) in cases {
+        let with = |solver: &str| case.clone().contact_setting("solver", solver);
         let auto = solve(&with("auto")).unwrap();
         let schur = solve(&with("schur")).unwrap();
         assert_same_contact(&auto, &schur, 1e-10, label);
@@ -229,9 +214,8 @@ fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer
 fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
     // With CG + AMG bodies, `schur` runs the interface GMRES (one body solve per product, no
     // per-node CG solves); each product is exact to CG's rtol (1e-10), GMRES stops at 1e-9.
-    let text = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0, "");
-    let cholesky =
-        solve(&text.edit("[contact]", "[solver]\nbody = \"cholesky\"\n\n[contact]")).unwrap();
-    let cg = solve(&text.edit("[contact]", "[solver]\nbody = \"cg-amg\"\n\n[contact]")).unwrap();
+    let case = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0);
+    let cholesky = solve(&case.clone().body_solver("cholesky")).unwrap();
+    let cg = solve(&case.body_solver("cg-amg")).unwrap();
     assert_same_contact(&cg, &cholesky, 1e-6, "CG + AMG");
 }

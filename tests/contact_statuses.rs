@@ -4,10 +4,10 @@
 mod common;
 
 use common::contact::{
-    failed_checks, failed_in_summary, half_disc_on_block, hemisphere_on_block, rollers, solve,
-    stiff_block, two_blocks,
+    failed_checks, failed_in_summary, half_disc_on_block, hemisphere_on_block, solve, stiff_block,
+    two_blocks, two_blocks_on_rollers,
 };
-use common::{Edit, run_solve, write_case};
+use common::{Edit, run_solve};
 use internodes::case::{Case, CaseError};
 use internodes::contact::{CheckKind, ContactStatus, solve_contact};
 use internodes::mesh::read_msh;
@@ -19,13 +19,10 @@ const FOREIGN_RIGID_FLAT_FORCE_2D: f64 = 1.3839070125526174;
 
 #[test]
 fn bodies_pulled_apart_end_with_no_contact() {
-    let text = two_blocks(2, "frictionless", "", "")
-        .edit("uy = -0.01", "uy = 0.01\nux = 0.0")
-        .edit(
-            "group = \"lower_base\"\nuy = 0.0",
-            "group = \"lower_base\"\nuy = 0.0\nux = 0.0",
-        );
-    let solution = solve(&text).unwrap();
+    let case = two_blocks(2, "frictionless")
+        .with_support("upper", "upper_top", |d| d.uy(0.01).ux(0.0))
+        .with_support("lower", "lower_base", |d| d.ux(0.0));
+    let solution = solve(&case).unwrap();
     assert_eq!(solution.status, ContactStatus::NoContact);
     assert!(solution.primary_fields.active.iter().all(|&a| !a));
     assert_eq!(solution.force_primary, [0.0; 3]);
@@ -34,36 +31,27 @@ fn bodies_pulled_apart_end_with_no_contact() {
 #[test]
 fn surfaces_that_do_not_face_each_other_end_with_no_contact() {
     // The base of the lower block and the top of the upper one are two units apart.
-    let text = two_blocks(
-        2,
-        "frictionless",
-        &rollers("lower", 2),
-        &rollers("upper", 2),
-    )
-    .edit(
-        "surfaces = [\"upper_contact\", \"lower_contact\"]",
-        "surfaces = [\"upper_top\", \"lower_base\"]",
-    );
+    let case =
+        two_blocks_on_rollers(2, "frictionless").contact_surfaces(["upper_top", "lower_base"]);
+    let text = case.to_toml();
     assert!(text.contains("upper_top"), "{text}");
-    let solution = solve(&text).unwrap();
+    let solution = solve(&case).unwrap();
     assert_eq!(solution.status, ContactStatus::NoContact);
 }
 
 #[test]
 fn the_iteration_cap_is_a_status() {
-    let solution = solve(&half_disc_on_block("max_iterations = 2")).unwrap();
+    let solution = solve(&half_disc_on_block().contact_setting("max_iterations", 2)).unwrap();
     assert_eq!(solution.status, ContactStatus::IterationLimit);
     assert_eq!(solution.history.len(), 2);
 }
 
 #[test]
 fn a_missing_candidate_group_is_named() {
-    let text = two_blocks(2, "frictionless", "", "").edit(
-        "surfaces = [\"upper_contact\"",
-        "surfaces = [\"upper_contct\"",
-    );
+    let case = two_blocks(2, "frictionless").contact_surfaces(["upper_contct", "lower_contact"]);
+    let text = case.to_toml();
     assert!(text.contains("upper_contct"), "{text}");
-    let message = solve(&text).err().expect("the case is invalid");
+    let message = solve(&case).err().expect("the case is invalid");
     assert!(
         message.contains("upper_contct") && message.contains("upper_contact"),
         "{message}"
@@ -73,15 +61,13 @@ fn a_missing_candidate_group_is_named() {
 #[test]
 fn a_candidate_group_empty_on_its_body_is_named() {
     // "lower_contact" exists, but has no facet on the upper body.
-    let text = two_blocks(2, "frictionless", "", "").edit(
-        "surfaces = [\"upper_contact\"",
-        "surfaces = [\"lower_contact\"",
-    );
+    let case = two_blocks(2, "frictionless").contact_surfaces(["lower_contact", "lower_contact"]);
+    let text = case.to_toml();
     assert!(
         text.contains("[\"lower_contact\", \"lower_contact\"]"),
         "{text}"
     );
-    let message = solve(&text).err().expect("the case is invalid");
+    let message = solve(&case).err().expect("the case is invalid");
     assert!(
         message.contains("'upper'")
             && message.contains("'lower_contact'")
@@ -101,10 +87,14 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_trusted() {
     // differs from the other primary's (primary agreement). With no block facet between two
     // constrained nodes there is no sag to measure: the disc's penetration is at the zone's
     // rim, whose place the resolution bounds.
-    let text = stiff_block("half_disc_on_block_coarse_block.msh", "block")
-        .edit("uy = -0.02", "uy = -0.001");
+    let case = stiff_block("half_disc_on_block_coarse_block.msh", "block").with_support(
+        "disc",
+        "disc_top",
+        |d| d.uy(-0.001),
+    );
+    let text = case.to_toml();
     assert!(text.contains("uy = -0.001"), "{text}");
-    let coarse = solve(&text).unwrap();
+    let coarse = solve(&case).unwrap();
     assert_eq!(coarse.status, ContactStatus::Converged);
     assert!(!coarse.is_trusted());
     assert_eq!(
@@ -115,7 +105,7 @@ fn a_coarse_flat_primary_under_a_narrow_zone_is_not_trusted() {
     );
 
     // The premise: constraining the disc's nodes instead changes the force by several percent.
-    let fine = solve(&text.edit("primary = \"block\"", "primary = \"disc\"")).unwrap();
+    let fine = solve(&case.primary("disc")).unwrap();
     let (on_disc_coarse, on_disc_fine) = (coarse.force_secondary[1], fine.force_primary[1]);
     let change = (on_disc_coarse - on_disc_fine).abs() / on_disc_fine.abs();
     assert!(change > 0.03, "{on_disc_coarse} against {on_disc_fine}");
@@ -129,10 +119,14 @@ fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
     // penetration, tension, sag and balance all pass, yet the force on the disc is more than
     // 1% off dolfinx's rigid flat on the same disc mesh. It must not be called converged, and
     // the resolution must be named, at that block node.
-    let text =
-        stiff_block("foreign_disc_on_coarse_block.msh", "block").edit("uy = -0.02", "uy = -0.003");
+    let case = stiff_block("foreign_disc_on_coarse_block.msh", "block").with_support(
+        "disc",
+        "disc_top",
+        |d| d.uy(-0.003),
+    );
+    let text = case.to_toml();
     assert!(text.contains("uy = -0.003"), "{text}");
-    let solution = solve(&text).unwrap();
+    let solution = solve(&case).unwrap();
     let error = solution.force_secondary[1] / FOREIGN_RIGID_FLAT_FORCE_2D - 1.0;
     assert!(
         error.abs() > 0.01,
@@ -158,7 +152,7 @@ fn a_zone_narrower_than_two_primary_spacings_is_not_certified() {
     // Auto makes the compliant disc primary, whose three nodes in contact resolve the zone
     // (the coarse stiff block, nearly rigid, need not):
     // certified, and dolfinx's force to 1%.
-    let auto = solve(&text.edit("primary = \"block\"", "primary = \"auto\"")).unwrap();
+    let auto = solve(&case.primary("auto")).unwrap();
     assert_eq!(
         auto.status,
         ContactStatus::Converged,
@@ -175,8 +169,8 @@ fn a_contact_zone_of_one_node_is_not_trusted_and_says_why() {
     // pole node alone: the discrete problem is solved, but one node cannot resolve the zone,
     // and the answer must say so: status `converged`, the accuracy report failed on the
     // resolution, exit status 3.
-    let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, "");
-    let solution = solve(&text).unwrap();
+    let case = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0);
+    let solution = solve(&case).unwrap();
     assert_eq!(
         solution.status,
         ContactStatus::Converged,
@@ -188,7 +182,7 @@ fn a_contact_zone_of_one_node_is_not_trusted_and_says_why() {
     assert!(failed.contains(&"resolution"), "{failed:?}");
 
     // The command line writes the answer, names the failed indicator, exits with status 3.
-    let (dir, path) = write_case(&text);
+    let (dir, path) = case.write();
     let output = run_solve(&path);
     assert_eq!(output.status.code(), Some(3));
     let stderr = String::from_utf8_lossy(&output.stderr);
@@ -211,11 +205,17 @@ fn no_setting_switches_the_resolution_check_off() {
     // `secondary_penetration_tolerance` spacings of the other surface, so that a stricter
     // tolerance could empty it and pass the check. The zone no longer depends on any setting:
     // whatever this one, a one-node zone is named.
-    for tolerance in ["1e-6", "0.05", "0.5"] {
-        let extra = format!("secondary_penetration_tolerance = {tolerance}");
-        let text = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0, &extra);
-        assert!(text.contains(&extra), "{text}");
-        let solution = solve(&text).unwrap();
+    for tolerance in [1e-6, 0.05, 0.5] {
+        let case = hemisphere_on_block("hemisphere_on_block.msh", 0.008, 1000.0, 1000.0)
+            .contact_setting("secondary_penetration_tolerance", tolerance);
+        let text = case.to_toml();
+        let written: toml::Table = toml::from_str(&text).unwrap();
+        assert_eq!(
+            written["contact"]["secondary_penetration_tolerance"].as_float(),
+            Some(tolerance),
+            "{text}"
+        );
+        let solution = solve(&case).unwrap();
         assert!(!solution.is_trusted(), "{tolerance}: {}", solution.ending());
         assert!(
             failed_checks(&solution).contains(&"resolution"),
@@ -227,18 +227,11 @@ fn no_setting_switches_the_resolution_check_off() {
 
 #[test]
 fn a_contact_body_needs_a_body_table() {
-    let text = two_blocks(
-        2,
-        "frictionless",
-        &rollers("lower", 2),
-        &rollers("upper", 2),
-    )
-    .edit(
-        "bodies = [\"upper\", \"lower\"]",
-        "bodies = [\"upper\", \"base\"]",
-    );
+    let mut case = two_blocks_on_rollers(2, "frictionless");
+    case.contact.as_mut().unwrap().bodies[1] = "base".to_string();
+    let text = case.to_toml();
     assert!(text.contains("\"base\""), "{text}");
-    let message = solve(&text).err().expect("the case is invalid");
+    let message = solve(&case).err().expect("the case is invalid");
     assert!(
         message.contains("'base'") && message.contains("[[body]]"),
         "{message}"
@@ -247,8 +240,9 @@ fn a_contact_body_needs_a_body_table() {
 
 #[test]
 fn misspelled_contact_keys_are_rejected() {
-    let (_dir, path) =
-        write_case(&two_blocks(2, "frictionless", "", "").edit("formulation", "formulatoin"));
+    // A misspelled key is no case the builder can describe: its text is edited.
+    let text = two_blocks(2, "frictionless").to_toml();
+    let (_dir, path) = common::write_case(&text.edit("formulation", "formulatoin"));
     let error = Case::load(&path).unwrap_err();
     assert!(matches!(error, CaseError::Syntax { .. }));
     assert!(error.to_string().contains("formulatoin"));
@@ -256,7 +250,7 @@ fn misspelled_contact_keys_are_rejected() {
 
 #[test]
 fn a_library_caller_without_load_factors_gets_an_error() {
-    let (_dir, path) = write_case(&half_disc_on_block(""));
+    let (_dir, path) = half_disc_on_block().write();
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
     for factors in [vec![], vec![0.5, f64::NAN]] {

@@ -3,16 +3,17 @@
 
 mod common;
 
-use common::{run_solve_with, write_case};
+use common::case_builder::CaseFile;
+use common::run_solve_with;
 
 /// The half-disc pressed onto the block (level-0 fixture) in two load steps.
-fn stepped_half_disc() -> String {
-    common::half_disc_on_block("half_disc_on_block.msh", "load_steps = [0.5, 1.0]")
+fn stepped_half_disc() -> CaseFile {
+    common::half_disc_on_block("half_disc_on_block.msh").load_steps(&[0.5, 1.0])
 }
 
 #[test]
 fn stepped_contact_writes_the_csv_and_a_png_plot_of_it() {
-    let (dir, path) = write_case(&stepped_half_disc());
+    let (dir, path) = stepped_half_disc().write();
     let output = run_solve_with(&path, &[]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
@@ -49,7 +50,7 @@ fn stepped_contact_writes_the_csv_and_a_png_plot_of_it() {
 
 #[test]
 fn without_a_font_the_run_succeeds_with_the_csv_and_a_warning() {
-    let (dir, path) = write_case(&stepped_half_disc());
+    let (dir, path) = stepped_half_disc().write();
     let missing = dir.path().join("no-such-font.ttf");
     let output = run_solve_with(
         &path,
@@ -68,7 +69,7 @@ fn without_a_font_the_run_succeeds_with_the_csv_and_a_warning() {
 
 #[test]
 fn a_file_that_is_not_a_font_is_reported() {
-    let (dir, path) = write_case(&stepped_half_disc());
+    let (dir, path) = stepped_half_disc().write();
     let output = run_solve_with(&path, &[("INTERNODES_PLOT_FONT", path.to_str().unwrap())]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");

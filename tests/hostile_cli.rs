@@ -5,8 +5,9 @@ mod common;
 
 use std::process::Command;
 
+use common::case_builder::Dirichlet;
+use common::fixture;
 use common::hostile::{BINARY, run_quiet, square_case, two_blocks_case};
-use common::{Edit, fixture, write_case};
 
 #[test]
 fn info_into_a_closed_pipe_does_not_panic() {
@@ -27,8 +28,7 @@ fn info_into_a_closed_pipe_does_not_panic() {
 fn solve_into_a_closed_stderr_pipe_does_not_panic() {
     // `internodes solve case 2>&1 | head -1`: the progress lines meet a closed pipe. A panic
     // exits with status 101; the process must end by SIGPIPE (or finish) instead.
-    let (_dir, case) =
-        common::write_case(&common::half_disc_on_block("half_disc_on_block.msh", ""));
+    let (_dir, case) = common::half_disc_on_block("half_disc_on_block.msh").write();
     let mut child = Command::new(BINARY)
         .args(["solve", case.to_str().unwrap()])
         .stdout(std::process::Stdio::null())
@@ -42,17 +42,11 @@ fn solve_into_a_closed_stderr_pipe_does_not_panic() {
 
 #[test]
 fn exporting_matrices_with_a_dirichlet_point_group_does_not_panic() {
-    let text = two_blocks_case(
-        &fixture("two_blocks_2d.msh"),
-        "upper",
-        "export_matrices = true",
-    )
-    .replacen(
-        "group = \"upper_top\"\nux = 0.0\nuy = 0.0",
-        "group = \"upper_top\"\nuy = 0.0\n[[body.dirichlet]]\ngroup = \"upper_corner\"\nux = 0.0",
-        1,
-    );
-    let (dir, path) = write_case(&text);
+    let (dir, path) = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper")
+        .export_matrices()
+        .with_support("upper", "upper_top", |_| Dirichlet::on("upper_top").uy(0.0))
+        .support("upper", Dirichlet::on("upper_corner").ux(0.0))
+        .write();
     run_quiet(&path).unwrap();
     let matrices = dir.path().join("out/matrices");
     assert!(matrices.join("upper__upper_top_mass.mtx").exists());
@@ -63,10 +57,9 @@ fn exporting_matrices_with_a_dirichlet_point_group_does_not_panic() {
 fn an_error_and_its_causes_are_printed_once() {
     // The case error quotes the mesh error, which quotes the I/O error: each once on stderr and
     // in the failure mark (every cause used to be printed again under its own message).
-    let (dir, case) = write_case(&square_case("square_sorted.msh", "[1.0, 0.0]").edit(
-        &fixture("square_sorted.msh").display().to_string(),
-        "missing.msh",
-    ));
+    let mut square = square_case("square_sorted.msh", &[1.0, 0.0]);
+    square.mesh = "missing.msh".into();
+    let (dir, case) = square.write();
     std::fs::create_dir(dir.path().join("out")).unwrap();
     let output = Command::new(BINARY)
         .args(["solve", case.to_str().unwrap(), "--quiet"])
@@ -90,13 +83,12 @@ fn bodies_pulled_apart_leave_no_null_in_the_iteration_history() {
     // The upper block is lifted off the lower one: the first iteration finds every active node
     // in tension and none compressed, and its tension over the largest pressure was
     // p / f64::MIN_POSITIVE = inf, written as `null` into summary.json.
-    let contact = "[contact]\nbodies = [\"upper\", \"lower\"]\nsurfaces = [\"upper_contact\", \"lower_contact\"]\n";
-    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", contact).edit(
-        "group = \"upper_top\"\nux = 0.0\nuy = 0.0",
-        "group = \"upper_top\"\nux = 0.0\nuy = 0.01",
-    );
+    let case = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper")
+        .contact(["upper", "lower"], ["upper_contact", "lower_contact"])
+        .with_support("upper", "upper_top", |d| d.uy(0.01));
+    let text = case.to_toml();
     assert!(text.contains("uy = 0.01"), "{text}");
-    let (dir, case) = write_case(&text);
+    let (dir, case) = case.write();
     run_quiet(&case).unwrap();
     let summary: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap(),

@@ -8,8 +8,9 @@ mod common;
 use std::collections::HashMap;
 use std::path::Path;
 
+use common::case_builder::{Body, CaseFile, Dirichlet};
 use common::hostile::{case_failure, displacement_by_tag, run_quiet, square_case};
-use common::{edited_fixture, fixture, read_fixture, write_case};
+use common::{edited_fixture, fixture, read_fixture};
 use internodes::mesh::{Mesh, MeshError, MeshSummary, read_msh, read_msh_bytes};
 
 /// The coordinates of every node of every body, by gmsh node tag.
@@ -121,22 +122,11 @@ fn xorshift(state: &mut u64) -> u64 {
 
 /// A case on `unnamed_groups_2d.msh`: the body '1' clamped on `clamped`, pulled down by its
 /// weight.
-fn unnamed_groups_case(clamped: &str) -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-
-[[body]]
-name = "1"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-body_force = [0.0, -1.0]
-[[body.dirichlet]]
-group = "{clamped}"
-ux = 0.0
-uy = 0.0
-"#,
-        fixture("unnamed_groups_2d.msh").display()
+fn unnamed_groups_case(clamped: &str) -> CaseFile {
+    CaseFile::on_fixture("unnamed_groups_2d.msh").body(
+        Body::new("1", 1000.0, 0.3)
+            .body_force(&[0.0, -1.0])
+            .dirichlet(Dirichlet::clamped(clamped, 2)),
     )
 }
 
@@ -183,7 +173,7 @@ fn the_square_written_in_the_order_3_4_1_2_is_read_as_written() {
 #[test]
 fn a_solve_on_shuffled_node_tags_equals_the_solve_on_sorted_ones() {
     let solve = |mesh: &str| {
-        let (dir, path) = write_case(&square_case(mesh, "[1.0, 0.5]"));
+        let (dir, path) = square_case(mesh, &[1.0, 0.5]).write();
         run_quiet(&path).unwrap_or_else(|e| panic!("{mesh}: {e}"));
         displacement_by_tag(&dir.path().join("out"))
     };
@@ -499,7 +489,7 @@ fn a_name_shared_by_unnamed_groups_of_two_dimensions_is_an_ambiguous_reference()
 
     // The unnamed curve 2 is the only group called '2': the weight of the unit square hangs on
     // it, to round-off.
-    let (_dir, path) = write_case(&unnamed_groups_case("2"));
+    let (_dir, path) = unnamed_groups_case("2").write();
     let report = run_quiet(&path).unwrap();
     let reaction = report.summary.bodies[0].reactions["2"][1];
     assert!((reaction - 1.0).abs() < 1e-10, "{reaction}");

@@ -6,11 +6,12 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use common::case_builder::{Body, Dirichlet};
 use common::hostile::{
     BINARY, assert_failed_without_results, case_failure, displacement_by_tag, exists, run_error,
     run_quiet, square_case, two_blocks_case,
 };
-use common::{Edit, fixture, write_case};
+use common::{Edit, fixture};
 use internodes::run::{RunOptions, solve_case};
 
 /// A folder holding `two_blocks_2d.msh` as `mesh` and the case `case` reading it, with the output
@@ -19,10 +20,10 @@ fn case_beside_its_outputs(mesh: &str, case: &str) -> (tempfile::TempDir, PathBu
     let dir = tempfile::tempdir().unwrap();
     let mesh_path = dir.path().join(mesh);
     std::fs::copy(fixture("two_blocks_2d.msh"), &mesh_path).unwrap();
-    let text =
-        two_blocks_case(Path::new(mesh), "upper", "").edit("output = \"out\"", "output = \".\"");
     let case_path = dir.path().join(case);
-    std::fs::write(&case_path, text).unwrap();
+    two_blocks_case(Path::new(mesh), "upper")
+        .output(".")
+        .write_to(&case_path);
     (dir, mesh_path, case_path)
 }
 
@@ -49,18 +50,15 @@ fn solve_within(case: &Path, limit: std::time::Duration) -> Option<std::process:
 
 #[test]
 fn a_failed_run_removes_earlier_results_and_marks_the_folder() {
-    let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let case = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper");
+    let (dir, good) = case.write();
     let out = dir.path().join("out");
     run_quiet(&good).unwrap();
     assert!(exists(&out, "solution.h5") && exists(&out, "summary.json"));
 
     // The same case, now failing in the solve of its second body.
     let bad = dir.path().join("bad.toml");
-    let text = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", "").edit(
-        "[[body]]\nname = \"lower\"",
-        "[solver]\nresidual_tolerance = 1e-300\n\n[[body]]\nname = \"lower\"",
-    );
-    std::fs::write(&bad, text).unwrap();
+    case.residual_tolerance(1e-300).write_to(&bad);
     let e = run_error(&bad, "the tolerance cannot be met");
     assert_failed_without_results(&out, &e.to_string());
 
@@ -72,19 +70,19 @@ fn a_failed_run_removes_earlier_results_and_marks_the_folder() {
 #[test]
 fn runs_remove_only_their_own_files_from_the_output_folder() {
     // An output folder the user keeps other files in, also inside matrices/.
-    let (dir, good) = write_case(&two_blocks_case(
-        &fixture("two_blocks_2d.msh"),
-        "upper",
-        "export_matrices = true",
-    ));
+    let case = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper").export_matrices();
+    let (dir, good) = case.write();
     let out = dir.path().join("out");
     std::fs::create_dir_all(out.join("matrices")).unwrap();
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
     std::fs::write(out.join("matrices/notes.txt"), "mine").unwrap();
     run_quiet(&good).unwrap();
     assert!(exists(&out, "matrices/lower_stiffness.mtx"));
-    let text = std::fs::read_to_string(&good).unwrap();
-    std::fs::write(&good, text.edit("name = \"upper\"", "name = \"nowhere\"")).unwrap();
+    case.with_body("upper", |b| Body {
+        name: "nowhere".to_string(),
+        ..b
+    })
+    .write_to(&good);
     run_error(&good, "no body 'nowhere'");
     assert!(!exists(&out, "matrices/lower_stiffness.mtx"));
     assert!(exists(&out, "notes.txt") && exists(&out, "matrices/notes.txt"));
@@ -92,8 +90,9 @@ fn runs_remove_only_their_own_files_from_the_output_folder() {
 
 #[test]
 fn a_case_file_that_does_not_parse_marks_the_folder_it_names() {
-    let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let (dir, good) = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper").write();
     run_quiet(&good).unwrap();
+    // A misspelled key is no case the builder can describe: its text is edited.
     let text = std::fs::read_to_string(&good).unwrap();
     std::fs::write(&good, text.edit("poisson_ratio", "poison_ratio")).unwrap();
     let e = run_error(&good, "misspelled key");
@@ -106,18 +105,16 @@ fn a_run_failing_after_writing_the_solution_leaves_no_result() {
     // The first run succeeds; the second writes solution.h5 and then fails exporting the
     // matrices of a body whose name is too long for a file name (250 bytes and
     // `_stiffness.mtx` exceed the 255 of Linux file systems).
-    let (dir, good) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let (dir, good) = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper").write();
     run_quiet(&good).unwrap();
     let long = "u".repeat(250);
     let mesh = dir.path().join("long.msh");
     let text = std::fs::read_to_string(fixture("two_blocks_2d.msh")).unwrap();
     std::fs::write(&mesh, text.replacen("\"upper\"", &format!("\"{long}\""), 1)).unwrap();
     let bad = dir.path().join("bad.toml");
-    std::fs::write(
-        &bad,
-        two_blocks_case(&mesh, &long, "export_matrices = true"),
-    )
-    .unwrap();
+    two_blocks_case(&mesh, &long)
+        .export_matrices()
+        .write_to(&bad);
     let e = run_error(&bad, "the file name is too long");
     assert!(e.to_string().contains("_stiffness.mtx"), "{e}");
     assert_failed_without_results(&dir.path().join("out"), &e.to_string());
@@ -127,14 +124,17 @@ fn a_run_failing_after_writing_the_solution_leaves_no_result() {
 fn concurrent_runs_into_one_folder_leave_one_runs_complete_results() {
     // Two cases that differ in Young's modulus, run together into one folder, ten times.
     let dir = tempfile::tempdir().unwrap();
-    let cases: Vec<PathBuf> = ["100.0", "400.0"]
+    let cases: Vec<PathBuf> = [100.0, 400.0]
         .iter()
-        .map(|e| {
-            let path = dir.path().join(format!("e{e}.toml"));
-            let text = square_case("square_sorted.msh", "[1.0, 0.0]")
-                .edit("youngs_modulus = 100.0", &format!("youngs_modulus = {e}"))
-                .edit("output = \"out\"", "output = \"shared\"");
-            std::fs::write(&path, text).unwrap();
+        .map(|&e| {
+            let path = dir.path().join(format!("e{e:?}.toml"));
+            square_case("square_sorted.msh", &[1.0, 0.0])
+                .with_body("square", |b| Body {
+                    youngs_modulus: e,
+                    ..b
+                })
+                .output("shared")
+                .write_to(&path);
             path
         })
         .collect();
@@ -253,7 +253,7 @@ fn an_output_folder_holding_an_input_under_a_result_name_is_refused() {
 #[test]
 fn a_folder_named_as_the_commit_lock_is_an_error_naming_it() {
     // The run used to wait for it forever without a word.
-    let (dir, case) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let (dir, case) = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper").write();
     let lock = dir.path().join("out/.internodes-commit.lock");
     std::fs::create_dir_all(&lock).unwrap();
     let output = solve_within(&case, std::time::Duration::from_secs(20))
@@ -272,7 +272,7 @@ fn a_folder_named_as_the_commit_lock_is_an_error_naming_it() {
 fn a_commit_lock_dated_in_the_future_is_not_fresh_forever() {
     // A lock file left with a modification time a year ahead (a clock set back, a folder copied
     // from another machine) used to make every run wait for it forever.
-    let (dir, case) = write_case(&two_blocks_case(&fixture("two_blocks_2d.msh"), "upper", ""));
+    let (dir, case) = two_blocks_case(&fixture("two_blocks_2d.msh"), "upper").write();
     let out = dir.path().join("out");
     std::fs::create_dir_all(&out).unwrap();
     let lock = out.join(".internodes-commit.lock");
@@ -300,11 +300,7 @@ fn names_with_a_slash_are_refused_before_solving_when_matrices_are_exported() {
     let text = std::fs::read_to_string(fixture("two_blocks_2d.msh")).unwrap();
     let body_mesh = dir.path().join("body.msh");
     std::fs::write(&body_mesh, text.replacen("\"upper\"", "\"up/per\"", 1)).unwrap();
-    let message = case_failure(&two_blocks_case(
-        &body_mesh,
-        "up/per",
-        "export_matrices = true",
-    ));
+    let message = case_failure(&two_blocks_case(&body_mesh, "up/per").export_matrices());
     assert!(
         message.contains("body 'up/per', export_matrices")
             && message.contains("matrices/up/per_stiffness.mtx")
@@ -318,16 +314,17 @@ fn names_with_a_slash_are_refused_before_solving_when_matrices_are_exported() {
         text.replacen("\"lower_base\"", "\"../../base\"", 1),
     )
     .unwrap();
-    let with_group = |extra: &str| {
-        two_blocks_case(&group_mesh, "upper", extra)
-            .edit("group = \"lower_base\"", "group = \"../../base\"")
-    };
-    let message = case_failure(&with_group("export_matrices = true"));
+    let with_group =
+        two_blocks_case(&group_mesh, "upper").with_support("lower", "lower_base", |d| Dirichlet {
+            group: "../../base".to_string(),
+            ..d
+        });
+    let message = case_failure(&with_group.clone().export_matrices());
     assert!(
         message.contains("group '../../base'") && message.contains("lower__../../base_mass.mtx"),
         "{message}"
     );
     // Without the export the names are fine: the solution files do not use them as paths.
-    let (_dir, path) = write_case(&with_group(""));
+    let (_dir, path) = with_group.write();
     run_quiet(&path).unwrap();
 }

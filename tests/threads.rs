@@ -12,7 +12,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
-use common::{block_3d_case, fixture, write_case};
+use common::block_3d_case;
+use common::case_builder::CaseFile;
 use internodes::elastic::{
     DirichletCondition, ElasticProblem, SolveStats, SolverSettings, assemble, solve,
 };
@@ -214,9 +215,9 @@ fn solve_with_threads(case: &Path, out: &Path, threads: usize, fields: &[&str]) 
         .collect()
 }
 
-/// Solves `text` with 1, 2 and 3 threads and checks `fields` are equal bit for bit.
-fn assert_thread_independent(text: &str, fields: &[&str]) {
-    let (dir, path) = write_case(text);
+/// Solves `case` with 1, 2 and 3 threads and checks `fields` are equal bit for bit.
+fn assert_thread_independent(case: &CaseFile, fields: &[&str]) {
+    let (dir, path) = case.write();
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     let reference = solve_with_threads(&path, &dir.path().join("t1"), 1, fields);
     for threads in &THREADS[1..] {
@@ -231,54 +232,17 @@ fn assert_thread_independent(text: &str, fields: &[&str]) {
 
 #[test]
 fn a_single_body_run_is_identical_for_any_thread_count() {
-    let text = block_3d_case();
-    assert_thread_independent(&text, &["fields/displacement", "fields/stress"]);
+    assert_thread_independent(&block_3d_case(), &["fields/displacement", "fields/stress"]);
 }
 
 #[test]
 fn a_contact_run_is_identical_for_any_thread_count() {
     // Two stacked 3D blocks with non-matching meshes, the upper one pressed down, each pinned at
     // corners only (the frictionless patch test of tests/contact_accuracy.rs), in two load steps.
-    let pins = |body: &str| {
-        format!(
-            "[[body.dirichlet]]\ngroup = \"{body}_corner_a\"\nux = 0.0\nuy = 0.0\n\
-             [[body.dirichlet]]\ngroup = \"{body}_corner_b\"\nuy = 0.0"
-        )
-    };
-    let text = format!(
-        r#"mesh = "{mesh}"
-output = "out"
-
-[contact]
-bodies = ["upper", "lower"]
-surfaces = ["upper_contact", "lower_contact"]
-primary = "upper"
-load_steps = [0.5, 1.0]
-
-[[body]]
-name = "lower"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "lower_base"
-uz = 0.0
-{lower}
-
-[[body]]
-name = "upper"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "upper_top"
-uz = -0.01
-{upper}
-"#,
-        mesh = fixture("two_blocks_3d.msh").display(),
-        lower = pins("lower"),
-        upper = pins("upper"),
-    );
+    let case = common::contact::pinned_at_corners(common::contact::stacked_blocks(3), 3)
+        .load_steps(&[0.5, 1.0]);
     assert_thread_independent(
-        &text,
+        &case,
         &[
             "fields/displacement",
             "fields/contact_pressure",

@@ -364,25 +364,9 @@ pub fn solve(
     state: &mut KrylovState,
     target: Target,
 ) -> Result<Vec<f64>, ContactError> {
-    let (n1, n2, m, s) = (system.n1, system.n2, system.m, system.s);
-
-    // z = K^-1 f, a multiple of the last load step's; r = g - C z.
-    let z = match &state.load_response {
-        Some((factor, z)) if *factor != 0.0 => {
-            let scale = system.load_factor / factor;
-            z.iter().map(|z| scale * z).collect()
-        }
-        _ => {
-            let mut z = system.f.clone();
-            bodies.solve(&mut z, n1)?;
-            state.load_response = Some((system.load_factor, z.clone()));
-            z
-        }
-    };
-    let mut r = system.g.clone();
-    for &(k, col, value) in &system.c {
-        r[k] -= value * z[col];
-    }
+    let (n1, n2, m) = (system.n1, system.n2, system.m);
+    let z = load_response(system, bodies, state)?;
+    let r = interface_rhs(system, &z);
     let r_norm = norm(&r);
     let tolerance = if r_norm > 0.0 {
         target.relative.max(target.absolute / r_norm)
@@ -393,24 +377,7 @@ pub fn solve(
         rtol: (bodies.rtol).map(|rtol| rtol.max(tolerance / KRYLOV_RTOL_OVER_BODY_RTOL)),
         ..*bodies
     };
-
-    // The starting guess: the last tractions along each multiplier's direction, and the
-    // uncoupled multipliers' exact values.
-    let mut lambda = vec![0.0; m];
-    for (k, column) in system.columns.iter().enumerate() {
-        if system.d[k] != 0.0 {
-            lambda[k] = r[k] / system.d[k];
-            continue;
-        }
-        let (mut along, mut weights) = (0.0, 0.0);
-        for (key, weight) in column {
-            along += weight * state.tractions.get(key).copied().unwrap_or(0.0);
-            weights += weight * weight;
-        }
-        if weights > 0.0 {
-            lambda[k] = along / (weights * s);
-        }
-    }
+    let mut lambda = starting_guess(system, &r, state);
 
     let mut stats = KrylovStats {
         tolerance,
@@ -422,33 +389,123 @@ pub fn solve(
         vec![0.0; n1 + n2]
     } else {
         let preconditioner = HalfSpace::new(system, coupling, coordinates1, dim);
+        let monitor = Monitor {
+            started: std::time::Instant::now(),
+            progress: state.progress,
+            tolerance,
+        };
         gmres(
             system,
             &inner,
             &preconditioner,
             &r,
             &mut lambda,
-            tolerance,
             target.max_iterations,
             &mut stats,
-            state.progress,
+            &monitor,
         )?
     };
     state.last = stats;
-
-    // Keep the tractions for the next iteration's start.
-    state.tractions.clear();
-    for (k, column) in system.columns.iter().enumerate() {
-        for (key, weight) in column {
-            state.tractions.insert(*key, s * lambda[k] * weight);
-        }
-    }
+    keep_tractions(system, &lambda, state);
 
     // u = z - K^-1 (B lambda), the response of the last true residual.
     let mut x: Vec<f64> = z.iter().zip(&w).map(|(z, w)| z - w).collect();
     debug_assert_eq!(x.len(), n1 + n2);
     x.extend(&lambda);
     Ok(x)
+}
+
+/// `z = K^-1 f`: a multiple of the last load step's, solved once per contact solve.
+fn load_response(
+    system: &CoupledSystem,
+    bodies: &Bodies,
+    state: &mut KrylovState,
+) -> Result<Vec<f64>, ContactError> {
+    Ok(match &state.load_response {
+        Some((factor, z)) if *factor != 0.0 => {
+            let scale = system.load_factor / factor;
+            z.iter().map(|z| scale * z).collect()
+        }
+        _ => {
+            let mut z = system.f.clone();
+            bodies.solve(&mut z, system.n1)?;
+            state.load_response = Some((system.load_factor, z.clone()));
+            z
+        }
+    })
+}
+
+/// The right-hand side of the interface problem, `r = g - C z`.
+fn interface_rhs(system: &CoupledSystem, z: &[f64]) -> Vec<f64> {
+    let mut r = system.g.clone();
+    for &(k, col, value) in &system.c {
+        r[k] -= value * z[col];
+    }
+    r
+}
+
+/// The starting guess: the last tractions along each multiplier's direction, and the
+/// uncoupled multipliers' exact values.
+fn starting_guess(system: &CoupledSystem, r: &[f64], state: &KrylovState) -> Vec<f64> {
+    let mut lambda = vec![0.0; system.m];
+    for (k, column) in system.columns.iter().enumerate() {
+        if system.d[k] != 0.0 {
+            lambda[k] = r[k] / system.d[k];
+            continue;
+        }
+        let (mut along, mut weights) = (0.0, 0.0);
+        for (key, weight) in column {
+            along += weight * state.tractions.get(key).copied().unwrap_or(0.0);
+            weights += weight * weight;
+        }
+        if weights > 0.0 {
+            lambda[k] = along / (weights * system.s);
+        }
+    }
+    lambda
+}
+
+/// Keeps the tractions of `lambda` for the next iteration's start.
+fn keep_tractions(system: &CoupledSystem, lambda: &[f64], state: &mut KrylovState) {
+    state.tractions.clear();
+    for (k, column) in system.columns.iter().enumerate() {
+        for (key, weight) in column {
+            state.tractions.insert(*key, system.s * lambda[k] * weight);
+        }
+    }
+}
+
+/// What a GMRES solve reports as it goes: its progress line, and why it failed.
+struct Monitor {
+    started: std::time::Instant,
+    /// [`KrylovState::progress`].
+    progress: bool,
+    /// The relative residual asked for.
+    tolerance: f64,
+}
+
+impl Monitor {
+    /// Rewrites the terminal line with the iterations and the residual `estimate`, once the
+    /// solve has run [`PROGRESS_AFTER`]; the caller's summary line replaces it.
+    fn show(&self, stats: &KrylovStats, estimate: f64) {
+        let seconds = self.started.elapsed().as_secs_f64();
+        if self.progress && seconds > PROGRESS_AFTER {
+            eprint!(
+                "\r\x1b[2K    interface GMRES: {} iterations, residual ~{estimate:.1e} (target \
+                 {:.1e}), {seconds:.1} s",
+                stats.iterations, self.tolerance
+            );
+        }
+    }
+
+    fn failure(&self, reason: KrylovFailure, stats: &KrylovStats, residual: f64) -> ContactError {
+        ContactError::from(KrylovError {
+            reason,
+            iterations: stats.iterations,
+            residual,
+            tolerance: self.tolerance,
+        })
+    }
 }
 
 /// Restarted GMRES, right-preconditioned (so the residual it minimizes is the true one, not a
@@ -461,34 +518,13 @@ fn gmres(
     preconditioner: &HalfSpace,
     r: &[f64],
     lambda: &mut [f64],
-    tolerance: f64,
     max_iterations: usize,
     stats: &mut KrylovStats,
-    progress: bool,
+    monitor: &Monitor,
 ) -> Result<Vec<f64>, ContactError> {
-    let started = std::time::Instant::now();
-    let show = |stats: &KrylovStats, estimate: f64| {
-        let seconds = started.elapsed().as_secs_f64();
-        if progress && seconds > PROGRESS_AFTER {
-            // Rewrites the terminal line; the caller's summary line replaces it.
-            eprint!(
-                "\r\x1b[2K    interface GMRES: {} iterations, residual ~{estimate:.1e} (target \
-                 {tolerance:.1e}), {seconds:.1} s",
-                stats.iterations
-            );
-        }
-    };
     let m = r.len();
     let r_norm = norm(r);
-    let target = tolerance * r_norm;
-    let fail = |reason, stats: &KrylovStats, residual| {
-        ContactError::from(KrylovError {
-            reason,
-            iterations: stats.iterations,
-            residual,
-            tolerance,
-        })
-    };
+    let target = monitor.tolerance * r_norm;
     let mut last_beta = f64::INFINITY;
     loop {
         // The true residual of the current iterate.
@@ -501,21 +537,64 @@ fn gmres(
             stats.initial_residual = stats.relative_residual;
         }
         if !beta.is_finite() {
-            return Err(fail(KrylovFailure::NotFinite, stats, beta / r_norm));
+            return Err(monitor.failure(KrylovFailure::NotFinite, stats, beta / r_norm));
         }
         if beta <= target {
             return Ok(w);
         }
         if stats.iterations >= max_iterations {
-            return Err(fail(KrylovFailure::IterationLimit, stats, beta / r_norm));
+            return Err(monitor.failure(KrylovFailure::IterationLimit, stats, beta / r_norm));
         }
         if beta > STAGNATION * last_beta {
-            return Err(fail(KrylovFailure::Stagnated, stats, beta / r_norm));
+            return Err(monitor.failure(KrylovFailure::Stagnated, stats, beta / r_norm));
         }
         last_beta = beta;
 
-        // One cycle: the Arnoldi basis V of S P^-1 from the residual, Z = P^-1 V.
         let steps = RESTART.min(m).min(max_iterations - stats.iterations);
+        let cycle = ArnoldiCycle {
+            system,
+            bodies,
+            preconditioner,
+            r_norm,
+            target,
+            monitor,
+        };
+        cycle.run(&residual, beta, steps, stats)?.add_to(lambda);
+    }
+}
+
+/// One restart cycle of [`gmres`]: what it multiplies by, and where it stops.
+struct ArnoldiCycle<'a> {
+    system: &'a CoupledSystem,
+    bodies: &'a Bodies<'a>,
+    preconditioner: &'a HalfSpace,
+    /// `|r|`, the scale of the relative residuals reported.
+    r_norm: f64,
+    /// The absolute residual the solve stops at.
+    target: f64,
+    monitor: &'a Monitor,
+}
+
+/// The least-squares problem a cycle leaves: `H y = g` (`H` upper triangular after the Givens
+/// rotations) over the directions `Z = P^-1 V`.
+struct CycleResult {
+    directions: Vec<Vec<f64>>,
+    h: Vec<Vec<f64>>,
+    g: Vec<f64>,
+    /// The columns of `H` filled.
+    used: usize,
+}
+
+impl ArnoldiCycle<'_> {
+    /// The Arnoldi basis `V` of `S P^-1` from `residual` (of norm `beta`), at most `steps`
+    /// vectors, with `H` rotated as it grows so that `|g[j + 1]|` is the residual's estimate.
+    fn run(
+        &self,
+        residual: &[f64],
+        beta: f64,
+        steps: usize,
+        stats: &mut KrylovStats,
+    ) -> Result<CycleResult, ContactError> {
         let mut basis: Vec<Vec<f64>> = vec![residual.iter().map(|x| x / beta).collect()];
         let mut directions: Vec<Vec<f64>> = Vec::new();
         let mut h = vec![vec![0.0; steps]; steps + 1];
@@ -524,33 +603,21 @@ fn gmres(
         g[0] = beta;
         let mut used = 0;
         for j in 0..steps {
-            let zj = preconditioner.apply(&basis[j]);
-            let (mut v, _) = product(system, bodies, &zj)?;
+            let zj = self.preconditioner.apply(&basis[j]);
+            let (mut v, _) = product(self.system, self.bodies, &zj)?;
             stats.iterations += 1;
             directions.push(zj);
-            // Modified Gram-Schmidt, twice: the basis stays orthogonal to round-off however
-            // many vectors it holds.
-            for _ in 0..2 {
-                for (i, q) in basis.iter().enumerate() {
-                    let c = dot(&v, q);
-                    h[i][j] += c;
-                    for (vi, qi) in v.iter_mut().zip(q) {
-                        *vi -= c * qi;
-                    }
-                }
-            }
+            orthogonalize(&mut v, &basis, &mut h, j);
             let next = norm(&v);
             h[j + 1][j] = next;
-            // The earlier rotations on the new column, then the one eliminating h[j+1][j].
-            for i in 0..j {
-                let (a, b) = (h[i][j], h[i + 1][j]);
-                h[i][j] = cs[i] * a + sn[i] * b;
-                h[i + 1][j] = -sn[i] * a + cs[i] * b;
-            }
+            apply_rotations(&mut h, &cs, &sn, j);
             let (a, b) = (h[j][j], h[j + 1][j]);
             let rho = a.hypot(b);
             if !rho.is_finite() {
-                return Err(fail(KrylovFailure::NotFinite, stats, beta / r_norm));
+                let residual = beta / self.r_norm;
+                return Err(self
+                    .monitor
+                    .failure(KrylovFailure::NotFinite, stats, residual));
             }
             (cs[j], sn[j]) = if rho > 0.0 {
                 (a / rho, b / rho)
@@ -562,14 +629,49 @@ fn gmres(
             g[j + 1] = -sn[j] * g[j];
             g[j] *= cs[j];
             used = j + 1;
-            show(stats, g[j + 1].abs() / r_norm);
+            self.monitor.show(stats, g[j + 1].abs() / self.r_norm);
             // Half the target, so that the true residual, recomputed next, passes too.
-            if g[j + 1].abs() <= 0.5 * target || next == 0.0 {
+            if g[j + 1].abs() <= 0.5 * self.target || next == 0.0 {
                 break;
             }
             basis.push(v.iter().map(|x| x / next).collect());
         }
-        // y = H^-1 g (upper triangular), lambda += Z y.
+        Ok(CycleResult {
+            directions,
+            h,
+            g,
+            used,
+        })
+    }
+}
+
+/// Modified Gram-Schmidt of `v` against `basis`, twice: the basis stays orthogonal to
+/// round-off however many vectors it holds. The coefficients accumulate in column `j` of `h`.
+fn orthogonalize(v: &mut [f64], basis: &[Vec<f64>], h: &mut [Vec<f64>], j: usize) {
+    for _ in 0..2 {
+        for (i, q) in basis.iter().enumerate() {
+            let c = dot(v, q);
+            h[i][j] += c;
+            for (vi, qi) in v.iter_mut().zip(q) {
+                *vi -= c * qi;
+            }
+        }
+    }
+}
+
+/// The earlier Givens rotations `(cs, sn)[..j]` applied to the new column `j` of `h`.
+fn apply_rotations(h: &mut [Vec<f64>], cs: &[f64], sn: &[f64], j: usize) {
+    for i in 0..j {
+        let (a, b) = (h[i][j], h[i + 1][j]);
+        h[i][j] = cs[i] * a + sn[i] * b;
+        h[i + 1][j] = -sn[i] * a + cs[i] * b;
+    }
+}
+
+impl CycleResult {
+    /// `lambda += Z y`, `y = H^-1 g` by back substitution.
+    fn add_to(&self, lambda: &mut [f64]) {
+        let (h, g, used) = (&self.h, &self.g, self.used);
         let mut y = vec![0.0; used];
         for i in (0..used).rev() {
             let tail: f64 = (i + 1..used).map(|k| h[i][k] * y[k]).sum();
@@ -579,7 +681,7 @@ fn gmres(
                 0.0
             };
         }
-        for (yi, zi) in y.iter().zip(&directions) {
+        for (yi, zi) in y.iter().zip(&self.directions) {
             for (l, z) in lambda.iter_mut().zip(zi) {
                 *l += yi * z;
             }

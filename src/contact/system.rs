@@ -172,54 +172,9 @@ impl CoupledSystem {
         let dropped: Vec<bool> = (0..m)
             .map(|col| coupling.is_dropped(col, body1, dim))
             .collect();
-        let free1 = |dof: usize| !body1.constraints.is_fixed(dof);
-        let free2 = |dof: usize| !body2.constraints.is_fixed(dof);
-
-        // Coupling columns: -M1 lambda on body 1, +M2 R21 lambda on body 2, one unit force
-        // per active node and component, combined per multiplier.
-        let mut b = Vec::new();
-        let mut columns = vec![Vec::new(); m];
-        let mut unit_loads = Vec::new();
-        for (k, &node) in coupling.primary_nodes.iter().enumerate() {
-            for c in 0..dim {
-                let (col, weight) = coupling.multiplier_terms(k, c, dim);
-                if dropped[col] || weight == 0.0 {
-                    continue;
-                }
-                let mut load = Vec::new();
-                let dof = dim * node + c;
-                if free1(dof) {
-                    load.push((dof, -coupling.areas1[k]));
-                }
-                for &(node2, value) in &coupling.loads2[k] {
-                    let dof2 = dim * node2 + c;
-                    if free2(dof2) {
-                        load.push((n1 + dof2, value));
-                    }
-                }
-                b.extend(load.iter().map(|&(row, v)| (row, col, s * v * weight)));
-                let key = (node, Some(c));
-                columns[col].push((key, weight));
-                unit_loads.push((key, load));
-            }
-        }
-        // Constraint rows: u1 - R12 u2 = d (tied), or its normal component (frictionless).
-        let mut c_entries = Vec::new();
-        let mut g = vec![0.0; m];
+        let columns = CouplingColumns::assemble(body1, body2, coupling, dim, &dropped, s);
+        let (c_entries, g) = constraint_rows(coupling, dim, n1, &dropped, t);
         let d: Vec<f64> = dropped.iter().map(|&x| if x { t } else { 0.0 }).collect();
-        for (a, &node) in coupling.primary_nodes.iter().enumerate() {
-            for c in 0..dim {
-                let (row, weight) = coupling.multiplier_terms(a, c, dim);
-                if dropped[row] || weight == 0.0 {
-                    continue;
-                }
-                c_entries.push((row, dim * node + c, t * weight));
-                for &(node2, w) in &coupling.r12[a] {
-                    c_entries.push((row, n1 + dim * node2 + c, -t * w * weight));
-                }
-                g[row] += t * weight * coupling.gaps[a][c];
-            }
-        }
         // Loads and prescribed displacements scale the constrained right-hand side linearly.
         let f: Vec<f64> = body1
             .f_c
@@ -231,11 +186,11 @@ impl CoupledSystem {
             n1,
             n2,
             m,
-            columns,
-            unit_loads,
+            columns: columns.columns,
+            unit_loads: columns.unit_loads,
             s,
             t,
-            b,
+            b: columns.b,
             c: c_entries,
             d,
             f,
@@ -348,6 +303,93 @@ impl CoupledSystem {
             relative_residual,
         }
     }
+}
+
+/// The coupling columns of the multipliers: `-M1 lambda` on body 1, `+M2 R21 lambda` on body
+/// 2, one unit force per active node and component, combined per multiplier.
+struct CouplingColumns {
+    /// [`CoupledSystem::b`].
+    b: Vec<(usize, usize, f64)>,
+    /// [`CoupledSystem::columns`].
+    columns: Vec<Vec<(MultiplierKey, f64)>>,
+    /// [`CoupledSystem::unit_loads`].
+    unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
+}
+
+impl CouplingColumns {
+    /// The columns of the multipliers not `dropped`, scaled by `s`; rows of prescribed dofs
+    /// carry no coupling.
+    fn assemble(
+        body1: &AssembledBody,
+        body2: &AssembledBody,
+        coupling: &Coupling,
+        dim: usize,
+        dropped: &[bool],
+        s: f64,
+    ) -> Self {
+        let n1 = body1.f_c.len();
+        let free1 = |dof: usize| !body1.constraints.is_fixed(dof);
+        let free2 = |dof: usize| !body2.constraints.is_fixed(dof);
+        let mut b = Vec::new();
+        let mut columns = vec![Vec::new(); dropped.len()];
+        let mut unit_loads = Vec::new();
+        for (k, &node) in coupling.primary_nodes.iter().enumerate() {
+            for c in 0..dim {
+                let (col, weight) = coupling.multiplier_terms(k, c, dim);
+                if dropped[col] || weight == 0.0 {
+                    continue;
+                }
+                let mut load = Vec::new();
+                let dof = dim * node + c;
+                if free1(dof) {
+                    load.push((dof, -coupling.areas1[k]));
+                }
+                for &(node2, value) in &coupling.loads2[k] {
+                    let dof2 = dim * node2 + c;
+                    if free2(dof2) {
+                        load.push((n1 + dof2, value));
+                    }
+                }
+                b.extend(load.iter().map(|&(row, v)| (row, col, s * v * weight)));
+                let key = (node, Some(c));
+                columns[col].push((key, weight));
+                unit_loads.push((key, load));
+            }
+        }
+        Self {
+            b,
+            columns,
+            unit_loads,
+        }
+    }
+}
+
+/// The constraint rows `C` and right-hand side `g`, scaled by `t`: `u1 - R12 u2 = d` (tied),
+/// or its normal component (frictionless), for the multipliers not `dropped`; body 2's dofs
+/// follow body 1's `n1`.
+fn constraint_rows(
+    coupling: &Coupling,
+    dim: usize,
+    n1: usize,
+    dropped: &[bool],
+    t: f64,
+) -> (Vec<(usize, usize, f64)>, Vec<f64>) {
+    let mut c_entries = Vec::new();
+    let mut g = vec![0.0; dropped.len()];
+    for (a, &node) in coupling.primary_nodes.iter().enumerate() {
+        for c in 0..dim {
+            let (row, weight) = coupling.multiplier_terms(a, c, dim);
+            if dropped[row] || weight == 0.0 {
+                continue;
+            }
+            c_entries.push((row, dim * node + c, t * weight));
+            for &(node2, w) in &coupling.r12[a] {
+                c_entries.push((row, n1 + dim * node2 + c, -t * w * weight));
+            }
+            g[row] += t * weight * coupling.gaps[a][c];
+        }
+    }
+    (c_entries, g)
 }
 
 fn diagonal_max(k: &SparseColMat<usize, f64>) -> f64 {

@@ -32,124 +32,13 @@ pub struct BodyFields<'a> {
 pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
     let h5_path = dir.join(format!("{stem}.h5"));
     let dim = bodies.first().map_or(3, |b| b.mesh.dim);
-    let num_nodes: usize = bodies.iter().map(|b| b.mesh.num_nodes()).sum();
-    let num_cells: usize = bodies.iter().map(|b| b.mesh.num_cells()).sum();
-
-    let mut geometry = Vec::with_capacity(3 * num_nodes);
-    let mut displacement = Vec::with_capacity(3 * num_nodes);
-    let mut node_tag = Vec::with_capacity(num_nodes);
-    let mut node_body = Vec::with_capacity(num_nodes);
-    let mut topology = Vec::with_capacity((dim + 1) * num_cells);
-    let (mut cell_tag, mut cell_body) = (Vec::new(), Vec::new());
-    let (mut strain, mut stress, mut von_mises) = (Vec::new(), Vec::new(), Vec::new());
-    let contact = bodies.iter().any(|b| b.surface.is_some());
-    let mut traction = vec![0.0; 3 * num_nodes];
-    let mut pressure = vec![0.0; num_nodes];
-    let mut mean_pressure = vec![0.0; num_nodes];
-    let mut gap = vec![0.0; num_nodes];
-    let mut active = vec![0i32; num_nodes];
-    let mut offset = 0;
-    for (id, body) in bodies.iter().enumerate() {
-        if let Some(surface) = body.surface {
-            for (s, &node) in surface.nodes.iter().enumerate() {
-                let row = offset + node;
-                traction[3 * row..3 * row + 3].copy_from_slice(&surface.traction[s]);
-                pressure[row] = surface.pressure[s];
-                mean_pressure[row] = surface.mean_pressure[s];
-                gap[row] = surface.normal_gap[s];
-                active[row] = i32::from(surface.active[s]);
-            }
-        }
-        let m = body.mesh;
-        for (a, x) in m.coords.iter().enumerate() {
-            geometry.extend_from_slice(x);
-            let mut u = [0.0; 3];
-            u[..dim].copy_from_slice(&body.displacement[dim * a..dim * a + dim]);
-            displacement.extend_from_slice(&u);
-        }
-        node_tag.extend(m.node_tags.iter().map(|&t| t as i64));
-        node_body.extend(std::iter::repeat_n(id as i32, m.num_nodes()));
-        topology.extend(m.cells.iter().map(|&n| (n + offset) as i64));
-        cell_tag.extend(m.cell_tags.iter().map(|&t| t as i64));
-        cell_body.extend(std::iter::repeat_n(id as i32, m.num_cells()));
-        strain.extend(body.cell_fields.strain.iter().flatten());
-        stress.extend(body.cell_fields.stress.iter().flatten());
-        von_mises.extend_from_slice(&body.cell_fields.von_mises);
-        offset += m.num_nodes();
-    }
-
-    let hdf5_error = |source| OutputError::Hdf5 {
-        path: h5_path.clone(),
-        source,
-    };
-    let write = || -> hdf5::Result<()> {
-        let file = hdf5::File::create(&h5_path)?;
-        let mesh = file.create_group("mesh")?;
-        let fields = file.create_group("fields")?;
-        let table = |v: Vec<f64>, cols: usize| {
-            Array2::from_shape_vec((v.len() / cols, cols), v).expect("rows * cols")
-        };
-        mesh.new_dataset_builder()
-            .with_data(&table(geometry, 3))
-            .create("geometry")?;
-        mesh.new_dataset_builder()
-            .with_data(
-                &Array2::from_shape_vec((num_cells, dim + 1), topology).expect("rows * cols"),
-            )
-            .create("topology")?;
-        mesh.new_dataset_builder()
-            .with_data(&Array1::from(node_tag))
-            .create("node_tag")?;
-        mesh.new_dataset_builder()
-            .with_data(&Array1::from(node_body))
-            .create("node_body")?;
-        mesh.new_dataset_builder()
-            .with_data(&Array1::from(cell_tag))
-            .create("cell_tag")?;
-        mesh.new_dataset_builder()
-            .with_data(&Array1::from(cell_body))
-            .create("cell_body")?;
-        fields
-            .new_dataset_builder()
-            .with_data(&table(displacement, 3))
-            .create("displacement")?;
-        fields
-            .new_dataset_builder()
-            .with_data(&table(strain, 9))
-            .create("strain")?;
-        fields
-            .new_dataset_builder()
-            .with_data(&table(stress, 9))
-            .create("stress")?;
-        fields
-            .new_dataset_builder()
-            .with_data(&Array1::from(von_mises))
-            .create("von_mises")?;
-        if contact {
-            fields
-                .new_dataset_builder()
-                .with_data(&table(traction, 3))
-                .create("contact_traction")?;
-            fields
-                .new_dataset_builder()
-                .with_data(&Array1::from(pressure))
-                .create("contact_pressure")?;
-            fields
-                .new_dataset_builder()
-                .with_data(&Array1::from(mean_pressure))
-                .create("contact_mean_pressure")?;
-            fields
-                .new_dataset_builder()
-                .with_data(&Array1::from(gap))
-                .create("normal_gap")?;
-            fields
-                .new_dataset_builder()
-                .with_data(&Array1::from(active))
-                .create("contact_active")?;
-        }
-        file.close()
-    };
-    write().map_err(hdf5_error)?;
+    let grid = Grid::gather(bodies, dim);
+    let (num_nodes, num_cells, contact) = (grid.num_nodes, grid.num_cells, grid.contact);
+    grid.write_h5(&h5_path, dim)
+        .map_err(|source| OutputError::Hdf5 {
+            path: h5_path.clone(),
+            source,
+        })?;
 
     let xdmf_path = dir.join(format!("{stem}.xdmf"));
     std::fs::write(
@@ -162,23 +51,259 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
     })
 }
 
+/// Every body's nodes and cells one after the other, as the datasets of the module doc.
+struct Grid {
+    num_nodes: usize,
+    num_cells: usize,
+    /// Whether any body has interface fields (a contact run).
+    contact: bool,
+    geometry: Vec<f64>,
+    displacement: Vec<f64>,
+    node_tag: Vec<i64>,
+    node_body: Vec<i32>,
+    topology: Vec<i64>,
+    cell_tag: Vec<i64>,
+    cell_body: Vec<i32>,
+    strain: Vec<f64>,
+    stress: Vec<f64>,
+    von_mises: Vec<f64>,
+    traction: Vec<f64>,
+    pressure: Vec<f64>,
+    mean_pressure: Vec<f64>,
+    gap: Vec<f64>,
+    active: Vec<i32>,
+}
+
+impl Grid {
+    fn gather(bodies: &[BodyFields], dim: usize) -> Self {
+        let num_nodes: usize = bodies.iter().map(|b| b.mesh.num_nodes()).sum();
+        let num_cells: usize = bodies.iter().map(|b| b.mesh.num_cells()).sum();
+        let mut grid = Self {
+            num_nodes,
+            num_cells,
+            contact: bodies.iter().any(|b| b.surface.is_some()),
+            geometry: Vec::with_capacity(3 * num_nodes),
+            displacement: Vec::with_capacity(3 * num_nodes),
+            node_tag: Vec::with_capacity(num_nodes),
+            node_body: Vec::with_capacity(num_nodes),
+            topology: Vec::with_capacity((dim + 1) * num_cells),
+            cell_tag: Vec::new(),
+            cell_body: Vec::new(),
+            strain: Vec::new(),
+            stress: Vec::new(),
+            von_mises: Vec::new(),
+            traction: vec![0.0; 3 * num_nodes],
+            pressure: vec![0.0; num_nodes],
+            mean_pressure: vec![0.0; num_nodes],
+            gap: vec![0.0; num_nodes],
+            active: vec![0i32; num_nodes],
+        };
+        let mut offset = 0;
+        for (id, body) in bodies.iter().enumerate() {
+            if let Some(surface) = body.surface {
+                grid.add_surface(surface, offset);
+            }
+            let m = body.mesh;
+            for (a, x) in m.coords.iter().enumerate() {
+                grid.geometry.extend_from_slice(x);
+                let mut u = [0.0; 3];
+                u[..dim].copy_from_slice(&body.displacement[dim * a..dim * a + dim]);
+                grid.displacement.extend_from_slice(&u);
+            }
+            grid.node_tag.extend(m.node_tags.iter().map(|&t| t as i64));
+            grid.node_body
+                .extend(std::iter::repeat_n(id as i32, m.num_nodes()));
+            grid.topology
+                .extend(m.cells.iter().map(|&n| (n + offset) as i64));
+            grid.cell_tag.extend(m.cell_tags.iter().map(|&t| t as i64));
+            grid.cell_body
+                .extend(std::iter::repeat_n(id as i32, m.num_cells()));
+            grid.strain.extend(body.cell_fields.strain.iter().flatten());
+            grid.stress.extend(body.cell_fields.stress.iter().flatten());
+            grid.von_mises
+                .extend_from_slice(&body.cell_fields.von_mises);
+            offset += m.num_nodes();
+        }
+        grid
+    }
+
+    /// The interface fields of a body whose first node is node `offset` of the grid.
+    fn add_surface(&mut self, surface: &SurfaceFields, offset: usize) {
+        for (s, &node) in surface.nodes.iter().enumerate() {
+            let row = offset + node;
+            self.traction[3 * row..3 * row + 3].copy_from_slice(&surface.traction[s]);
+            self.pressure[row] = surface.pressure[s];
+            self.mean_pressure[row] = surface.mean_pressure[s];
+            self.gap[row] = surface.normal_gap[s];
+            self.active[row] = i32::from(surface.active[s]);
+        }
+    }
+
+    fn write_h5(self, path: &Path, dim: usize) -> hdf5::Result<()> {
+        let file = hdf5::File::create(path)?;
+        let mesh = file.create_group("mesh")?;
+        let fields = file.create_group("fields")?;
+        let table = |v: Vec<f64>, cols: usize| {
+            Array2::from_shape_vec((v.len() / cols, cols), v).expect("rows * cols")
+        };
+        let topology =
+            Array2::from_shape_vec((self.num_cells, dim + 1), self.topology).expect("rows * cols");
+        write_dataset(&mesh, "geometry", &table(self.geometry, 3))?;
+        write_dataset(&mesh, "topology", &topology)?;
+        write_dataset(&mesh, "node_tag", &Array1::from(self.node_tag))?;
+        write_dataset(&mesh, "node_body", &Array1::from(self.node_body))?;
+        write_dataset(&mesh, "cell_tag", &Array1::from(self.cell_tag))?;
+        write_dataset(&mesh, "cell_body", &Array1::from(self.cell_body))?;
+        write_dataset(&fields, "displacement", &table(self.displacement, 3))?;
+        write_dataset(&fields, "strain", &table(self.strain, 9))?;
+        write_dataset(&fields, "stress", &table(self.stress, 9))?;
+        write_dataset(&fields, "von_mises", &Array1::from(self.von_mises))?;
+        if self.contact {
+            write_dataset(&fields, "contact_traction", &table(self.traction, 3))?;
+            write_dataset(&fields, "contact_pressure", &Array1::from(self.pressure))?;
+            write_dataset(
+                &fields,
+                "contact_mean_pressure",
+                &Array1::from(self.mean_pressure),
+            )?;
+            write_dataset(&fields, "normal_gap", &Array1::from(self.gap))?;
+            write_dataset(&fields, "contact_active", &Array1::from(self.active))?;
+        }
+        file.close()
+    }
+}
+
+/// Creates the dataset `name` in `group` holding `data`.
+fn write_dataset<T: hdf5::H5Type, D: ndarray::Dimension>(
+    group: &hdf5::Group,
+    name: &str,
+    data: &ndarray::Array<T, D>,
+) -> hdf5::Result<()> {
+    group.new_dataset_builder().with_data(data).create(name)?;
+    Ok(())
+}
+
+/// One `<Attribute>` of the grid: a dataset of the `.h5` by its path.
+struct Attribute {
+    name: &'static str,
+    /// `Scalar`, `Vector` or `Tensor`.
+    kind: &'static str,
+    /// `Node` or `Cell`.
+    center: &'static str,
+    /// Values per node or cell (1, 3 or 9).
+    components: usize,
+    /// `Int` or `Float`.
+    number: &'static str,
+    /// Bytes per value.
+    precision: u8,
+    path: &'static str,
+}
+
+impl Attribute {
+    const fn new(
+        name: &'static str,
+        kind: &'static str,
+        center: &'static str,
+        components: usize,
+        (number, precision): (&'static str, u8),
+        path: &'static str,
+    ) -> Self {
+        Self {
+            name,
+            kind,
+            center,
+            components,
+            number,
+            precision,
+            path,
+        }
+    }
+}
+
+const INT32: (&str, u8) = ("Int", 4);
+const INT64: (&str, u8) = ("Int", 8);
+const FLOAT64: (&str, u8) = ("Float", 8);
+
+/// The attributes of every run, in the order written.
+const ATTRIBUTES: [Attribute; 6] = [
+    Attribute::new(
+        "displacement",
+        "Vector",
+        "Node",
+        3,
+        FLOAT64,
+        "/fields/displacement",
+    ),
+    Attribute::new(
+        "gmsh_node_tag",
+        "Scalar",
+        "Node",
+        1,
+        INT64,
+        "/mesh/node_tag",
+    ),
+    Attribute::new("body_id", "Scalar", "Cell", 1, INT32, "/mesh/cell_body"),
+    Attribute::new("strain", "Tensor", "Cell", 9, FLOAT64, "/fields/strain"),
+    Attribute::new("stress", "Tensor", "Cell", 9, FLOAT64, "/fields/stress"),
+    Attribute::new(
+        "von_mises",
+        "Scalar",
+        "Cell",
+        1,
+        FLOAT64,
+        "/fields/von_mises",
+    ),
+];
+
+/// The attributes a contact run adds.
+const CONTACT_ATTRIBUTES: [Attribute; 5] = [
+    Attribute::new(
+        "contact_traction",
+        "Vector",
+        "Node",
+        3,
+        FLOAT64,
+        "/fields/contact_traction",
+    ),
+    Attribute::new(
+        "contact_pressure",
+        "Scalar",
+        "Node",
+        1,
+        FLOAT64,
+        "/fields/contact_pressure",
+    ),
+    Attribute::new(
+        "contact_mean_pressure",
+        "Scalar",
+        "Node",
+        1,
+        FLOAT64,
+        "/fields/contact_mean_pressure",
+    ),
+    Attribute::new(
+        "normal_gap",
+        "Scalar",
+        "Node",
+        1,
+        FLOAT64,
+        "/fields/normal_gap",
+    ),
+    Attribute::new(
+        "contact_active",
+        "Scalar",
+        "Node",
+        1,
+        INT32,
+        "/fields/contact_active",
+    ),
+];
+
 fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize, contact: bool) -> String {
     let h5 = format!("{stem}.h5");
     let item = |dims: String, number: &str, precision: u8, path: &str| {
         format!(
             "<DataItem Dimensions=\"{dims}\" NumberType=\"{number}\" Precision=\"{precision}\" Format=\"HDF\">{h5}:{path}</DataItem>"
-        )
-    };
-    let attribute = |name: &str,
-                     kind: &str,
-                     center: &str,
-                     dims: String,
-                     number: &str,
-                     precision: u8,
-                     path: &str| {
-        format!(
-            "      <Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"{center}\">\n        {}\n      </Attribute>\n",
-            item(dims, number, precision, path)
         )
     };
     let (topology, per_cell) = if dim == 2 {
@@ -198,105 +323,19 @@ fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize, contact
         "      <Geometry GeometryType=\"XYZ\">\n        {}\n      </Geometry>\n",
         item(format!("{n} 3"), "Float", 8, "/mesh/geometry")
     );
-    s += &attribute(
-        "displacement",
-        "Vector",
-        "Node",
-        format!("{n} 3"),
-        "Float",
-        8,
-        "/fields/displacement",
-    );
-    s += &attribute(
-        "gmsh_node_tag",
-        "Scalar",
-        "Node",
-        n.to_string(),
-        "Int",
-        8,
-        "/mesh/node_tag",
-    );
-    s += &attribute(
-        "body_id",
-        "Scalar",
-        "Cell",
-        c.to_string(),
-        "Int",
-        4,
-        "/mesh/cell_body",
-    );
-    s += &attribute(
-        "strain",
-        "Tensor",
-        "Cell",
-        format!("{c} 9"),
-        "Float",
-        8,
-        "/fields/strain",
-    );
-    s += &attribute(
-        "stress",
-        "Tensor",
-        "Cell",
-        format!("{c} 9"),
-        "Float",
-        8,
-        "/fields/stress",
-    );
-    s += &attribute(
-        "von_mises",
-        "Scalar",
-        "Cell",
-        c.to_string(),
-        "Float",
-        8,
-        "/fields/von_mises",
-    );
-    if contact {
-        s += &attribute(
-            "contact_traction",
-            "Vector",
-            "Node",
-            format!("{n} 3"),
-            "Float",
-            8,
-            "/fields/contact_traction",
-        );
-        s += &attribute(
-            "contact_pressure",
-            "Scalar",
-            "Node",
-            n.to_string(),
-            "Float",
-            8,
-            "/fields/contact_pressure",
-        );
-        s += &attribute(
-            "contact_mean_pressure",
-            "Scalar",
-            "Node",
-            n.to_string(),
-            "Float",
-            8,
-            "/fields/contact_mean_pressure",
-        );
-        s += &attribute(
-            "normal_gap",
-            "Scalar",
-            "Node",
-            n.to_string(),
-            "Float",
-            8,
-            "/fields/normal_gap",
-        );
-        s += &attribute(
-            "contact_active",
-            "Scalar",
-            "Node",
-            n.to_string(),
-            "Int",
-            4,
-            "/fields/contact_active",
+    let extra: &[Attribute] = if contact { &CONTACT_ATTRIBUTES } else { &[] };
+    for a in ATTRIBUTES.iter().chain(extra) {
+        let rows = if a.center == "Node" { n } else { c };
+        let dims = match a.components {
+            1 => rows.to_string(),
+            k => format!("{rows} {k}"),
+        };
+        s += &format!(
+            "      <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{}\">\n        {}\n      </Attribute>\n",
+            a.name,
+            a.kind,
+            a.center,
+            item(dims, a.number, a.precision, a.path)
         );
     }
     s += "    </Grid>\n  </Domain>\n</Xdmf>\n";

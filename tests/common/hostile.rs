@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::{fixture, write_case};
+use super::case_builder::{Body, CaseFile, Dirichlet, Load};
 use internodes::run::{RunError, RunOptions, solve_case};
 
 pub const BINARY: &str = env!("CARGO_BIN_EXE_internodes");
@@ -28,65 +28,32 @@ pub fn run_error(case: &Path, why: &str) -> RunError {
 }
 
 /// The message of a case that must fail.
-pub fn case_failure(text: &str) -> String {
-    let (_dir, path) = write_case(text);
+pub fn case_failure(case: &CaseFile) -> String {
+    let (_dir, path) = case.write();
     match run_quiet(&path) {
-        Ok(_) => panic!("the case should fail:\n{text}"),
+        Ok(_) => panic!("the case should fail:\n{}", case.to_toml()),
         Err(e) => e.to_string(),
     }
 }
 
-/// The two bodies of `two_blocks_2d.msh` (or an edit of it at `mesh`), each supported on its own.
-pub fn two_blocks_case(mesh: &Path, upper: &str, extra: &str) -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-{extra}
-
-[[body]]
-name = "lower"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "lower_base"
-ux = 0.0
-uy = 0.0
-[[body.load]]
-group = "lower_contact"
-traction = [0.0, -1.0]
-
-[[body]]
-name = "{upper}"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "upper_top"
-ux = 0.0
-uy = 0.0
-"#,
-        mesh.display()
-    )
+/// The two bodies of `two_blocks_2d.msh` (or an edit of it at `mesh`), each supported on its
+/// own, the lower one loaded on its contact surface; the second is named `upper`.
+pub fn two_blocks_case(mesh: &Path, upper: &str) -> CaseFile {
+    CaseFile::new(mesh)
+        .body(
+            Body::new("lower", 1000.0, 0.3)
+                .dirichlet(Dirichlet::clamped("lower_base", 2))
+                .load(Load::traction("lower_contact", &[0.0, -1.0])),
+        )
+        .body(Body::new(upper, 1000.0, 0.3).dirichlet(Dirichlet::clamped("upper_top", 2)))
 }
 
 /// The unit square of `square_*.msh`: clamped on `left`, pulled by `traction` on `right`.
-pub fn square_case(mesh: &str, traction: &str) -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-
-[[body]]
-name = "square"
-youngs_modulus = 100.0
-poisson_ratio = 0.25
-[[body.dirichlet]]
-group = "left"
-ux = 0.0
-uy = 0.0
-[[body.load]]
-group = "right"
-traction = {traction}
-"#,
-        fixture(mesh).display()
+pub fn square_case(mesh: &str, traction: &[f64]) -> CaseFile {
+    CaseFile::on_fixture(mesh).body(
+        Body::new("square", 100.0, 0.25)
+            .dirichlet(Dirichlet::clamped("left", 2))
+            .load(Load::traction("right", traction)),
     )
 }
 

@@ -1,12 +1,14 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
+pub mod case_builder;
 pub mod contact;
 pub mod hostile;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use case_builder::{Body, CaseFile, Dirichlet, Load};
 use internodes::mesh::{Mesh, read_msh};
 
 /// A committed mesh from `tests/fixtures/` (generated from `geo/`; see its README).
@@ -97,63 +99,21 @@ pub fn run_solve_with(case: &Path, env: &[(&str, &str)]) -> Output {
 }
 
 /// A valid 3D case on the `block_3d` fixture: the block clamped at its base under a Hertzian
-/// pressure on its top; tests edit its text.
-pub fn block_3d_case() -> String {
-    format!(
-        r#"mesh = "{}"
-output = "out"
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-uz = 0.0
-
-[[body.load]]
-group = "block_top"
-hertz_pressure = {{ p0 = 10.0, a = 0.5, center = [0.0, 0.0, 0.0] }}
-"#,
-        fixture("block_3d.msh").display()
+/// pressure on its top.
+pub fn block_3d_case() -> CaseFile {
+    CaseFile::on_fixture("block_3d.msh").body(
+        Body::new("block", 1000.0, 0.3)
+            .dirichlet(Dirichlet::clamped("block_base", 3))
+            .load(Load::hertz("block_top", 10.0, 0.5, &[0.0, 0.0, 0.0])),
     )
 }
 
 /// The contact case of `geo/half_disc_on_block.toml` on the fixture `mesh`: the half-disc
-/// (R = 1) pressed by 0.02 onto the block, both E = 1000, nu = 0.3; `extra` lines go into the
-/// `[contact]` table.
-pub fn half_disc_on_block(mesh: &str, extra: &str) -> String {
-    format!(
-        r#"mesh = "{mesh}"
-output = "out"
-
-[contact]
-bodies = ["disc", "block"]
-surfaces = ["disc_contact", "block_contact"]
-primary = "disc"
-{extra}
-
-[[body]]
-name = "disc"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "disc_top"
-ux = 0.0
-uy = -0.02
-
-[[body]]
-name = "block"
-youngs_modulus = 1000.0
-poisson_ratio = 0.3
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-"#,
-        mesh = fixture(mesh).display()
-    )
+/// (R = 1) pressed by 0.02 onto the block, both E = 1000, nu = 0.3, the disc primary.
+pub fn half_disc_on_block(mesh: &str) -> CaseFile {
+    CaseFile::on_fixture(mesh)
+        .contact(["disc", "block"], ["disc_contact", "block_contact"])
+        .primary("disc")
+        .body(Body::new("disc", 1000.0, 0.3).dirichlet(Dirichlet::on("disc_top").ux(0.0).uy(-0.02)))
+        .body(Body::new("block", 1000.0, 0.3).dirichlet(Dirichlet::clamped("block_base", 2)))
 }
