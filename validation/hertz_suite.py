@@ -132,6 +132,10 @@ CASES = (
     HertzCase("two_half_discs", 2, "upper", "upper_contact", "upper_support", "lower", "lower_contact",
               "lower_support", 0.03, 0.5, {"r_c": 0.2, "h_far": 0.5, "d_far": 2.0, "ratio": 1.5}, 0.025, True,
               (1.0, 1.0), True, {"half-disc radius R (each)": 1.0}),
+    HertzCase("half_disc_in_groove", 2, "disc", "disc_contact", "disc_top", "block", "block_contact", "block_base",
+              0.02, 1.5, {"r_c": 0.2, "h_far": 0.5, "d_far": 2.0}, 0.025, True, (1.0, 2.0), False,
+              {"block half-width W": 2.0, "block depth H": 2.0, "half-disc radius R": 1.0, "groove radius R_g": 3.0},
+              ("Hertz a", "Hertz p0")),
 )
 
 
