@@ -634,7 +634,7 @@ def geometry_lines(cases: list, results: dict) -> str:
         sizes = ", ".join(f"{name} {size:g} = {size / a:.1f} a" for name, size in case.sizes.items())
         lines.append(f"* `{case.name}`: delta = {case.delta}, R_eff = {case.radius}; r_c = "
                      f"{case.geo_parameters['r_c']:g}, h_c = {case.contact_spacing:g} at level 0; a_H = {a:.4f} at "
-                     f"the finest level (a / R = {a:.3f} per body, a / R_eff = {a / case.radius:.3f}); {sizes}.")
+                     f"the finest level (a / R_eff = {a / case.radius:.3f}); {sizes}.")
     return "\n".join(lines)
 
 
