@@ -1,25 +1,23 @@
 #!/usr/bin/python3
-"""Hertz suite: internodes on the four geo/ contact cases at several mesh levels, against Hertz.
+"""Hertz suite: internodes on the geo/ contact cases of ``CASES`` at several mesh levels, against Hertz.
 
-Cases (E = 1000, nu = 0.3 on both bodies; the primary's support is pushed down by delta and held
-laterally, the secondary's is clamped):
-
-* ``hemisphere_on_block`` (3D): hemisphere R = 1 pushed 0.01 onto a 4 x 4 x 2 block;
-* ``two_hemispheres`` (3D): two hemispheres R = 1, the upper mesh 1.5 times coarser, pushed 0.02;
-* ``half_disc_on_block`` (2D, plane strain): half-disc R = 1 pushed 0.02 onto a 4 x 2 block;
-* ``two_half_discs`` (2D): two half-discs R = 1, the upper mesh 1.5 times coarser, pushed 0.03.
+One row of ``CASES`` per geo script (the row's name is the script's): its bodies and surfaces, the
+approach, Hertz's effective radius, the mesh sizes and the targets it is judged on. E = 1000,
+nu = 0.3 on both bodies; the primary's support is pushed down by delta and held laterally, the
+secondary's is clamped. The report lists each row's geometry (``geometry_lines``).
 
 The curved body (the coarser upper one in the two-body cases) is the primary. Every case runs at
 three levels, the contact-zone spacing halving (3D: h_c = R/33, R/67, R/133 with the far field
 fixed; 2D: R/40, R/80, R/160 with every size halving); ``--quick`` runs the coarsest only, with
 the same thresholds. Each level is solved frictionless with load steps 0.25, 0.5, 0.75, 1 (the
-force-approach curve) and tied in one step.
+force-approach curve) and tied in one step. A row is judged at its finest level on the targets it
+names (``TARGETS``); two equal bodies also on their symmetry plane.
 
 Definitions (for each run, on its final step):
 
 * P: the vertical contact force on the primary (``summary.json`` contact.force_primary);
-* Hertz for that P, 1/R = 1/R1 + 1/R2, 1/E* = 2 (1 - nu^2) / E: 3D a_H = (3PR/(4E*))^(1/3),
-  p0_H = 3P/(2 pi a_H^2); 2D a_H = sqrt(4PR/(pi E*)), p0_H = 2P/(pi a_H);
+* Hertz for that P, 1/R = 1/R1 + 1/R2 (R2 < 0 for a concave surface), 1/E* = 2 (1 - nu^2) / E:
+  3D a_H = (3PR/(4E*))^(1/3), p0_H = 3P/(2 pi a_H^2); 2D a_H = sqrt(4PR/(pi E*)), p0_H = 2P/(pi a_H);
 * a, p0: the solver's Hertz fit (least squares of p_i^2 against r_i^2 over the loaded active
   primary nodes, ``summary.json`` contact.hertz_fit);
 * interface spacing h: mean length of the primary candidate-surface mesh edges within 0.15 of
@@ -80,6 +78,15 @@ PROFILE_RMS = 0.03  # RMS (p_i - p_H(r_i)) / p0_H
 SYMMETRY = 0.01  # max distance from the symmetry plane / h
 SHRINKS = 1.0  # finest error / coarsest error
 QUANTITIES = {"a": "|a/a_H - 1|", "p0": "|p0/p0_H - 1|", "rms": "profile RMS / p0_H"}
+# The targets a row can name: check -> (figure of ``analyse``, tolerance, note: a template filled
+# with the run's numbers of ``analyse`` and ``numbers``, the fit against Hertz).
+TARGETS = {
+    "Hertz a / h": ("error_a_over_h", A_OVER_H_3D, "|a - a_H| / h; {numbers}"),
+    "Hertz a": ("error_a", RELATIVE_2D_A, "|a/a_H - 1|; {numbers}"),
+    "Hertz p0": ("error_p0", RELATIVE_P0, "|p0/p0_H - 1|; {numbers}"),
+    "pressure RMS": ("error_rms", PROFILE_RMS, "RMS of nodal p - Hertz over {active_primary} active nodes / p0_H "
+                                               "(mean pressure, for information: {rms_mean_pressure:.3f})"),
+}
 
 
 @dataclass
@@ -102,6 +109,7 @@ class HertzCase:
     support_depths: tuple  # distances of the two supports from the contact point (Boussinesq)
     two_equal_bodies: bool
     sizes: dict = field(default_factory=dict)  # body dimensions seen from the contact, for the text
+    targets: tuple = ()  # keys of TARGETS judged at the finest level
 
     def gmsh_parameters(self, level: int) -> dict:
         """-setnumber values of a level: h_c halves each level (and the far field if refined)."""
@@ -113,16 +121,21 @@ class HertzCase:
 CASES = (
     HertzCase("hemisphere_on_block", 3, "sphere", "sphere_contact", "sphere_top", "block", "block_contact",
               "block_base", 0.01, 1.0, {"r_c": 0.16, "h_far": 0.5, "d_far": 1.0}, 0.03, False, (1.0, 2.0),
-              False, {"block half-width W": 2.0, "block height H": 2.0, "hemisphere radius R": 1.0}),
+              False, {"block half-width W": 2.0, "block height H": 2.0, "hemisphere radius R": 1.0},
+              ("Hertz a / h", "Hertz p0", "pressure RMS")),
     HertzCase("two_hemispheres", 3, "upper", "upper_contact", "upper_support", "lower", "lower_contact",
               "lower_support", 0.02, 0.5, {"r_c": 0.16, "h_far": 0.5, "d_far": 1.0, "ratio": 1.5}, 0.03, False,
               (1.0, 1.0), True, {"hemisphere radius R (each)": 1.0}),
     HertzCase("half_disc_on_block", 2, "disc", "disc_contact", "disc_top", "block", "block_contact", "block_base",
               0.02, 1.0, {"r_c": 0.2, "h_far": 0.5, "d_far": 2.0}, 0.025, True, (1.0, 2.0), False,
-              {"block half-width W": 2.0, "block height H": 2.0, "half-disc radius R": 1.0}),
+              {"block half-width W": 2.0, "block height H": 2.0, "half-disc radius R": 1.0}, ("Hertz a", "Hertz p0")),
     HertzCase("two_half_discs", 2, "upper", "upper_contact", "upper_support", "lower", "lower_contact",
               "lower_support", 0.03, 0.5, {"r_c": 0.2, "h_far": 0.5, "d_far": 2.0, "ratio": 1.5}, 0.025, True,
               (1.0, 1.0), True, {"half-disc radius R (each)": 1.0}),
+    HertzCase("half_disc_in_groove", 2, "disc", "disc_contact", "disc_top", "block", "block_contact", "block_base",
+              0.02, 1.5, {"r_c": 0.2, "h_far": 0.5, "d_far": 2.0}, 0.025, True, (1.0, 2.0), False,
+              {"block half-width W": 2.0, "block depth H": 2.0, "half-disc radius R": 1.0, "groove radius R_g": 3.0},
+              ("Hertz a", "Hertz p0")),
 )
 
 
@@ -321,19 +334,9 @@ def target_checks(case: HertzCase, finest: dict, level: int) -> list[Check]:
     numbers = (f"a = {finest['a']:.5f}, a_H = {finest['a_hertz']:.5f}, p0 = {finest['p0']:.4g}, "
                f"p0_H = {finest['p0_hertz']:.4g}, h = {finest['h']:.4g}")
     checks = []
-    if case.name == "hemisphere_on_block":
-        checks += [
-            Check("Hertz a / h", where, finest["error_a_over_h"], A_OVER_H_3D, f"|a - a_H| / h; {numbers}"),
-            Check("Hertz p0", where, finest["error_p0"], RELATIVE_P0, f"|p0/p0_H - 1|; {numbers}"),
-            Check("pressure RMS", where, finest["error_rms"], PROFILE_RMS,
-                  f"RMS of nodal p - Hertz over {finest['active_primary']} active nodes / p0_H "
-                  f"(mean pressure, for information: {finest['rms_mean_pressure']:.3f})"),
-        ]
-    elif case.name == "half_disc_on_block":
-        checks += [
-            Check("Hertz a", where, finest["error_a"], RELATIVE_2D_A, f"|a/a_H - 1|; {numbers}"),
-            Check("Hertz p0", where, finest["error_p0"], RELATIVE_P0, f"|p0/p0_H - 1|; {numbers}"),
-        ]
+    for target in case.targets:
+        key, tolerance, note = TARGETS[target]
+        checks.append(Check(target, where, finest[key], tolerance, note.format(numbers=numbers, **finest)))
     if case.two_equal_bodies:
         worst = finest.get("symmetry_worst_node", {})
         checks.append(Check("symmetry plane", where, finest["symmetry_over_h"], SYMMETRY,
@@ -540,9 +543,9 @@ def check_table(checks: list[Check]) -> str:
 
 GEOMETRY_TEXT = """\
 **Geometry and meshes.** E = 1000, nu = 0.3 on both bodies (E* = E / (2 (1 - nu^2)) = {e_star:.2f}).
-The contact zone r < r_c (0.16 in 3D, 0.2 in 2D) is meshed at h_c, halving per level; in 3D only
-h_c halves (far field h_far = 0.5 reached at distance d_far = 1, to keep the largest mesh small),
-in 2D every size halves (gmsh `level`). a / R is about 0.1, so:
+The contact zone r < r_c is meshed at h_c (per case below), halving per level; in 3D only h_c
+halves (the far field stays at h_far, to keep the largest mesh small), in 2D every size halves
+(gmsh `level`). Per case:
 
 {geometry}
 
@@ -610,6 +613,8 @@ LIMITS_TEXT = """\
   the rim nodes.
 * Modelling: Hertz assumes half-spaces and a << R; with a / R = 0.1 and bodies 10-20 a in size the
   a and p0 errors level off at the per-mille to percent level (see the floor in the convergence plots).
+  Where the coarsest level is already at that floor, the error moves within it, up or down, under
+  refinement, and an "error shrinks" target can miss although every level meets the 3% target.
 * Mesh: in 3D only the contact zone is refined (the far field stays at h_far = 0.5), so the
   stiffness of the far field, and with it P(delta) and the compliance difference between the two
   bodies' meshes (a rigid shift of the contact surface of two equal bodies), carries an error that
@@ -627,8 +632,9 @@ def geometry_lines(cases: list, results: dict) -> str:
         done = [r for _, r in sorted(runs.items()) if "status" in r]
         a = done[-1]["a_hertz"] if done else math.nan
         sizes = ", ".join(f"{name} {size:g} = {size / a:.1f} a" for name, size in case.sizes.items())
-        lines.append(f"* `{case.name}`: delta = {case.delta}, R_eff = {case.radius}; a_H = {a:.4f} at the finest "
-                     f"level (a / R = {a:.3f} per body, a / R_eff = {a / case.radius:.3f}); {sizes}.")
+        lines.append(f"* `{case.name}`: delta = {case.delta}, R_eff = {case.radius}; r_c = "
+                     f"{case.geo_parameters['r_c']:g}, h_c = {case.contact_spacing:g} at level 0; a_H = {a:.4f} at "
+                     f"the finest level (a / R_eff = {a / case.radius:.3f}); {sizes}.")
     return "\n".join(lines)
 
 
@@ -723,7 +729,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
     data = {"levels": list(levels), "quick": quick, "seconds": seconds, "young_modulus": YOUNGS_MODULUS,
             "poisson_ratio": POISSON_RATIO, "E_star": E_STAR, "load_steps": list(LOAD_STEPS),
             "cases": {c.name: asdict(c) for c in CASES}, "rates": rates, "results": json_safe(results)}
-    return SuiteResult("Hertz contact: four cases under refinement", checks, figures, text, data)
+    return SuiteResult(f"Hertz contact: {len(CASES)} cases under refinement", checks, figures, text, data)
 
 
 def main() -> int:

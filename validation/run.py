@@ -90,6 +90,9 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--write-bands", action="store_true",
                         help="record this run's target figures as the regression bands of its mode "
                              "(validation/bands.json) instead of checking them against the committed ones")
+    parser.add_argument("--add-bands", action="store_true",
+                        help="record a band for each target figure of this run that has none in its mode (a new "
+                             "case's), leaving the committed bands as they are")
     parser.add_argument("--reuse", action="store_true",
                         help="Hertz suite: take each run's output from an earlier run of the same case, mesh and "
                              "binary (binary modification time included) instead of solving again")
@@ -99,17 +102,19 @@ def parse_args() -> argparse.Namespace:
     return args
 
 
-def regression_bands(targets: list[SuiteResult], mode: str, write: bool) -> SuiteResult:
+def regression_bands(targets: list[SuiteResult], mode: str, write: bool, add: bool) -> SuiteResult:
     """Gate checks: every finite figure of the target suites within its committed band
     (``BAND_RELATIVE`` x the committed figure + ``BAND_ABSOLUTE``). With ``write``, this run's
-    figures become the bands of ``mode`` first. A figure without a band fails: a new target must
-    be recorded deliberately."""
+    figures become the bands of ``mode`` first; with ``add``, only the figures without a band get
+    one. A figure without a band fails: a new target must be recorded deliberately."""
     figures = {f"{c.check} | {c.case}": c.figure for suite in targets for c in suite.checks
                if math.isfinite(c.figure)}
     bands = json.loads(BANDS.read_text()) if BANDS.exists() else {}
-    if write:
-        bands[mode] = {key: {"figure": value, "band": BAND_RELATIVE * value + BAND_ABSOLUTE}
-                       for key, value in sorted(figures.items())}
+    if write or add:
+        kept = {} if write else bands.get(mode, {})
+        recorded = {key: {"figure": value, "band": BAND_RELATIVE * value + BAND_ABSOLUTE}
+                    for key, value in figures.items() if key not in kept}
+        bands[mode] = dict(sorted((kept | recorded).items()))
         BANDS.write_text(json.dumps(bands, indent=1) + "\n")
     committed = bands.get(mode, {})
     checks = []
@@ -117,7 +122,8 @@ def regression_bands(targets: list[SuiteResult], mode: str, write: bool) -> Suit
         check, case = key.split(" | ", 1)
         band = committed.get(key)
         if band is None:
-            checks.append(failure(f"band: {check}", case, f"no committed band in {BANDS.name} ({mode})"))
+            checks.append(failure(f"band: {check}", case, f"no committed band in {BANDS.name} ({mode}); a new "
+                                                          f"case's is recorded by run.py --add-bands"))
         else:
             checks.append(Check(f"band: {check}", case, value, band["band"],
                                 f"committed figure {band['figure']:.4g}"))
@@ -280,7 +286,7 @@ def main() -> int:
         for c in result.checks:
             print(f"   {'PASS' if c.passed else 'FAIL'}  {c.check}: {c.case}: {c.figure:.3g} (<= {c.tolerance:g})")
         print(f"   {time.perf_counter() - start:.1f} s", flush=True)
-    gate.append(regression_bands(targets, "quick" if args.quick else "full", args.write_bands))
+    gate.append(regression_bands(targets, "quick" if args.quick else "full", args.write_bands, args.add_bands))
     command = "make validate" if not args.quick else "make test (run.py --quick)"
     counts = report.write(report_dir, gate, targets, command)
     print(f"\nreport written to {report_dir / 'README.md'}")
