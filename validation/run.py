@@ -292,7 +292,7 @@ def main() -> int:
     print(f"\nreport written to {report_dir / 'README.md'}")
     # Only the complete run speaks for the project: it alone rewrites the README's headline.
     complete = not args.quick and list(args.levels) == list(DEFAULT_LEVELS) and set(args.suites) == set(SUITES)
-    if complete and report.update_readme(REPO / "README.md", gate, targets, counts):
+    if complete and report.update_readme(REPO / "README.md", counts):
         print(f"headline table updated in {REPO / 'README.md'}")
     print(f"gate checks: {counts['gate_passed']} passed, {counts['gate_failed']} failed; "
           f"targets: {counts['targets_met']} met, {counts['targets_missed']} missed")
