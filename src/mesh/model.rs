@@ -56,77 +56,12 @@ impl GmshModel {
             path: label.to_owned(),
             message,
         };
-        if self.coords.len() != 3 * self.node_tags.len() {
-            return Err(invalid(format!(
-                "{} node tags but {} coordinates: expected three per node",
-                self.node_tags.len(),
-                self.coords.len()
-            )));
-        }
-        let mut nodes = HashMap::with_capacity(self.node_tags.len());
-        for (&tag, xyz) in self.node_tags.iter().zip(self.coords.chunks_exact(3)) {
-            if !xyz.iter().all(|x| x.is_finite()) {
-                return Err(invalid(format!(
-                    "node {tag} has a coordinate that is not finite"
-                )));
-            }
-            match nodes.entry(tag) {
-                Entry::Occupied(_) => return Err(invalid(format!("node tag {tag} appears twice"))),
-                Entry::Vacant(slot) => slot.insert([xyz[0], xyz[1], xyz[2]]),
-            };
-        }
-        let mut entity_groups: HashMap<(Dim, i32), Vec<i32>> = HashMap::new();
-        let mut physical_names = Vec::new();
-        for group in &self.physical_groups {
-            if group.dim > 3 {
-                return Err(invalid(format!(
-                    "physical group {} has dimension {}: expected 0 to 3",
-                    group.tag, group.dim
-                )));
-            }
-            for &entity in &group.entities {
-                entity_groups
-                    .entry((group.dim, entity))
-                    .or_default()
-                    .push(group.tag);
-            }
-            if !group.name.is_empty() {
-                physical_names.push(PhysicalName {
-                    dim: group.dim,
-                    tag: group.tag,
-                    name: group.name.clone(),
-                });
-            }
-        }
-        let mut element_blocks = Vec::with_capacity(self.element_blocks.len());
-        for block in self.element_blocks {
-            let count = block.element_tags.len();
-            let Some(per_element) = nodes_per_element(block.element_type) else {
-                return Err(invalid(format!(
-                    "entity {} (dimension {}) has elements of type {}, which gmsh does not \
-                     define up to order 4",
-                    block.entity_tag, block.entity_dim, block.element_type
-                )));
-            };
-            if block.node_tags.len() != per_element * count {
-                return Err(invalid(format!(
-                    "the {count} {} elements of entity {} (dimension {}) have {} node tags in \
-                     all: expected {per_element} per element",
-                    element_type_name(block.element_type),
-                    block.entity_tag,
-                    block.entity_dim,
-                    block.node_tags.len(),
-                )));
-            }
-            element_blocks.push(ElementBlock {
-                entity_dim: block.entity_dim,
-                entity_tag: block.entity_tag,
-                element_type: block.element_type,
-                nodes_per_element: per_element,
-                element_tags: block.element_tags,
-                node_tags: block.node_tags,
-            });
-        }
+        let nodes = nodes(&self.node_tags, &self.coords).map_err(invalid)?;
+        let (physical_names, entity_groups) = groups(&self.physical_groups).map_err(invalid)?;
+        let element_blocks = (self.element_blocks.into_iter())
+            .map(element_block)
+            .collect::<Result<_, _>>()
+            .map_err(invalid)?;
         Ok(MshContents {
             physical_names,
             entity_groups,
@@ -135,4 +70,88 @@ impl GmshModel {
             element_blocks,
         })
     }
+}
+
+/// gmsh node tag -> coordinates: three finite coordinates per tag, each tag once.
+fn nodes(tags: &[u64], coords: &[f64]) -> Result<HashMap<u64, [f64; 3]>, String> {
+    if coords.len() != 3 * tags.len() {
+        return Err(format!(
+            "{} node tags but {} coordinates: expected three per node",
+            tags.len(),
+            coords.len()
+        ));
+    }
+    let mut nodes = HashMap::with_capacity(tags.len());
+    for (&tag, xyz) in tags.iter().zip(coords.chunks_exact(3)) {
+        if !xyz.iter().all(|x| x.is_finite()) {
+            return Err(format!("node {tag} has a coordinate that is not finite"));
+        }
+        match nodes.entry(tag) {
+            Entry::Occupied(_) => return Err(format!("node tag {tag} appears twice")),
+            Entry::Vacant(slot) => slot.insert([xyz[0], xyz[1], xyz[2]]),
+        };
+    }
+    Ok(nodes)
+}
+
+/// The named groups (a file's `$PhysicalNames`) and each entity's physical tags (its
+/// `$Entities`).
+#[allow(clippy::type_complexity)]
+fn groups(
+    groups: &[ModelGroup],
+) -> Result<(Vec<PhysicalName>, HashMap<(Dim, i32), Vec<i32>>), String> {
+    let mut entity_groups: HashMap<(Dim, i32), Vec<i32>> = HashMap::new();
+    let mut physical_names = Vec::new();
+    for group in groups {
+        if group.dim > 3 {
+            return Err(format!(
+                "physical group {} has dimension {}: expected 0 to 3",
+                group.tag, group.dim
+            ));
+        }
+        for &entity in &group.entities {
+            entity_groups
+                .entry((group.dim, entity))
+                .or_default()
+                .push(group.tag);
+        }
+        if !group.name.is_empty() {
+            physical_names.push(PhysicalName {
+                dim: group.dim,
+                tag: group.tag,
+                name: group.name.clone(),
+            });
+        }
+    }
+    Ok((physical_names, entity_groups))
+}
+
+/// One block of elements, with as many node tags as its element type has nodes.
+fn element_block(block: ModelElements) -> Result<ElementBlock, String> {
+    let count = block.element_tags.len();
+    let Some(per_element) = nodes_per_element(block.element_type) else {
+        return Err(format!(
+            "entity {} (dimension {}) has elements of type {}, which gmsh does not define up to \
+             order 4",
+            block.entity_tag, block.entity_dim, block.element_type
+        ));
+    };
+    if block.node_tags.len() != per_element * count {
+        return Err(format!(
+            "the {count} {} elements of entity {} (dimension {}) have {} node tags in all: \
+             expected {per_element} per element",
+            element_type_name(block.element_type),
+            block.entity_tag,
+            block.entity_dim,
+            block.node_tags.len(),
+        ));
+    }
+    Ok(ElementBlock {
+        entity_dim: block.entity_dim,
+        entity_tag: block.entity_tag,
+        element_type: block.element_type,
+        nodes_per_element: per_element,
+        element_tags: block.element_tags,
+        node_tags: block.node_tags,
+    })
 }

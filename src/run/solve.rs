@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use crate::case::Case;
+use crate::case::{BodySpec, Case};
 use crate::contact::{ContactProblem, ContactRun, ContactSolution, SurfaceFields, solve_contact};
 use crate::elastic::{DirichletCondition, ElasticSolution, solve};
 use crate::mesh::Mesh;
@@ -75,8 +75,8 @@ pub struct SolvedContact {
     pub imposed_approach: f64,
 }
 
-/// Solves every body of `case` on `mesh`. Every body's problem is built first, so that bad
-/// input is an error before anything is solved.
+/// Solves every body of `case` on `mesh`: the two in contact together, the others alone. Every
+/// body's problem is built first, so that bad input is an error before anything is solved.
 pub fn solve_case_on(
     case: &Case,
     mesh: &Mesh,
@@ -89,86 +89,110 @@ pub fn solve_case_on(
     let mut bodies = Vec::new();
     let mut contact = None;
     if let Some(problem) = case.contact_problem(mesh)? {
-        log::info!(
-            "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
-            problem.primary.body.name,
-            problem.primary_surface.group,
-            problem.primary_surface.len(),
-            problem.secondary.body.name,
-            problem.secondary_surface.group,
-            problem.secondary_surface.len(),
-            serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
-        );
-        log::info!(
-            "primary body '{}' ({}): {}",
-            problem.primary.body.name,
-            problem.primary_report.mode,
-            problem.primary_report.reason
-        );
-        let run = solve_contact(problem, &case.solver, &case.load_steps()).map_err(|source| {
-            RunError::Contact {
-                path: case.path.clone(),
-                source,
-            }
-        })?;
-        let ContactRun {
-            problem,
-            solution,
-            steps,
-            timings: contact_timings,
-        } = run;
-        timings.phases.extend(contact_timings);
-        contact = Some(SolvedContact {
-            summary: summarize_contact(&problem, &solution, steps),
-            plot_title: format!(
-                "{}: contact of '{}' (primary) and '{}'",
-                case_name(case),
-                problem.primary.body.name,
-                problem.secondary.body.name
-            ),
-            imposed_approach: imposed_approach(&problem),
-        });
-        bodies.push(SolvedBody {
-            name: problem.primary.body.name.clone(),
-            solution: solution.primary,
-            surface: Some(solution.primary_fields),
-        });
-        bodies.push(SolvedBody {
-            name: problem.secondary.body.name.clone(),
-            solution: solution.secondary,
-            surface: Some(solution.secondary_fields),
-        });
+        let (solved, pair) = solve_contact_pair(case, problem, &mut timings)?;
+        contact = Some(solved);
+        bodies.extend(pair);
     }
     for spec in &case.bodies {
-        if bodies.iter().any(|s| s.name == spec.name) {
-            continue;
+        if !bodies.iter().any(|s| s.name == spec.name) {
+            bodies.push(solve_alone(case, mesh, spec, &mut timings)?);
         }
-        let body = case.body_mesh(mesh, spec)?;
-        let problem = case.elastic_problem(body, spec)?;
-        log::info!(
-            "body '{}': {} nodes, {} cells, {} dofs",
-            body.name,
-            body.num_nodes(),
-            body.num_cells(),
-            body.num_dofs()
-        );
-        let phase = Instant::now();
-        let solution = solve(&problem, &case.solver).map_err(|source| RunError::Solve {
-            path: case.path.clone(),
-            source,
-        })?;
-        timings.record(format!("solve {}", body.name), phase);
-        bodies.push(SolvedBody {
-            name: spec.name.clone(),
-            solution,
-            surface: None,
-        });
     }
     bodies.sort_by_key(|s| case.bodies.iter().position(|b| b.name == s.name));
     Ok(CaseSolution {
         bodies,
         contact,
         timings,
+    })
+}
+
+/// The contact solve of the case's two bodies ([`solve_contact`]: its load steps, and the other
+/// primary's solve when the first choice may be wrong).
+fn solve_contact_pair(
+    case: &Case,
+    problem: ContactProblem,
+    timings: &mut Timings,
+) -> Result<(SolvedContact, [SolvedBody; 2]), RunError> {
+    log::info!(
+        "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
+        problem.primary.body.name,
+        problem.primary_surface.group,
+        problem.primary_surface.len(),
+        problem.secondary.body.name,
+        problem.secondary_surface.group,
+        problem.secondary_surface.len(),
+        serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
+    );
+    log::info!(
+        "primary body '{}' ({}): {}",
+        problem.primary.body.name,
+        problem.primary_report.mode,
+        problem.primary_report.reason
+    );
+    let run = solve_contact(problem, &case.solver, &case.load_steps()).map_err(|source| {
+        RunError::Contact {
+            path: case.path.clone(),
+            source,
+        }
+    })?;
+    let ContactRun {
+        problem,
+        solution,
+        steps,
+        timings: contact_timings,
+    } = run;
+    timings.phases.extend(contact_timings);
+    let solved = SolvedContact {
+        summary: summarize_contact(&problem, &solution, steps),
+        plot_title: format!(
+            "{}: contact of '{}' (primary) and '{}'",
+            case_name(case),
+            problem.primary.body.name,
+            problem.secondary.body.name
+        ),
+        imposed_approach: imposed_approach(&problem),
+    };
+    let bodies = [
+        SolvedBody {
+            name: problem.primary.body.name.clone(),
+            solution: solution.primary,
+            surface: Some(solution.primary_fields),
+        },
+        SolvedBody {
+            name: problem.secondary.body.name.clone(),
+            solution: solution.secondary,
+            surface: Some(solution.secondary_fields),
+        },
+    ];
+    Ok((solved, bodies))
+}
+
+/// One body that is in no contact, solved alone.
+fn solve_alone(
+    case: &Case,
+    mesh: &Mesh,
+    spec: &BodySpec,
+    timings: &mut Timings,
+) -> Result<SolvedBody, RunError> {
+    let body = case.body_mesh(mesh, spec)?;
+    let problem = case.elastic_problem(body, spec)?;
+    log::info!(
+        "body '{}': {} nodes, {} cells, {} dofs",
+        body.name,
+        body.num_nodes(),
+        body.num_cells(),
+        body.num_dofs()
+    );
+    let phase = Instant::now();
+    let solution = solve(&problem, &case.solver).map_err(|source| RunError::Solve {
+        path: case.path.clone(),
+        source,
+    })?;
+    timings.record(format!("solve {}", body.name), phase);
+    Ok(SolvedBody {
+        name: spec.name.clone(),
+        solution,
+        surface: None,
     })
 }
 
