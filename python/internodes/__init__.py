@@ -15,31 +15,7 @@ Progress goes to the ``logging`` logger ``internodes`` (silent unless configured
 
 import logging
 
-from ._internodes import (
-    BodyResult,
-    Case,
-    InputError,
-    Mesh,
-    NotSolvedError,
-    Result,
-    SolveError,
-    SurfaceResult,
-    WriteError,
-    solve,
-)
+from ._internodes import *  # noqa: F403 (the native module's classes and solve())
 
 # A library's logger stays silent until the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())
-
-__all__ = [
-    "BodyResult",
-    "Case",
-    "InputError",
-    "Mesh",
-    "NotSolvedError",
-    "Result",
-    "SolveError",
-    "SurfaceResult",
-    "WriteError",
-    "solve",
-]
