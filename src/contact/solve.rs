@@ -275,6 +275,28 @@ struct LoopState {
     solved: BTreeSet<usize>,
 }
 
+impl LoopState {
+    /// Keeps an iteration's `record` and `last` iterate, and moves on to its `step`: the status
+    /// the loop ends with, or `None` to go on with the next active set.
+    fn advance(
+        &mut self,
+        record: IterationRecord,
+        last: (Coupling, CoupledSolution),
+        step: Step,
+    ) -> Option<ContactStatus> {
+        self.history.push(record);
+        self.last = Some(last);
+        self.solved = self.active.clone();
+        match step {
+            Step::Solve(next) => {
+                self.active = next;
+                None
+            }
+            Step::Stop(end) => Some(end),
+        }
+    }
+}
+
 impl ContactSolver<'_> {
     /// One iteration of the loop on `state.active`, recorded in `state`: the status the loop
     /// ends with, or `None` to go on with the next active set.
@@ -353,16 +375,7 @@ impl ContactSolver<'_> {
         if self.solver.verbose {
             log::info!("{}", record.line());
         }
-        state.history.push(record);
-        state.last = Some((coupling, solution));
-        state.solved = state.active.clone();
-        Ok(match step {
-            Step::Solve(next) => {
-                state.active = next;
-                None
-            }
-            Step::Stop(end) => Some(end),
-        })
+        Ok(state.advance(record, (coupling, solution), step))
     }
 
     /// The tied corrections of the current operators at `solution`, whose geometric gaps are
