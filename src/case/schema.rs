@@ -505,39 +505,41 @@ impl Case {
         body: &'m BodyMesh,
         spec: &BodySpec,
     ) -> Result<ElasticProblem<'m>, CaseError> {
-        let dim = body.dim;
-        let range = magnitude_range();
-        let context = |what: &str| format!("body '{}', {what}", spec.name);
-        let finite = |value: f64, what: &str| -> Result<f64, CaseError> {
-            if in_range(value) {
-                Ok(value)
-            } else {
-                Err(self.invalid(
-                    context(what),
-                    format!("expected a finite number {range}, got {value:e}"),
-                ))
-            }
+        let values = BodyValues {
+            case: self,
+            body: &spec.name,
+            dim: body.dim,
+            range: magnitude_range(),
         };
-        let vector = |v: &[f64], what: &str| -> Result<[f64; 3], CaseError> {
-            if let Some(bad) = v.iter().find(|&&x| !in_range(x)) {
-                return Err(self.invalid(
-                    context(what),
-                    format!("expected finite components {range}, got {bad:e} in {v:?}"),
-                ));
+        let material = self.material(spec)?;
+        values.check_dirichlet_values(&spec.dirichlet)?;
+        let dirichlet = spec
+            .dirichlet
+            .iter()
+            .map(|d| DirichletCondition {
+                group: d.group.clone(),
+                components: [d.ux, d.uy, d.uz],
+            })
+            .collect();
+        let mut loads = Vec::new();
+        for l in &spec.loads {
+            loads.push(values.load_condition(body, l)?);
+        }
+        let body_force = spec
+            .body_force
+            .as_deref()
+            .map(|b| values.vector(b, "body_force"))
+            .transpose()?;
+        ElasticProblem::new(body, material, dirichlet, loads, body_force).map_err(|source| {
+            CaseError::Problem {
+                path: self.path.clone(),
+                source,
             }
-            if v.len() != dim {
-                return Err(self.invalid(
-                    context(what),
-                    format!(
-                        "expected {dim} components (the mesh is {dim}D), got {}",
-                        v.len()
-                    ),
-                ));
-            }
-            let mut out = [0.0; 3];
-            out[..dim].copy_from_slice(v);
-            Ok(out)
-        };
+        })
+    }
+
+    /// The body's material, its Young's modulus also within the range [`MAX_MAGNITUDE`] allows.
+    fn material(&self, spec: &BodySpec) -> Result<Material, CaseError> {
         let material =
             Material::new(spec.youngs_modulus, spec.poisson_ratio).map_err(|source| {
                 CaseError::Material {
@@ -549,7 +551,7 @@ impl Case {
         let modulus = spec.youngs_modulus;
         if !(1.0 / MAX_MAGNITUDE..=MAX_MAGNITUDE).contains(&modulus) {
             return Err(self.invalid(
-                context("youngs_modulus"),
+                format!("body '{}', youngs_modulus", spec.name),
                 format!(
                     "expected a value from {:e} to {MAX_MAGNITUDE:e} (MAX_MAGNITUDE in \
                      src/case/schema.rs says why), got {modulus:e}",
@@ -557,110 +559,7 @@ impl Case {
                 ),
             ));
         }
-        for d in &spec.dirichlet {
-            for (key, value) in ["ux", "uy", "uz"].iter().zip([d.ux, d.uy, d.uz]) {
-                if let Some(value) = value.filter(|&v| !in_range(v)) {
-                    return Err(self.invalid(
-                        context(&format!("Dirichlet condition on '{}', {key}", d.group)),
-                        format!("expected a finite number {range}, got {value:e}"),
-                    ));
-                }
-            }
-        }
-        let dirichlet = spec
-            .dirichlet
-            .iter()
-            .map(|d| DirichletCondition {
-                group: d.group.clone(),
-                components: [d.ux, d.uy, d.uz],
-            })
-            .collect();
-        let mut loads = Vec::new();
-        for l in &spec.loads {
-            let what = format!("load on '{}'", l.group);
-            if body.point_groups.contains_key(&l.group) && body.boundary_group(&l.group).is_none() {
-                return Err(self.invalid(
-                    context(&what),
-                    format!(
-                        "'{}' is a group of points; a load needs a boundary group (a physical {} \
-                         of this body) to act on",
-                        l.group,
-                        if dim == 2 { "curve" } else { "surface" }
-                    ),
-                ));
-            }
-            // A pressure pushes along the outward normal of each facet's cell; a facet between
-            // two cells has two, and the pushes of the facets of an embedded line or surface
-            // cancel (the run once succeeded with zero reaction). A traction vector does not
-            // depend on the side: inside the body it is a line (surface) force, and stays.
-            if l.traction.is_none()
-                && let Some(group) = body.boundary_group(&l.group)
-                && !group.is_boundary()
-            {
-                return Err(self.invalid(
-                    context(&what),
-                    format!(
-                        "'{}' lies inside the body: {} of its facets (gmsh element {}{}) are \
-                         shared by two cells of '{}', where a pressure has no outward side; a \
-                         pressure needs a boundary group, whose facets lie on one cell only",
-                        l.group,
-                        group.interior_facets.len(),
-                        group.interior_facets[0],
-                        if group.interior_facets.len() > 1 {
-                            " and others"
-                        } else {
-                            ""
-                        },
-                        spec.name
-                    ),
-                ));
-            }
-            let load = match (&l.traction, l.pressure, &l.hertz_pressure) {
-                (Some(t), None, None) => SurfaceLoad::Traction(vector(t, &what)?),
-                (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(finite(
-                    p,
-                    &format!("{what}, pressure"),
-                )?)),
-                (None, None, Some(h)) => {
-                    finite(h.p0, &format!("{what}, hertz_pressure.p0"))?;
-                    if !(h.a > 0.0 && in_range(h.a)) {
-                        return Err(self.invalid(
-                            context(&what),
-                            format!(
-                                "hertz_pressure.a must be positive and {range}, got {:e}",
-                                h.a
-                            ),
-                        ));
-                    }
-                    SurfaceLoad::Pressure(PressureField::Hertz {
-                        p0: h.p0,
-                        a: h.a,
-                        center: vector(&h.center, &format!("{what}, hertz_pressure.center"))?,
-                    })
-                }
-                _ => {
-                    return Err(self.invalid(
-                        context(&what),
-                        "give exactly one of traction, pressure, hertz_pressure",
-                    ));
-                }
-            };
-            loads.push(LoadCondition {
-                group: l.group.clone(),
-                load,
-            });
-        }
-        let body_force = spec
-            .body_force
-            .as_deref()
-            .map(|b| vector(b, "body_force"))
-            .transpose()?;
-        ElasticProblem::new(body, material, dirichlet, loads, body_force).map_err(|source| {
-            CaseError::Problem {
-                path: self.path.clone(),
-                source,
-            }
-        })
+        Ok(material)
     }
 
     /// The load factors of the contact solve (default: one step at 1).
@@ -706,6 +605,151 @@ impl Case {
         ContactProblem::new(sides, &spec.primary, spec.settings)
             .map(Some)
             .map_err(|message| self.invalid("[contact]", message))
+    }
+}
+
+/// The checks of one body's values, whose messages name the case file and the body.
+struct BodyValues<'a> {
+    case: &'a Case,
+    body: &'a str,
+    dim: usize,
+    /// [`magnitude_range`], for messages.
+    range: String,
+}
+
+impl BodyValues<'_> {
+    fn invalid(&self, what: &str, message: impl Into<String>) -> CaseError {
+        self.case
+            .invalid(format!("body '{}', {what}", self.body), message)
+    }
+
+    fn finite(&self, value: f64, what: &str) -> Result<f64, CaseError> {
+        if in_range(value) {
+            Ok(value)
+        } else {
+            Err(self.invalid(
+                what,
+                format!("expected a finite number {}, got {value:e}", self.range),
+            ))
+        }
+    }
+
+    /// `v` as a 3-vector, its components past the mesh's dimension zero.
+    fn vector(&self, v: &[f64], what: &str) -> Result<[f64; 3], CaseError> {
+        let dim = self.dim;
+        if let Some(bad) = v.iter().find(|&&x| !in_range(x)) {
+            return Err(self.invalid(
+                what,
+                format!(
+                    "expected finite components {}, got {bad:e} in {v:?}",
+                    self.range
+                ),
+            ));
+        }
+        if v.len() != dim {
+            return Err(self.invalid(
+                what,
+                format!(
+                    "expected {dim} components (the mesh is {dim}D), got {}",
+                    v.len()
+                ),
+            ));
+        }
+        let mut out = [0.0; 3];
+        out[..dim].copy_from_slice(v);
+        Ok(out)
+    }
+
+    fn check_dirichlet_values(&self, dirichlet: &[DirichletSpec]) -> Result<(), CaseError> {
+        for d in dirichlet {
+            for (key, value) in ["ux", "uy", "uz"].iter().zip([d.ux, d.uy, d.uz]) {
+                if let Some(value) = value.filter(|&v| !in_range(v)) {
+                    return Err(self.invalid(
+                        &format!("Dirichlet condition on '{}', {key}", d.group),
+                        format!("expected a finite number {}, got {value:e}", self.range),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The load `l` on `body`, its group checked to be one a load of its kind can act on.
+    fn load_condition(&self, body: &BodyMesh, l: &LoadSpec) -> Result<LoadCondition, CaseError> {
+        let what = format!("load on '{}'", l.group);
+        if body.point_groups.contains_key(&l.group) && body.boundary_group(&l.group).is_none() {
+            return Err(self.invalid(
+                &what,
+                format!(
+                    "'{}' is a group of points; a load needs a boundary group (a physical {} \
+                     of this body) to act on",
+                    l.group,
+                    if self.dim == 2 { "curve" } else { "surface" }
+                ),
+            ));
+        }
+        // A pressure pushes along the outward normal of each facet's cell; a facet between
+        // two cells has two, and the pushes of the facets of an embedded line or surface
+        // cancel (the run once succeeded with zero reaction). A traction vector does not
+        // depend on the side: inside the body it is a line (surface) force, and stays.
+        if l.traction.is_none()
+            && let Some(group) = body.boundary_group(&l.group)
+            && !group.is_boundary()
+        {
+            return Err(self.invalid(
+                &what,
+                format!(
+                    "'{}' lies inside the body: {} of its facets (gmsh element {}{}) are \
+                     shared by two cells of '{}', where a pressure has no outward side; a \
+                     pressure needs a boundary group, whose facets lie on one cell only",
+                    l.group,
+                    group.interior_facets.len(),
+                    group.interior_facets[0],
+                    if group.interior_facets.len() > 1 {
+                        " and others"
+                    } else {
+                        ""
+                    },
+                    self.body
+                ),
+            ));
+        }
+        Ok(LoadCondition {
+            group: l.group.clone(),
+            load: self.surface_load(l, &what)?,
+        })
+    }
+
+    fn surface_load(&self, l: &LoadSpec, what: &str) -> Result<SurfaceLoad, CaseError> {
+        Ok(match (&l.traction, l.pressure, &l.hertz_pressure) {
+            (Some(t), None, None) => SurfaceLoad::Traction(self.vector(t, what)?),
+            (None, Some(p), None) => SurfaceLoad::Pressure(PressureField::Uniform(
+                self.finite(p, &format!("{what}, pressure"))?,
+            )),
+            (None, None, Some(h)) => {
+                self.finite(h.p0, &format!("{what}, hertz_pressure.p0"))?;
+                if !(h.a > 0.0 && in_range(h.a)) {
+                    return Err(self.invalid(
+                        what,
+                        format!(
+                            "hertz_pressure.a must be positive and {}, got {:e}",
+                            self.range, h.a
+                        ),
+                    ));
+                }
+                SurfaceLoad::Pressure(PressureField::Hertz {
+                    p0: h.p0,
+                    a: h.a,
+                    center: self.vector(&h.center, &format!("{what}, hertz_pressure.center"))?,
+                })
+            }
+            _ => {
+                return Err(self.invalid(
+                    what,
+                    "give exactly one of traction, pressure, hertz_pressure",
+                ));
+            }
+        })
     }
 }
 

@@ -220,67 +220,26 @@ fn check_against(
         problem.settings.accuracy_tolerance,
         problem.settings.formulation,
     );
-    // The other solve's forces on [this primary body, this secondary body]: its primary is
-    // this solve's secondary when the primaries are swapped.
-    let (other, kind, swapped) = match alternative {
-        Alternative::OtherPrimary => (
-            problem.clone().with_other_primary(),
-            CheckKind::PrimaryAgreement,
-            true,
-        ),
-        Alternative::AutoTransfer => (
-            problem.clone().with_transfer(Transfer::Auto),
-            CheckKind::TransferAgreement,
-            false,
-        ),
-    };
-    let on_these_bodies = |primary: [f64; 3], secondary: [f64; 3]| {
-        if swapped {
-            [secondary, primary]
-        } else {
-            [primary, secondary]
-        }
-    };
-    let with = match alternative {
-        Alternative::OtherPrimary => format!("'{}' as primary", other.primary.body.name),
-        Alternative::AutoTransfer => format!(
-            "the {} transfer",
-            serde_json::to_value(other.transfer().transfer).expect("a unit enum serializes")
-        )
-        .replace('"', ""),
-    };
+    let other = OtherSolve::new(problem, alternative);
+    let with = &other.with;
     log.say(format!("checking the answer: solving again with {with}"));
     let label = format!("check with {with}: ");
-    let trusted = |o: &StepRecord| o.status == ContactStatus::Converged && o.is_trusted();
-    let (reference, other_steps) = match solve_load_steps(&other, solver, load_factors, &label, log)
-    {
+    let solved = solve_load_steps(&other.problem, solver, load_factors, &label, log);
+    let (reference, other_steps) = match solved {
         Ok((check, other_steps))
             if check.status == ContactStatus::Converged && check.is_trusted() =>
         {
             (
-                Ok(on_these_bodies(check.force_primary, check.force_secondary)),
+                Ok(other.on_these_bodies(check.force_primary, check.force_secondary)),
                 other_steps,
             )
         }
         Ok((check, other_steps)) => (Err(check.ending()), other_steps),
         Err(e) => (Err(format!("with an error ({e})")), Vec::new()),
     };
-    // The earlier steps, each against the other solve's step at the same load factor.
-    let earlier = steps.len().saturating_sub(1);
-    for (k, step) in steps[..earlier].iter_mut().enumerate() {
-        let other_step = match other_steps.get(k) {
-            Some(o) if trusted(o) => Ok(on_these_bodies(
-                vector(&o.force_primary),
-                vector(&o.force_secondary),
-            )),
-            Some(o) => Err(o.ending()),
-            None => Err("before this load step (its load steps stopped)".to_string()),
-        };
-        let forces = [vector(&step.force_primary), vector(&step.force_secondary)];
-        step.certify_further(&agreement(kind, forces, other_step, &with, tolerance));
-    }
+    other.certify_earlier_steps(steps, &other_steps, tolerance);
     let forces = [solution.force_primary, solution.force_secondary];
-    let check = agreement(kind, forces, reference, &with, tolerance);
+    let check = agreement(other.kind, forces, reference, with, tolerance);
     log.say(format!("check with {with}: {}", check.describe()));
     solution.certify_further(check);
     log.say(format!(
@@ -288,6 +247,81 @@ fn check_against(
         solution.describe(formulation)
     ));
     solution
+}
+
+/// The solve of an [`Alternative`] that an answer is checked against.
+struct OtherSolve<'m> {
+    problem: ContactProblem<'m>,
+    kind: CheckKind,
+    /// Whether its primary is this solve's secondary.
+    swapped: bool,
+    /// What the messages call it: "'block' as primary", "the interpolation transfer".
+    with: String,
+}
+
+impl<'m> OtherSolve<'m> {
+    fn new(problem: &ContactProblem<'m>, alternative: Alternative) -> Self {
+        let (other, kind, swapped) = match alternative {
+            Alternative::OtherPrimary => (
+                problem.clone().with_other_primary(),
+                CheckKind::PrimaryAgreement,
+                true,
+            ),
+            Alternative::AutoTransfer => (
+                problem.clone().with_transfer(Transfer::Auto),
+                CheckKind::TransferAgreement,
+                false,
+            ),
+        };
+        let with = match alternative {
+            Alternative::OtherPrimary => format!("'{}' as primary", other.primary.body.name),
+            Alternative::AutoTransfer => format!(
+                "the {} transfer",
+                serde_json::to_value(other.transfer().transfer).expect("a unit enum serializes")
+            )
+            .replace('"', ""),
+        };
+        OtherSolve {
+            problem: other,
+            kind,
+            swapped,
+            with,
+        }
+    }
+
+    /// The other solve's forces on [this primary body, this secondary body]: its primary is
+    /// this solve's secondary when the primaries are swapped.
+    fn on_these_bodies(&self, primary: [f64; 3], secondary: [f64; 3]) -> [[f64; 3]; 2] {
+        if self.swapped {
+            [secondary, primary]
+        } else {
+            [primary, secondary]
+        }
+    }
+
+    /// The agreement check of the steps before the last, each against `other_steps`' step at
+    /// the same load factor.
+    fn certify_earlier_steps(
+        &self,
+        steps: &mut [StepRecord],
+        other_steps: &[StepRecord],
+        tolerance: f64,
+    ) {
+        let trusted = |o: &StepRecord| o.status == ContactStatus::Converged && o.is_trusted();
+        let earlier = steps.len().saturating_sub(1);
+        for (k, step) in steps[..earlier].iter_mut().enumerate() {
+            let other_step = match other_steps.get(k) {
+                Some(o) if trusted(o) => {
+                    Ok(self.on_these_bodies(vector(&o.force_primary), vector(&o.force_secondary)))
+                }
+                Some(o) => Err(o.ending()),
+                None => Err("before this load step (its load steps stopped)".to_string()),
+            };
+            let forces = [vector(&step.force_primary), vector(&step.force_secondary)];
+            let check = agreement(self.kind, forces, other_step, &self.with, tolerance);
+            step.certify_further(&check);
+        }
+    }
 }
 
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per

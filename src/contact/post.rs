@@ -52,15 +52,8 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         active_set.nodes.contains(&s)
     });
     let mut secondary_fields = surface_fields(s2, &solution.contact_force2, gaps2, |_| false);
-    // The secondary surface has no active set of its own: a node is in contact where it
-    // receives a compressive force and touches the primary body to the certified accuracy.
     let touching = problem.settings.secondary_penetration_tolerance;
-    secondary_fields.active = (0..s2.len())
-        .map(|j| {
-            secondary_fields.mean_pressure[j] > 0.0
-                && secondary_fields.normal_gap[j].abs() <= touching * s2.spacing[j]
-        })
-        .collect();
+    secondary_fields.active = secondary_in_contact(s2, &secondary_fields, touching);
     let [force_primary, force_secondary] = solution.total_forces(dim);
     let force_imbalance = certificate
         .checks
@@ -68,18 +61,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         .find(|c| c.name == CheckKind::Equilibrium)
         .map_or(f64::NAN, |c| c.value);
     let hertz_primary = hertz::fit(s1, &primary_fields);
-    // Tangential with respect to the contact normal the constraint used: zero for
-    // frictionless, the glue's shear for tied.
-    let max_tangential_traction = solution
-        .traction
-        .iter()
-        .zip(&coupling.normals)
-        .map(|(t, n)| {
-            let normal = dot(t, n);
-            let tangential: [f64; 3] = std::array::from_fn(|k| t[k] - normal * n[k]);
-            dot(&tangential, &tangential).sqrt()
-        })
-        .fold(0.0, f64::max);
+    let max_tangential_traction = max_tangential(&solution.traction, &coupling.normals);
     let residual = solution.relative_residual;
     let primary = body_solution(
         &problem.primary,
@@ -114,6 +96,31 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         load_factor,
         active_set,
     })
+}
+
+/// The secondary surface has no active set of its own: a node is in contact where it receives
+/// a compressive force and touches the primary body to within `touching` of its spacing (the
+/// certified accuracy).
+fn secondary_in_contact(s2: &ContactSurface, fields: &SurfaceFields, touching: f64) -> Vec<bool> {
+    (0..s2.len())
+        .map(|j| {
+            fields.mean_pressure[j] > 0.0 && fields.normal_gap[j].abs() <= touching * s2.spacing[j]
+        })
+        .collect()
+}
+
+/// The largest traction tangential to the contact normal the constraint used: zero for
+/// frictionless, the glue's shear for tied.
+fn max_tangential(traction: &[[f64; 3]], normals: &[[f64; 3]]) -> f64 {
+    traction
+        .iter()
+        .zip(normals)
+        .map(|(t, n)| {
+            let normal = dot(t, n);
+            let tangential: [f64; 3] = std::array::from_fn(|k| t[k] - normal * n[k]);
+            dot(&tangential, &tangential).sqrt()
+        })
+        .fold(0.0, f64::max)
 }
 
 /// One body's part of the answer: displacement `u`, the reactions of its Dirichlet groups

@@ -223,108 +223,171 @@ impl<'a> ContactSolver<'a> {
         load_factor: f64,
         start: Option<&ActiveSet>,
     ) -> Result<ContactSolution, ContactError> {
-        let problem = self.problem;
-        let settings = &problem.settings;
-        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
         if start.is_none() && self.operators.slid != [0.0; 3] {
             self.pair_again([0.0; 3])?;
         }
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
-        let (mut active, mut rows, mut corrections) = (start.nodes, start.rows, start.corrections);
-        let mut safeguard = Safeguard::default();
-        let mut history = Vec::new();
+        let mut state = LoopState {
+            solved: start.nodes.clone(),
+            active: start.nodes,
+            rows: start.rows,
+            corrections: start.corrections,
+            safeguard: Safeguard::default(),
+            history: Vec::new(),
+            last: None,
+        };
         let mut status = ContactStatus::IterationLimit;
-        let mut last = None;
-        // The active set `last` was solved on (`active` moves on to the next one).
-        let mut solved = active.clone();
-
-        for iteration in 1..=settings.max_iterations {
-            let mut seconds = PhaseSeconds::default();
-            // 1. The coupling of the active set: rows and columns of the fixed operators.
-            let nodes: Vec<usize> = active.iter().copied().collect();
-            let coupling = timed(&mut seconds.operators, || {
-                self.coupling(&nodes, &rows, &corrections)
-            });
-            // 2-4. The coupled solve, the gaps at the iterate, the active set update.
-            let iterate = self.iterate(
-                &coupling,
-                &active,
-                load_factor,
-                &safeguard,
-                &mut rows,
-                &mut seconds,
-            );
-            let Iterate {
-                solution,
-                gaps,
-                linear,
-                slid,
-                update,
-                krylov_iterations,
-            } = match iterate {
-                // After a solve that left active nodes a spacing off the surface, an interface
-                // system that cannot be solved accurately is the same diagnosis as `Unstable`:
-                // the constraint does not control the geometry. The last iterate is the
-                // answer, its certificate says what fails.
-                Err(ContactError::Inaccurate { .. })
-                    if safeguard.off_surface.is_some() && last.is_some() =>
-                {
-                    status = ContactStatus::Unstable;
-                    active = solved;
-                    break;
-                }
-                iterate => iterate?,
-            };
-            let drift = pairing_drift(&self.operators.slid, &slid, s1, &nodes);
-            if settings.formulation == Formulation::Tied {
-                corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
-            }
-            // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
-            //    settled on a pairing the surfaces have slid away from is paired again where
-            //    they touch, and solved again.
-            let step = match safeguard.next(&active, &update) {
-                Step::Stop(ContactStatus::Converged) if drift > REPAIR_DRIFT_OVER_H => {
-                    timed(&mut seconds.operators, || self.pair_again(slid))?;
-                    let jumps = (self.operators).jumps(s1, s2, &solution.u1, &solution.u2);
-                    let linear = self.operators.linearized_gaps(&jumps);
-                    corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
-                    safeguard = Safeguard::default();
-                    Step::Solve(active.clone())
-                }
-                step => step,
-            };
-            let residual = solution.relative_residual;
-            let mut record = record(&update, iteration, residual, drift, seconds);
-            record.krylov_iterations = krylov_iterations;
-            if self.solver.verbose {
-                log::info!("{}", record.line());
-            }
-            history.push(record);
-            last = Some((coupling, solution));
-            solved = active.clone();
-            match step {
-                Step::Solve(next) => active = next,
-                Step::Stop(end) => {
-                    status = end;
-                    break;
-                }
+        for iteration in 1..=self.problem.settings.max_iterations {
+            if let Some(end) = self.iteration(&mut state, iteration, load_factor)? {
+                status = end;
+                break;
             }
         }
 
-        let (coupling, solution) = last.expect("max_iterations >= 1 is validated");
+        let (coupling, solution) = state.last.expect("max_iterations >= 1 is validated");
         let next_start = ActiveSet {
-            nodes: active,
-            rows,
-            corrections,
+            nodes: state.active,
+            rows: state.rows,
+            corrections: state.corrections,
         };
         self.finish(
             load_factor,
             status,
-            history,
+            state.history,
             &coupling,
             solution,
             next_start,
         )
+    }
+}
+
+/// The active-set loop between two iterations.
+struct LoopState {
+    /// The active set the next iteration solves on.
+    active: BTreeSet<usize>,
+    rows: Vec<GapRow>,
+    corrections: Vec<f64>,
+    safeguard: Safeguard,
+    history: Vec<IterationRecord>,
+    /// The last iterate: its coupling and solution.
+    last: Option<(Coupling, CoupledSolution)>,
+    /// The active set `last` was solved on (`active` moves on to the next one).
+    solved: BTreeSet<usize>,
+}
+
+impl LoopState {
+    /// Keeps an iteration's `record` and `last` iterate, and moves on to its `step`: the status
+    /// the loop ends with, or `None` to go on with the next active set.
+    fn advance(
+        &mut self,
+        record: IterationRecord,
+        last: (Coupling, CoupledSolution),
+        step: Step,
+    ) -> Option<ContactStatus> {
+        self.history.push(record);
+        self.last = Some(last);
+        self.solved = self.active.clone();
+        match step {
+            Step::Solve(next) => {
+                self.active = next;
+                None
+            }
+            Step::Stop(end) => Some(end),
+        }
+    }
+}
+
+impl ContactSolver<'_> {
+    /// One iteration of the loop on `state.active`, recorded in `state`: the status the loop
+    /// ends with, or `None` to go on with the next active set.
+    fn iteration(
+        &mut self,
+        state: &mut LoopState,
+        iteration: usize,
+        load_factor: f64,
+    ) -> Result<Option<ContactStatus>, ContactError> {
+        let problem = self.problem;
+        let mut seconds = PhaseSeconds::default();
+        // 1. The coupling of the active set: rows and columns of the fixed operators.
+        let nodes: Vec<usize> = state.active.iter().copied().collect();
+        let coupling = timed(&mut seconds.operators, || {
+            self.coupling(&nodes, &state.rows, &state.corrections)
+        });
+        // 2-4. The coupled solve, the gaps at the iterate, the active set update.
+        let iterate = self.iterate(
+            &coupling,
+            &state.active,
+            load_factor,
+            &state.safeguard,
+            &mut state.rows,
+            &mut seconds,
+        );
+        let Iterate {
+            solution,
+            gaps,
+            linear,
+            slid,
+            update,
+            krylov_iterations,
+        } = match iterate {
+            // After a solve that left active nodes a spacing off the surface, an interface
+            // system that cannot be solved accurately is the same diagnosis as `Unstable`:
+            // the constraint does not control the geometry. The last iterate is the
+            // answer, its certificate says what fails.
+            Err(ContactError::Inaccurate { .. })
+                if state.safeguard.off_surface.is_some() && state.last.is_some() =>
+            {
+                state.active = std::mem::take(&mut state.solved);
+                return Ok(Some(ContactStatus::Unstable));
+            }
+            iterate => iterate?,
+        };
+        let drift = pairing_drift(
+            &self.operators.slid,
+            &slid,
+            &problem.primary_surface,
+            &nodes,
+        );
+        if problem.settings.formulation == Formulation::Tied {
+            state.corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
+        }
+        // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
+        //    settled on a pairing the surfaces have slid away from is paired again where
+        //    they touch, and solved again.
+        let step = match state.safeguard.next(&state.active, &update) {
+            Step::Stop(ContactStatus::Converged) if drift > REPAIR_DRIFT_OVER_H => {
+                timed(&mut seconds.operators, || self.pair_again(slid))?;
+                state.corrections = self.corrections(&solution, &gaps);
+                state.safeguard = Safeguard::default();
+                Step::Solve(state.active.clone())
+            }
+            step => step,
+        };
+        let residual = solution.relative_residual;
+        let record = record(
+            &update,
+            iteration,
+            residual,
+            drift,
+            krylov_iterations,
+            seconds,
+        );
+        if self.solver.verbose {
+            log::info!("{}", record.line());
+        }
+        Ok(state.advance(record, (coupling, solution), step))
+    }
+
+    /// The tied corrections of the current operators at `solution`, whose geometric gaps are
+    /// `gaps`: each gap less its linearization.
+    fn corrections(&self, solution: &CoupledSolution, gaps: &[f64]) -> Vec<f64> {
+        let (s1, s2) = (
+            &self.problem.primary_surface,
+            &self.problem.secondary_surface,
+        );
+        let jumps = (self.operators).jumps(s1, s2, &solution.u1, &solution.u2);
+        let linear = self.operators.linearized_gaps(&jumps);
+        gaps.iter().zip(&linear).map(|(g, l)| g - l).collect()
     }
 }
 
@@ -515,6 +578,7 @@ fn record(
     iteration: usize,
     residual: f64,
     pairing_drift_over_h: f64,
+    krylov_iterations: Option<usize>,
     seconds: PhaseSeconds,
 ) -> IterationRecord {
     let max = |v: &[(usize, f64)]| v.iter().map(|x| x.1).fold(0.0, f64::max);
@@ -528,7 +592,7 @@ fn record(
         max_gap_error_over_h: update.max_gap_error_over_h,
         pairing_drift_over_h,
         relative_residual: residual,
-        krylov_iterations: None,
+        krylov_iterations,
         seconds,
     }
 }

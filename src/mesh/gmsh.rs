@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::fs;
 use std::path::Path;
 
-use super::msh41::{self, MshContents, element_type_name};
+use super::msh41::{self, ElementBlock, MshContents, element_type_name};
 use super::{BodyMesh, Dim, FacetGroup, GmshModel, Mesh, MeshError, PhysicalGroup, check_cells};
 
 /// gmsh element types: 1 the 2-node line, 2 the 3-node triangle, 4 the 4-node tetrahedron, 15
@@ -52,68 +52,9 @@ fn split(path: &Path, msh: MshContents) -> Result<Mesh, MeshError> {
         .map(|n| ((n.dim, n.tag), n.name.clone()))
         .collect();
     let file = FileContents::new(path, msh, &physical_names)?;
-
     let dim = file.dim;
-    let name_of = |d: Dim, tag: i32| -> String {
-        physical_names
-            .get(&(d, tag))
-            .cloned()
-            .unwrap_or_else(|| tag.to_string())
-    };
-    let mut physical_groups: Vec<PhysicalGroup> = file
-        .groups
-        .keys()
-        .map(|&(d, tag)| PhysicalGroup {
-            dim: d,
-            tag,
-            name: name_of(d, tag),
-            named: physical_names.contains_key(&(d, tag)),
-        })
-        .collect();
-    for (&(d, tag), name) in &physical_names {
-        if !file.groups.contains_key(&(d, tag)) {
-            physical_groups.push(PhysicalGroup {
-                dim: d,
-                tag,
-                name: name.clone(),
-                named: true,
-            });
-        }
-    }
-
-    let mut bodies = Vec::new();
-    for (&(d, tag), elements) in &file.groups {
-        if d != dim {
-            continue;
-        }
-        let mut body = file.body(name_of(d, tag), tag, elements)?;
-        if body.cells.is_empty() {
-            return Err(MeshError::EmptyBody {
-                path: path.to_owned(),
-                body: body.name,
-            });
-        }
-        for (&(fd, ftag), facets) in &file.groups {
-            if fd + 1 == dim {
-                let group = file.facet_group(&body, ftag, facets);
-                if !group.facets.is_empty() {
-                    body.boundary_groups.insert(name_of(fd, ftag), group);
-                }
-            } else if fd == 0 {
-                let nodes = file.point_group(&body, facets);
-                if !nodes.is_empty() {
-                    body.point_groups.insert(name_of(fd, ftag), nodes);
-                }
-            }
-        }
-        bodies.push(body);
-    }
-    if bodies.is_empty() {
-        return Err(MeshError::NoBodies {
-            path: path.to_owned(),
-            expected: "surface (2D) or volume (3D) of triangles / tetrahedra",
-        });
-    }
+    let physical_groups = file.physical_groups(&physical_names);
+    let bodies = file.bodies(path, &physical_names)?;
     // A 2D mesh off the xy plane has cells that look degenerate in xy: say why first.
     if dim == 2 {
         check_planar(path, &bodies)?;
@@ -127,6 +68,14 @@ fn split(path: &Path, msh: MshContents) -> Result<Mesh, MeshError> {
         bodies,
         physical_groups,
     })
+}
+
+/// The name of a physical group: its `$PhysicalNames` entry, or else its tag.
+fn group_name(names: &BTreeMap<(Dim, i32), String>, d: Dim, tag: i32) -> String {
+    names
+        .get(&(d, tag))
+        .cloned()
+        .unwrap_or_else(|| tag.to_string())
 }
 
 /// The raw elements of one physical group: gmsh element tags and node tags.
@@ -153,32 +102,9 @@ impl FileContents {
         names: &BTreeMap<(Dim, i32), String>,
     ) -> Result<Self, MeshError> {
         let physical_tags = &msh.entity_groups;
-        let blocks = &msh.element_blocks;
-        let in_group =
-            |d: Dim, tag: i32| physical_tags.get(&(d, tag)).is_some_and(|t| !t.is_empty());
-        let dim = blocks
-            .iter()
-            .filter(|b| in_group(b.entity_dim, b.entity_tag))
-            .map(|b| b.entity_dim)
-            .max()
-            .unwrap_or(0);
-        if dim < 2 {
-            return Err(MeshError::NoBodies {
-                path: path.to_owned(),
-                expected: "surface (2D) or volume (3D)",
-            });
-        }
-        // gmsh saves only the elements of physical groups: a 3D geometry with physical surfaces
-        // but no physical volume gives a file of surface triangles, which is not a 2D body.
-        if dim == 2 && msh.num_volumes > 0 {
-            return Err(MeshError::NoPhysicalVolume {
-                path: path.to_owned(),
-                volumes: msh.num_volumes,
-            });
-        }
-
+        let dim = mesh_dim(path, &msh)?;
         let mut groups: BTreeMap<(Dim, i32), GroupElements> = BTreeMap::new();
-        for block in blocks {
+        for block in &msh.element_blocks {
             let d = block.entity_dim;
             let Some(tags) = physical_tags.get(&(d, block.entity_tag)) else {
                 continue;
@@ -196,40 +122,9 @@ impl FileContents {
                 facet_type(dim)
             };
             if block.element_type != expected_type {
-                return Err(MeshError::UnsupportedElement {
-                    path: path.to_owned(),
-                    element_type: element_type_name(block.element_type),
-                    location: format!(
-                        "entity {} of dimension {} (physical group {})",
-                        block.entity_tag,
-                        d,
-                        tags.iter()
-                            .map(|&t| names
-                                .get(&(d, t))
-                                .map_or_else(|| format!("{t} (unnamed)"), |n| format!("'{n}'")))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
-                    expected: if dim == 2 {
-                        "3-node triangles with 2-node boundary lines"
-                    } else {
-                        "4-node tetrahedra with 3-node boundary triangles"
-                    },
-                });
+                return Err(unsupported_element(path, block, tags, names, dim));
             }
-            let elements = block
-                .element_tags
-                .iter()
-                .zip(block.node_tags.chunks_exact(block.nodes_per_element));
-            for (&element_tag, nodes) in elements {
-                if let Some(&node_tag) = nodes.iter().find(|t| !msh.nodes.contains_key(t)) {
-                    return Err(MeshError::UndefinedNode {
-                        path: path.to_owned(),
-                        element_tag,
-                        node_tag,
-                    });
-                }
-            }
+            check_nodes_defined(path, block, &msh.nodes)?;
             for &tag in tags {
                 let group = groups.entry((d, tag)).or_default();
                 group.element_tags.extend_from_slice(&block.element_tags);
@@ -241,6 +136,82 @@ impl FileContents {
             coords: msh.nodes,
             groups,
         })
+    }
+
+    /// Every physical group of the file: those with elements, then those only named in
+    /// `$PhysicalNames`.
+    fn physical_groups(&self, names: &BTreeMap<(Dim, i32), String>) -> Vec<PhysicalGroup> {
+        let mut physical_groups: Vec<PhysicalGroup> = self
+            .groups
+            .keys()
+            .map(|&(d, tag)| PhysicalGroup {
+                dim: d,
+                tag,
+                name: group_name(names, d, tag),
+                named: names.contains_key(&(d, tag)),
+            })
+            .collect();
+        for (&(d, tag), name) in names {
+            if !self.groups.contains_key(&(d, tag)) {
+                physical_groups.push(PhysicalGroup {
+                    dim: d,
+                    tag,
+                    name: name.clone(),
+                    named: true,
+                });
+            }
+        }
+        physical_groups
+    }
+
+    /// The bodies (physical groups of the mesh's dimension), each with its boundary and point
+    /// groups.
+    fn bodies(
+        &self,
+        path: &Path,
+        names: &BTreeMap<(Dim, i32), String>,
+    ) -> Result<Vec<BodyMesh>, MeshError> {
+        let dim = self.dim;
+        let mut bodies = Vec::new();
+        for (&(d, tag), elements) in &self.groups {
+            if d != dim {
+                continue;
+            }
+            let mut body = self.body(group_name(names, d, tag), tag, elements)?;
+            if body.cells.is_empty() {
+                return Err(MeshError::EmptyBody {
+                    path: path.to_owned(),
+                    body: body.name,
+                });
+            }
+            self.add_groups(&mut body, names);
+            bodies.push(body);
+        }
+        if bodies.is_empty() {
+            return Err(MeshError::NoBodies {
+                path: path.to_owned(),
+                expected: "surface (2D) or volume (3D) of triangles / tetrahedra",
+            });
+        }
+        Ok(bodies)
+    }
+
+    /// Adds to `body` the boundary and point groups with facets or nodes on it.
+    fn add_groups(&self, body: &mut BodyMesh, names: &BTreeMap<(Dim, i32), String>) {
+        for (&(fd, ftag), facets) in &self.groups {
+            if fd + 1 == self.dim {
+                let group = self.facet_group(body, ftag, facets);
+                if !group.facets.is_empty() {
+                    body.boundary_groups
+                        .insert(group_name(names, fd, ftag), group);
+                }
+            } else if fd == 0 {
+                let nodes = self.point_group(body, facets);
+                if !nodes.is_empty() {
+                    body.point_groups.insert(group_name(names, fd, ftag), nodes);
+                }
+            }
+        }
     }
 
     /// Builds a body from the cells of one physical group; nodes are numbered locally in
@@ -333,6 +304,88 @@ impl FileContents {
             interior_facets: interior.into_iter().map(|(_, tag)| tag).collect(),
         }
     }
+}
+
+/// The mesh's dimension, the highest of the elements in physical groups: 2 or 3.
+fn mesh_dim(path: &Path, msh: &MshContents) -> Result<Dim, MeshError> {
+    let physical_tags = &msh.entity_groups;
+    let in_group = |d: Dim, tag: i32| physical_tags.get(&(d, tag)).is_some_and(|t| !t.is_empty());
+    let dim = msh
+        .element_blocks
+        .iter()
+        .filter(|b| in_group(b.entity_dim, b.entity_tag))
+        .map(|b| b.entity_dim)
+        .max()
+        .unwrap_or(0);
+    if dim < 2 {
+        return Err(MeshError::NoBodies {
+            path: path.to_owned(),
+            expected: "surface (2D) or volume (3D)",
+        });
+    }
+    // gmsh saves only the elements of physical groups: a 3D geometry with physical surfaces
+    // but no physical volume gives a file of surface triangles, which is not a 2D body.
+    if dim == 2 && msh.num_volumes > 0 {
+        return Err(MeshError::NoPhysicalVolume {
+            path: path.to_owned(),
+            volumes: msh.num_volumes,
+        });
+    }
+    Ok(dim)
+}
+
+/// The error for a block whose element type is not the P1 cell, facet or point its dimension
+/// calls for, naming the block's entity and physical groups (`tags`).
+fn unsupported_element(
+    path: &Path,
+    block: &ElementBlock,
+    tags: &[i32],
+    names: &BTreeMap<(Dim, i32), String>,
+    dim: Dim,
+) -> MeshError {
+    let d = block.entity_dim;
+    MeshError::UnsupportedElement {
+        path: path.to_owned(),
+        element_type: element_type_name(block.element_type),
+        location: format!(
+            "entity {} of dimension {} (physical group {})",
+            block.entity_tag,
+            d,
+            tags.iter()
+                .map(|&t| names
+                    .get(&(d, t))
+                    .map_or_else(|| format!("{t} (unnamed)"), |n| format!("'{n}'")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        expected: if dim == 2 {
+            "3-node triangles with 2-node boundary lines"
+        } else {
+            "4-node tetrahedra with 3-node boundary triangles"
+        },
+    }
+}
+
+/// Checks that every node of the block's elements is in `$Nodes`.
+fn check_nodes_defined(
+    path: &Path,
+    block: &ElementBlock,
+    nodes: &HashMap<u64, [f64; 3]>,
+) -> Result<(), MeshError> {
+    let elements = block
+        .element_tags
+        .iter()
+        .zip(block.node_tags.chunks_exact(block.nodes_per_element));
+    for (&element_tag, element_nodes) in elements {
+        if let Some(&node_tag) = element_nodes.iter().find(|t| !nodes.contains_key(t)) {
+            return Err(MeshError::UndefinedNode {
+                path: path.to_owned(),
+                element_tag,
+                node_tag,
+            });
+        }
+    }
+    Ok(())
 }
 
 fn cell_type(dim: Dim) -> i32 {

@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use thiserror::Error;
@@ -53,10 +54,7 @@ pub fn write_force_displacement_png(
     approach: f64,
 ) -> Result<(), PlotError> {
     register_font()?;
-    let draw_error = |e: &dyn std::fmt::Display| PlotError::Draw {
-        path: path.to_owned(),
-        message: e.to_string(),
-    };
+    let draw_error = |e: &dyn std::fmt::Display| draw_error(path, e);
     let (scale, x_desc) = if approach > 0.0 {
         (
             approach,
@@ -99,38 +97,59 @@ pub fn write_force_displacement_png(
         ),
     ];
     for (area, points, y_desc, colour) in panels {
-        let x_range = padded_range(points.iter().map(|p| p.0));
-        let y_range = padded_range(points.iter().map(|p| p.1));
-        let mut chart = ChartBuilder::on(area)
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
-            .build_cartesian_2d(x_range, y_range)
-            .map_err(|e| draw_error(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc.as_str())
-            .y_desc(y_desc)
-            .axis_desc_style((FAMILY, 16))
-            .label_style((FAMILY, 14))
-            .x_labels(6)
-            .y_labels(8)
-            .x_label_formatter(&|v| tick_label(*v))
-            .y_label_formatter(&|v| tick_label(*v))
-            .draw()
-            .map_err(|e| draw_error(&e))?;
-        let color = Palette99::pick(colour).to_rgba();
-        chart
-            .draw_series(LineSeries::new(
-                points.iter().copied(),
-                color.stroke_width(2),
-            ))
-            .map_err(|e| draw_error(&e))?;
-        chart
-            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
-            .map_err(|e| draw_error(&e))?;
+        draw_panel(path, area, points, (&x_desc, y_desc), colour)?;
     }
     root.present().map_err(|e| draw_error(&e))
+}
+
+/// One panel: `points` as a line with a dot at each, on axes described by `desc` (x, y), in
+/// colour number `colour` of plotters' palette.
+fn draw_panel(
+    path: &Path,
+    area: &DrawingArea<BitMapBackend, Shift>,
+    points: &[(f64, f64)],
+    (x_desc, y_desc): (&str, &str),
+    colour: usize,
+) -> Result<(), PlotError> {
+    let draw_error = |e: &dyn std::fmt::Display| draw_error(path, e);
+    let x_range = padded_range(points.iter().map(|p| p.0));
+    let y_range = padded_range(points.iter().map(|p| p.1));
+    let mut chart = ChartBuilder::on(area)
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(90)
+        .build_cartesian_2d(x_range, y_range)
+        .map_err(|e| draw_error(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style((FAMILY, 16))
+        .label_style((FAMILY, 14))
+        .x_labels(6)
+        .y_labels(8)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
+        .draw()
+        .map_err(|e| draw_error(&e))?;
+    let color = Palette99::pick(colour).to_rgba();
+    chart
+        .draw_series(LineSeries::new(
+            points.iter().copied(),
+            color.stroke_width(2),
+        ))
+        .map_err(|e| draw_error(&e))?;
+    chart
+        .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+        .map_err(|e| draw_error(&e))?;
+    Ok(())
+}
+
+fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> PlotError {
+    PlotError::Draw {
+        path: path.to_owned(),
+        message: e.to_string(),
+    }
 }
 
 /// Plain decimals for moderate magnitudes, scientific notation otherwise (forces range from
