@@ -339,20 +339,10 @@ fn mesh_error(error: MeshError, case: Option<&Path>) -> PyErr {
 
 /// The model that `internodes._gmsh.model_arrays` read from gmsh's API.
 fn gmsh_model(arrays: &Bound<'_, PyAny>) -> PyResult<GmshModel> {
-    let vector_u64 = |value: Bound<'_, PyAny>| -> PyResult<Vec<u64>> {
-        Ok(value
-            .cast_into::<PyArray1<u64>>()?
-            .readonly()
-            .as_slice()?
-            .to_vec())
-    };
     let mut model = GmshModel {
         num_volumes: arrays.get_item("num_volumes")?.extract()?,
-        node_tags: vector_u64(arrays.get_item("node_tags")?)?,
-        coords: (arrays.get_item("coords")?.cast_into::<PyArray1<f64>>()?)
-            .readonly()
-            .as_slice()?
-            .to_vec(),
+        node_tags: vector(arrays.get_item("node_tags")?)?,
+        coords: vector(arrays.get_item("coords")?)?,
         ..GmshModel::default()
     };
     for group in arrays.get_item("groups")?.cast_into::<PyList>()?.iter() {
@@ -376,11 +366,20 @@ fn gmsh_model(arrays: &Bound<'_, PyAny>) -> PyResult<GmshModel> {
             entity_dim,
             entity_tag,
             element_type,
-            element_tags: vector_u64(element_tags)?,
-            node_tags: vector_u64(node_tags)?,
+            element_tags: vector(element_tags)?,
+            node_tags: vector(node_tags)?,
         });
     }
     Ok(model)
+}
+
+/// A contiguous one-dimensional NumPy array (as `internodes._gmsh` makes them) as a vector.
+fn vector<T: numpy::Element + Copy>(array: Bound<'_, PyAny>) -> PyResult<Vec<T>> {
+    Ok(array
+        .cast_into::<PyArray1<T>>()?
+        .readonly()
+        .as_slice()?
+        .to_vec())
 }
 
 /// Solves a case, on `mesh` or on the mesh the case names (read, or meshed with gmsh when it
