@@ -36,6 +36,7 @@
 //! (error doubling each iteration) where it extrapolates, at the ends of two clamped blocks.
 
 use super::ContactSurface;
+use super::projection::{Projection, SurfaceIndex};
 
 /// Within what distance of a contact surface a node is judged by the plane of the facet it
 /// faces, in units of that facet's longest edge. Two faces meant to end flush (equal blocks
@@ -51,17 +52,31 @@ use super::ContactSurface;
 /// the plane of the facet it faces, yet outside.
 pub const NEAR_SURFACE: f64 = 0.1;
 
+/// How far beyond the rim of the other surface, in units of the node's own spacing, a node
+/// must lie to be measured by its distance rather than by the plane of the rim's facet: the
+/// scale of `penetration_tolerance` (1e-3), so that a node on the rim to the precision the
+/// checks judge a gap is held on the facet's plane as before.
+pub const BEYOND_RIM: f64 = 1e-3;
+
 /// The geometric gap of every node of `own` to the `other` body, each displaced by its body's
 /// displacement (`None`: reference geometry), the one gap measure of the loop's penetration
 /// test, the checks and the `normal_gap` output. The node's closest point `q` on the other
 /// candidate surface's P1 facets ([`super::projection`], on the facet that faces the node's own
 /// normal where several share it, as its linearization does, [`gap_rows`]) and that
 /// facet's outward normal `m` give:
-/// - within [`NEAR_SURFACE`] of the facet (beyond the surface's rim too), `g = m . (x - q)`,
-///   the distance to the facet's plane: positive outside, negative inside, exact against a
-///   flat;
-/// - farther, the distance `|x - q|`, negative when the node is inside the other body (decided
-///   on that body's closed boundary, [`super::boundary`]).
+/// - for a node **beside the surface**, whose closest point is on the other surface's rim
+///   (its free edges or end points) and which lies beyond the rim, along the facet's plane, by
+///   more than [`BEYOND_RIM`] of its spacing, both in the reference configuration and now:
+///   the distance `|x - q|`, negative only when the node is inside the other body (decided on
+///   that body's closed boundary, [`super::boundary`]). Such a node faces no facet: the plane
+///   of the rim's facet extends the surface where there is no surface, and a node of a block
+///   bulging up beside a punch would read as penetrating the punch it does not touch
+///   (`docs/method.md` 3.2). The reference configuration decides too because whether a node
+///   faces a surface is a property of the two meshes: two blocks meant to end flush end a hair
+///   apart once deformed, and a node whose side flips with that hair makes the loop cycle;
+/// - otherwise, within [`NEAR_SURFACE`] of the facet, `g = m . (x - q)`, the distance to the
+///   facet's plane: positive outside, negative inside, exact against a flat;
+/// - farther, the distance `|x - q|`, negative when the node is inside the other body.
 ///
 /// Defined at any distance.
 pub fn geometric_gaps(
@@ -70,26 +85,133 @@ pub fn geometric_gaps(
     u_own: Option<&[f64]>,
     u_other: Option<&[f64]>,
 ) -> Vec<f64> {
-    let surface = other.index(u_other);
-    let boundary = other.boundary.index(u_other);
+    let measure = Measure::new(own, other, u_own, u_other);
     (0..own.len())
         .map(|s| {
-            let x = u_own.map_or(own.coords[s], |u| own.deformed(u, s));
-            let closest = (surface.project_facing(&x, Some(&own.normals[s])))
-                .expect("a contact surface has facets");
-            let m = surface.normal(closest.facet);
-            let offset: [f64; 3] = std::array::from_fn(|k| x[k] - closest.point[k]);
-            let plane: f64 = (0..3).map(|k| m[k] * offset[k]).sum();
-            let distance = closest.signed_distance.abs();
-            if distance <= NEAR_SURFACE * surface.facet_size(closest.facet) {
-                return plane;
+            let gap = measure.at(s);
+            if gap.beside_rim || gap.distance <= NEAR_SURFACE * gap.facet_size {
+                return gap.value;
             }
-            let inside = boundary
-                .project(&x)
-                .is_some_and(|p| p.signed_distance < 0.0);
-            if inside { -distance } else { distance }
+            if measure.inside(&gap.position) {
+                -gap.distance
+            } else {
+                gap.distance
+            }
         })
         .collect()
+}
+
+/// The gap of one node of a surface to the other body (the rule of [`geometric_gaps`]).
+struct NodeGap {
+    /// The node's position.
+    position: [f64; 3],
+    closest: Projection,
+    /// The gap's gradient with respect to the node's position: the facet's outward normal `m`,
+    /// or, beside the rim, the unit vector `sign (x - q) / |x - q|`.
+    direction: [f64; 3],
+    /// `direction . (x - q)`: the distance to the facet's plane, or the signed distance beside
+    /// the rim.
+    value: f64,
+    distance: f64,
+    beside_rim: bool,
+    facet_size: f64,
+}
+
+/// The projections one gap evaluation needs: the other surface displaced and its closed
+/// boundary, and which nodes lie beside the other surface's rim in the reference
+/// configuration.
+struct Measure<'a> {
+    own: &'a ContactSurface,
+    other: &'a ContactSurface,
+    u_own: Option<&'a [f64]>,
+    surface: SurfaceIndex,
+    boundary: SurfaceIndex,
+    beside_in_reference: Vec<bool>,
+}
+
+impl<'a> Measure<'a> {
+    fn new(
+        own: &'a ContactSurface,
+        other: &'a ContactSurface,
+        u_own: Option<&'a [f64]>,
+        u_other: Option<&'a [f64]>,
+    ) -> Self {
+        let surface = other.index(u_other);
+        let reference = u_other.map(|_| other.index(None));
+        let beside_in_reference = (0..own.len())
+            .map(|s| {
+                let index = reference.as_ref().unwrap_or(&surface);
+                beside_rim(own, other, index, &own.coords[s], s).is_some()
+            })
+            .collect();
+        Self {
+            own,
+            other,
+            u_own,
+            boundary: other.boundary.index(u_other),
+            surface,
+            beside_in_reference,
+        }
+    }
+
+    fn at(&self, s: usize) -> NodeGap {
+        let x = self
+            .u_own
+            .map_or(self.own.coords[s], |u| self.own.deformed(u, s));
+        let beside = self.beside_in_reference[s]
+            .then(|| beside_rim(self.own, self.other, &self.surface, &x, s))
+            .flatten();
+        let closest = beside.unwrap_or_else(|| {
+            (self.surface.project_facing(&x, Some(&self.own.normals[s])))
+                .expect("a contact surface has facets")
+        });
+        let offset: [f64; 3] = std::array::from_fn(|k| x[k] - closest.point[k]);
+        let distance = closest.signed_distance.abs();
+        let direction = match beside {
+            Some(_) => {
+                let sign = if self.inside(&x) { -1.0 } else { 1.0 };
+                offset.map(|v| sign * v / distance)
+            }
+            None => self.surface.normal(closest.facet),
+        };
+        NodeGap {
+            position: x,
+            value: (0..3).map(|k| direction[k] * offset[k]).sum(),
+            closest,
+            direction,
+            distance,
+            beside_rim: beside.is_some(),
+            facet_size: self.surface.facet_size(closest.facet),
+        }
+    }
+
+    fn inside(&self, x: &[f64; 3]) -> bool {
+        (self.boundary.project(x)).is_some_and(|p| p.signed_distance < 0.0)
+    }
+}
+
+/// The closest point of `x` (node `s` of `own`) on `other`'s surface `index`, if it is on the
+/// rim and `x` lies beyond it along the facet's plane by more than [`BEYOND_RIM`] of the
+/// node's spacing.
+fn beside_rim(
+    own: &ContactSurface,
+    other: &ContactSurface,
+    index: &SurfaceIndex,
+    x: &[f64; 3],
+    s: usize,
+) -> Option<Projection> {
+    let closest =
+        (index.project_facing(x, Some(&own.normals[s]))).expect("a contact surface has facets");
+    if !other.on_rim(closest.facet, &closest.barycentric) {
+        return None;
+    }
+    let m = index.normal(closest.facet);
+    let offset: [f64; 3] = std::array::from_fn(|k| x[k] - closest.point[k]);
+    let normal: f64 = (0..3).map(|k| m[k] * offset[k]).sum();
+    let along: f64 = (0..3)
+        .map(|k| (offset[k] - normal * m[k]).powi(2))
+        .sum::<f64>();
+    (along.sqrt() > BEYOND_RIM * own.spacing[s]).then_some(closest)
 }
 
 /// The gap of one primary node linearized at an iterate.
@@ -114,7 +236,7 @@ pub fn gap_rows(
     u1: Option<&[f64]>,
     u2: Option<&[f64]>,
 ) -> Vec<GapRow> {
-    let index = secondary.index(u2);
+    let measure = Measure::new(primary, secondary, u1, u2);
     let dim = primary.dim;
     let displacement = |surface: &ContactSurface, u: Option<&[f64]>, s: usize| -> [f64; 3] {
         let node = surface.nodes[s];
@@ -125,14 +247,11 @@ pub fn gap_rows(
     };
     (0..primary.len())
         .map(|i| {
-            let x = u1.map_or(primary.coords[i], |u| primary.deformed(u, i));
-            let closest = (index.project_facing(&x, Some(&primary.normals[i])))
-                .expect("a contact surface has facets");
-            let m = index.normal(closest.facet);
-            let normal = m.map(|v| -v);
-            let gap: f64 = (0..3).map(|k| m[k] * (x[k] - closest.point[k])).sum();
-            let corners: Vec<(usize, f64)> = (secondary.facet_nodes(closest.facet).iter())
-                .zip(closest.barycentric)
+            let node_gap = measure.at(i);
+            let normal = node_gap.direction.map(|v| -v);
+            let corners: Vec<(usize, f64)> = (secondary.facet_nodes(node_gap.closest.facet))
+                .iter()
+                .zip(node_gap.closest.barycentric)
                 .map(|(&s, b)| (s, b))
                 .collect();
             let own = displacement(primary, u1, i);
@@ -142,11 +261,11 @@ pub fn gap_rows(
                         .map(|&(s, b)| b * displacement(secondary, u2, s)[k])
                         .sum::<f64>()
             });
-            let target = (0..3).map(|k| normal[k] * jump[k]).sum::<f64>() + gap;
+            let target = (0..3).map(|k| normal[k] * jump[k]).sum::<f64>() + node_gap.value;
             GapRow {
                 corners,
                 normal,
-                gap,
+                gap: node_gap.value,
                 target,
             }
         })

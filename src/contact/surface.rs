@@ -60,6 +60,8 @@ pub struct ContactSurface {
     pub nodal_area: Vec<f64>,
     /// Facets as surface node indices, `dim` per facet.
     facets: Vec<usize>,
+    /// The surface's rim ([`Rim`]): where it ends.
+    rim: Rim,
     /// The body's whole boundary, which tells inside from outside.
     pub boundary: BodyBoundary,
 }
@@ -108,6 +110,7 @@ impl ContactSurface {
             group: group_name.to_string(),
             message: e.to_string(),
         })?;
+        let rim = Rim::new(&facets, dim, nodes.len());
         Ok(Self {
             body: body.name.clone(),
             group: group_name.to_string(),
@@ -119,6 +122,7 @@ impl ContactSurface {
             spacing,
             nodal_area,
             facets,
+            rim,
             boundary: BodyBoundary::new(body),
         })
     }
@@ -160,6 +164,13 @@ impl ContactSurface {
         &self.facets[self.dim * facet..self.dim * (facet + 1)]
     }
 
+    /// Whether the point with `barycentric` coordinates on facet `facet` (a closest point,
+    /// [`super::projection::Projection`]) lies on the surface's rim ([`Rim`]).
+    pub fn on_rim(&self, facet: usize, barycentric: &[f64; 3]) -> bool {
+        self.rim
+            .contains(self.facet_nodes(facet), facet, barycentric)
+    }
+
     /// The reference position of the point with `barycentric` coordinates on facet `facet`: the
     /// material point a projection onto the displaced surface found.
     pub fn reference_point(&self, facet: usize, barycentric: &[f64; 3]) -> [f64; 3] {
@@ -179,5 +190,94 @@ impl ContactSurface {
             None => self.coords.clone(),
         };
         SurfaceIndex::new(&self.facets, self.dim, &positions)
+    }
+}
+
+/// Where a candidate surface ends: its free edges (3D: the edges of one facet only) and their
+/// nodes, or its end points (2D: the nodes of one facet only). A closed candidate surface has
+/// none. A point beyond the rim faces no facet, so the plane of the facet it is closest to
+/// says nothing about it (`super::gap`).
+#[derive(Debug, Clone)]
+struct Rim {
+    /// Surface nodes on the rim.
+    nodes: Vec<bool>,
+    /// 3D: per facet, whether the edge opposite each corner is a free edge.
+    edges: Vec<[bool; 3]>,
+}
+
+impl Rim {
+    fn new(facets: &[usize], dim: usize, num_nodes: usize) -> Self {
+        let mut nodes = vec![false; num_nodes];
+        let mut edges = Vec::new();
+        if dim == 2 {
+            let mut count = vec![0usize; num_nodes];
+            facets.iter().for_each(|&s| count[s] += 1);
+            (nodes.iter_mut().zip(count)).for_each(|(rim, c)| *rim = c == 1);
+            return Self { nodes, edges };
+        }
+        let edge = |corners: &[usize], k: usize| {
+            let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
+            (a.min(b), a.max(b))
+        };
+        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
+        for corners in facets.chunks_exact(3) {
+            (0..3).for_each(|k| *count.entry(edge(corners, k)).or_default() += 1);
+        }
+        for corners in facets.chunks_exact(3) {
+            let free: [bool; 3] = std::array::from_fn(|k| count[&edge(corners, k)] == 1);
+            for k in (0..3).filter(|&k| free[k]) {
+                let (a, b) = edge(corners, k);
+                nodes[a] = true;
+                nodes[b] = true;
+            }
+            edges.push(free);
+        }
+        Self { nodes, edges }
+    }
+
+    /// Whether the point with `barycentric` coordinates on the facet with `corners` (index
+    /// `facet`) is on the rim: at a rim node, or (3D) inside a free edge. The closest-point
+    /// projection puts exact zeros in the coordinates of a point on an edge or a corner.
+    fn contains(&self, corners: &[usize], facet: usize, barycentric: &[f64; 3]) -> bool {
+        let dim = corners.len();
+        let zeros: Vec<usize> = (0..dim).filter(|&k| barycentric[k] == 0.0).collect();
+        match zeros.len() {
+            // At a corner: the one with coordinate 1.
+            n if n == dim - 1 => (0..dim).any(|k| !zeros.contains(&k) && self.nodes[corners[k]]),
+            1 => self.edges[facet][zeros[0]],
+            _ => false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Rim;
+
+    #[test]
+    fn the_rim_of_a_square_of_four_triangles_is_its_outline() {
+        // Corners 0..3 of the unit square and its centre 4, four triangles about the centre.
+        let facets = [0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4];
+        let rim = Rim::new(&facets, 3, 5);
+        assert_eq!(rim.nodes, [true, true, true, true, false]);
+        // Each triangle's free edge is the one opposite the centre (its third corner).
+        assert!(rim.edges.iter().all(|e| *e == [false, false, true]));
+        // On the free edge 0-1, at corner 1, inside the facet, on the inner edge 1-4.
+        assert!(rim.contains(&facets[0..3], 0, &[0.5, 0.5, 0.0]));
+        assert!(rim.contains(&facets[0..3], 0, &[0.0, 1.0, 0.0]));
+        assert!(!rim.contains(&facets[0..3], 0, &[0.2, 0.3, 0.5]));
+        assert!(!rim.contains(&facets[0..3], 0, &[0.0, 0.5, 0.5]));
+        // The centre is no rim node.
+        assert!(!rim.contains(&facets[0..3], 0, &[0.0, 0.0, 1.0]));
+    }
+
+    #[test]
+    fn the_rim_of_a_polyline_is_its_two_ends() {
+        let facets = [0, 1, 1, 2, 2, 3];
+        let rim = Rim::new(&facets, 2, 4);
+        assert_eq!(rim.nodes, [true, false, false, true]);
+        assert!(rim.contains(&facets[0..2], 0, &[1.0, 0.0, 0.0]));
+        assert!(!rim.contains(&facets[0..2], 0, &[0.0, 1.0, 0.0]));
+        assert!(!rim.contains(&facets[2..4], 1, &[0.5, 0.5, 0.0]));
     }
 }
