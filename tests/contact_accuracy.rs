@@ -591,3 +591,54 @@ fn a_stiff_flat_punch_is_solved_and_accurate_with_the_defaults() {
         }
     }
 }
+
+#[test]
+fn the_accuracy_report_says_which_errors_it_estimated() {
+    // The half-disc on the block, equal materials: auto's primary alone, then with the other
+    // primary solved on request.
+    let coverage = |contact: &serde_json::Value, error: &str| -> serde_json::Value {
+        let rows = contact["accuracy"]["coverage"].as_array().unwrap();
+        (rows.iter().find(|row| row["error"] == error))
+            .unwrap_or_else(|| panic!("no coverage row '{error}' in {rows:?}"))
+            .clone()
+    };
+    let (code, summary) = solve_cli(&half_disc_on_block());
+    assert_eq!(code, Some(0));
+    let contact = &summary["contact"];
+    let coupling = coverage(contact, "interface coupling");
+    assert_eq!(
+        coupling["estimated_by"],
+        serde_json::json!(["secondary sag", "force centre"])
+    );
+    assert!(
+        coupling["not_estimated"]
+            .as_str()
+            .unwrap()
+            .contains("check_other_primary")
+    );
+    let bulk = coverage(contact, "bulk discretization");
+    assert_eq!(bulk["estimated_by"], serde_json::json!([]));
+    assert!(
+        bulk["not_estimated"]
+            .as_str()
+            .unwrap()
+            .contains("internodes study")
+    );
+    assert_eq!(
+        coverage(contact, "contact zone resolution")["estimated_by"],
+        serde_json::json!(["resolution"])
+    );
+
+    let case = half_disc_on_block().contact_setting("check_other_primary", true);
+    let (code, summary) = solve_cli(&case);
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(0), "{contact}");
+    let indicators = contact["accuracy"]["indicators"].as_array().unwrap();
+    let agreement = (indicators.iter())
+        .find(|c| c["name"] == "primary agreement")
+        .expect("the other primary was solved");
+    assert_eq!(agreement["passed"], true);
+    let coupling = coverage(contact, "interface coupling");
+    assert!((coupling["estimated_by"].as_array().unwrap()).contains(&"primary agreement".into()));
+    assert!(coupling.get("not_estimated").is_none());
+}

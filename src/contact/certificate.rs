@@ -155,6 +155,74 @@ impl Certificate {
     }
 }
 
+/// One source of error in what a user reads, and the indicators of this answer that estimate
+/// it ([`Certificate::coverage`]): the accuracy report claims only what they measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct ErrorCoverage {
+    /// The error's source.
+    pub error: &'static str,
+    /// What it affects of what a user reads.
+    pub affects: &'static str,
+    /// The indicators of this answer that estimate it (none: not estimated).
+    pub estimated_by: Vec<CheckKind>,
+    /// What is not estimated of it in this run, and how to estimate it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_estimated: Option<&'static str>,
+}
+
+impl Certificate {
+    /// Which errors of what a user reads the accuracy report estimates, and which it does not
+    /// (`docs/method.md` 4.2):
+    /// - the coupling of the two meshes at the interface (the multiplier space, the transfer,
+    ///   the secondary's sag between primary nodes): by the sag and the force centres, and by
+    ///   another discretization of the coupling only where the other primary or the automatic
+    ///   transfer was solved too (primary or transfer agreement);
+    /// - the resolution of the contact zone: by the zone's width in spacings;
+    /// - the bulk discretization of each body (P1 elements, faceted curved surfaces): never;
+    ///   one mesh cannot measure its own error, a refinement study does.
+    pub fn coverage(&self) -> Vec<ErrorCoverage> {
+        let has = |kind: CheckKind| self.checks.iter().any(|c| c.name == kind);
+        let present = |kinds: &[CheckKind]| -> Vec<CheckKind> {
+            kinds.iter().copied().filter(|&k| has(k)).collect()
+        };
+        use CheckKind::*;
+        let compared = has(PrimaryAgreement) || has(TransferAgreement);
+        vec![
+            ErrorCoverage {
+                error: "interface coupling",
+                affects: "contact force and where it acts",
+                estimated_by: present(&[
+                    SecondarySag,
+                    ForceCentre,
+                    PrimaryAgreement,
+                    TransferAgreement,
+                ]),
+                not_estimated: (!compared).then_some(
+                    "by another discretization of the coupling: only the secondary's sag and \
+                     the force centres were measured; [contact] check_other_primary = true \
+                     solves the other body as primary and compares the forces",
+                ),
+            },
+            ErrorCoverage {
+                error: "contact zone resolution",
+                affects: "contact zone, peak pressure",
+                estimated_by: present(&[Resolution]),
+                not_estimated: None,
+            },
+            ErrorCoverage {
+                error: "bulk discretization",
+                affects: "contact force, contact zone, peak pressure, stresses",
+                estimated_by: Vec::new(),
+                not_estimated: Some(
+                    "the P1 error of each body's mesh and its faceted surfaces: one mesh \
+                     cannot measure its own discretization error; solve a refinement \
+                     sequence (internodes study CASE.toml --parameter level=0,1,2)",
+                ),
+            },
+        ]
+    }
+}
+
 impl CertificateCheck {
     pub fn describe(&self) -> String {
         let at = match (&self.body, self.node_tag) {

@@ -49,7 +49,7 @@ mod surface;
 pub mod system;
 
 pub use active_set::ActiveSet;
-pub use certificate::{Certificate, CertificateCheck, CheckKind};
+pub use certificate::{Certificate, CertificateCheck, CheckKind, ErrorCoverage};
 pub use driver::{ContactRun, StepRecord, solve_contact};
 pub use interface_krylov::{KrylovError, KrylovFailure};
 pub use problem::{

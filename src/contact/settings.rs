@@ -156,6 +156,13 @@ pub struct ContactSettings {
     /// to its nearest node (default 2, the radius Algorithm 1 of `docs/method.md` starts from; see
     /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
     pub rbf_radius: f64,
+    /// Solve every load step again with the other body as primary and check that the two
+    /// contact forces agree within `accuracy_tolerance` (`primary agreement`), whatever the
+    /// primary (default false: done anyway for a named primary that `auto` avoids). The other
+    /// primary is an independent discretization of the coupling of the two meshes, the one
+    /// error of the interface that the other indicators estimate only in part; it doubles the
+    /// cost, and where the other body is much stiffer its answer is the unstable choice's.
+    pub check_other_primary: bool,
 }
 
 impl Default for ContactSettings {
@@ -176,6 +183,7 @@ impl Default for ContactSettings {
             imbalance_tolerance: 0.01,
             force_centre_tolerance: 1.0,
             rbf_radius: 2.0,
+            check_other_primary: false,
         }
     }
 }

@@ -8,8 +8,8 @@ use serde::Serialize;
 use super::OutputError;
 use crate::contact::LinearSolvers;
 use crate::contact::{
-    Certificate, CertificateCheck, ContactSettings, ContactStatus, HertzFit, IterationRecord,
-    PrimaryReport, StepRecord, TransferReport,
+    Certificate, CertificateCheck, ContactSettings, ContactStatus, ErrorCoverage, HertzFit,
+    IterationRecord, PrimaryReport, StepRecord, TransferReport,
 };
 use crate::elastic::SolveStats;
 
@@ -102,6 +102,8 @@ pub struct SolvedChecks {
 pub struct AccuracyReport {
     pub passed: bool,
     pub indicators: Vec<CertificateCheck>,
+    /// Which errors of what a user reads the indicators estimate, and which they do not.
+    pub coverage: Vec<ErrorCoverage>,
 }
 
 /// How a solved case ended, as the command line's exit status tells it.
@@ -172,6 +174,7 @@ impl ContactSummary {
             AccuracyReport {
                 passed: certificate.accurate(),
                 indicators: certificate.indicators().cloned().collect(),
+                coverage: certificate.coverage(),
             },
         )
     }
