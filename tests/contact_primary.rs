@@ -337,3 +337,28 @@ fn a_named_transfer_is_checked_against_the_automatic_one() {
     let (code, summary) = solve_cli(&case);
     assert_eq!(code, Some(3), "{}", summary["contact"]);
 }
+
+#[test]
+fn a_retry_is_checked_against_the_first_answer_where_that_one_settled() {
+    // Two equal flat blocks, the upper narrower and coarser: auto's first choice (the coarser
+    // upper block) ends not-solved on its force balance alone (the interpolation transfer),
+    // with a passing accuracy report; the lower block as primary is solved. Its answer is kept
+    // only after its force is compared with the first one's, within accuracy_tolerance plus
+    // the first answer's imbalance.
+    let (code, summary) = solve_cli(&narrow_blocks());
+    let contact = &summary["contact"];
+    assert_eq!(code, Some(0), "{contact}");
+    assert_eq!(contact["primary"], "lower");
+    let reason = contact["primary_choice"]["reason"].as_str().unwrap();
+    assert!(reason.contains("'upper' as primary ended not-solved (equilibrium"), "{reason}");
+    let indicators = contact["accuracy"]["indicators"].as_array().unwrap();
+    let check = (indicators.iter())
+        .find(|c| c["name"] == "primary agreement")
+        .expect("the retry is compared with the first answer");
+    let note = check["note"].as_str().unwrap();
+    assert!(note.contains("with the first choice of primary"), "{note}");
+    let value = check["value"].as_f64().unwrap();
+    let tolerance = check["tolerance"].as_f64().unwrap();
+    assert!(value > 0.01 && value < tolerance, "{check}");
+    assert!(tolerance > 0.01, "the first answer's imbalance widens the bound: {check}");
+}
