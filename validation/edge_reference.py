@@ -1,0 +1,244 @@
+#!/usr/bin/python3
+"""Independent dolfinx references for contact at edges and corners (``edge_sweep.py``).
+
+Every reference is computed by dolfinx (0.5.2) on exactly the gmsh nodes and cells of the compliant
+body of the two-body mesh the internodes run reads, with nothing taken from internodes. The stiff
+body of the internodes run (1e3 times stiffer) is taken as rigid. The bound-constrained solver is
+``contact_reference.RigidFlatContact`` (PETSc SNES ``vinewtonrsls``: frictionless node-to-surface
+contact, n . u >= -g0 at each candidate node, tangential components free; its KKT conditions are
+checked on the returned solution).
+
+* ``punch_solve``: the block of ``geo/square_punch_3d.geo`` under the punch taken as rigid. The mesh
+  is turned upside down (``contact_reference.turned_mesh``) and the block pressed by ``delta`` onto
+  the punch's lower surface:
+  - ``exact=None``: the punch's own P1 face (``contact_reference.obstacle_below``: each block top
+    node under a punch facet held on that facet's plane). With sharp edges the face is flat and its
+    outline exact, so this is the rigid sharp punch: every block node under the footprint touches
+    and the others are free (``premise: whole footprint``).
+  - ``exact={"w", "rho", "sx", "sy"}``: the exact filleted punch, the square of half-width
+    w - rho grown by a ball of radius rho (what OpenCASCADE's fillets of the geo script make, checked
+    by ``fillet_surface_error``): each block top node's gap is its distance to that surface,
+    |P - C| - rho, C the closest point of the core square (at height rho), and n = (P - C) / |P - C|.
+    The contact edge is the solution's (an active-set / VI solve on the block nodes).
+* ``plane_solve``: the compliant body of ``geo/tilted_cube_3d.geo`` (the cube) or
+  ``geo/tilted_square_2d.geo`` (the square) pressed by ``delta`` (its top faces moved down, lateral
+  components held) onto the rigid plane x_v = 0 that stands for the stiff block's top; the contact
+  set is the solution's.
+* ``prescribed_footprint``: the sharp punch's reference a second way, without a contact solver: the
+  block alone, its top nodes under the footprint moved down by delta (tangentially free), one linear
+  solve. It must equal ``punch_solve`` (every footprint node touches, the rest are free).
+
+Each returns the force on the body, the contact nodes (gmsh tags, deformed positions in the frame of
+the two-body mesh), the solver's convergence and KKT figures.
+
+Usage:
+  /usr/bin/python3 validation/edge_reference.py punch MESH.msh --delta 0.0025 [--rho 0.1 --w 0.3 --sx .. --sy ..]
+  /usr/bin/python3 validation/edge_reference.py plane MESH.msh --delta 0.004 --body cube
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from contact_reference import (GAP_TOLERANCE, KKT_TOLERANCE, RigidFlatContact, obstacle_below,  # noqa: E402
+                               read_body, turned_mesh)
+from dolfinx_reference import ReferenceFailure, solve_constrained  # noqa: E402,F401
+
+
+def _turned_back(x: np.ndarray) -> np.ndarray:
+    """Coordinates of the turned mesh (3D: y, z -> -y, -z) in the frame of the two-body mesh."""
+    out = np.array(x, float, copy=True)
+    out[:, 1:3] *= -1
+    return out
+
+
+def exact_fillet(points: np.ndarray, w: float, rho: float, sx: float, sy: float, turned: bool = True):
+    """(g0, n) of ``points`` (k, 3) against the exact filleted punch (module doc). ``turned``: the
+    points and the punch in the turned frame (punch below, pointing up at z = 0 of its face, its axis
+    at (sx, -sy)); else in the mesh's frame (punch above, axis (sx, sy), n pointing down)."""
+    p = np.asarray(points, float)
+    cy = -sy if turned else sy
+    core = w - rho
+    q = np.empty_like(p)
+    q[:, 0] = sx + np.clip(p[:, 0] - sx, -core, core)
+    q[:, 1] = cy + np.clip(p[:, 1] - cy, -core, core)
+    q[:, 2] = -rho if turned else rho
+    v = p - q
+    lateral = np.hypot(v[:, 0], v[:, 1])
+    distance = np.linalg.norm(v, axis=1)
+    gap = np.where(lateral < rho, distance - rho, np.inf)
+    normals = np.zeros((len(p), 3))
+    normals[:, 2] = 1.0 if turned else -1.0
+    under = np.isfinite(gap)
+    normals[under] = v[under] / distance[under, None]
+    return gap, normals
+
+
+def fillet_surface_error(msh: Path, w: float, rho: float, sx: float, sy: float) -> float:
+    """Largest distance of a node of the punch's meshed contact surface from the exact filleted
+    surface of ``exact_fillet`` (mesh frame), over rho: the premise that the analytic surface is the
+    one gmsh meshed."""
+    punch = read_body(msh, "punch", ["punch_contact"])
+    nodes = np.unique(punch.facets["punch_contact"])
+    x = punch.x[nodes]
+    core = w - rho
+    q = np.empty_like(x)
+    q[:, 0] = sx + np.clip(x[:, 0] - sx, -core, core)
+    q[:, 1] = sy + np.clip(x[:, 1] - sy, -core, core)
+    q[:, 2] = rho
+    distance = np.linalg.norm(x - q, axis=1)
+    # the flat face lies at z = 0 (distance rho from the core plane), the fillet on the grown ball
+    return float(np.abs(distance - rho).max() / rho)
+
+
+def _solve(model: RigidFlatContact, delta: float) -> tuple:
+    solution = model.solve(delta)
+    bounded = model.contact_nodes[model.bounded]
+    normals = model.normals[model.bounded] if model.rotation is not None else \
+        np.tile(np.eye(model.dim)[model.v], (len(bounded), 1))
+    gap = model.height[model.bounded] + (solution.u[bounded] * normals).sum(axis=1)
+    reaction = solution.reaction[bounded]
+    contact = (gap <= GAP_TOLERANCE * delta) & ((reaction * normals).sum(axis=1) > 0)
+    return solution, bounded, contact, reaction
+
+
+def _record(model: RigidFlatContact, solution, bounded, contact, reaction, delta: float, start: float,
+            turned: bool) -> dict:
+    v = model.dim - 1
+    force = float(reaction[:, v].sum())
+    top_reaction = float(solution.reaction[model.top_nodes, v].sum())
+    nodes = bounded[contact]
+    deformed = model.body.x[nodes] + np.pad(solution.u[nodes], ((0, 0), (0, 3 - model.dim)))
+    if turned:
+        deformed = _turned_back(deformed)
+    return {
+        "delta": delta, "num_nodes": int(model.body.num_nodes), "force": force,
+        "force_balance": float(abs(force + top_reaction) / abs(force)) if force else float("nan"),
+        "nodes_constrained": int(len(bounded)), "nodes_in_contact": int(contact.sum()),
+        "contact_tags": model.body.node_tags[nodes].astype(int).tolist(),
+        "contact_deformed": deformed[:, :3].tolist(),
+        "snes": {"iterations": solution.iterations, "converged_reason": solution.reason},
+        "kkt": solution.kkt, "seconds": time.perf_counter() - start,
+    }
+
+
+def punch_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio: float,
+                exact: dict | None = None, footprint: dict | None = None) -> dict:
+    """The block of ``msh`` under its punch taken as rigid (module doc). ``footprint`` {"w", "sx",
+    "sy"}: also count the block top nodes strictly inside the square footprint and those of them in
+    contact (the sharp punch's premise)."""
+    start = time.perf_counter()
+    turned = turned_mesh(msh, 3)
+    block = read_body(turned, "block", ["block_contact", "block_base"])
+    if exact is None:
+        punch = read_body(turned, "punch", ["punch_contact"])
+        facets = punch.x[punch.facets["punch_contact"]]
+
+        def obstacle(points):
+            return obstacle_below(facets, 3, points)
+    else:
+        def obstacle(points):
+            return exact_fillet(points, exact["w"], exact["rho"], exact["sx"], exact["sy"])
+    model = RigidFlatContact(block, "block_contact", "block_base", youngs_modulus, poisson_ratio,
+                             obstacle=obstacle)
+    solution, bounded, contact, reaction = _solve(model, delta)
+    record = _record(model, solution, bounded, contact, reaction, delta, start, turned=True)
+    if footprint is not None:
+        x = _turned_back(block.x[bounded])
+        inside = ((np.abs(x[:, 0] - footprint["sx"]) < footprint["w"] - 1e-9)
+                  & (np.abs(x[:, 1] - footprint["sy"]) < footprint["w"] - 1e-9))
+        record["footprint_nodes"] = int(inside.sum())
+        record["footprint_nodes_in_contact"] = int((inside & contact).sum())
+        record["in_contact_outside_footprint"] = int((~inside & contact).sum())
+    if exact is not None:
+        # how far onto the fillet the contact reaches: the largest lateral distance of a contact
+        # node from the flat face (0: the flat face only)
+        x = _turned_back(block.x[bounded[contact]])
+        core = exact["w"] - exact["rho"]
+        beyond = np.hypot(np.maximum(np.abs(x[:, 0] - exact["sx"]) - core, 0),
+                          np.maximum(np.abs(x[:, 1] - exact["sy"]) - core, 0))
+        record["contact_beyond_flat"] = float(beyond.max()) if len(beyond) else 0.0
+    return record
+
+
+def prescribed_footprint(msh: Path, delta: float, youngs_modulus: float, poisson_ratio: float,
+                         w: float, sx: float, sy: float) -> dict:
+    """The sharp rigid punch without a contact solver (module doc): force of the block whose top nodes
+    strictly inside the footprint are moved down by delta, free sideways, its base clamped."""
+    from dolfinx_reference import Body, ReferenceModel
+
+    start = time.perf_counter()
+    block = read_body(msh, "block", ["block_contact", "block_base"])
+    model = ReferenceModel(msh, {"block": block.x})
+    K = model.stiffness(Body("block", youngs_modulus, poisson_ratio))
+    n = block.num_nodes
+    g = np.full(3 * n, np.nan)
+    base = np.unique(block.facets["block_base"])
+    top = np.unique(block.facets["block_contact"])
+    for c in range(3):
+        g[3 * base + c] = 0.0
+    x = block.x[top]
+    inside = top[(np.abs(x[:, 0] - sx) < w - 1e-9) & (np.abs(x[:, 1] - sy) < w - 1e-9)]
+    g[3 * inside + 2] = -delta
+    u = solve_constrained(K, np.zeros(3 * n), g, f"{msh}: prescribed footprint")
+    r = (K @ u).reshape(-1, 3)
+    return {"force": float(-r[inside, 2].sum()), "footprint_nodes": int(len(inside)),
+            "seconds": time.perf_counter() - start}
+
+
+def plane_solve(msh: Path, dim: int, body: str, delta: float, youngs_modulus: float,
+                poisson_ratio: float) -> dict:
+    """``body`` of ``msh`` (groups ``<body>_contact``, ``<body>_top``) pressed by ``delta`` onto the
+    rigid plane x_v = 0 (module doc)."""
+    start = time.perf_counter()
+    mesh = read_body(msh, body, [f"{body}_contact", f"{body}_top"])
+    model = RigidFlatContact(mesh, f"{body}_contact", f"{body}_top", youngs_modulus, poisson_ratio)
+    model.normals = None
+    solution, bounded, contact, reaction = _solve(model, delta)
+    return _record(model, solution, bounded, contact, reaction, delta, start, turned=False)
+
+
+def converged(reference: dict) -> bool:
+    """The VI converged and its KKT conditions hold."""
+    return bool(reference["snes"]["converged_reason"] > 0 and reference["kkt"].get("passed"))
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    punch = sub.add_parser("punch", help="the block of a square_punch_3d mesh under the punch taken as rigid")
+    punch.add_argument("mesh", type=Path)
+    punch.add_argument("--delta", type=float, required=True)
+    punch.add_argument("--rho", type=float, default=0.0, help="> 0: the exact fillet (with --w, --sx, --sy)")
+    punch.add_argument("--w", type=float, default=0.3)
+    punch.add_argument("--sx", type=float, default=0.0137)
+    punch.add_argument("--sy", type=float, default=0.0071)
+    plane = sub.add_parser("plane", help="a body pressed onto the rigid plane x_v = 0")
+    plane.add_argument("mesh", type=Path)
+    plane.add_argument("--delta", type=float, required=True)
+    plane.add_argument("--body", required=True)
+    plane.add_argument("--dim", type=int, default=3)
+    for p in (punch, plane):
+        p.add_argument("--E", type=float, default=1000.0)
+        p.add_argument("--nu", type=float, default=0.3)
+    args = parser.parse_args(argv)
+    if args.command == "punch":
+        exact = {"w": args.w, "rho": args.rho, "sx": args.sx, "sy": args.sy} if args.rho > 0 else None
+        data = punch_solve(args.mesh, args.delta, args.E, args.nu, exact,
+                           footprint={"w": args.w, "sx": args.sx, "sy": args.sy})
+    else:
+        data = plane_solve(args.mesh, args.dim, args.body, args.delta, args.E, args.nu)
+    data.pop("contact_deformed")
+    data.pop("contact_tags")
+    print(json.dumps(data, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

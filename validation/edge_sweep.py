@@ -1,0 +1,518 @@
+#!/usr/bin/python3
+"""Gated sweep of contact at edges and corners: a held-out family, each run right or named.
+
+The other sweeps put the contact zone where both meshes were made for it: a pole at the origin, a
+punch whose rim carries the same nodes as the block's circle under it. Here the edges of one body
+fall anywhere on the other body's mesh: a stiff square punch shifted off the block's mesh lines
+(sharp or filleted edges), the lowest edge of a tilted elastic cube on a stiff block, the lowest
+corner of a tilted square (2D). A block node just beyond a punch's edge faces no facet of the
+punch; a solver that measures it against the plane of the face's last facet makes it active where
+the block bulges, and certifies a force several percent too high (the defect this family was made
+to catch, fixed by ``4636835 gap: ...``).
+
+Families (``FAMILIES``), each at two spacing ratios (r = h_stiff / h_compliant, 0.7 and 1.4) and two
+or three approaches d, each solved with the compliant body primary, the stiff body primary and
+"auto" (three runs of one mesh and one reference). E = 1000 for the compliant body and 1e6 for the
+stiff one (E ratio 1e3), nu = 0.3:
+
+* ``square-sharp``: ``geo/square_punch_3d.geo``, a square punch of half-width 0.3 (12 block
+  spacings across at h_block 0.05) and height H_p = 0.5, its axis shifted by (0.0137, 0.0071), on
+  the block [-1, 1]^2 x [-1, 0] clamped at its base; the punch's top pushed down by d = 0.1%, 0.5%,
+  2% of H_p. Reference: the block under the rigid sharp punch (``edge_reference.punch_solve``, the
+  punch's P1 face): every block node under the footprint touches, the others are free.
+* ``square-fillet``: the same punch with its lower and vertical edges filleted, radius 0.1 (two
+  block spacings; the fillets meshed at 0.025), d = 0.5% and 2% of H_p. Reference: the block under
+  the exact filleted punch (the analytic surface, checked against the punch's mesh nodes), the
+  contact edge the VI's.
+* ``cube-edge``: ``geo/tilted_cube_3d.geo``, an elastic cube of side a = 0.4 turned by 20 degrees
+  about x (its lowest edge along x, the faces there sloping by 20 and 70 degrees) and by 17 degrees
+  about z (the edge along no axis), the edge's middle at (0.0031, 0.0057), on a stiff block
+  [-0.6, 0.6]^2 x [-0.5, 0] clamped at its base; the cube's two upper faces pushed down by d = 1%,
+  2%, 4% of a; both meshes refined to h_cube = 0.01 (and r h_cube on the block) within 0.04 of the
+  edge. Reference: the cube on a rigid plane (``edge_reference.plane_solve``).
+* ``square-corner-2d``: ``geo/tilted_square_2d.geo``, an elastic square of side a = 0.4 turned by 30
+  degrees (its lowest corner at x = 0.0013, the sides there sloping by 30 and 60 degrees) on a stiff
+  block [-0.6, 0.6] x [-0.5, 0]; the square's two upper sides pushed down by d = 0.5%, 1%, 2% of a;
+  h_square = 0.002 within 0.03 of the corner. Reference: the square on a rigid plane. The stiff
+  block (1e3) stands for the plane; a two-body reference with equal materials was not built.
+
+Each run is classified (``classify``) from its exit status and its answer:
+
+* RIGHT: exit 0 (solved, accuracy report passed) and the force on the compliant body within 1% of
+  the reference (``FORCE_TOLERANCE``) and the contact zone within one spacing (``ZONE_TOLERANCE``:
+  the Hausdorff distance, in the lateral plane, between the deformed positions of the primary's
+  active nodes with pressure and the reference's contact nodes, over the coarser of the two contact
+  faces' measured spacings);
+* NAMED: exit 2 (not solved) or 3 (solved, accuracy report failed): the solver said so;
+* WRONG: exit 0 outside either bound: a certified wrong answer;
+* ERROR: exit 1, a timeout, no output, or an exit status that contradicts summary.json.
+
+Gate rows per run: ``<primary>: right or named`` (figure 0 for RIGHT or NAMED, 1 for WRONG or ERROR)
+for an explicit primary, ``auto: right`` (0 only for RIGHT: "auto not right" otherwise) for auto,
+and ``primary`` (an explicit primary honoured, auto reported as auto). Per case: ``mesh`` (the
+contact faces' measured mean edge lengths within 25% of the asked spacings), ``reference`` (the VI
+converged, its KKT conditions hold) and a premise: ``premise: whole footprint`` (sharp: every block
+node under the footprint in contact in the reference, none outside), ``premise: fillet surface``
+(the punch's contact nodes on the analytic fillet within 1e-6 rho), ``premise: zone`` (the plane
+references: the contact zone at least 1.5 spacings across, the accuracy report's own lower limit;
+below it the case tests nothing but the resolution indicator).
+
+Usage:  /usr/bin/python3 validation/edge_sweep.py [--quick] [--binary PATH] [--cases NAME ...] [--out DIR]
+
+Meshes, case files, outputs, logs and cached dolfinx references go to validation/build/edge_sweep/.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+VALIDATION = Path(__file__).resolve().parent
+REPO = VALIDATION.parent
+
+import edge_reference  # noqa: E402
+from compare import Check  # noqa: E402
+from contact_reference import ReferenceFailure  # noqa: E402
+from flat_sweep import RunFailed, mesh_check  # noqa: E402,F401
+from suite import (MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,  # noqa: E402
+                   run_solve, solver_reports, surface_spacing, vouched)
+from sweep import loaded, read_output, solved_primary, vertical_force  # noqa: E402
+
+BUILD = VALIDATION / "build" / "edge_sweep"
+E_COMPLIANT = 1000.0
+E_RATIO = 1e3
+POISSON_RATIO = 0.3
+
+# Tolerances, fixed before any run.
+FORCE_TOLERANCE = 0.01
+ZONE_TOLERANCE = 1.0  # spacings
+MESH_TOLERANCE = 0.25
+FILLET_TOLERANCE = 1e-6  # of rho
+ZONE_PREMISE = 1.5  # spacings across (the accuracy report's resolution limit)
+RATIOS = (0.7, 1.4)
+
+
+@dataclass(frozen=True)
+class Family:
+    """One geometry (module doc)."""
+
+    name: str
+    dim: int
+    script: str
+    compliant: str
+    stiff: str
+    h: float  # the compliant body's spacing at the contact
+    length: float  # d = approach x length (H_p of a punch, a of a cube / square)
+    approaches: tuple
+    geo: tuple = ()  # fixed geo parameters (name, value)
+    within: float = 0.3  # mesh check: edges within this lateral distance of the axis
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        """(moving, fixed): the moving body's top is pushed down, the fixed one's base clamped."""
+        return (self.stiff, self.compliant) if self.compliant == "block" else (self.compliant, self.stiff)
+
+
+FAMILIES = {
+    f.name: f for f in (
+        Family("square-sharp", 3, "square_punch_3d", "block", "punch", 0.05, 0.5, (0.001, 0.005, 0.02),
+               (("rho", 0.0),)),
+        Family("square-fillet", 3, "square_punch_3d", "block", "punch", 0.05, 0.5, (0.005, 0.02),
+               (("rho", 0.1),)),
+        Family("cube-edge", 3, "tilted_cube_3d", "cube", "block", 0.01, 0.4, (0.01, 0.02, 0.04), within=0.04),
+        Family("square-corner-2d", 2, "tilted_square_2d", "square", "block", 0.002, 0.4, (0.005, 0.01, 0.02),
+               within=0.03),
+    )
+}
+# The square punch's geometry (geo defaults): half-width, shift; fillet radius per family.
+PUNCH = {"w": 0.3, "sx": 0.0137, "sy": 0.0071}
+
+
+@dataclass(frozen=True)
+class EdgeCase:
+    """One mesh and approach of a family; three runs (primaries)."""
+
+    family: str
+    ratio: float  # h_stiff / h_compliant
+    approach: float
+    quick: bool = False
+
+    @property
+    def f(self) -> Family:
+        return FAMILIES[self.family]
+
+    @property
+    def name(self) -> str:
+        return f"{self.family}-r{self.ratio:g}-d{self.approach * 100:g}%"
+
+    @property
+    def delta(self) -> float:
+        return float(f"{self.approach * self.f.length:.6g}")
+
+    @property
+    def spacings(self) -> dict:
+        """Contact group -> asked spacing."""
+        f = self.f
+        return {f"{f.compliant}_contact": f.h, f"{f.stiff}_contact": round(f.h * self.ratio, 6)}
+
+    @property
+    def primaries(self) -> tuple[str, ...]:
+        return (self.f.compliant, self.f.stiff, "auto")
+
+    def geo_parameters(self) -> dict:
+        f = self.f
+        hs = round(f.h * self.ratio, 6)
+        if f.script == "square_punch_3d":
+            return {"h_b": f.h, "h_p": hs, **dict(f.geo)}
+        return {"h_c": f.h, "h_b": hs, **dict(f.geo)}
+
+    def text(self) -> str:
+        f = self.f
+        return (f"{f.dim}D {f.name}, h_{f.compliant} {f.h:g}, h_{f.stiff} / h_{f.compliant} {self.ratio:g}, "
+                f"d = {self.delta:g} ({self.approach:.1%} of {f.length:g})")
+
+
+QUICK = {("square-sharp", 1.4, 0.005), ("square-corner-2d", 1.4, 0.01)}
+CASES = tuple(EdgeCase(f.name, r, d, (f.name, r, d) in QUICK)
+              for f in FAMILIES.values() for r in RATIOS for d in f.approaches)
+
+
+# ---------------------------------------------------------------------------
+# Meshes, case files, solves, references
+# ---------------------------------------------------------------------------
+
+
+def mesh(case: EdgeCase) -> Path:
+    parameters = case.geo_parameters()
+    name = case.f.script + "".join(f"_{k}{v:g}" for k, v in parameters.items()) + ".msh"
+    try:
+        return mesh_geo(case.f.script, case.f.dim, parameters, BUILD / "meshes" / name)
+    except MeshFailed as error:
+        raise RunFailed(str(error)) from error
+
+
+def case_text(case: EdgeCase, msh: Path, output: Path, primary: str) -> str:
+    f = case.f
+    moving, fixed = f.bodies
+    lateral = ["ux", "uy"][: f.dim - 1]
+    v = "uz" if f.dim == 3 else "uy"
+    contact = contact_table((moving, fixed), (f"{moving}_contact", f"{fixed}_contact"), primary)
+    moduli = {f.compliant: E_COMPLIANT, f.stiff: E_COMPLIANT * E_RATIO}
+    bodies = [body_table(moving, moduli[moving], POISSON_RATIO,
+                         [(f"{moving}_top", dict.fromkeys(lateral, 0.0) | {v: -case.delta})]),
+              body_table(fixed, moduli[fixed], POISSON_RATIO,
+                         [(f"{fixed}_base", dict.fromkeys(lateral + [v], 0.0))])]
+    return case_toml(msh, output, contact, bodies,
+                     f"{case.name}, primary {primary}: {case.text()} (written by validation/edge_sweep.py)")
+
+
+def solve(binary: Path, case: EdgeCase, msh: Path, primary: str, timeout: float = 900.0) -> tuple[Path, dict]:
+    folder = BUILD / "runs" / f"{case.name}-{primary}"
+    folder.mkdir(parents=True, exist_ok=True)
+    output = folder / "internodes"
+    toml = folder / "case.toml"
+    toml.write_text(case_text(case, msh, output, primary))
+    run = run_solve(binary, toml, output, timeout, folder / "log.txt")
+    return output, {"exit": run.exit, "seconds": run.seconds, "tail": run.tail()}
+
+
+def reference(case: EdgeCase, msh: Path) -> dict:
+    """The case's dolfinx reference (module doc), cached per mesh, approach and kind."""
+    f = case.f
+    rho = dict(f.geo).get("rho", 0.0)
+    kind = "plane" if f.compliant != "block" else ("fillet" if rho else "sharp")
+    stamp = {"mesh": json.loads(msh.with_suffix(".json").read_text()), "delta": case.delta, "kind": kind,
+             "E": E_COMPLIANT, "nu": POISSON_RATIO, "version": 1}
+    folder = BUILD / "references"
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{msh.stem}_{kind}_delta{case.delta:g}.json"
+    if path.is_file():
+        data = json.loads(path.read_text())
+        if data.get("stamp") == stamp:
+            return data
+    if kind == "plane":
+        data = edge_reference.plane_solve(msh, f.dim, f.compliant, case.delta, E_COMPLIANT, POISSON_RATIO)
+    elif kind == "sharp":
+        data = edge_reference.punch_solve(msh, case.delta, E_COMPLIANT, POISSON_RATIO, footprint=PUNCH)
+    else:
+        exact = PUNCH | {"rho": rho}
+        data = edge_reference.punch_solve(msh, case.delta, E_COMPLIANT, POISSON_RATIO, exact=exact)
+        p1 = edge_reference.punch_solve(msh, case.delta, E_COMPLIANT, POISSON_RATIO)
+        data["p1_face_force"] = p1["force"]
+        data["fillet_surface_error"] = edge_reference.fillet_surface_error(msh, **exact)
+    data["stamp"] = stamp
+    path.write_text(json.dumps(json_safe(data)))
+    return data
+
+
+# ---------------------------------------------------------------------------
+# Checks and the classification
+# ---------------------------------------------------------------------------
+
+
+def case_checks(case: EdgeCase, msh: Path, ref: dict) -> tuple[list[Check], dict]:
+    """Mesh, reference and premise rows of a case; the measured spacings."""
+    f = case.f
+    measured = {g: surface_spacing(msh, g, f.dim, f.within) for g in case.spacings}
+    errors = [abs(measured[g] / h - 1) for g, h in case.spacings.items()]
+    checks = [Check("mesh", case.name, max(errors) if all(map(math.isfinite, errors)) else math.nan,
+                    MESH_TOLERANCE, "; ".join(f"{g} {measured[g]:.4g} (asked {h:.4g})"
+                                              for g, h in case.spacings.items())),
+              Check("reference", case.name, 0.0 if edge_reference.converged(ref) else 1.0, 0.0,
+                    f"dolfinx VI: reason {ref['snes']['converged_reason']}, {ref['snes']['iterations']} its, KKT "
+                    + ", ".join(f"{k} {v:.1e}" for k, v in ref["kkt"].items() if k != "passed")
+                    + f"; {ref['nodes_in_contact']} of {ref['nodes_constrained']} candidate nodes in contact, "
+                      f"P_ref = {ref['force']:.6g}")]
+    h = measured[f"{f.compliant}_contact"]
+    if "footprint_nodes" in ref:
+        missing = ref["footprint_nodes"] - ref["footprint_nodes_in_contact"] + ref["in_contact_outside_footprint"]
+        checks.append(Check("premise: whole footprint", case.name, missing / max(ref["footprint_nodes"], 1), 0.0,
+                            f"{ref['footprint_nodes_in_contact']} of the {ref['footprint_nodes']} block nodes under "
+                            f"the footprint in contact, {ref['in_contact_outside_footprint']} outside"))
+    elif "fillet_surface_error" in ref:
+        checks.append(Check("premise: fillet surface", case.name, ref["fillet_surface_error"], FILLET_TOLERANCE,
+                            f"largest distance of a punch contact node from the exact fillet / rho; the contact "
+                            f"reaches {ref['contact_beyond_flat'] / h:.2f} block spacings onto the fillet; the "
+                            f"punch's P1 face as the obstacle gives P = {ref['p1_face_force']:.6g} "
+                            f"({ref['p1_face_force'] / ref['force'] - 1:+.2%})"))
+    else:
+        width = zone_width(ref, f.dim)
+        checks.append(Check("premise: zone", case.name, ZONE_PREMISE * h / max(width, 1e-300), 1.0,
+                            f"the reference's contact zone {width:.4g} across ({width / h:.2f} spacings of "
+                            f"{f.compliant}) at its narrowest section"))
+    return checks, measured
+
+
+def zone_width(ref: dict, dim: int) -> float:
+    """Width of the reference's contact zone across the edge / corner: in 2D its extent; in 3D its
+    extent across the zone's long axis (principal axes of the contact nodes' lateral positions)."""
+    x = np.array(ref["contact_deformed"])[:, : dim - 1]
+    if len(x) < 2:
+        return 0.0
+    if dim == 2:
+        return float(np.ptp(x[:, 0]))
+    centred = x - x.mean(axis=0)
+    _, _, axes = np.linalg.svd(centred, full_matrices=False)
+    return float(np.ptp(centred @ axes[1]))
+
+
+def zone_distance(out: dict, body: str, ref: dict, dim: int) -> tuple[float, float]:
+    """(ours -> reference, reference -> ours): the largest lateral distance from a deformed loaded
+    active node of ``body`` to the nearest reference contact node, and back."""
+    from scipy.spatial import cKDTree
+
+    on = loaded(out, body, "contact_pressure")
+    ours = (out["geometry"][on] + out["displacement"][on])[:, : dim - 1]
+    theirs = np.array(ref["contact_deformed"])[:, : dim - 1]
+    if len(ours) == 0 or len(theirs) == 0:
+        return math.inf, math.inf
+    return (float(cKDTree(theirs).query(ours)[0].max()), float(cKDTree(ours).query(theirs)[0].max()))
+
+
+def classify(case: EdgeCase, msh: Path, primary: str, run: dict, out: dict | None, ref: dict,
+             measured: dict) -> dict:
+    """RIGHT / NAMED / WRONG / ERROR (module doc) with its figures."""
+    f = case.f
+    record = {"primary_asked": primary, "exit": run["exit"], "seconds": run["seconds"]}
+    if out is None:
+        return record | {"class": "ERROR", "why": f"no output (exit {run['exit']}): {run['tail']}"}
+    contact = out["contact"]
+    solved, accuracy = solver_reports(contact)
+    failed = [c.get("name") for c in (solved or {}).get("checks", []) + (accuracy or {}).get("indicators", [])
+              if isinstance(c, dict) and c.get("passed") is False]
+    record |= {"status": contact.get("status"), "primary": solved_primary(out), "failed": failed,
+               "iterations": len(contact.get("iterations", []))}
+    try:
+        force = vertical_force(out, f.compliant, f.dim)
+        record["force"] = force
+        record["force_error"] = force / ref["force"] - 1
+        extra, missing = zone_distance(out, record["primary"], ref, f.dim)
+        spacing = max(measured.values())
+        record |= {"zone_extra": extra / spacing, "zone_missing": missing / spacing}
+    except (RunFailed, KeyError, ValueError) as error:
+        record["why"] = f"{type(error).__name__}: {error}"
+    if run["exit"] in (2, 3):
+        consistent = not vouched(contact)
+        return record | {"class": "NAMED" if consistent else "ERROR",
+                         "why": f"{contact.get('status')}; failed: {', '.join(failed) or 'none'}"
+                                + ("" if consistent else "; the exit status contradicts summary.json")}
+    if run["exit"] != 0 or not vouched(contact) or "force_error" not in record:
+        return record | {"class": "ERROR", "why": record.get("why", f"exit {run['exit']}, status "
+                                                                  f"{contact.get('status')}: {run['tail']}")}
+    zone = max(record["zone_extra"], record["zone_missing"])
+    right = abs(record["force_error"]) <= FORCE_TOLERANCE and zone <= ZONE_TOLERANCE
+    return record | {"class": "RIGHT" if right else "WRONG",
+                     "why": f"force {record['force_error']:+.2%}, zone {zone:.2f} spacings"}
+
+
+def run_checks(case: EdgeCase, record: dict) -> list[Check]:
+    """The gate rows of one run (module doc)."""
+    label = f"{case.name} [{record['primary_asked']}]"
+    klass = record["class"]
+    figures = ""
+    if "force_error" in record:
+        figures = (f"P = {record['force']:.6g} ({record['force_error']:+.3%} against the reference), zone "
+                   f"{record.get('zone_extra', math.nan):.2f} / {record.get('zone_missing', math.nan):.2f} spacings "
+                   f"(ours beyond / reference missed); ")
+    note = (f"{klass}: exit {record['exit']}, {record.get('status')}, primary {record.get('primary')}; {figures}"
+            f"{record.get('why', '')}; {record['seconds']:.1f} s")
+    if record["primary_asked"] == "auto":
+        rows = [Check("auto: right", label, 0.0 if klass == "RIGHT" else 1.0, 0.0,
+                      note if klass == "RIGHT" else "auto not right: " + note)]
+    else:
+        rows = [Check(f"{record['primary_asked']}: right or named", label,
+                      0.0 if klass in ("RIGHT", "NAMED") else 1.0, 0.0, note)]
+    if record.get("primary") is not None or klass != "ERROR":
+        asked = record["primary_asked"]
+        ok = record.get("primary") in case.f.bodies if asked == "auto" else record.get("primary") == asked
+        rows.append(Check("primary", label, 0.0 if ok else 1.0, 0.0, f"asked {asked}, solved with "
+                                                                      f"{record.get('primary')}"))
+    return rows
+
+
+# ---------------------------------------------------------------------------
+# One case, the suite
+# ---------------------------------------------------------------------------
+
+
+def run_case(binary: Path, case: EdgeCase) -> tuple[list[Check], dict]:
+    """Mesh, reference, the three runs, the checks. Anything that fails is a failed row, never a skip."""
+    record: dict = {"parameters": asdict(case) | {"delta": case.delta, "name": case.name}, "runs": {}}
+    checks: list[Check] = []
+    try:
+        msh = mesh(case)
+        ref = reference(case, msh)
+        more, measured = case_checks(case, msh, ref)
+        checks += more
+        record |= {"spacings": measured, "reference": {k: v for k, v in ref.items()
+                                                       if k not in ("contact_deformed", "contact_tags", "stamp")}}
+        for primary in case.primaries:
+            output, run = solve(binary, case, msh, primary)
+            try:
+                out = read_output(output) if (output / "summary.json").is_file() else None
+            except (RunFailed, OSError, KeyError, ValueError, json.JSONDecodeError) as error:
+                out, run["tail"] = None, f"{type(error).__name__}: {error}"
+            result = classify(case, msh, primary, run, out, ref, measured)
+            record["runs"][primary] = result
+            checks += run_checks(case, result)
+            print(f"    {primary}: {result['class']} ({result.get('why', '')}), {run['seconds']:.1f} s", flush=True)
+    except (RunFailed, ReferenceFailure, OSError, KeyError, ValueError, TypeError, json.JSONDecodeError) as error:
+        checks.append(Check("run", case.name, math.nan, 0.0, f"{type(error).__name__}: {error}"))
+        record["error"] = f"{type(error).__name__}: {error}"
+    return checks, record
+
+
+def counts(records: dict) -> dict:
+    """Runs per class, auto runs not right, worst force error of the exit-0 runs."""
+    runs = [(name, r) for name, rec in records.items() for r in rec.get("runs", {}).values()]
+    tally = {k: sum(r["class"] == k for _, r in runs) for k in ("RIGHT", "NAMED", "WRONG", "ERROR")}
+    exit0 = [(abs(r["force_error"]), name, r) for name, r in runs if r["exit"] == 0 and "force_error" in r]
+    worst = max(exit0, key=lambda t: t[0], default=None)
+    return tally | {"runs": len(runs), "auto_not_right": [f"{name} ({r['class']})" for name, r in runs
+                                                          if r["primary_asked"] == "auto" and r["class"] != "RIGHT"],
+                    "worst_exit0": (f"{worst[2]['force_error']:+.2%} ({worst[1]}, {worst[2]['primary_asked']})"
+                                    if worst else "none")}
+
+
+def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None = None) -> SuiteResult:
+    start = time.perf_counter()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    cases = [c for c in CASES if (c.quick or not quick) and (not names or c.name in names or c.family in names)]
+    checks: list[Check] = []
+    records: dict = {}
+    for case in cases:
+        print(f"  {case.name}: {case.text()} ...", flush=True)
+        case_start = time.perf_counter()
+        case_checks_, record = run_case(binary, case)
+        record["wall_seconds"] = time.perf_counter() - case_start
+        checks += case_checks_
+        records[case.name] = record
+        failed = [f"{c.check} {c.case}" for c in case_checks_ if not c.passed]
+        print(f"    {record['wall_seconds']:.1f} s; {'all checks pass' if not failed else 'FAILED: ' + '; '.join(failed)}",
+              flush=True)
+    seconds = time.perf_counter() - start
+    tally = counts(records)
+    text = report_text(cases, checks, records, quick, seconds, tally)
+    return SuiteResult("Sweep, edges and corners: stiff square punches, a tilted cube's edge, a tilted square's "
+                       "corner (gate)", checks, [], text,
+                       {"quick": quick, "seconds": seconds, "counts": tally, "cases": json_safe(records)})
+
+
+DECISIONS = """\
+**Decisions** (module doc of `validation/edge_sweep.py`; fixed before any run):
+
+* The stiff body (E ratio 1e3) is taken as rigid in every reference; its compliance moves the force
+  by about 1e-3, a tenth of the force tolerance.
+* The edges of one body fall off the other's mesh lines: the punch is shifted by (0.0137, 0.0071)
+  off the block's axis and the block's top face is not split under it; the cube's edge is turned
+  by 17 degrees about the vertical and shifted; the square's corner is at x = 0.0013.
+* The contact zone is compared as point sets (the primary's active nodes with pressure against the
+  reference's contact nodes, deformed, lateral plane) in units of the coarser contact spacing: a
+  node one spacing beyond the footprint passes this row; the force row is the one that sees it.
+* A run that ends with exit 2 or 3 is NAMED (acceptable) for an explicit primary; "auto" must be
+  RIGHT (the default has to answer, or the family is outside what the default supports: the row
+  says "auto not right").
+"""
+
+
+def report_text(cases: list[EdgeCase], checks: list[Check], records: dict, quick: bool, seconds: float,
+                tally: dict) -> str:
+    lines = [f"{'Quick subset' if quick else 'Full edge sweep'}: {len(cases)} cases, {tally['runs']} runs, "
+             f"{len(checks)} checks, {sum(not c.passed for c in checks)} failed; wall time {seconds:.0f} s.", "",
+             f"Runs: {tally['RIGHT']} RIGHT, {tally['NAMED']} NAMED, {tally['WRONG']} WRONG, {tally['ERROR']} ERROR; "
+             f"auto not right: {', '.join(tally['auto_not_right']) or 'none'}; largest force error of an exit-0 "
+             f"run: {tally['worst_exit0']}.", "",
+             f"**Runs** (E = {E_COMPLIANT:g} for the compliant body, {E_COMPLIANT * E_RATIO:g} for the stiff one, "
+             f"nu = {POISSON_RATIO}; force error against the dolfinx reference on the compliant body's mesh; zone: "
+             "ours beyond / reference missed, in spacings):", "",
+             "| case | quick | P_ref | primary | solved with | exit | status | force error | zone | class | s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for case in cases:
+        rec = records[case.name]
+        if "error" in rec and not rec.get("runs"):
+            lines.append(f"| {case.name} | {'yes' if case.quick else ''} | | | | | | | | ERROR: {rec['error']} | |")
+            continue
+        for primary, r in rec["runs"].items():
+            fe = f"{r['force_error']:+.2%}" if "force_error" in r else ""
+            zone = (f"{r['zone_extra']:.2f} / {r['zone_missing']:.2f}" if "zone_extra" in r else "")
+            lines.append(f"| {case.name} | {'yes' if case.quick else ''} | {rec['reference']['force']:.5g} | {primary} "
+                         f"| {r.get('primary', '')} | {r['exit']} | {r.get('status', '')}"
+                         f"{' (' + ', '.join(r['failed']) + ')' if r.get('failed') else ''} | {fe} | {zone} "
+                         f"| {'**' + r['class'] + '**' if r['class'] in ('WRONG', 'ERROR') else r['class']} "
+                         f"| {r['seconds']:.1f} |")
+    lines += ["", "**Checks**", "", "| check | case | figure | tolerance | result | note |", "|---|---|---|---|---|---|"]
+    lines += [f"| {c.check} | {c.case} | {'n/a' if math.isnan(c.figure) else f'{c.figure:.3g}'} | {c.tolerance:.3g} "
+              f"| {'PASS' if c.passed else '**FAIL**'} | {c.note} |" for c in checks]
+    lines += ["", DECISIONS]
+    return "\n".join(lines)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="the quick subset only (make test)")
+    parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes")
+    parser.add_argument("--cases", nargs="+", help="case or family names (default: all)")
+    parser.add_argument("--out", type=Path, default=BUILD / "report")
+    args = parser.parse_args()
+    known = {c.name for c in CASES} | set(FAMILIES)
+    unknown = set(args.cases or []) - known
+    if unknown:
+        parser.error(f"unknown cases {sorted(unknown)}; known: {sorted(known)}")
+    result = run_suite(args.binary, args.quick, args.out, args.cases)
+    print(result.text)
+    (args.out / "edge_sweep.json").write_text(json.dumps(
+        {"binary": str(args.binary), "checks": [asdict(c) | {"figure": c.figure if math.isfinite(c.figure) else None,
+                                                             "passed": c.passed} for c in result.checks],
+         "data": result.data}, indent=1))
+    return 0 if all(c.passed for c in result.checks) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
