@@ -22,6 +22,8 @@
 //          rho / 128).
 //
 // Parameters (override with  -setnumber name value; lengths in model units):
+//   level  refinement level (integer, may be negative to coarsen);
+//          every mesh size below is multiplied by 2^-level          [0]
 //   W      half-width of the block                                   [1]
 //   H      height of the block                                       [1]
 //   w      half-width of the punch (< W)                             [0.3]
@@ -57,6 +59,7 @@
 
 SetFactory("OpenCASCADE");
 DefineConstant[
+  level = {0, Name "Parameters/level"},
   W = {1, Name "Parameters/W"},
   H = {1, Name "Parameters/H"},
   w = {0.3, Name "Parameters/w"},
@@ -76,6 +79,7 @@ If (w + Fabs(sx) >= W || w + Fabs(sy) >= W || rho < 0 || rho >= w / 2 || rho >= 
   Abort;
 EndIf
 Geometry.AutoCoherence = 0;
+sf = 2 ^ (-level);  // size factor of this refinement level
 
 Box(1) = {-W, -W, -H, 2 * W, 2 * W, H};
 Box(2) = {sx - w, sy - w, gap, 2 * w, 2 * w, H_p};
@@ -167,8 +171,8 @@ EndIf
 
 // sizes: the block refined in a box around the footprint, the punch uniform, finer on the fillets
 Field[1] = Box;
-Field[1].VIn = h_b;
-Field[1].VOut = h_far;
+Field[1].VIn = h_b * sf;
+Field[1].VOut = h_far * sf;
 Field[1].XMin = -w - d_c + sx;
 Field[1].XMax = w + d_c + sx;
 Field[1].YMin = -w - d_c + sy;
@@ -183,7 +187,7 @@ Field[2].SurfacesList = {b_surfaces[]};
 Field[2].CurvesList = {b_curves[]};
 Field[2].PointsList = {b_points[]};
 Field[3] = MathEval;
-Field[3].F = Sprintf("%.17g", h_p);
+Field[3].F = Sprintf("%.17g", h_p * sf);
 Field[4] = Restrict;
 Field[4].InField = 3;
 Field[4].VolumesList = {punch[0]};
@@ -191,7 +195,7 @@ Field[4].SurfacesList = {p_all[]};
 Field[4].CurvesList = {pc_curves[]};
 Field[4].PointsList = {pc_points[]};
 Field[5] = MathEval;
-Field[5].F = Sprintf("%.17g", h_fillet);
+Field[5].F = Sprintf("%.17g", h_fillet * sf);
 Field[6] = Restrict;
 Field[6].InField = 5;
 Field[6].SurfacesList = {p_fillet[]};

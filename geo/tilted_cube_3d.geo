@@ -15,6 +15,8 @@
 //          meshes (no shared nodes, no boolean operation).
 //
 // Parameters (override with  -setnumber name value; lengths in model units):
+//   level  refinement level (integer, may be negative to coarsen);
+//          every mesh size below is multiplied by 2^-level          [0]
 //   W      half-width of the block                                   [0.6]
 //   H      height of the block                                       [0.5]
 //   a      side of the cube                                          [0.4]
@@ -50,6 +52,7 @@
 
 SetFactory("OpenCASCADE");
 DefineConstant[
+  level = {0, Name "Parameters/level"},
   W = {0.6, Name "Parameters/W"},
   H = {0.5, Name "Parameters/H"},
   a = {0.4, Name "Parameters/a"},
@@ -69,6 +72,7 @@ If (theta <= 0 || theta >= 90 || a * Sqrt(2) + Fabs(sx) + Fabs(sy) >= 2 * W)
   Abort;
 EndIf
 Geometry.AutoCoherence = 0;
+sf = 2 ^ (-level);  // size factor of this refinement level
 t = theta * Pi / 180;
 f = phi * Pi / 180;
 
@@ -112,8 +116,8 @@ Field[1].CurvesList = {edge[0]};
 Field[1].NumPointsPerCurve = 400;
 Field[2] = Threshold;
 Field[2].InField = 1;
-Field[2].SizeMin = h_c;
-Field[2].SizeMax = h_far;
+Field[2].SizeMin = h_c * sf;
+Field[2].SizeMax = h_far * sf;
 Field[2].DistMin = r_c;
 Field[2].DistMax = d_far;
 cl_s[] = {7, 8, 9, 10, 11, 12};
@@ -126,8 +130,8 @@ Field[3].CurvesList = {cl_c[]};
 Field[3].PointsList = {cl_p[]};
 Field[5] = Threshold;
 Field[5].InField = 1;
-Field[5].SizeMin = h_b;
-Field[5].SizeMax = h_far;
+Field[5].SizeMin = h_b * sf;
+Field[5].SizeMax = h_far * sf;
 Field[5].DistMin = r_c;
 Field[5].DistMax = d_far;
 cl_s[] = {1, 2, 3, 4, 5, 6};

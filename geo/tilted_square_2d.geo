@@ -14,15 +14,17 @@
 //          boolean operation).
 //
 // Parameters (override with  -setnumber name value; lengths in model units):
+//   level  refinement level (integer, may be negative to coarsen);
+//          every mesh size below is multiplied by 2^-level          [0]
 //   W      half-width of the block                                   [0.6]
 //   H      height of the block                                       [0.5]
 //   a      side of the square                                        [0.4]
 //   theta  turn, degrees (0 < theta < 90; 45: symmetric)             [30]
 //   sx     abscissa of the lowest corner                             [0.0013]
 //   gap    height of the corner above y = 0 (neg.: overlap)          [0]
-//   h_c    square size near the corner                               [0.002]
+//   h_c    square size near the corner                               [0.001]
 //   h_b    block size near the corner                                [h_c]
-//   r_c    distance from the corner with sizes h_c, h_b              [0.03]
+//   r_c    distance from the corner with sizes h_c, h_b              [0.05]
 //   h_far  size far from the corner                                  [0.05]
 //   d_far  distance where h_far is reached                           [0.3]
 //
@@ -47,15 +49,16 @@
 
 SetFactory("OpenCASCADE");
 DefineConstant[
+  level = {0, Name "Parameters/level"},
   W = {0.6, Name "Parameters/W"},
   H = {0.5, Name "Parameters/H"},
   a = {0.4, Name "Parameters/a"},
   theta = {30, Name "Parameters/theta"},
   sx = {0.0013, Name "Parameters/sx"},
   gap = {0, Name "Parameters/gap"},
-  h_c = {0.002, Name "Parameters/h_c"},
+  h_c = {0.001, Name "Parameters/h_c"},
   h_b = {h_c, Name "Parameters/h_b"},
-  r_c = {0.03, Name "Parameters/r_c"},
+  r_c = {0.05, Name "Parameters/r_c"},
   h_far = {0.05, Name "Parameters/h_far"},
   d_far = {0.3, Name "Parameters/d_far"}
 ];
@@ -64,6 +67,7 @@ If (theta <= 0 || theta >= 90 || a * Sqrt(2) + Fabs(sx) >= 2 * W)
   Abort;
 EndIf
 Geometry.AutoCoherence = 0;
+sf = 2 ^ (-level);  // size factor of this refinement level
 t = theta * Pi / 180;
 
 Rectangle(1) = {-W, -H, 0, 2 * W, H};
@@ -92,8 +96,8 @@ Field[1] = Distance;
 Field[1].PointsList = {corner[0]};
 Field[2] = Threshold;
 Field[2].InField = 1;
-Field[2].SizeMin = h_c;
-Field[2].SizeMax = h_far;
+Field[2].SizeMin = h_c * sf;
+Field[2].SizeMax = h_far * sf;
 Field[2].DistMin = r_c;
 Field[2].DistMax = d_far;
 Field[3] = Restrict;
@@ -103,8 +107,8 @@ Field[3].CurvesList = {5, 6, 7, 8};
 Field[3].PointsList = {PointsOf{ Surface{2}; }};
 Field[5] = Threshold;
 Field[5].InField = 1;
-Field[5].SizeMin = h_b;
-Field[5].SizeMax = h_far;
+Field[5].SizeMin = h_b * sf;
+Field[5].SizeMax = h_far * sf;
 Field[5].DistMin = r_c;
 Field[5].DistMax = d_far;
 Field[6] = Restrict;

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -209,6 +210,66 @@ def converged(reference: dict) -> bool:
     return bool(reference["snes"]["converged_reason"] > 0 and reference["kkt"].get("passed"))
 
 
+def verify(folder: Path) -> dict:
+    """The references checked independently (``edge_reference.py verify``; the figures are quoted in
+    validation/README.md): meshes in ``folder``."""
+    import flat_reference
+    from suite import mesh_geo
+
+    E, nu = 1000.0, 0.3
+    w, sx, sy = 0.3, 0.0137, 0.0071
+    results: dict = {}
+
+    def msh(script, dim, parameters):
+        name = script + "".join(f"_{k}{v:g}" for k, v in parameters.items()) + ".msh"
+        return mesh_geo(script, dim, parameters, folder / name)
+
+    # 1. The sharp punch: the VI against the footprint prescribed in one linear solve.
+    delta = 0.0025
+    sharp = msh("square_punch_3d", 3, {"h_b": 0.05, "h_p": 0.07, "rho": 0.0})
+    vi = punch_solve(sharp, delta, E, nu, footprint={"w": w, "sx": sx, "sy": sy})
+    linear = prescribed_footprint(sharp, delta, E, nu, w, sx, sy)
+    results["sharp: VI against prescribed footprint"] = {
+        "vi": vi["force"], "prescribed": linear["force"], "relative": vi["force"] / linear["force"] - 1}
+    # 2. The exact-fillet obstacle with a vanishing radius on the sharp mesh is the sharp punch.
+    tiny = punch_solve(sharp, delta, E, nu, exact={"w": w, "rho": 1e-7, "sx": sx, "sy": sy})
+    results["fillet obstacle, rho -> 0, against the sharp punch"] = {
+        "fillet": tiny["force"], "sharp": vi["force"], "relative": tiny["force"] / vi["force"] - 1}
+    # 3. The fillet: the analytic surface is the meshed one; exact against the punch's P1 face.
+    filleted = msh("square_punch_3d", 3, {"h_b": 0.05, "h_p": 0.07, "rho": 0.1})
+    for d in (0.0025, 0.01):
+        exact = punch_solve(filleted, d, E, nu, exact={"w": w, "rho": 0.1, "sx": sx, "sy": sy})
+        p1 = punch_solve(filleted, d, E, nu)
+        results[f"fillet d={d:g}: exact against the P1 face"] = {
+            "exact": exact["force"], "p1_face": p1["force"], "relative": p1["force"] / exact["force"] - 1,
+            "contact_beyond_flat": exact["contact_beyond_flat"]}
+    results["fillet surface error / rho"] = fillet_surface_error(filleted, w, 0.1, sx, sy)
+    # 4. The sharp punch under refinement, and on a block large enough to compare with the rigid
+    # square punch on a half-space: P = 2 beta E* sqrt(A / pi) delta, beta = 1.012 (square).
+    estar = E / (1 - nu**2)
+    half_space = 2 * 1.012 * estar * math.sqrt((2 * w) ** 2 / math.pi) * delta
+    for label, extra in (("block 2 x 2 x 1", {}), ("block 8 x 8 x 4", {"W": 4.0, "H": 4.0, "h_far": 0.6})):
+        forces = {}
+        for h in (0.05, 0.035, 0.025):
+            m = msh("square_punch_3d", 3, {"h_b": h, "h_p": 0.07, "rho": 0.0, **extra})
+            forces[h] = prescribed_footprint(m, delta, E, nu, w, sx, sy)["force"]
+        results[f"sharp punch refined, {label}"] = {"forces": forces, "half_space_estimate": half_space}
+    # 5. The rigid plane: an untilted block face down (the upper block of flat_blocks) on the plane
+    # against dolfinx's union of two such blocks clamped at their ends (flat_reference.union_solve:
+    # the interface is a symmetry plane, so the union at 2 d is each half on a frictionless plane at d).
+    for dim, b in ((3, {"W_l": 0.5, "H_l": 0.5, "H_u": 0.5}), (2, {"W_l": 1.0, "H_l": 0.5, "H_u": 0.5})):
+        h = 0.05 if dim == 3 else 0.025
+        d = 0.005
+        two = msh(f"flat_blocks_{dim}d", dim, {**b, "W_u": b["W_l"], "h_l": h, "h_u": h})
+        union = msh(f"flat_blocks_{dim}d", dim, {"union": 1, **b, "h_l": h, "h_u": h})
+        plane = plane_solve(two, dim, "upper", d, E, nu)
+        whole = flat_reference.union_solve(union, dim, "clamped", 2 * d, E, nu, b["W_l"], b["H_l"], b["H_u"])
+        results[f"plane {dim}D: upper block on the plane against the union"] = {
+            "plane": plane["force"], "union": whole["force"], "relative": plane["force"] / whole["force"] - 1,
+            "in_contact": plane["nodes_in_contact"], "candidates": plane["nodes_constrained"]}
+    return results
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -219,15 +280,21 @@ def main(argv=None) -> int:
     punch.add_argument("--w", type=float, default=0.3)
     punch.add_argument("--sx", type=float, default=0.0137)
     punch.add_argument("--sy", type=float, default=0.0071)
+    check = sub.add_parser("verify", help="the independent checks of the references (validation/README.md)")
+    check.add_argument("--folder", type=Path, default=Path(__file__).resolve().parent / "build" / "edge_sweep"
+                       / "verify")
     plane = sub.add_parser("plane", help="a body pressed onto the rigid plane x_v = 0")
     plane.add_argument("mesh", type=Path)
     plane.add_argument("--delta", type=float, required=True)
     plane.add_argument("--body", required=True)
     plane.add_argument("--dim", type=int, default=3)
-    for p in (punch, plane):
+    for p in (punch, plane, check):
         p.add_argument("--E", type=float, default=1000.0)
         p.add_argument("--nu", type=float, default=0.3)
     args = parser.parse_args(argv)
+    if args.command == "verify":
+        print(json.dumps(verify(args.folder), indent=1))
+        return 0
     if args.command == "punch":
         exact = {"w": args.w, "rho": args.rho, "sx": args.sx, "sy": args.sy} if args.rho > 0 else None
         data = punch_solve(args.mesh, args.delta, args.E, args.nu, exact,

@@ -18,7 +18,9 @@ contact solutions (``body_by_body.py``), the Hertz suite with its convergence
 study (``hertz_suite.py``), the independent dolfinx rigid-flat reference
 (``rigid_flat.py``), the gated sweep of the contact solver over its required
 parameter ranges (``sweep.py``; ``--quick``: its quick subset) and the gated sweep of flat faces
-in contact, flat blocks and stiff flat punches (``flat_sweep.py``; ``--quick``: its quick subset). Everything goes into ``validation/report/`` (``report.py``):
+in contact, flat blocks and stiff flat punches (``flat_sweep.py``; ``--quick``: its quick subset), and the
+gated sweep of contact at edges and corners off the other body's mesh lines (``edge_sweep.py``;
+``--quick``: its quick subset). Everything goes into ``validation/report/`` (``report.py``):
 README.md with every table and figure, and results.json.
 
 Exit status 1 if a gate check failed or anything is missing (report.py says
@@ -57,7 +59,8 @@ BUILD = VALIDATION / "build"
 REPORT = VALIDATION / "report"
 QUICK_REPORT = BUILD / "report-quick"
 # Contact suites: module name, whether its checks gate the run.
-SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False, "sweep": True, "flat_sweep": True}
+SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False, "sweep": True, "flat_sweep": True,
+          "edge_sweep": True}
 # Regression bands on the target suites' figures, one section per mode.
 BANDS = VALIDATION / "bands.json"
 # A figure may grow to BAND_RELATIVE times its committed value plus BAND_ABSOLUTE before the band
