@@ -80,7 +80,9 @@ Box(1) = {-W, -W, -H, 2 * W, 2 * W, H};
 Box(2) = {-a / 2, -a / 2, -a / 2, a, a, a};
 Rotate {{1, 0, 0}, {0, 0, 0}, t} { Volume{2}; }
 Rotate {{0, 0, 1}, {0, 0, 0}, f} { Volume{2}; }
-Translate {sx, sy, gap + a / 2 * (Sin(t) + Cos(t))} { Volume{2}; }
+// the lowest edge's middle, (0, -a/2, -a/2) turned, to (sx, sy, gap)
+y_e = -a / 2 * (Cos(t) - Sin(t));
+Translate {sx + Sin(f) * y_e, sy - Cos(f) * y_e, gap + a / 2 * (Sin(t) + Cos(t))} { Volume{2}; }
 eps = 1e-6;
 edge[] = Curve In BoundingBox{-W + eps, -W + eps, gap - eps, W - eps, W - eps, gap + eps};
 If (#edge[] != 1)
