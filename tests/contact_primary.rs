@@ -350,7 +350,10 @@ fn a_retry_is_checked_against_the_first_answer_where_that_one_settled() {
     assert_eq!(code, Some(0), "{contact}");
     assert_eq!(contact["primary"], "lower");
     let reason = contact["primary_choice"]["reason"].as_str().unwrap();
-    assert!(reason.contains("'upper' as primary ended not-solved (equilibrium"), "{reason}");
+    assert!(
+        reason.contains("'upper' as primary ended not-solved (equilibrium"),
+        "{reason}"
+    );
     let indicators = contact["accuracy"]["indicators"].as_array().unwrap();
     let check = (indicators.iter())
         .find(|c| c["name"] == "primary agreement")
@@ -360,5 +363,8 @@ fn a_retry_is_checked_against_the_first_answer_where_that_one_settled() {
     let value = check["value"].as_f64().unwrap();
     let tolerance = check["tolerance"].as_f64().unwrap();
     assert!(value > 0.01 && value < tolerance, "{check}");
-    assert!(tolerance > 0.01, "the first answer's imbalance widens the bound: {check}");
+    assert!(
+        tolerance > 0.01,
+        "the first answer's imbalance widens the bound: {check}"
+    );
 }

@@ -204,7 +204,12 @@ fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer
             .err()
             .expect("an error, not an answer");
         assert!(
-            message.contains("interface GMRES did not converge (iteration limit reached)"),
+            message.contains("interface GMRES did not converge (iteration limit reached"),
+            "{label}: {message}"
+        );
+        // The message names the setting and the way out.
+        assert!(
+            message.contains("krylov_max_iterations") && message.contains("solver = \"auto\""),
             "{label}: {message}"
         );
     }
@@ -218,4 +223,18 @@ fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
     let cholesky = solve(&case.clone().body_solver("cholesky")).unwrap();
     let cg = solve(&case.body_solver("cg-amg")).unwrap();
     assert_same_contact(&cg, &cholesky, 1e-6, "CG + AMG");
+}
+
+#[test]
+fn a_coupled_solve_held_back_by_a_loose_cg_tolerance_names_both_tolerances() {
+    // rtol = 5e-9 is allowed (not above residual_tolerance = 1e-8), but the coupled system's
+    // residual after CG bodies stopped there is 5e-8 on the 3D Hertz case: the error must name
+    // the two settings and the way out.
+    let case = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
+        .body_solver("cg-amg")
+        .rtol(5e-9);
+    let message = solve(&case).err().expect("an error, not an answer");
+    for part in ["residual_tolerance 1e-8", "rtol = 5e-9", "lower rtol"] {
+        assert!(message.contains(part), "{part}: {message}");
+    }
 }

@@ -48,6 +48,44 @@ fn stepped_contact_writes_the_csv_and_a_png_plot_of_it() {
     );
 }
 
+/// The pixels of the force panel (the left half) drawn in the force curve's colour.
+fn force_curve_pixels(png_path: &std::path::Path) -> usize {
+    let bytes = std::fs::read(png_path).unwrap();
+    let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes))
+        .read_info()
+        .unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let frame = reader.next_frame(&mut pixels).unwrap();
+    let samples = frame.color_type.samples();
+    use plotters::style::{Color, Palette, Palette99};
+    let colour = Palette99::pick(0).to_rgba();
+    let rgb = [colour.0, colour.1, colour.2];
+    let width = frame.width as usize;
+    (pixels[..frame.buffer_size()].chunks(samples).enumerate())
+        .filter(|(i, p)| i % width < width / 2 && p[..3] == rgb)
+        .count()
+}
+
+#[test]
+fn one_load_step_is_a_dot_not_a_line_from_the_origin() {
+    // A line from the origin to the only point would draw a linear law: one step is one dot,
+    // two steps a dot each and the segment between them.
+    let count = |case: CaseFile| {
+        let (dir, path) = case.write();
+        let output = run_solve_with(&path, &[]);
+        assert!(output.status.success());
+        force_curve_pixels(&dir.path().join("out/force_displacement.png"))
+    };
+    let one = count(common::half_disc_on_block("half_disc_on_block.msh"));
+    let two = count(stepped_half_disc());
+    // A filled dot of radius 4 covers about 50 pixels.
+    assert!(one > 20 && one < 120, "one step: {one} pixels");
+    assert!(
+        two > 2 * one + 50,
+        "two steps: {two} pixels against {one} for one"
+    );
+}
+
 #[test]
 fn without_a_font_the_run_succeeds_with_the_csv_and_a_warning() {
     let (dir, path) = stepped_half_disc().write();

@@ -251,10 +251,13 @@ def failed_report_names(contact: dict) -> list[str]:
 
 
 def vouched(contact: dict) -> bool:
-    """The solver vouches for its answer: converged (or no contact) and its accuracy report passed
-    (CLI exit code 0)."""
+    """The solver vouches for its answer: converged (or no contact) and its accuracy report passed,
+    and so did every earlier load step (CLI exit code 0)."""
     _, accuracy = solver_reports(contact)
-    return contact.get("status") in ("converged", "no-contact") and bool(accuracy and accuracy.get("passed") is True)
+    steps_trusted = all(step.get("status") in ("converged", "no-contact") and step.get("accurate") is True
+                        for step in contact.get("steps", []))
+    return (contact.get("status") in ("converged", "no-contact")
+            and bool(accuracy and accuracy.get("passed") is True) and steps_trusted)
 
 
 def report_rows(case: str, contact: dict, accuracy_required: tuple[str, ...] = ACCURACY_INDICATORS) -> list[Check]:

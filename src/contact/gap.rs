@@ -13,7 +13,10 @@
 //! ([`geometric_gaps`]); where the node has slid past the end of the
 //! secondary surface (the corner of a block pressed onto a block as wide), it is the distance
 //! to the end facet's plane, so a node at the corner is held level with the face it left
-//! rather than pulled sideways onto the corner point.
+//! rather than pulled sideways onto the corner point. A node that lies beside the secondary
+//! surface's rim in the reference configuration already (a block's node beside a punch) is
+//! measured by its distance to the rim instead, and linearized along that distance's
+//! gradient ([`geometric_gaps`]).
 //!
 //! **Its linearization.** With the facet and `b` fixed, `g` is linear in the positions along
 //! `m`, and the rotation of `m` does not change it to first order (`dm . m = 0` and
@@ -71,7 +74,7 @@ pub const BEYOND_RIM: f64 = 1e-3;
 ///   that body's closed boundary, [`super::boundary`]). Such a node faces no facet: the plane
 ///   of the rim's facet extends the surface where there is no surface, and a node of a block
 ///   bulging up beside a punch would read as penetrating the punch it does not touch
-///   (`docs/method.md` 3.2). The reference configuration decides too because whether a node
+///   (`docs/method.md` 3.1). The reference configuration decides too because whether a node
 ///   faces a surface is a property of the two meshes: two blocks meant to end flush end a hair
 ///   apart once deformed, and a node whose side flips with that hair makes the loop cycle;
 /// - otherwise, within [`NEAR_SURFACE`] of the facet, `g = m . (x - q)`, the distance to the

@@ -118,7 +118,10 @@ pub enum KrylovFailure {
 impl fmt::Display for KrylovFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
-            Self::IterationLimit => "iteration limit reached",
+            Self::IterationLimit => {
+                "iteration limit reached: [contact] krylov_max_iterations; raise it, or let \
+                 solver = \"auto\" move to the dense Schur complement"
+            }
             Self::Stagnated => "stagnated: a restart cycle did not reduce the true residual",
             Self::NotFinite => "a non-finite value appeared",
         })

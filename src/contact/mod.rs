@@ -97,8 +97,16 @@ pub enum ContactError {
     EmptyInterfaceMass,
     #[error("{0}")]
     Linalg(String),
-    #[error("the coupled solve is inaccurate (relative residual {residual:.2e} > {tolerance:.0e})")]
-    Inaccurate { residual: f64, tolerance: f64 },
+    #[error(
+        "the coupled solve is inaccurate: relative residual {residual:.2e} > [solver] \
+         residual_tolerance {tolerance:.0e}{advice}"
+    )]
+    Inaccurate {
+        residual: f64,
+        tolerance: f64,
+        /// What bounds the residual when it is not round-off: the bodies' CG tolerance.
+        advice: String,
+    },
     #[error(transparent)]
     Krylov(#[from] interface_krylov::KrylovError),
 }

@@ -532,9 +532,18 @@ impl ContactSolver<'_> {
             gap_tolerance.is_some() && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let residual = system.relative_residual(&self.body1, &self.body2, &x);
         if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
+            let advice = match self.body_solver {
+                BodySolverKind::CgAmg => format!(
+                    "; the bodies' CG + AMG solves stop at [solver] rtol = {:.0e}, which bounds \
+                     it: lower rtol (default 1e-10) or raise residual_tolerance",
+                    self.solver.rtol
+                ),
+                _ => String::new(),
+            };
             return Err(ContactError::Inaccurate {
                 residual,
                 tolerance: self.solver.residual_tolerance,
+                advice,
             });
         }
         Ok(system.solution(&x, coupling, dim, residual))

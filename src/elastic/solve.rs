@@ -82,8 +82,9 @@ pub enum SolveError {
     #[error("body '{body}': {source}")]
     Linalg { body: String, source: LinalgError },
     #[error(
-        "body '{body}': the linear solve is inaccurate (relative residual {residual:.2e} > {tolerance:.0e}); \
-         the mesh may be badly graded or the material nearly incompressible"
+        "body '{body}': the linear solve is inaccurate (relative residual {residual:.2e} > [solver] \
+         residual_tolerance {tolerance:.0e}); the mesh may be badly graded or the material nearly \
+         incompressible"
     )]
     Inaccurate {
         body: String,

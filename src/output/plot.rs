@@ -41,8 +41,8 @@ pub enum PlotError {
 /// Width and height of the picture in pixels: two panels side by side.
 pub const PLOT_SIZE: (u32, u32) = (1200, 540);
 
-/// Draws `steps` into the PNG file `path`, two panels against the imposed approach, each from
-/// the origin: the magnitude of the contact force on the primary body, and the contact radius
+/// Draws `steps` into the PNG file `path`, two panels against the imposed approach, axes from
+/// 0, a dot per step and a line between successive steps (none from the origin): the magnitude of the contact force on the primary body, and the contact radius
 /// (half-width in 2D) of each step's Hertz fit. `approach` is the imposed approach at load
 /// factor 1 (the largest difference between the two bodies' prescribed displacements); where
 /// no displacement is imposed (0: the bodies are loaded by forces) the x axis is the load
@@ -64,21 +64,12 @@ pub fn write_force_displacement_png(
         (1.0, "load factor (no displacement imposed)".to_string())
     };
     let norm = |f: &[f64]| f.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let origin = std::iter::once((0.0, 0.0));
-    let force: Vec<(f64, f64)> = origin
-        .clone()
-        .chain(
-            steps
-                .iter()
-                .map(|s| (scale * s.load_factor, norm(&s.force_primary))),
-        )
+    // Only solved points: a line from the origin to a single step would read as a linear law.
+    let force: Vec<(f64, f64)> = (steps.iter())
+        .map(|s| (scale * s.load_factor, norm(&s.force_primary)))
         .collect();
-    let radius: Vec<(f64, f64)> = origin
-        .chain(
-            steps
-                .iter()
-                .filter_map(|s| s.hertz_a.map(|a| (scale * s.load_factor, a))),
-        )
+    let radius: Vec<(f64, f64)> = (steps.iter())
+        .filter_map(|s| s.hertz_a.map(|a| (scale * s.load_factor, a)))
         .collect();
 
     let root = BitMapBackend::new(path, PLOT_SIZE).into_drawing_area();
@@ -102,7 +93,8 @@ pub fn write_force_displacement_png(
     root.present().map_err(|e| draw_error(&e))
 }
 
-/// One panel: `points` as a line with a dot at each, on axes described by `desc` (x, y), in
+/// One panel: `points` as a line with a dot at each (one point: the dot alone), on axes from 0
+/// described by `desc` (x, y), in
 /// colour number `colour` of plotters' palette.
 fn draw_panel(
     path: &Path,

@@ -150,9 +150,54 @@ impl CaseSummary {
                 "the contact problem was solved, but its accuracy report failed: {}",
                 failures(&contact.accuracy.indicators)
             )),
-            _ => Verdict::Solved,
+            Some(contact) => earlier_steps_verdict(&contact.steps),
+            None => Verdict::Solved,
         }
     }
+}
+
+/// The verdict of the load steps before the last, whose answer was trusted: every step is an
+/// answer a user reads (the force-displacement curve), so the run is only as good as its worst
+/// step. A step that was not solved makes the run not solved, one whose accuracy report failed
+/// makes it inaccurate; the message names the steps.
+fn earlier_steps_verdict(steps: &[StepRecord]) -> Verdict {
+    let describe = |step: &StepRecord| {
+        let failed: Vec<&str> = step.failed_checks.iter().map(|c| c.name()).collect();
+        format!(
+            "step {} (load factor {}): {}{}",
+            step.step,
+            step.load_factor,
+            step.status.name(),
+            if failed.is_empty() {
+                String::new()
+            } else {
+                format!(", failed: {}", failed.join(", "))
+            }
+        )
+    };
+    let list = |steps: Vec<&StepRecord>| -> String {
+        steps
+            .into_iter()
+            .map(describe)
+            .collect::<Vec<_>>()
+            .join("; ")
+    };
+    let unsolved: Vec<&StepRecord> = steps.iter().filter(|s| !s.status.is_solution()).collect();
+    if !unsolved.is_empty() {
+        return Verdict::NotSolved(format!(
+            "the last load step was solved, but an earlier one was not: {}",
+            list(unsolved)
+        ));
+    }
+    let inaccurate: Vec<&StepRecord> = steps.iter().filter(|s| !s.accurate).collect();
+    if !inaccurate.is_empty() {
+        return Verdict::Inaccurate(format!(
+            "the last load step was solved and accurate, but the accuracy report of an earlier \
+             one failed: {}",
+            list(inaccurate)
+        ));
+    }
+    Verdict::Solved
 }
 
 /// The failed checks among `checks`, in one line.
