@@ -232,7 +232,8 @@ class EdgeCase:
                 f"d = {self.delta:g} ({self.approach:.1%} of {f.length:g})")
 
 
-QUICK = {("square-sharp", 1.4, 0.005), ("square-corner-2d", 1.4, 0.02)}
+QUICK = {("square-sharp", 1.4, 0.005), ("square-fillet", 1.4, 0.02), ("cube-edge", 1.4, 0.02),
+         ("square-corner-2d", 1.4, 0.02)}
 CASES = tuple(EdgeCase(f.name, r, d, (f.name, r, d) in QUICK)
               for f in FAMILIES.values() for r in RATIOS for d in f.approaches)
 
