@@ -248,9 +248,12 @@ def verify(folder: Path) -> dict:
     # square punch on a half-space: P = 2 beta E* sqrt(A / pi) delta, beta = 1.012 (square).
     estar = E / (1 - nu**2)
     half_space = 2 * 1.012 * estar * math.sqrt((2 * w) ** 2 / math.pi) * delta
-    for label, extra in (("block 2 x 2 x 1", {}), ("block 8 x 8 x 4", {"W": 4.0, "H": 4.0, "h_far": 0.6})):
+    for label, extra, spacings in (
+            ("block 2 x 2 x 1", {}, (0.05, 0.035, 0.025)),
+            ("block 8 x 8 x 4", {"W": 4.0, "H": 4.0, "h_far": 0.5, "d_c": 0.45}, (0.07, 0.05, 0.035)),
+            ("block 16 x 16 x 8", {"W": 8.0, "H": 8.0, "h_far": 0.5, "d_c": 0.45}, (0.05,))):
         forces = {}
-        for h in (0.05, 0.035, 0.025):
+        for h in spacings:
             m = msh("square_punch_3d", 3, {"h_b": h, "h_p": 0.07, "rho": 0.0, **extra})
             forces[h] = prescribed_footprint(m, delta, E, nu, w, sx, sy)["force"]
         results[f"sharp punch refined, {label}"] = {"forces": forces, "half_space_estimate": half_space}
