@@ -47,9 +47,8 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_reference import (GAP_TOLERANCE, KKT_TOLERANCE, RigidFlatContact, obstacle_below,  # noqa: E402
-                               read_body, turned_mesh)
-from dolfinx_reference import ReferenceFailure, solve_constrained  # noqa: E402,F401
+from contact_reference import GAP_TOLERANCE, RigidFlatContact, obstacle_below, read_body, turned_mesh  # noqa: E402
+from dolfinx_reference import solve_constrained  # noqa: E402
 
 
 def _turned_back(x: np.ndarray) -> np.ndarray:

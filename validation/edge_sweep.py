@@ -21,7 +21,7 @@ stiff one (E ratio 1e3), nu = 0.3:
   2% of H_p. Reference: the block under the rigid sharp punch (``edge_reference.punch_solve``, the
   punch's P1 face): every block node under the footprint touches, the others are free.
 * ``square-fillet``: the same punch with its lower and vertical edges filleted, radius 0.1 (two
-  block spacings; the fillets meshed at 0.025), d = 0.5% and 2% of H_p. Reference: the block under
+  block spacings; the fillets meshed at rho / 16 = 0.00625), d = 0.5% and 2% of H_p. Reference: the block under
   the exact filleted punch (the analytic surface, checked against the punch's mesh nodes), the
   contact edge the VI's.
 * ``cube-edge``: ``geo/tilted_cube_3d.geo``, an elastic cube of side a = 0.4 turned by 20 degrees
@@ -34,8 +34,9 @@ stiff one (E ratio 1e3), nu = 0.3:
   degrees (its lowest corner at x = 0.0013, the sides there sloping by 30 and 60 degrees) on a stiff
   block [-0.6, 0.6] x [-0.5, 0]; the square's two upper sides pushed down by d = 1%, 2%, 4% of a;
   h_square = 0.001 within 0.05 of the corner (at 0.002 and d = 0.5% and 1% the zone was under 1.5
-  spacings across and every run ended named, auto too: outside the supported range). Reference: the square on a rigid plane. The stiff
-  block (1e3) stands for the plane; a two-body reference with equal materials was not built.
+  spacings across and every run ended named, auto too: outside the supported range). Reference:
+  the square on a rigid plane. The stiff block (1e3) stands for the plane; a two-body reference
+  with equal materials was not built.
 
 Each run is classified (``classify``) from its exit status and its answer:
 
@@ -57,10 +58,13 @@ converged, its KKT conditions hold) and a premise: ``premise: whole footprint`` 
 node under the footprint in contact in the reference, none outside), ``premise: fillet surface``
 (the punch's contact nodes on the analytic fillet within 1e-6 rho) and ``premise: P1 fillet`` (the
 block under the punch's own P1 face within 0.3% of the block under the exact fillet: the faceting
-of the punch, which no solver can undo, takes at most 0.3% of the force tolerance; with the fillets
-meshed at rho / 4 it took 2.9% at d = 0.5%, hence rho / 16). The plane references' contact zone
-width is in the ``reference`` row's note (at 1% of a the cube's zone is one row of nodes along the
-edge: an edge contact, kept).
+of the punch, which no solver can undo, takes at most 0.3% of the force, under a third of its
+tolerance; with the fillets meshed at rho / 4 it took 2.9% at d = 0.5%, hence rho / 16). The plane
+references' contact zone width is in the ``reference`` row's note (at 1% of a the cube's zone is
+one row of nodes along the edge: an edge contact, kept).
+
+The quick subset (``QUICK``, ``run.py --quick``): the four families at r = 1.4, one approach each
+(the sharp punch at 0.5%, the case that showed the defect).
 
 Usage:  /usr/bin/python3 validation/edge_sweep.py [--quick] [--binary PATH] [--cases NAME ...] [--out DIR]
 
@@ -534,8 +538,8 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
         checks += case_checks_
         records[case.name] = record
         failed = [f"{c.check} {c.case}" for c in case_checks_ if not c.passed]
-        print(f"    {record['wall_seconds']:.1f} s; {'all checks pass' if not failed else 'FAILED: ' + '; '.join(failed)}",
-              flush=True)
+        verdict = "all checks pass" if not failed else "FAILED: " + "; ".join(failed)
+        print(f"    {record['wall_seconds']:.1f} s; {verdict}", flush=True)
     seconds = time.perf_counter() - start
     tally = counts(records)
     text = report_text(cases, checks, records, quick, seconds, tally)
@@ -588,7 +592,8 @@ def report_text(cases: list[EdgeCase], checks: list[Check], records: dict, quick
                          f"{' (' + ', '.join(r['failed']) + ')' if r.get('failed') else ''} | {fe} | {zone} "
                          f"| {'**' + r['class'] + '**' if r['class'] in ('WRONG', 'ERROR') else r['class']} "
                          f"| {r['seconds']:.1f} |")
-    lines += ["", "**Checks**", "", "| check | case | figure | tolerance | result | note |", "|---|---|---|---|---|---|"]
+    lines += ["", "**Checks**", "", "| check | case | figure | tolerance | result | note |",
+              "|---|---|---|---|---|---|"]
     lines += [f"| {c.check} | {c.case} | {'n/a' if math.isnan(c.figure) else f'{c.figure:.3g}'} | {c.tolerance:.3g} "
               f"| {'PASS' if c.passed else '**FAIL**'} | {c.note} |" for c in checks]
     lines += ["", DECISIONS]
