@@ -36,8 +36,12 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
-    /// Solve a case whose mesh is a .geo on a sequence of meshes and estimate the discretization
-    /// error of its contact quantities (observed order, Richardson extrapolation, GCI).
+    /// Refinement study: solve a .geo case on a sequence of meshes and estimate its error (GCI).
+    ///
+    /// One solve per value of a gmsh parameter of the case's .geo, each into its own folder; for
+    /// the contact force, contact radius and peak pressure the observed order, the Richardson
+    /// extrapolation and the grid convergence index (Celik et al. 2008), with flags for a
+    /// sequence not in its asymptotic range. See docs/study.md.
     Study {
         /// The case file (its `mesh` a .geo script).
         case: PathBuf,

@@ -181,7 +181,7 @@ pub fn run_study(
         message,
     };
     spec.check()
-        .map_err(|m| invalid(format!("--parameter: {m}")))?;
+        .map_err(|m| invalid(format!("study parameter: {m}")))?;
     if case.contact.is_none() {
         return Err(invalid(
             "a refinement study measures contact quantities, and the case has no [contact] table"
@@ -195,8 +195,8 @@ pub fn run_study(
         .or_else(|| case.output.as_ref().map(|o| o.join("study")))
         .ok_or_else(|| {
             invalid(
-                "no output folder: give the `output` key in the case file or the --output flag \
-                 of `internodes study`"
+                "no output folder: give the `output` key in the case file, or the --output flag \
+                 of `internodes study` (output= in Python)"
                     .to_string(),
             )
         })?;
