@@ -108,6 +108,11 @@ fn two_levels_give_the_difference_and_say_there_is_no_order() {
         "{force}"
     );
     assert_eq!(force["flags"], serde_json::json!(["two-levels"]));
+    let md = std::fs::read_to_string(out.join("study.md")).unwrap();
+    assert!(
+        md.contains("Two levels only") && md.contains("no order"),
+        "{md}"
+    );
 }
 
 #[test]

@@ -94,22 +94,29 @@ pub fn markdown(study: &Study) -> String {
         ));
     }
     lines.push(String::new());
-    lines.push(format!(
-        "Estimates from the three finest levels (Celik et al. 2008; GCI_fine with Fs = \
-         {SAFETY_FACTOR}, relative to phi1; band: phi1 +- GCI_fine |phi1|; ratio: GCI_32 / \
-         (r21^p GCI_fine), 1 in the asymptotic range):"
-    ));
+    lines.push(if study.levels.len() < 3 {
+        "Two levels only: their difference (e_a21 = |phi1 - phi2| / |phi1|); an observed order, \
+         an extrapolation and a GCI need three levels."
+            .to_string()
+    } else {
+        format!(
+            "Estimates from the three finest levels (Celik et al. 2008; GCI_fine with Fs = \
+             {SAFETY_FACTOR}, relative to phi1; band: phi1 +- GCI_fine |phi1|; ratio: GCI_32 / \
+             (r21^p GCI_fine), 1 in the asymptotic range):"
+        )
+    });
     lines.push(String::new());
     lines.push(
-        "| quantity | phi1 (finest) | phi1 - phi2 | p | extrapolated | GCI_fine | band | ratio | flags |"
+        "| quantity | phi1 (finest) | phi1 - phi2 | e_a21 | p | extrapolated | GCI_fine | band | ratio \
+         | flags |"
             .to_string(),
     );
-    lines.push("|---|---|---|---|---|---|---|---|---|".to_string());
+    lines.push("|---|---|---|---|---|---|---|---|---|---|".to_string());
     for q in &study.estimates {
         lines.push(match (&q.estimate, &q.error) {
             (Some(e), _) => estimate_row(&q.name, e),
             (None, error) => format!(
-                "| {} | - | - | - | - | - | - | - | {} |",
+                "| {} | - | - | - | - | - | - | - | - | {} |",
                 q.name,
                 error.as_deref().unwrap_or("")
             ),
@@ -133,9 +140,10 @@ fn estimate_row(name: &str, e: &Estimate) -> String {
     });
     let flags: Vec<&str> = e.flags.iter().map(|f: &Flag| f.describe()).collect();
     format!(
-        "| {name} | {} | {} | {} | {} | {} | {band} | {} | {} |",
+        "| {name} | {} | {} | {} | {} | {} | {} | {band} | {} | {} |",
         significant(e.phi[0]),
         significant(e.difference),
+        percent(Some(e.relative_difference)),
         e.order.map_or("-".to_string(), |p| format!("{p:.2}")),
         optional(e.extrapolated),
         percent(e.gci_fine),
