@@ -309,3 +309,28 @@ fn finish(
         folder,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parameters_parse_and_name_their_folders() {
+        let spec: StudySpec = "h_c = 0.03, 0.015,0.0075".parse().unwrap();
+        assert_eq!(spec.parameter, "h_c");
+        assert_eq!(spec.values, vec![0.03, 0.015, 0.0075]);
+        assert_eq!(spec.folder_name(0.015), "h_c_0.015");
+        let level: StudySpec = "level=-1,0".parse().unwrap();
+        assert_eq!(level.folder_name(-1.0), "level_-1");
+        for bad in [
+            "level",
+            "=0,1",
+            "level=0",
+            "level=1,1",
+            "level=0,inf",
+            "level=0,a",
+        ] {
+            assert!(bad.parse::<StudySpec>().is_err(), "{bad}");
+        }
+    }
+}
