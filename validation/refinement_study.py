@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Refinement study suite: ``internodes study`` on four geo/ contact cases, three levels each, and
+"""Refinement study suite: ``internodes study`` on six geo/ contact cases, three levels each, and
 its extrapolated contact radius and peak pressure against Hertz where Hertz applies.
 
 Cases (E = 1000, nu = 0.3 unless said; the upper body's support pushed down by delta and held
@@ -13,6 +13,8 @@ laterally, the lower body's base clamped; one load step; the curved body primary
   size of the block is the one change, to tell its effect from the discretization's;
 * ``half_disc_in_groove`` (2D, a disc R = 1 in a concave groove R_g = 3: Hertz with the effective
   radius 1/R = 1/1 - 1/3, R = 1.5; delta = 0.02): level = 0, 1, 2;
+* ``half_disc_in_big_groove``: a groove in a block W = H = 8 R; the groove must be wider than
+  the block (R_g > W), so R_g = 9 (R_eff = 1.125): a larger block, but also another groove;
 * ``punch_2d`` (a flat punch of half-width 0.25, E = 1e6, on the block, delta = 0.01; sharp
   corners): level = 0, 1, 2. No Hertz: the pressure is singular at the corners, so the peak
   pressure has no limit and the "Hertz fit" of a flat pressure is no contact radius.
@@ -42,7 +44,7 @@ Usage:  /usr/bin/python3 validation/refinement_study.py [--binary PATH] [--out D
 
 Case files and the per-level solutions go to validation/build/refinement_study/; each case's
 study.{json,csv,md,png} is copied to --out (default validation/report/refinement_study/<case>/).
-A full run takes about 40 s on 2 shared cores, most of it the finest hemisphere level.
+A full run takes 30 to 45 s on 2 shared cores, most of it the finest hemisphere level.
 """
 
 from __future__ import annotations
@@ -124,6 +126,10 @@ CASES = (
     StudyCase("half_disc_in_groove", 2, ("disc", "block"), ("disc_contact", "block_contact"),
               ("disc_top", "block_base"), "disc", 0.02, "level", (0, 1, 2), FAR_2D, 1.5,
               what="2D Hertz in a concave groove (R_eff = 1.5), every size halving"),
+    StudyCase("half_disc_in_big_groove", 2, ("disc", "block"), ("disc_contact", "block_contact"),
+              ("disc_top", "block_base"), "disc", 0.02, "level", (0, 1, 2),
+              {**FAR_2D, "W": 8.0, "H": 8.0, "R_g": 9.0}, 1.125, script="half_disc_in_groove",
+              what="2D Hertz in a wider groove (R_g = 9, R_eff = 1.125) of a block W = H = 8 R"),
     StudyCase("punch_2d", 2, ("punch", "block"), ("punch_contact", "block_contact"),
               ("punch_top", "block_base"), "auto", 0.01, "level", (0, 1, 2), {}, None, upper_modulus=1.0e6,
               what="2D flat punch with sharp corners, 1000 times stiffer than the block"),
