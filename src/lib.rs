@@ -27,7 +27,8 @@
 //!   coupled system and its solvers, the active-set loop;
 //! - [`case`]: the TOML case file;
 //! - [`output`]: XDMF/HDF5, JSON summary, Matrix Market;
-//! - [`run`]: `internodes solve CASE`, from the case file to the result files.
+//! - [`run`]: `internodes solve CASE`, from the case file to the result files;
+//! - [`study`]: `internodes study CASE`, a mesh refinement study with the grid convergence index.
 
 pub mod case;
 pub mod contact;
@@ -37,3 +38,4 @@ pub mod linalg;
 pub mod mesh;
 pub mod output;
 pub mod run;
+pub mod study;

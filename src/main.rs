@@ -1,14 +1,17 @@
-//! The `internodes` command line: `solve CASE` and `info MESH`.
+//! The `internodes` command line: `solve CASE`, `study CASE --parameter NAME=V1,V2,...` and
+//! `info MESH`.
 
 use std::error::Error;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use internodes::case::Case;
 use internodes::mesh::{MeshSummary, read_msh};
 use internodes::output::{Verdict, unsaid_causes};
 use internodes::run::{RunOptions, solve_case};
+use internodes::study::{StudyOptions, StudySpec, files::markdown, run_study};
 
 #[derive(Parser)]
 #[command(version, about = "Elastic bodies in contact, solved with INTERNODES")]
@@ -29,6 +32,26 @@ enum Command {
         /// Also write the assembled stiffness and surface mass matrices (Matrix Market).
         #[arg(long)]
         export_matrices: bool,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Refinement study: solve a .geo case on a sequence of meshes and estimate its error (GCI).
+    ///
+    /// One solve per value of a gmsh parameter of the case's .geo, each into its own folder; for
+    /// the contact force, contact radius and peak pressure the observed order, the Richardson
+    /// extrapolation and the grid convergence index (Celik et al. 2008), with flags for a
+    /// sequence not in its asymptotic range. See docs/study.md.
+    Study {
+        /// The case file (its `mesh` a .geo script).
+        case: PathBuf,
+        /// The gmsh parameter of the .geo and its values, one mesh each: NAME=V1,V2,...
+        /// (e.g. level=0,1,2).
+        #[arg(long, short)]
+        parameter: StudySpec,
+        /// The study's folder (default: the case's `output` folder followed by /study).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
@@ -54,7 +77,10 @@ fn main() -> ExitCode {
     // reference solver) take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
     let cli = Cli::parse();
-    let quiet = matches!(cli.command, Command::Solve { quiet: true, .. });
+    let quiet = matches!(
+        cli.command,
+        Command::Solve { quiet: true, .. } | Command::Study { quiet: true, .. }
+    );
     StderrLogger::install(if quiet {
         log::LevelFilter::Warn
     } else {
@@ -87,6 +113,12 @@ fn main() -> ExitCode {
             }
             verdict.exit_status()
         }),
+        Command::Study {
+            case,
+            parameter,
+            output,
+            quiet,
+        } => study(&case, &parameter, &StudyOptions { output, quiet }),
         Command::Info { mesh } => read_msh(&mesh)
             .map_err(Into::into)
             .and_then(|m| print_stdout(&MeshSummary(&m).to_string()))
@@ -102,6 +134,24 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `internodes study`: runs the study, prints its tables on stdout (unless quiet) and returns its
+/// exit status, the worst level's.
+fn study(case: &Path, spec: &StudySpec, options: &StudyOptions) -> Result<u8, Box<dyn Error>> {
+    let case = Case::load(case)?;
+    let study = run_study(&case, spec, options)?;
+    if !options.quiet {
+        print_stdout(&markdown(&study))?;
+    }
+    let folder = study.folder.display();
+    for level in study.levels.iter().filter(|l| l.exit_status != 0) {
+        eprintln!(
+            "error: {} = {}: {} (exit status {}; see {folder}/{}/summary.json)",
+            spec.parameter, level.value, level.status, level.exit_status, level.folder
+        );
+    }
+    Ok(study.exit_status)
 }
 
 /// Prints the library's progress messages on stderr as they are, and its warnings prefixed

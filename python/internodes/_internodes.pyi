@@ -2,7 +2,7 @@
 
 from os import PathLike
 from pathlib import Path
-from typing import Any, Mapping, Optional, Union, final
+from typing import Any, Mapping, Optional, Sequence, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -15,9 +15,11 @@ __all__ = [
     "NotSolvedError",
     "Result",
     "SolveError",
+    "Study",
     "SurfaceResult",
     "WriteError",
     "solve",
+    "study",
 ]
 
 _StrPath = Union[str, PathLike[str]]
@@ -161,3 +163,42 @@ def solve(case: Case, mesh: Optional[Mesh] = None) -> Result:
 
     Raises InputError for a case or mesh that cannot be used and SolveError when a solve fails;
     a contact problem not solved (or inaccurate) is a Result with that status."""
+
+@final
+class Study:
+    """A finished mesh refinement study (see docs/study.md)."""
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        """What study.json holds: levels, estimates with their flags, exit status."""
+    @property
+    def parameter(self) -> str:
+        """The gmsh parameter the study varied."""
+    @property
+    def values(self) -> npt.NDArray[np.float64]:
+        """(n,) the parameter's values, in the order given."""
+    @property
+    def h(self) -> npt.NDArray[np.float64]:
+        """(n,) each level's measured spacing."""
+    @property
+    def quantities(self) -> dict[str, npt.NDArray[np.float64]]:
+        """Each quantity's (n,) values by key (force, a, p0, max_pressure); NaN where none."""
+    @property
+    def estimates(self) -> dict[str, dict[str, Any]]:
+        """Each quantity's estimate by key, as in study.json."""
+    @property
+    def exit_code(self) -> int:
+        """The worst level's exit status: 0, 2 (a level not solved) or 3 (inaccurate)."""
+    @property
+    def folder(self) -> Path:
+        """The study's folder."""
+
+def study(
+    case: Case,
+    parameter: str,
+    values: Sequence[float],
+    output: Optional[_StrPath] = None,
+) -> Study:
+    """Solves `case` (its mesh a .geo) once per value of the gmsh parameter `parameter` and
+    estimates each contact quantity's discretization error (observed order, Richardson
+    extrapolation, GCI), writing the files of `internodes study` into `output`."""

@@ -27,6 +27,7 @@ use internodes::output::{
     CaseSummary, GENERATED_MESH, OutputError, ResultFolder, Verdict, unsaid_causes,
 };
 use internodes::run::{CaseSolution, RunError, Timings, solve_case_on, write_results};
+use internodes::study::{Study as StudyRun, StudyError, StudyOptions, StudySpec, run_study};
 
 create_exception!(
     internodes,
@@ -561,6 +562,164 @@ impl Result {
     }
 }
 
+/// A mesh refinement study: `case` (whose mesh is a `.geo`) solved once per value of the gmsh
+/// parameter `parameter`, each level written into `<output>/<parameter>_<value>/`, and the
+/// study's files (`study.json`, `.csv`, `.md`, `.png`) into `output` (default: the case's
+/// `output` folder followed by `/study`), as `internodes study` does. The solves run without
+/// the GIL.
+///
+/// Raises `InputError` for a case, parameter or values that cannot be used (a parameter the
+/// `.geo` does not use is refused with the ones it defines), `SolveError` when a level's solve
+/// fails and `WriteError` when a file cannot be written.
+#[pyfunction]
+#[pyo3(signature = (case, parameter, values, output = None))]
+fn study(
+    py: Python<'_>,
+    case: &Case,
+    parameter: String,
+    values: Vec<f64>,
+    output: Option<PathBuf>,
+) -> PyResult<Study> {
+    if !case.names_mesh {
+        return Err(InputError::new_err(format!(
+            "case '{}' names no mesh: a study needs the `mesh` key naming a .geo",
+            case.file.path.display()
+        )));
+    }
+    let spec = StudySpec { parameter, values };
+    let mut file = case.file.clone();
+    file.solver.progress_line = false;
+    let options = StudyOptions {
+        output,
+        quiet: false,
+    };
+    let study = py.detach(|| {
+        guarded("the study", || {
+            run_study(&file, &spec, &options).map_err(study_error)
+        })
+    })?;
+    Ok(Study { study })
+}
+
+/// The Python exception of a study's error.
+fn study_error(error: StudyError) -> PyErr {
+    match error {
+        StudyError::Level {
+            parameter,
+            value,
+            source,
+        } => {
+            let text = format!("study level {parameter} = {value}: {}", message(&*source));
+            match *source {
+                RunError::Case(_) => InputError::new_err(text),
+                RunError::Solve { .. } | RunError::Contact { .. } => SolveError::new_err(text),
+                RunError::Output(_) => WriteError::new_err(text),
+            }
+        }
+        StudyError::Io { .. } => WriteError::new_err(message(&error)),
+        StudyError::Case(_) | StudyError::Invalid { .. } => InputError::new_err(message(&error)),
+    }
+}
+
+/// A finished refinement study: `summary` is `study.json`'s contents; `values`, `h` and each
+/// quantity's column are NumPy arrays, one entry per level in the order given.
+#[pyclass(module = "internodes", frozen)]
+struct Study {
+    study: StudyRun,
+}
+
+#[pymethods]
+impl Study {
+    /// What `study.json` holds: the levels, the estimates with their flags, the exit status.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = serde_json::to_string(&self.study)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
+    /// The gmsh parameter the study varied.
+    #[getter]
+    fn parameter(&self) -> String {
+        self.study.parameter.clone()
+    }
+
+    /// `(n,)` the parameter's values.
+    #[getter]
+    fn values(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let values: Vec<f64> = self.study.levels.iter().map(|l| l.value).collect();
+        array(py, values.clone(), &[values.len()])
+    }
+
+    /// `(n,)` each level's measured spacing.
+    #[getter]
+    fn h(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let h: Vec<f64> = self.study.levels.iter().map(|l| l.spacing.h).collect();
+        array(py, h.clone(), &[h.len()])
+    }
+
+    /// Each quantity's `(n,)` values by key (`force`, `a`, `p0`, `max_pressure`); NaN where a
+    /// level has none.
+    #[getter]
+    fn quantities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let dict = PyDict::new(py);
+        for (k, q) in self.study.estimates.iter().enumerate() {
+            let column: Vec<f64> = (self.study.levels.iter())
+                .map(|l| l.quantities[k].1.unwrap_or(f64::NAN))
+                .collect();
+            dict.set_item(&q.key, array(py, column.clone(), &[column.len()])?)?;
+        }
+        Ok(dict)
+    }
+
+    /// Each quantity's estimate by key, as in `study.json` (`None` with an `error` when a level
+    /// has no value).
+    #[getter]
+    fn estimates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let summary = self.summary(py)?;
+        let dict = PyDict::new(py);
+        for item in summary.get_item("estimates")?.try_iter()? {
+            let item = item?;
+            dict.set_item(item.get_item("key")?, item)?;
+        }
+        Ok(dict.into_any())
+    }
+
+    /// The worst level's exit status: 0 all solved and accurate, 2 a level not solved, 3 a
+    /// level inaccurate.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.study.exit_status
+    }
+
+    /// The study's folder.
+    #[getter]
+    fn folder(&self) -> PathBuf {
+        self.study.folder.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        let values: Vec<f64> = self.study.levels.iter().map(|l| l.value).collect();
+        let orders: Vec<String> = (self.study.estimates.iter())
+            .map(|q| {
+                let p = q.estimate.as_ref().and_then(|e| e.order);
+                format!(
+                    "{}: p={}",
+                    q.key,
+                    p.map_or("-".to_string(), |p| format!("{p:.2}"))
+                )
+            })
+            .collect();
+        format!(
+            "Study('{}', parameter='{}', values={values:?}, exit_code={}, {})",
+            self.study.case,
+            self.study.parameter,
+            self.study.exit_status,
+            orders.join(", ")
+        )
+    }
+}
+
 /// One body's fields: node-wise arrays in the body's local numbering, cell-wise arrays in its
 /// cell order.
 #[pyclass(module = "internodes", frozen, get_all)]
@@ -678,7 +837,9 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Result>()?;
     m.add_class::<BodyResult>()?;
     m.add_class::<SurfaceResult>()?;
+    m.add_class::<Study>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(study, m)?)?;
     let py = m.py();
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("SolveError", py.get_type::<SolveError>())?;

@@ -230,6 +230,16 @@ impl Case {
         Ok(case)
     }
 
+    /// This case with the gmsh parameter `name` set to `value` (the refinement study's levels),
+    /// checked as the case file's `geo_parameters` are: a name the script does not use is
+    /// refused with the parameters it defines.
+    pub fn with_geo_parameter(&self, name: &str, value: f64) -> Result<Case, CaseError> {
+        let mut case = self.clone();
+        case.geo_parameters.insert(name.to_string(), value);
+        case.check_geo_parameters()?;
+        Ok(case)
+    }
+
     /// Whether the run meshes a `.geo` with gmsh (into `mesh.msh` in the output folder) rather
     /// than reading a `.msh`.
     pub fn generates_mesh(&self) -> bool {

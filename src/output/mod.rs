@@ -3,7 +3,7 @@
 
 mod folder;
 mod matrix_market;
-mod plot;
+pub(crate) mod plot;
 mod summary;
 mod xdmf;
 

@@ -20,7 +20,7 @@ use crate::contact::StepRecord;
 const DEFAULT_PLOT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
 /// The font family name the chart asks plotters for; [`register_font`] binds it to the file.
-const FAMILY: &str = "sans-serif";
+pub(crate) const FAMILY: &str = "sans-serif";
 
 #[derive(Debug, Error)]
 pub enum PlotError {
@@ -146,7 +146,7 @@ fn draw_error(path: &Path, e: &dyn std::fmt::Display) -> PlotError {
 
 /// Plain decimals for moderate magnitudes, scientific notation otherwise (forces range from
 /// micro-newtons to mega-newtons depending on the model's units).
-fn tick_label(v: f64) -> String {
+pub(crate) fn tick_label(v: f64) -> String {
     if v == 0.0 || (1e-2..1e4).contains(&v.abs()) {
         format!("{v:.3}")
     } else {
@@ -164,7 +164,7 @@ fn padded_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 
 /// Binds [`FAMILY`] to the font file, once per process: plotters keeps the font for the rest of
 /// the process and wants `'static` bytes, so the file's bytes are leaked (once, when valid).
-fn register_font() -> Result<(), PlotError> {
+pub(crate) fn register_font() -> Result<(), PlotError> {
     static REGISTERED: Mutex<bool> = Mutex::new(false);
     let mut registered = REGISTERED.lock().unwrap_or_else(PoisonError::into_inner);
     if *registered {

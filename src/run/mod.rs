@@ -76,6 +76,26 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
             return Err(e.into());
         }
     };
+    solve_loaded_case(case, options, &origin, &command).map(|run| run.report)
+}
+
+/// A run's report with the mesh it solved on and the solution it wrote, for callers that
+/// measure them (the refinement study, `internodes study`).
+pub struct SolvedRun {
+    pub report: RunReport,
+    pub mesh: Mesh,
+    pub solution: CaseSolution,
+}
+
+/// [`solve_case`] of a case already loaded (and perhaps changed, as the refinement study sets a
+/// gmsh parameter): `origin` says where the output folder was set and `command` what ran, for
+/// the messages of a failed run.
+pub fn solve_loaded_case(
+    case: Case,
+    options: &RunOptions,
+    origin: &str,
+    command: &str,
+) -> Result<SolvedRun, RunError> {
     let Some(output) = options.output.as_ref().or(case.output.as_ref()) else {
         return Err(CaseError::Invalid {
             path: case.path.clone(),
@@ -88,32 +108,37 @@ pub fn solve_case(case_path: &Path, options: &RunOptions) -> Result<RunReport, R
     };
     let results = ResultFolder::create(
         output,
-        &origin,
+        origin,
         &[&case.path, &case.mesh],
         case.generates_mesh(),
     )?;
-    let outcome = solve_into(case, options, &results).and_then(|summary| {
+    let outcome = solve_into(case, options, &results).and_then(|run| {
         results.commit()?;
-        Ok(summary)
+        Ok(run)
     });
     match outcome {
-        Ok(summary) => Ok(RunReport {
-            output_dir: results.dir().to_owned(),
-            summary,
+        Ok((summary, mesh, solution)) => Ok(SolvedRun {
+            report: RunReport {
+                output_dir: results.dir().to_owned(),
+                summary,
+            },
+            mesh,
+            solution,
         }),
         Err(e) => {
-            results.fail(&command, &e);
+            results.fail(command, &e);
             Err(e)
         }
     }
 }
 
-/// The run itself: every result file is written into the staging folder of `results`.
+/// The run itself: every result file is written into the staging folder of `results`; returns
+/// the summary, the mesh and the solution.
 fn solve_into(
     mut case: Case,
     options: &RunOptions,
     results: &ResultFolder,
-) -> Result<CaseSummary, RunError> {
+) -> Result<(CaseSummary, Mesh, CaseSolution), RunError> {
     let mut timings = Timings::start();
     case.export_matrices |= options.export_matrices;
     // The live progress line of long interface solves, on a terminal.
@@ -150,7 +175,7 @@ fn solve_into(
         results.dir().display(),
         solution.timings.elapsed()
     );
-    Ok(summary)
+    Ok((summary, mesh, solution))
 }
 
 /// Meshes the case's `.geo` with its `geo_parameters` into the staging folder, moves the mesh to

@@ -1,0 +1,186 @@
+//! The study's files: `study.json` (everything), `study.csv` (one row per level), `study.md`
+//! (the two tables a publication reports) and `study.png` ([`super::plot`]).
+
+use std::path::Path;
+
+use super::gci::{Estimate, Flag, SAFETY_FACTOR};
+use super::{QUANTITIES, Study, StudyError};
+
+/// Writes the four files into the study's folder. The plot only pictures the tables: a plot
+/// that cannot be drawn (no font) is a warning.
+pub fn write_study_files(study: &Study) -> Result<(), StudyError> {
+    let dir = &study.folder;
+    let json = serde_json::to_string_pretty(study).expect("a study serializes");
+    write(&dir.join("study.json"), &(json + "\n"))?;
+    write(&dir.join("study.csv"), &csv(study))?;
+    write(&dir.join("study.md"), &markdown(study))?;
+    let png = dir.join("study.png");
+    if let Err(e) = super::plot::write_study_png(&png, study) {
+        log::warn!("{} not written: {e}", png.display());
+    }
+    Ok(())
+}
+
+fn write(path: &Path, text: &str) -> Result<(), StudyError> {
+    std::fs::write(path, text).map_err(|source| StudyError::Io {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// One row per level, in the order given: the parameter's value, the spacing, the sizes, the
+/// outcome and every quantity (empty where the level has none).
+pub fn csv(study: &Study) -> String {
+    let mut text = format!(
+        "{},h,facets,contact_zone,dofs,primary,status,exit_status,seconds",
+        study.parameter
+    );
+    for q in &QUANTITIES {
+        text += &format!(",{}", q.key);
+    }
+    text += "\n";
+    for l in &study.levels {
+        text += &format!(
+            "{},{:.10e},{},{},{},{},{},{},{:.3}",
+            l.value,
+            l.spacing.h,
+            l.spacing.facets,
+            l.spacing.contact_zone,
+            l.num_dofs,
+            l.primary,
+            l.status,
+            l.exit_status,
+            l.seconds
+        );
+        for (_, value) in &l.quantities {
+            text += &value.map_or(",".to_string(), |v| format!(",{v:.10e}"));
+        }
+        text += "\n";
+    }
+    text
+}
+
+/// The levels' table and the estimates' table, with what each column is.
+pub fn markdown(study: &Study) -> String {
+    let mut lines = vec![
+        format!("# Refinement study of {}", study.case),
+        String::new(),
+        format!(
+            "Parameter `{}`; h: {}. Total {:.1} s; exit status {}.",
+            study.parameter, study.spacing, study.seconds, study.exit_status
+        ),
+        String::new(),
+    ];
+    let header: Vec<&str> = QUANTITIES.iter().map(|q| q.name).collect();
+    lines.push(format!(
+        "| {} | h | DOFs | primary | status | {} | seconds |",
+        study.parameter,
+        header.join(" | ")
+    ));
+    lines.push(format!("|{}", "---|".repeat(6 + QUANTITIES.len())));
+    for l in &study.levels {
+        let values: Vec<String> = (l.quantities.iter())
+            .map(|(_, v)| v.map_or("-".to_string(), significant))
+            .collect();
+        lines.push(format!(
+            "| {} | {} | {} | {} | {} | {} | {:.1} |",
+            l.value,
+            significant(l.spacing.h),
+            l.num_dofs,
+            l.primary,
+            l.status,
+            values.join(" | "),
+            l.seconds
+        ));
+    }
+    lines.push(String::new());
+    lines.push(if study.levels.len() < 3 {
+        "Two levels only: their difference (e_a21 = |phi1 - phi2| / |phi1|); an observed order, \
+         an extrapolation and a GCI need three levels."
+            .to_string()
+    } else {
+        format!(
+            "Estimates from the three finest levels (Celik et al. 2008; GCI_fine with Fs = \
+             {SAFETY_FACTOR}, relative to phi1; band: phi1 +- GCI_fine |phi1|; ratio: GCI_32 / \
+             (r21^p GCI_fine), 1 in the asymptotic range):"
+        )
+    });
+    lines.push(String::new());
+    lines.push(
+        "| quantity | phi1 (finest) | phi1 - phi2 | e_a21 | p | extrapolated | GCI_fine | band | ratio \
+         | flags |"
+            .to_string(),
+    );
+    lines.push("|---|---|---|---|---|---|---|---|---|---|".to_string());
+    for q in &study.estimates {
+        lines.push(match (&q.estimate, &q.error) {
+            (Some(e), _) => estimate_row(&q.name, e),
+            (None, error) => format!(
+                "| {} | - | - | - | - | - | - | - | - | {} |",
+                q.name,
+                error.as_deref().unwrap_or("")
+            ),
+        });
+    }
+    lines.push(String::new());
+    lines.join("\n")
+}
+
+/// One row of the estimates' table.
+fn estimate_row(name: &str, e: &Estimate) -> String {
+    let optional = |v: Option<f64>| v.map_or("-".to_string(), significant);
+    let percent = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.3}%", 100.0 * v));
+    let band = e.gci_fine.map_or("-".to_string(), |g| {
+        let half = g * e.phi[0].abs();
+        format!(
+            "[{}, {}]",
+            significant(e.phi[0] - half),
+            significant(e.phi[0] + half)
+        )
+    });
+    let flags: Vec<&str> = e.flags.iter().map(|f: &Flag| f.describe()).collect();
+    format!(
+        "| {name} | {} | {} | {} | {} | {} | {} | {band} | {} | {} |",
+        significant(e.phi[0]),
+        significant(e.difference),
+        percent(Some(e.relative_difference)),
+        e.order.map_or("-".to_string(), |p| format!("{p:.2}")),
+        optional(e.extrapolated),
+        percent(e.gci_fine),
+        e.gci_ratio.map_or("-".to_string(), |r| format!("{r:.3}")),
+        if flags.is_empty() {
+            "none (asymptotic)".to_string()
+        } else {
+            flags.join("; ")
+        }
+    )
+}
+
+/// Five significant digits, scientific notation outside [1e-3, 1e5).
+fn significant(v: f64) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    if v == 0.0 {
+        return "0".to_string();
+    }
+    if (1e-3..1e5).contains(&v.abs()) {
+        let decimals = (4 - v.abs().log10().floor() as i32).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::significant;
+
+    #[test]
+    fn five_significant_digits() {
+        assert_eq!(significant(5.29312), "5.2931");
+        assert_eq!(significant(0.0123456), "0.012346");
+        assert_eq!(significant(123456.0), "1.2346e5");
+        assert_eq!(significant(-0.5), "-0.50000");
+    }
+}
