@@ -91,7 +91,7 @@ import edge_reference  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ReferenceFailure  # noqa: E402
 from flat_sweep import RunFailed  # noqa: E402
-from suite import (MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,  # noqa: E402
+from suite import (MeshFailed, SuiteResult, body_table, case_toml, contact_table, group_edges, json_safe, mesh_geo,  # noqa: E402
                    run_solve, solver_reports, vouched)
 from sweep import loaded, read_output, solved_primary, vertical_force  # noqa: E402
 
@@ -165,27 +165,10 @@ def near_feature(family: Family, x: np.ndarray) -> np.ndarray:
 
 def feature_spacing(msh: Path, group: str, family: Family) -> float:
     """Mean length of the edges of a boundary group with both ends ``near_feature``."""
-    import gmsh
-
-    gmsh.initialize(["gmsh", "-v", "0"])
     try:
-        gmsh.open(str(msh))
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        x = np.zeros((int(tags.max()) + 1, 3))
-        x[tags.astype(int)] = coords.reshape(-1, 3)
-        groups = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in gmsh.model.getPhysicalGroups(family.dim - 1)}
-        if group not in groups:
-            raise RunFailed(f"{msh}: no physical group '{group}'")
-        facets = []
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(*groups[group]):
-            _, _, nodes = gmsh.model.mesh.getElements(family.dim - 1, entity)
-            facets += [n.astype(int).reshape(-1, family.dim) for n in nodes]
-    finally:
-        gmsh.finalize()
-    facets = np.concatenate(facets)
-    dim = family.dim
-    edges = np.concatenate([facets[:, [i, (i + 1) % dim]] for i in range(dim if dim == 3 else 1)])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
+        x, edges = group_edges(msh, group, family.dim)
+    except ValueError as error:
+        raise RunFailed(str(error)) from error
     near = edges[near_feature(family, x)[edges].all(axis=1)]
     if len(near) == 0:
         return math.nan
@@ -366,23 +349,7 @@ def zone_width(ref: dict, dim: int) -> float:
 @functools.lru_cache(maxsize=16)
 def local_spacing(msh: Path, group: str, dim: int) -> dict:
     """gmsh node tag -> the longest edge of the boundary group ``group`` at that node."""
-    import gmsh
-
-    gmsh.initialize(["gmsh", "-v", "0"])
-    try:
-        gmsh.open(str(msh))
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        x = np.zeros((int(tags.max()) + 1, 3))
-        x[tags.astype(int)] = coords.reshape(-1, 3)
-        groups = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in gmsh.model.getPhysicalGroups(dim - 1)}
-        facets = []
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(*groups[group]):
-            _, _, nodes = gmsh.model.mesh.getElements(dim - 1, entity)
-            facets += [n.astype(int).reshape(-1, dim) for n in nodes]
-    finally:
-        gmsh.finalize()
-    facets = np.concatenate(facets)
-    edges = np.concatenate([facets[:, [i, (i + 1) % dim]] for i in range(dim if dim == 3 else 1)])
+    x, edges = group_edges(msh, group, dim)
     length = np.linalg.norm(x[edges[:, 0]] - x[edges[:, 1]], axis=1)
     longest = np.zeros(len(x))
     np.maximum.at(longest, edges[:, 0], length)

@@ -177,8 +177,10 @@ def contact_sides(table: dict) -> dict[str, str]:
     return dict(zip(table["bodies"], table["surfaces"]))
 
 
-def surface_spacing(msh: Path, group: str, dim: int, radius: float) -> float:
-    """Mean length of the edges of a surface group with both ends within ``radius`` of the contact axis."""
+def group_edges(msh: Path, group: str, dim: int):
+    """(node coordinates indexed by gmsh node tag, the distinct edges of the boundary group
+    ``group`` as pairs of node tags) of a ``dim``-dimensional mesh; ValueError when it has no such
+    group."""
     import gmsh
     import numpy as np
 
@@ -199,7 +201,14 @@ def surface_spacing(msh: Path, group: str, dim: int, radius: float) -> float:
         gmsh.finalize()
     facets = np.concatenate(facets)
     edges = np.concatenate([facets[:, [i, (i + 1) % dim]] for i in range(dim if dim == 3 else 1)])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    return x, np.unique(np.sort(edges, axis=1), axis=0)
+
+
+def surface_spacing(msh: Path, group: str, dim: int, radius: float) -> float:
+    """Mean length of the edges of a surface group with both ends within ``radius`` of the contact axis."""
+    import numpy as np
+
+    x, edges = group_edges(msh, group, dim)
     r = np.linalg.norm(x[:, : dim - 1], axis=1)
     near = edges[(r[edges] <= radius).all(axis=1)]
     if len(near) == 0:
