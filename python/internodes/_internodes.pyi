@@ -9,6 +9,8 @@ import numpy.typing as npt
 
 __all__ = [
     "BodyResult",
+    "Cancel",
+    "Cancelled",
     "Case",
     "InputError",
     "Mesh",
@@ -33,6 +35,22 @@ class NotSolvedError(RuntimeError):
 
 class WriteError(OSError):
     """The result files could not be written."""
+
+class Cancelled(Exception):
+    """Raised by solve() when its Cancel token was cancelled."""
+
+@final
+class Cancel:
+    """A token that cancels the solves given it (solve(case, cancel=token)) from another thread,
+    at their next load step, active-set iteration or interface GMRES iteration. A cancelled
+    token stays cancelled."""
+
+    def __init__(self) -> None: ...
+    def cancel(self) -> None:
+        """Stops every solve holding this token at its next safe point."""
+    @property
+    def cancelled(self) -> bool:
+        """Whether cancel() was called."""
 
 @final
 class Case:
@@ -156,8 +174,10 @@ class Result:
     def write(self, folder: _StrPath) -> Path:
         """Writes the command line's result files into `folder` and returns it."""
 
-def solve(case: Case, mesh: Optional[Mesh] = None) -> Result:
+def solve(case: Case, mesh: Optional[Mesh] = None, *, cancel: Optional[Cancel] = None) -> Result:
     """Solves `case` on `mesh` or on the mesh the case names, without holding the GIL.
 
     Raises InputError for a case or mesh that cannot be used and SolveError when a solve fails;
-    a contact problem not solved (or inaccurate) is a Result with that status."""
+    a contact problem not solved (or inaccurate) is a Result with that status. Ctrl-C stops the
+    solve within about a second with KeyboardInterrupt; `cancel` stops it from another thread
+    with Cancelled."""

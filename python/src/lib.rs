@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
@@ -46,6 +46,13 @@ create_exception!(
     PyRuntimeError,
     "Raised by Result.raise_for_status: the contact problem was not solved, or its accuracy \
      report failed."
+);
+create_exception!(
+    internodes,
+    Cancelled,
+    PyException,
+    "Raised by solve() when its Cancel token was cancelled (from another thread): the solve \
+     stopped at its next load step, active-set iteration or interface GMRES iteration."
 );
 create_exception!(
     internodes,
@@ -389,9 +396,18 @@ fn vector<T: numpy::Element + Copy>(array: Bound<'_, PyAny>) -> PyResult<Vec<T>>
 /// fails; a contact problem that was not solved, or whose accuracy report failed, is a result
 /// with that status (see `Result.exit_code` and `Result.raise_for_status`), as the command line
 /// writes its results and says so in its exit status.
+///
+/// Ctrl-C stops the solve within about a second (at its next safe point) with
+/// `KeyboardInterrupt`; `cancel`, a `Cancel` token, stops it from another thread with
+/// `Cancelled`.
 #[pyfunction]
-#[pyo3(signature = (case, mesh = None))]
-fn solve(py: Python<'_>, case: &Case, mesh: Option<PyRef<'_, Mesh>>) -> PyResult<Result> {
+#[pyo3(signature = (case, mesh = None, *, cancel = None))]
+fn solve(
+    py: Python<'_>,
+    case: &Case,
+    mesh: Option<PyRef<'_, Mesh>>,
+    cancel: Option<PyRef<'_, Cancel>>,
+) -> PyResult<Result> {
     let mesh = match mesh {
         Some(mesh) => mesh.clone(),
         None if !case.names_mesh => {
@@ -417,9 +433,13 @@ fn solve(py: Python<'_>, case: &Case, mesh: Option<PyRef<'_, Mesh>>) -> PyResult
     let mut file = case.file.clone();
     file.solver.verbose = true;
     file.solver.progress_line = false;
-    let solution = py.detach(|| {
+    file.solver.cancel = cancel.map(|c| c.token.clone()).unwrap_or_default();
+    let solution = interruptible(py, &file.solver.cancel, || {
         guarded("the solve", || {
-            solve_case_on(&file, &mesh.mesh, Timings::start()).map_err(run_error)
+            solve_case_on(&file, &mesh.mesh, Timings::start()).map_err(|e| match e.is_cancelled() {
+                true => Cancelled::new_err(message(&e)),
+                false => run_error(e),
+            })
         })
     })?;
     let summary = solution.summary(&file, &mesh.mesh);
@@ -430,6 +450,144 @@ fn solve(py: Python<'_>, case: &Case, mesh: Option<PyRef<'_, Mesh>>) -> PyResult
         summary,
         bodies: PyOnceLock::new(),
     })
+}
+
+/// A token that cancels the solves given it (`solve(case, cancel=token)`) from another thread:
+/// `token.cancel()` stops them at their next load step, active-set iteration or interface GMRES
+/// iteration, and they raise `Cancelled`. A cancelled token stays cancelled.
+#[pyclass(module = "internodes", frozen)]
+struct Cancel {
+    token: internodes::cancel::Cancel,
+}
+
+#[pymethods]
+impl Cancel {
+    #[new]
+    fn new() -> Self {
+        Cancel {
+            token: internodes::cancel::Cancel::new(),
+        }
+    }
+
+    /// Stops every solve holding this token at its next safe point.
+    fn cancel(&self) {
+        self.token.cancel();
+    }
+
+    /// Whether `cancel()` was called.
+    #[getter]
+    fn cancelled(&self) -> bool {
+        self.token.is_cancelled()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Cancel(cancelled={})", self.cancelled())
+    }
+}
+
+/// How often a waiting `solve` looks for Ctrl-C (Python's signal handlers).
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Runs `work` on a thread of its own, without the GIL, while this thread checks Python's
+/// signals every [`SIGNAL_POLL`]: a signal handler that raises (Ctrl-C's `KeyboardInterrupt`)
+/// cancels `token`, the work stops at its next safe point, and its exception is raised once the
+/// work has returned (nothing of it is left running). Signals are only handled on Python's
+/// main thread; a solve run from another thread is cancelled by its token.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    token: &internodes::cancel::Cancel,
+    work: impl FnOnce() -> PyResult<T> + Send,
+) -> PyResult<T> {
+    use std::sync::mpsc::{RecvTimeoutError, channel};
+    std::thread::scope(|scope| {
+        let (sender, receiver) = channel();
+        // A receiver is not `Sync`: it crosses into `detach` behind a lock.
+        let receiver = std::sync::Mutex::new(receiver);
+        let worker = scope.spawn(move || {
+            // `work` catches its own panics (`guarded`), so it always sends.
+            let _ = sender.send(work());
+        });
+        let mut interrupt: Option<PyErr> = None;
+        let outcome = loop {
+            let received = py.detach(|| {
+                let receiver = receiver.lock().unwrap_or_else(|e| e.into_inner());
+                receiver.recv_timeout(SIGNAL_POLL)
+            });
+            match received {
+                Ok(outcome) => break outcome,
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => {
+                    break Err(SolveError::new_err(
+                        "the solve's thread ended without an answer",
+                    ));
+                }
+            }
+            if interrupt.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                token.cancel();
+                interrupt = Some(e);
+            }
+        };
+        let _ = py.detach(|| worker.join());
+        match interrupt {
+            Some(e) => Err(e),
+            None => outcome,
+        }
+    })
+}
+
+/// The solver's `log` messages into Python's `logging`, to the logger named after their Rust
+/// module (`internodes.contact.driver`, ...), looked up at each message so that a logging
+/// configuration made after the import holds. A Python exception raised while logging never
+/// stays pending (which would make the next call into Python fail with `SystemError`): a
+/// `KeyboardInterrupt` is handed back to Python's signal machinery, to be raised where the
+/// interpreter next checks for signals (`solve` checks while it waits), and any other
+/// exception is reported as unraisable, as `logging` reports a handler's error.
+struct LogBridge;
+
+impl LogBridge {
+    fn forward(py: Python<'_>, record: &log::Record) -> PyResult<()> {
+        let level = match record.level() {
+            log::Level::Error => 40,
+            log::Level::Warn => 30,
+            log::Level::Info => 20,
+            log::Level::Debug => 10,
+            log::Level::Trace => 5,
+        };
+        let name = record.target().replace("::", ".");
+        let logger = (py.import("logging")?).call_method1("getLogger", (name,))?;
+        if logger.call_method1("isEnabledFor", (level,))?.is_truthy()? {
+            logger.call_method1("log", (level, "%s", record.args().to_string()))?;
+        }
+        Ok(())
+    }
+}
+
+impl log::Log for LogBridge {
+    fn enabled(&self, _: &log::Metadata) -> bool {
+        true
+    }
+
+    fn log(&self, record: &log::Record) {
+        Python::attach(|py| {
+            // An exception pending before this message is left as it was found.
+            let pending = PyErr::take(py);
+            if let Err(e) = Self::forward(py, record) {
+                if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                    // SAFETY: called with the GIL held; it only sets the interpreter's flag.
+                    unsafe { pyo3::ffi::PyErr_SetInterrupt() };
+                } else {
+                    e.write_unraisable(py, None);
+                }
+            }
+            if let Some(e) = pending {
+                e.restore(py);
+            }
+        })
+    }
+
+    fn flush(&self) {}
 }
 
 /// A solved case: the summary (`summary.json`'s contents), every body's fields as NumPy
@@ -669,20 +827,23 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // Results must not depend on the number of threads, as in the command line: faer's sparse
     // LUs take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
-    // The solver's messages go to the Python logger named after their Rust module
-    // (`internodes.contact.driver`, ...), read afresh at each message so that a logging
-    // configuration made after the import holds.
-    let _ = pyo3_log::Logger::new(m.py(), pyo3_log::Caching::Nothing)?.install();
+    // The solver's messages go to Python's logging ([`LogBridge`]); a second import of the
+    // module (a subinterpreter) keeps the first bridge.
+    if log::set_boxed_logger(Box::new(LogBridge)).is_ok() {
+        log::set_max_level(log::LevelFilter::Debug);
+    }
     m.add_class::<Case>()?;
     m.add_class::<Mesh>()?;
     m.add_class::<Result>()?;
     m.add_class::<BodyResult>()?;
     m.add_class::<SurfaceResult>()?;
+    m.add_class::<Cancel>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     let py = m.py();
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("SolveError", py.get_type::<SolveError>())?;
     m.add("NotSolvedError", py.get_type::<NotSolvedError>())?;
     m.add("WriteError", py.get_type::<WriteError>())?;
+    m.add("Cancelled", py.get_type::<Cancelled>())?;
     Ok(())
 }
