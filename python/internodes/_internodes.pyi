@@ -88,7 +88,8 @@ class Mesh:
         """Reads a gmsh MSH 4.1 file (ASCII or binary)."""
     @staticmethod
     def from_geo(path: _StrPath, parameters: Optional[Mapping[str, float]] = None) -> Mesh:
-        """Meshes a .geo script with the gmsh program (`parameters`: its -setnumber values)."""
+        """Meshes a .geo script with the gmsh program (`parameters`: its -setnumber values,
+        checked as a case's geo_parameters: a name the script does not use is refused)."""
     @staticmethod
     def from_gmsh(model: Optional[str] = None) -> Mesh:
         """The meshed current model of the gmsh Python module (or the model named `model`),

@@ -18,7 +18,7 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
 
-use internodes::case::{Case as CaseFile, CaseError};
+use internodes::case::{Case as CaseFile, CaseError, check_geo_parameters};
 use internodes::mesh::{
     GmshModel, Mesh as BodyMeshes, MeshError, ModelElements, ModelGroup, mesh_from_model, mesh_geo,
     read_msh, read_msh_bytes,
@@ -243,7 +243,8 @@ impl Mesh {
     }
 
     /// Meshes a `.geo` script with gmsh (the `gmsh` program), with `parameters` as gmsh's
-    /// `-setnumber` values.
+    /// `-setnumber` values, checked as a case's `geo_parameters` are: a name the script does
+    /// not use is refused with the case file's message.
     #[staticmethod]
     #[pyo3(signature = (path, parameters = None))]
     fn from_geo(
@@ -251,7 +252,9 @@ impl Mesh {
         path: PathBuf,
         parameters: Option<BTreeMap<String, f64>>,
     ) -> PyResult<Self> {
-        let parameters: Vec<(String, f64)> = parameters.unwrap_or_default().into_iter().collect();
+        let parameters = parameters.unwrap_or_default();
+        check_geo_parameters(&path, &parameters).map_err(|e| InputError::new_err(e.to_string()))?;
+        let parameters: Vec<(String, f64)> = parameters.into_iter().collect();
         py.detach(|| generate(&path, &parameters, None))
     }
 

@@ -117,3 +117,19 @@ def test_a_contact_problem_not_solved_is_a_status_as_in_the_cli(cli, tmp_path):
     with pytest.raises(internodes.NotSolvedError) as raised:
         result.raise_for_status()
     assert stderr.startswith(f"error: {raised.value} (see ")
+
+
+def test_an_unknown_mesh_parameter_is_refused_as_in_a_case_file(cli, tmp_path):
+    # `Level` for the script's `level`: gmsh would ignore it and mesh the default level.
+    geo = REPO / "geo" / "half_disc_on_block.geo"
+    case_file = tmp_path / "case.toml"
+    case_file.write_text(f'mesh = "{geo}"\ngeo_parameters = {{ Level = 2 }}\n'
+                         '[[body]]\nname = "disc"\nyoungs_modulus = 1.0\npoisson_ratio = 0.3\n')
+    expected = cli_error(cli, case_file, tmp_path)
+    prefix = f"case file {case_file}: "
+    assert expected.startswith(prefix) and "does not use a parameter 'Level'" in expected
+    with pytest.raises(internodes.InputError) as raised:
+        internodes.Mesh.from_geo(geo, {"Level": 2})
+    assert str(raised.value) == expected[len(prefix):]
+    with pytest.raises(internodes.InputError, match="expected a finite number"):
+        internodes.Mesh.from_geo(geo, {"level": float("nan")})
