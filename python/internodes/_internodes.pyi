@@ -175,10 +175,17 @@ class Result:
     def write(self, folder: _StrPath) -> Path:
         """Writes the command line's result files into `folder` and returns it."""
 
-def solve(case: Case, mesh: Optional[Mesh] = None, *, cancel: Optional[Cancel] = None) -> Result:
+def solve(
+    case: Case,
+    mesh: Optional[Mesh] = None,
+    *,
+    cancel: Optional[Cancel] = None,
+    threads: Optional[int] = None,
+) -> Result:
     """Solves `case` on `mesh` or on the mesh the case names, without holding the GIL.
 
     Raises InputError for a case or mesh that cannot be used and SolveError when a solve fails;
     a contact problem not solved (or inaccurate) is a Result with that status. Ctrl-C stops the
     solve within about a second with KeyboardInterrupt; `cancel` stops it from another thread
-    with Cancelled."""
+    with Cancelled. `threads`: the solver's threads, in a pool of this solve's own (default: the
+    cores, or RAYON_NUM_THREADS); the answer does not depend on it."""
