@@ -19,6 +19,9 @@ __all__ = [
     "SolveError",
     "SurfaceResult",
     "WriteError",
+    "_restore_case",
+    "_restore_generated_mesh",
+    "_restore_model_mesh",
     "solve",
 ]
 
@@ -189,3 +192,8 @@ def solve(
     solve within about a second with KeyboardInterrupt; `cancel` stops it from another thread
     with Cancelled. `threads`: the solver's threads, in a pool of this solve's own (default: the
     cores, or RAYON_NUM_THREADS); the answer does not depend on it."""
+
+# What pickles of cases and meshes are read back with (not for direct use).
+def _restore_case(text: str, name: str, folder: _StrPath, names_mesh: bool) -> Case: ...
+def _restore_generated_mesh(geo: _StrPath, bytes: bytes) -> Mesh: ...
+def _restore_model_mesh(arrays: Mapping[str, Any]) -> Mesh: ...

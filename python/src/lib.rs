@@ -104,6 +104,8 @@ struct Case {
     file: CaseFile,
     /// Whether the case names a mesh (a case built in code may leave it to `solve(mesh=...)`).
     names_mesh: bool,
+    /// What the case was made from, for pickling ([`CaseSource`]).
+    source: CaseSource,
 }
 
 #[pymethods]
@@ -112,9 +114,16 @@ impl Case {
     #[staticmethod]
     fn from_toml(path: PathBuf) -> PyResult<Self> {
         let file = CaseFile::load(&path).map_err(|e| InputError::new_err(message(&e)))?;
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| InputError::new_err(e.to_string()))?;
         Ok(Case {
             file,
             names_mesh: true,
+            source: CaseSource {
+                text,
+                name: path.to_string_lossy().into_owned(),
+                folder: path.parent().unwrap_or(Path::new("")).to_owned(),
+            },
         })
     }
 
@@ -157,9 +166,18 @@ impl Case {
             value.insert("mesh".to_string(), toml::Value::String(String::new()));
         }
         let folder = folder.unwrap_or_default();
+        let text = toml::to_string(&value).map_err(|e| InputError::new_err(e.to_string()))?;
         let file = CaseFile::from_table(value, name, &folder)
             .map_err(|e| InputError::new_err(message(&e)))?;
-        Ok(Case { file, names_mesh })
+        Ok(Case {
+            file,
+            names_mesh,
+            source: CaseSource {
+                text,
+                name: name.to_string(),
+                folder,
+            },
+        })
     }
 
     /// The case file, or the name given to `from_dict`.
@@ -184,6 +202,16 @@ impl Case {
     #[getter]
     fn load_steps(&self) -> Vec<f64> {
         self.file.load_steps()
+    }
+
+    /// Pickling: the case's keys (as TOML), name and folder, read again with the same checks.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let restore = py
+            .import("internodes._internodes")?
+            .getattr("_restore_case")?;
+        let CaseSource { text, name, folder } = &self.source;
+        let arguments = (text, name, folder, self.names_mesh).into_pyobject(py)?;
+        Ok((restore, arguments.into_any()))
     }
 
     fn __repr__(&self) -> String {
@@ -217,6 +245,73 @@ fn first_none(value: &serde_json::Value, at: String) -> Option<String> {
     }
 }
 
+/// What a `Case` was made from: its keys as TOML text, the name that stands for its file, and
+/// the folder its relative paths are relative to. A pickled case is this, read again by
+/// [`restore_case`] with the same checks; it holds no solver state.
+#[derive(Clone)]
+struct CaseSource {
+    text: String,
+    name: String,
+    folder: PathBuf,
+}
+
+/// The `Case` of a pickle ([`Case::__reduce__`]).
+#[pyfunction]
+#[pyo3(name = "_restore_case")]
+fn restore_case(text: String, name: String, folder: PathBuf, names_mesh: bool) -> PyResult<Case> {
+    let table: toml::Table =
+        toml::from_str(&text).map_err(|e| InputError::new_err(e.to_string()))?;
+    let file = CaseFile::from_table(table, &name, &folder)
+        .map_err(|e| InputError::new_err(message(&e)))?;
+    Ok(Case {
+        file,
+        names_mesh,
+        source: CaseSource { text, name, folder },
+    })
+}
+
+/// Where a `Mesh` came from, for pickling: a file is read again by path, a mesh gmsh made of a
+/// `.geo` is its MSH bytes (kept anyway, for `mesh.msh`), a gmsh model is the arrays read from it.
+#[derive(Clone)]
+enum MeshSource {
+    File,
+    Generated,
+    Model(Arc<Py<PyAny>>),
+}
+
+/// The `Mesh` of a pickle of a `.geo`'s mesh: the MSH bytes gmsh made, named after the `.geo`.
+#[pyfunction]
+#[pyo3(name = "_restore_generated_mesh")]
+fn restore_generated_mesh(geo: PathBuf, bytes: Vec<u8>) -> PyResult<Mesh> {
+    let mesh = read_msh_bytes(&geo, &bytes).map_err(|e| mesh_error(e, None))?;
+    Ok(Mesh {
+        mesh: Arc::new(mesh),
+        generated: Some(Arc::new(bytes)),
+        source: MeshSource::Generated,
+    })
+}
+
+/// The `Mesh` of a pickle of a gmsh model's mesh: the arrays `internodes._gmsh` read.
+#[pyfunction]
+#[pyo3(name = "_restore_model_mesh")]
+fn restore_model_mesh(py: Python<'_>, arrays: Bound<'_, PyAny>) -> PyResult<Mesh> {
+    mesh_of_model(py, arrays)
+}
+
+/// A mesh from the arrays of a gmsh model (`internodes._gmsh.model_arrays`).
+fn mesh_of_model(py: Python<'_>, arrays: Bound<'_, PyAny>) -> PyResult<Mesh> {
+    let label: String = arrays.get_item("label")?.extract()?;
+    let model = gmsh_model(&arrays)?;
+    let mesh = py
+        .detach(|| mesh_from_model(Path::new(&label), model))
+        .map_err(|e| mesh_error(e, None))?;
+    Ok(Mesh {
+        mesh: Arc::new(mesh),
+        generated: None,
+        source: MeshSource::Model(Arc::new(arrays.unbind())),
+    })
+}
+
 /// A mesh: the bodies (physical surfaces in 2D, volumes in 3D), their boundary groups and point
 /// groups, as `docs/meshes.md` describes.
 #[pyclass(module = "internodes", frozen)]
@@ -226,6 +321,7 @@ struct Mesh {
     /// The MSH file gmsh made of a `.geo`: written as `mesh.msh` with the results, as the
     /// command line does.
     generated: Option<Arc<Vec<u8>>>,
+    source: MeshSource,
 }
 
 #[pymethods]
@@ -239,6 +335,7 @@ impl Mesh {
         Ok(Mesh {
             mesh: Arc::new(mesh),
             generated: None,
+            source: MeshSource::File,
         })
     }
 
@@ -264,15 +361,7 @@ impl Mesh {
     #[pyo3(signature = (model = None))]
     fn from_gmsh(py: Python<'_>, model: Option<String>) -> PyResult<Self> {
         let arrays = (py.import("internodes._gmsh")?).call_method1("model_arrays", (model,))?;
-        let label: String = arrays.get_item("label")?.extract()?;
-        let model = gmsh_model(&arrays)?;
-        let mesh = py
-            .detach(|| mesh_from_model(Path::new(&label), model))
-            .map_err(|e| mesh_error(e, None))?;
-        Ok(Mesh {
-            mesh: Arc::new(mesh),
-            generated: None,
-        })
+        mesh_of_model(py, arrays)
     }
 
     /// The file (or model) the mesh came from.
@@ -301,6 +390,30 @@ impl Mesh {
             .iter()
             .map(|g| g.name.clone())
             .collect()
+    }
+
+    /// Pickling: a mesh read from a file is read again from its path (in the process that
+    /// unpickles it), a mesh gmsh made of a `.geo` travels as its MSH bytes, a gmsh model's mesh
+    /// as the arrays read from the model.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let module = py.import("internodes._internodes")?;
+        let path = &self.mesh.path;
+        Ok(match (&self.source, &self.generated) {
+            (MeshSource::Generated, Some(bytes)) => (
+                module.getattr("_restore_generated_mesh")?,
+                (path, pyo3::types::PyBytes::new(py, bytes))
+                    .into_pyobject(py)?
+                    .into_any(),
+            ),
+            (MeshSource::Model(arrays), _) => (
+                module.getattr("_restore_model_mesh")?,
+                (arrays.clone_ref(py),).into_pyobject(py)?.into_any(),
+            ),
+            _ => (
+                module.getattr("Mesh")?.getattr("from_msh")?,
+                (path,).into_pyobject(py)?.into_any(),
+            ),
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -333,6 +446,7 @@ fn generate(geo: &Path, parameters: &[(String, f64)], case: Option<&Path>) -> Py
     Ok(Mesh {
         mesh: Arc::new(mesh),
         generated: Some(Arc::new(bytes)),
+        source: MeshSource::Generated,
     })
 }
 
@@ -441,6 +555,7 @@ fn solve(
                     .map_err(|e| mesh_error(e, Some(&case.file.path)))?,
             ),
             generated: None,
+            source: MeshSource::File,
         },
     };
     let mut file = case.file.clone();
@@ -573,7 +688,10 @@ fn in_own_pool<T: Send>(
                 let handle = std::thread::Builder::new()
                     .name(thread.name().unwrap_or("internodes-solve").to_string())
                     .spawn_scoped(scope, || thread.run())?;
-                handles.lock().unwrap_or_else(|e| e.into_inner()).push(handle);
+                handles
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(handle);
                 Ok(())
             })
             .build()
@@ -889,6 +1007,10 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SurfaceResult>()?;
     m.add_class::<Cancel>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
+    // What pickles of cases and meshes are read back with.
+    m.add_function(wrap_pyfunction!(restore_case, m)?)?;
+    m.add_function(wrap_pyfunction!(restore_generated_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(restore_model_mesh, m)?)?;
     let py = m.py();
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("SolveError", py.get_type::<SolveError>())?;
