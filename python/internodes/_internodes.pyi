@@ -17,6 +17,7 @@ __all__ = [
     "NotSolvedError",
     "Result",
     "SolveError",
+    "Step",
     "SurfaceResult",
     "WriteError",
     "_restore_case",
@@ -151,6 +152,32 @@ class BodyResult:
     """The contact surface's fields in contact runs, else None."""
 
 @final
+class Step:
+    """How one load step ended (the library's record of it). Status, accuracy verdict, failed
+    checks, forces and Hertz fit are this step's own; the accuracy report's details and the
+    iteration history are kept for the last step only (Result.summary["contact"])."""
+
+    step: int
+    """1, 2, ... in the order solved."""
+    load_factor: float
+    status: str
+    """This step's contact status ("converged", "not-solved", ...)."""
+    solved: bool
+    """Whether the status is a solution ("converged" or "no-contact")."""
+    accurate: bool
+    """Whether this step's accuracy report passed."""
+    failed_checks: list[str]
+    """The checks this step failed, by name."""
+    iterations: int
+    force_primary: npt.NDArray[np.float64]
+    """(dim,) total contact force on the primary body."""
+    force_secondary: npt.NDArray[np.float64]
+    force_imbalance: float
+    hertz_a: Optional[float]
+    hertz_p0: Optional[float]
+    seconds: float
+
+@final
 class Result:
     """A solved case."""
 
@@ -171,7 +198,12 @@ class Result:
     def exit_code(self) -> int:
         """The command line's exit status: 0 solved, 2 not solved, 3 solved but inaccurate."""
     def raise_for_status(self) -> None:
-        """Raises NotSolvedError, with the command line's message, unless exit_code is 0."""
+        """Raises NotSolvedError unless every load step was solved and passed its accuracy
+        report: the command line's message when exit_code is not 0, else the first earlier
+        step that failed."""
+    @property
+    def steps(self) -> list[Step]:
+        """One Step per load step solved, in order (empty without contact)."""
     @property
     def bodies(self) -> dict[str, BodyResult]:
         """Each body's fields by name."""

@@ -19,6 +19,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
 
 use internodes::case::{Case as CaseFile, CaseError, check_geo_parameters};
+use internodes::contact::StepRecord;
 use internodes::mesh::{
     GmshModel, Mesh as BodyMeshes, MeshError, ModelElements, ModelGroup, mesh_from_model, mesh_geo,
     read_msh, read_msh_bytes,
@@ -806,12 +807,25 @@ impl Result {
         self.summary.verdict().exit_status()
     }
 
-    /// Raises `NotSolvedError`, with the command line's message, unless `exit_code` is 0.
+    /// Raises `NotSolvedError` unless every load step was solved and passed its accuracy
+    /// report: with the command line's message when `exit_code` is not 0 (the answer, the last
+    /// step), else naming the first earlier step that failed (`steps`).
     fn raise_for_status(&self) -> PyResult<()> {
         match self.summary.verdict() {
-            Verdict::Solved => Ok(()),
+            Verdict::Solved => failed_step(self.step_records())
+                .map_or(Ok(()), |why| Err(NotSolvedError::new_err(why))),
             Verdict::NotSolved(why) | Verdict::Inaccurate(why) => Err(NotSolvedError::new_err(why)),
         }
+    }
+
+    /// One `Step` per load step solved, in order (empty without contact). The solve stops at
+    /// the first step whose active set did not settle, so there may be fewer than the case's
+    /// `load_steps`.
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> PyResult<Vec<Step>> {
+        (self.step_records().iter())
+            .map(|record| Step::new(py, record))
+            .collect()
     }
 
     /// Each body's fields by name (a `dict` of `BodyResult`), built on first access.
@@ -852,6 +866,10 @@ impl Result {
 }
 
 impl Result {
+    fn step_records(&self) -> &[StepRecord] {
+        self.summary.contact.as_ref().map_or(&[], |c| &c.steps)
+    }
+
     fn write_into(&self, folder: &Path) -> PyResult<()> {
         let write_error = |e: OutputError| WriteError::new_err(message(&e));
         let mut inputs = vec![self.mesh.mesh.path.as_path()];
@@ -884,6 +902,92 @@ impl Result {
             results.fail("Result.write", &e);
             run_error(e)
         })
+    }
+}
+
+/// Why a result whose answer (the last step) passed must still not be relied on: the first load
+/// step that was not solved or failed its accuracy report, if any.
+fn failed_step(steps: &[StepRecord]) -> Option<String> {
+    let step = steps
+        .iter()
+        .find(|s| !s.status.is_solution() || !s.accurate)?;
+    let failed: Vec<&str> = step.failed_checks.iter().map(|c| c.name()).collect();
+    Some(format!(
+        "load step {} of {} (load factor {}) {}{}",
+        step.step,
+        steps.len(),
+        step.load_factor,
+        match step.status.is_solution() {
+            true => format!(
+                "ended {}, but its accuracy report failed",
+                step.status.name()
+            ),
+            false => format!("was not solved: status \"{}\"", step.status.name()),
+        },
+        match failed.is_empty() {
+            true => String::new(),
+            false => format!(" (failed: {})", failed.join(", ")),
+        }
+    ))
+}
+
+/// How one load step ended: the library's record of it (`StepRecord`). Each step's status,
+/// accuracy verdict, failed checks, forces and Hertz fit are its own; the accuracy report's
+/// details (each check's value and tolerance) and the iteration history are kept for the last
+/// step only (`Result.summary["contact"]`).
+#[pyclass(module = "internodes", frozen, get_all)]
+struct Step {
+    /// 1, 2, ... in the order solved.
+    step: usize,
+    load_factor: f64,
+    /// The contact status of this step (`"converged"`, `"not-solved"`, ...).
+    status: &'static str,
+    /// Whether the status is a solution (`"converged"` or `"no-contact"`).
+    solved: bool,
+    /// Whether this step's accuracy report passed.
+    accurate: bool,
+    /// The checks this step failed: residuals and accuracy indicators, by name.
+    failed_checks: Vec<&'static str>,
+    /// Active-set iterations.
+    iterations: usize,
+    /// `(dim,)` total contact force on each body.
+    force_primary: Py<PyAny>,
+    force_secondary: Py<PyAny>,
+    force_imbalance: f64,
+    /// The Hertz fit of the primary pressure (contact radius or half-width, peak), if any.
+    hertz_a: Option<f64>,
+    hertz_p0: Option<f64>,
+    seconds: f64,
+}
+
+impl Step {
+    fn new(py: Python<'_>, record: &StepRecord) -> PyResult<Self> {
+        let dim = record.force_primary.len();
+        Ok(Step {
+            step: record.step,
+            load_factor: record.load_factor,
+            status: record.status.name(),
+            solved: record.status.is_solution(),
+            accurate: record.accurate,
+            failed_checks: record.failed_checks.iter().map(|c| c.name()).collect(),
+            iterations: record.iterations,
+            force_primary: array(py, record.force_primary.clone(), &[dim])?,
+            force_secondary: array(py, record.force_secondary.clone(), &[dim])?,
+            force_imbalance: record.force_imbalance,
+            hertz_a: record.hertz_a,
+            hertz_p0: record.hertz_p0,
+            seconds: record.seconds,
+        })
+    }
+}
+
+#[pymethods]
+impl Step {
+    fn __repr__(&self) -> String {
+        format!(
+            "Step({}, load_factor={}, status={}, accurate={})",
+            self.step, self.load_factor, self.status, self.accurate
+        )
     }
 }
 
@@ -1006,6 +1110,7 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<BodyResult>()?;
     m.add_class::<SurfaceResult>()?;
     m.add_class::<Cancel>()?;
+    m.add_class::<Step>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     // What pickles of cases and meshes are read back with.
     m.add_function(wrap_pyfunction!(restore_case, m)?)?;
