@@ -140,11 +140,14 @@ impl Case {
         name: &str,
         folder: Option<PathBuf>,
     ) -> PyResult<Self> {
-        // The dict goes through JSON (its values may be path objects: `os.fspath` turns them
-        // into strings), then into the same schema as a file.
-        let os = py.import("os")?;
+        // The dict goes through JSON (its values may be path objects, NumPy scalars or arrays:
+        // `internodes._values.json_value` turns them into strings, numbers and lists), then into
+        // the same schema as a file.
         let kwargs = PyDict::new(py);
-        kwargs.set_item("default", os.getattr("fspath")?)?;
+        kwargs.set_item(
+            "default",
+            py.import("internodes._values")?.getattr("json_value")?,
+        )?;
         let text: String = (py.import("json")?)
             .call_method("dumps", (table,), Some(&kwargs))
             .map_err(|e| InputError::new_err(format!("case '{name}': {e}")))?

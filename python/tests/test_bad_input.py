@@ -133,3 +133,44 @@ def test_an_unknown_mesh_parameter_is_refused_as_in_a_case_file(cli, tmp_path):
     assert str(raised.value) == expected[len(prefix):]
     with pytest.raises(internodes.InputError, match="expected a finite number"):
         internodes.Mesh.from_geo(geo, {"level": float("nan")})
+
+
+def disc_dict(youngs_modulus=1e3, poisson_ratio=0.3, uy=-0.02, load_steps=(0.5, 1.0)):
+    return {
+        "contact": {"bodies": ["disc", "block"], "surfaces": ["disc_contact", "block_contact"],
+                    "load_steps": load_steps},
+        "body": [{"name": "disc", "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
+                  "dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": uy}]},
+                 {"name": "block", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
+                  "dirichlet": [{"group": "block_base", "ux": 0, "uy": 0}]}]}
+
+
+def test_numpy_scalars_and_arrays_are_numbers():
+    np = pytest.importorskip("numpy")
+    mesh = internodes.Mesh.from_msh(MESH)
+    plain = internodes.solve(internodes.Case.from_dict(disc_dict()), mesh=mesh)
+    numpy = internodes.solve(internodes.Case.from_dict(disc_dict(
+        youngs_modulus=np.int64(1000), poisson_ratio=np.array(0.3), uy=np.float64(-0.02),
+        load_steps=np.array([0.5, 1.0]))), mesh=mesh)
+    assert plain.summary["contact"]["force_primary"] == numpy.summary["contact"]["force_primary"]
+    # float32 holds 0.3 as 0.30000001192...: accepted, as that number.
+    case = internodes.Case.from_dict(disc_dict(poisson_ratio=np.float32(0.3), uy=np.float32(-0.02)))
+    assert internodes.solve(case, mesh=mesh).status == "converged"
+    geo = REPO / "geo" / "half_disc_on_block.geo"
+    assert internodes.Mesh.from_geo(geo, {"level": np.int64(0)}).dim == 2
+    assert internodes.Mesh.from_geo(geo, {"level": np.array(0.0)}).dim == 2
+
+
+@pytest.mark.parametrize("material, match", [
+    ({"youngs_modulus": 0.0}, "Young's modulus must be positive and finite, got 0"),
+    ({"youngs_modulus": -1e3}, "Young's modulus must be positive and finite, got -1000"),
+    ({"poisson_ratio": 0.5}, r"Poisson's ratio must lie in \(-1, 0.5\)"),
+    ({"poisson_ratio": -1.0}, r"Poisson's ratio must lie in \(-1, 0.5\)"),
+], ids=["E = 0", "E < 0", "nu = 0.5", "nu = -1"])
+def test_a_bad_material_is_refused_by_from_dict(material, match):
+    np = pytest.importorskip("numpy")
+    with pytest.raises(internodes.InputError, match=f"case file study: body 'disc': {match}"):
+        internodes.Case.from_dict(disc_dict(**material), name="study")
+    # NumPy values are checked alike.
+    with pytest.raises(internodes.InputError, match=match):
+        internodes.Case.from_dict(disc_dict(**{k: np.float64(v) for k, v in material.items()}))

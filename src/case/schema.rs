@@ -224,6 +224,11 @@ impl Case {
                  or use body = \"cholesky\" or \"auto\")",
             ));
         }
+        // Each body's material now, not only when its problem is set up on a mesh: a study
+        // learns of a Young's modulus <= 0 when it builds the case.
+        for spec in &case.bodies {
+            case.material(spec)?;
+        }
         case.check_unique_bodies()?;
         case.check_geo_parameters()?;
         case.check_load_steps()?;
