@@ -8,6 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "__version__",
     "BodyResult",
     "Cancel",
     "Cancelled",
@@ -27,6 +28,9 @@ __all__ = [
 ]
 
 _StrPath = Union[str, PathLike[str]]
+
+__version__: str
+"""The version of the solver the module was built from."""
 
 class InputError(ValueError):
     """A case or a mesh that cannot be used; the message is the command line's."""
@@ -109,6 +113,12 @@ class Mesh:
     @property
     def groups(self) -> list[str]:
         """The names of every physical group."""
+    @property
+    def num_nodes(self) -> dict[str, int]:
+        """Each body's number of nodes, by name."""
+    @property
+    def num_cells(self) -> dict[str, int]:
+        """Each body's number of cells (triangles in 2D, tetrahedra in 3D), by name."""
 
 @final
 class SurfaceResult:

@@ -420,12 +420,38 @@ impl Mesh {
         })
     }
 
+    /// Each body's number of nodes, by name.
+    #[getter]
+    fn num_nodes(&self) -> BTreeMap<String, usize> {
+        (self.mesh.bodies.iter())
+            .map(|b| (b.name.clone(), b.num_nodes()))
+            .collect()
+    }
+
+    /// Each body's number of cells (triangles in 2D, tetrahedra in 3D), by name.
+    #[getter]
+    fn num_cells(&self) -> BTreeMap<String, usize> {
+        (self.mesh.bodies.iter())
+            .map(|b| (b.name.clone(), b.num_cells()))
+            .collect()
+    }
+
     fn __repr__(&self) -> String {
+        let bodies: Vec<String> = (self.mesh.bodies.iter())
+            .map(|b| {
+                format!(
+                    "'{}': {} nodes, {} cells",
+                    b.name,
+                    b.num_nodes(),
+                    b.num_cells()
+                )
+            })
+            .collect();
         format!(
-            "Mesh('{}', dim={}, bodies={:?})",
+            "Mesh('{}', dim={}, bodies={{{}}})",
             self.mesh.path.display(),
             self.mesh.dim,
-            self.bodies()
+            bodies.join(", ")
         )
     }
 }
@@ -1036,6 +1062,15 @@ struct SurfaceResult {
     active: Py<PyAny>,
 }
 
+#[pymethods]
+impl SurfaceResult {
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let k = self.nodes.bind(py).len()?;
+        let active: usize = (self.active.bind(py).call_method0("sum")?).extract()?;
+        Ok(format!("SurfaceResult({k} nodes, {active} active)"))
+    }
+}
+
 /// A flat vector as a NumPy array of shape `shape`.
 fn array<T: numpy::Element>(py: Python<'_>, data: Vec<T>, shape: &[usize]) -> PyResult<Py<PyAny>> {
     Ok(PyArray1::from_vec(py, data)
@@ -1107,6 +1142,7 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     if log::set_boxed_logger(Box::new(LogBridge)).is_ok() {
         log::set_max_level(log::LevelFilter::Debug);
     }
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Case>()?;
     m.add_class::<Mesh>()?;
     m.add_class::<Result>()?;
