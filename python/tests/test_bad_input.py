@@ -89,7 +89,8 @@ def test_gmsh_after_finalize_raises_input_error():
     gmsh = pytest.importorskip("gmsh")
     gmsh.initialize()
     gmsh.finalize()
-    with pytest.raises(internodes.InputError, match="no gmsh model to read .*gmsh.initialize()"):
+    with pytest.raises(internodes.InputError,
+                       match=r"gmsh is not initialized: call gmsh.initialize\(\)"):
         internodes.Mesh.from_gmsh()
 
 
