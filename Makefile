@@ -25,6 +25,7 @@ build: deps
 python: build
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv --system-site-packages $(VENV)
 	$(VENV)/bin/pip install --quiet "maturin>=1.5,<2" mypy
+	@echo "make python: building the Rust module with maturin (release; several minutes on 2 cores the first time, pip prints nothing meanwhile)"
 	MATURIN_PEP517_ARGS="$(if $(findstring petsc,$(FEATURES)),,--no-default-features)" \
 	    $(VENV)/bin/pip install --quiet ./python
 

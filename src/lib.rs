@@ -27,9 +27,11 @@
 //!   coupled system and its solvers, the active-set loop;
 //! - [`case`]: the TOML case file;
 //! - [`output`]: XDMF/HDF5, JSON summary, Matrix Market;
+//! - [`cancel`]: the token that stops a solve from outside it;
 //! - [`run`]: `internodes solve CASE`, from the case file to the result files;
 //! - [`study`]: `internodes study CASE`, a mesh refinement study with the grid convergence index.
 
+pub mod cancel;
 pub mod case;
 pub mod contact;
 pub mod elastic;

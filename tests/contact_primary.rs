@@ -140,7 +140,7 @@ fn every_load_step_of_an_explicit_stiff_primary_is_right_or_named() {
     let mesh = read_msh(&case.mesh).unwrap();
     let settings = SolverSettings {
         verbose: false,
-        ..case.solver
+        ..case.solver.clone()
     };
     let references: Vec<f64> = FOREIGN_RIGID_FLAT_FORCES_3D
         .into_iter()

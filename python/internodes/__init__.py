@@ -16,6 +16,7 @@ Progress goes to the ``logging`` logger ``internodes`` (silent unless configured
 import logging
 
 from ._internodes import *  # noqa: F403 (the native module's classes and solve())
+from ._internodes import __version__
 
 # A library's logger stays silent until the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -9,10 +9,28 @@ import numpy as np
 from ._internodes import InputError
 
 
+def _initialized(gmsh):
+    """Whether gmsh is initialized. gmsh 4.8 (Debian 12) has no ``isInitialized``; an initialized
+    gmsh has a model (at least the unnamed one), an uninitialized one lists none."""
+    if hasattr(gmsh, "isInitialized"):
+        return bool(gmsh.isInitialized())
+    try:
+        return bool(gmsh.model.list())
+    except Exception:  # after gmsh.finalize(), gmsh 4.8 fails to fetch its own error
+        return False
+
+
 def model_arrays(model=None):
     """The physical groups, nodes and element blocks of gmsh's current model (or ``model``)."""
     import gmsh
 
+    # gmsh's API answers an uninitialized gmsh with an empty model, read as a mesh without
+    # bodies: say what is wrong instead.
+    if not _initialized(gmsh):
+        raise InputError(
+            "gmsh is not initialized: call gmsh.initialize(), build and mesh a model, then "
+            "Mesh.from_gmsh() before gmsh.finalize()"
+        )
     try:
         if model is not None:
             gmsh.model.setCurrent(model)

@@ -8,21 +8,31 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "__version__",
     "BodyResult",
+    "Cancel",
+    "Cancelled",
     "Case",
     "InputError",
     "Mesh",
     "NotSolvedError",
     "Result",
     "SolveError",
+    "Step",
     "Study",
     "SurfaceResult",
     "WriteError",
+    "_restore_case",
+    "_restore_generated_mesh",
+    "_restore_model_mesh",
     "solve",
     "study",
 ]
 
 _StrPath = Union[str, PathLike[str]]
+
+__version__: str
+"""The version of the solver the module was built from."""
 
 class InputError(ValueError):
     """A case or a mesh that cannot be used; the message is the command line's."""
@@ -35,6 +45,22 @@ class NotSolvedError(RuntimeError):
 
 class WriteError(OSError):
     """The result files could not be written."""
+
+class Cancelled(Exception):
+    """Raised by solve() when its Cancel token was cancelled."""
+
+@final
+class Cancel:
+    """A token that cancels the solves given it (solve(case, cancel=token)) from another thread,
+    at their next load step, active-set iteration or interface GMRES iteration. A cancelled
+    token stays cancelled."""
+
+    def __init__(self) -> None: ...
+    def cancel(self) -> None:
+        """Stops every solve holding this token at its next safe point."""
+    @property
+    def cancelled(self) -> bool:
+        """Whether cancel() was called."""
 
 @final
 class Case:
@@ -72,7 +98,8 @@ class Mesh:
         """Reads a gmsh MSH 4.1 file (ASCII or binary)."""
     @staticmethod
     def from_geo(path: _StrPath, parameters: Optional[Mapping[str, float]] = None) -> Mesh:
-        """Meshes a .geo script with the gmsh program (`parameters`: its -setnumber values)."""
+        """Meshes a .geo script with the gmsh program (`parameters`: its -setnumber values,
+        checked as a case's geo_parameters: a name the script does not use is refused)."""
     @staticmethod
     def from_gmsh(model: Optional[str] = None) -> Mesh:
         """The meshed current model of the gmsh Python module (or the model named `model`),
@@ -88,6 +115,12 @@ class Mesh:
     @property
     def groups(self) -> list[str]:
         """The names of every physical group."""
+    @property
+    def num_nodes(self) -> dict[str, int]:
+        """Each body's number of nodes, by name."""
+    @property
+    def num_cells(self) -> dict[str, int]:
+        """Each body's number of cells (triangles in 2D, tetrahedra in 3D), by name."""
 
 @final
 class SurfaceResult:
@@ -131,6 +164,32 @@ class BodyResult:
     """The contact surface's fields in contact runs, else None."""
 
 @final
+class Step:
+    """How one load step ended (the library's record of it). Status, accuracy verdict, failed
+    checks, forces and Hertz fit are this step's own; the accuracy report's details and the
+    iteration history are kept for the last step only (Result.summary["contact"])."""
+
+    step: int
+    """1, 2, ... in the order solved."""
+    load_factor: float
+    status: str
+    """This step's contact status ("converged", "not-solved", ...)."""
+    solved: bool
+    """Whether the status is a solution ("converged" or "no-contact")."""
+    accurate: bool
+    """Whether this step's accuracy report passed."""
+    failed_checks: list[str]
+    """The checks this step failed, by name."""
+    iterations: int
+    force_primary: npt.NDArray[np.float64]
+    """(dim,) total contact force on the primary body."""
+    force_secondary: npt.NDArray[np.float64]
+    force_imbalance: float
+    hertz_a: Optional[float]
+    hertz_p0: Optional[float]
+    seconds: float
+
+@final
 class Result:
     """A solved case."""
 
@@ -149,20 +208,35 @@ class Result:
         """Solved, and the accuracy report passed."""
     @property
     def exit_code(self) -> int:
-        """The command line's exit status: 0 solved, 2 not solved, 3 solved but inaccurate."""
+        """The command line's exit status, the worst load step's: 0 solved, 2 not solved, 3
+        solved but inaccurate."""
     def raise_for_status(self) -> None:
-        """Raises NotSolvedError, with the command line's message, unless exit_code is 0."""
+        """Raises NotSolvedError unless every load step was solved and passed its accuracy
+        report (exit_code 0), with the command line's message, which names the failed steps."""
+    @property
+    def steps(self) -> list[Step]:
+        """One Step per load step solved, in order (empty without contact)."""
     @property
     def bodies(self) -> dict[str, BodyResult]:
         """Each body's fields by name."""
     def write(self, folder: _StrPath) -> Path:
         """Writes the command line's result files into `folder` and returns it."""
 
-def solve(case: Case, mesh: Optional[Mesh] = None) -> Result:
+def solve(
+    case: Case,
+    mesh: Optional[Mesh] = None,
+    *,
+    cancel: Optional[Cancel] = None,
+    threads: Optional[int] = None,
+) -> Result:
     """Solves `case` on `mesh` or on the mesh the case names, without holding the GIL.
 
     Raises InputError for a case or mesh that cannot be used and SolveError when a solve fails;
-    a contact problem not solved (or inaccurate) is a Result with that status."""
+    a contact problem not solved (or inaccurate) is a Result with that status. Ctrl-C stops the
+    solve within about a second with KeyboardInterrupt; `cancel` stops it from another thread
+    with Cancelled. `threads`: the solver's threads, in a pool of this solve's own (default: the
+    cores, or RAYON_NUM_THREADS); the answer does not depend on it."""
+
 
 @final
 class Study:
@@ -202,3 +276,8 @@ def study(
     """Solves `case` (its mesh a .geo) once per value of the gmsh parameter `parameter` and
     estimates each contact quantity's discretization error (observed order, Richardson
     extrapolation, GCI), writing the files of `internodes study` into `output`."""
+
+# What pickles of cases and meshes are read back with (not for direct use).
+def _restore_case(text: str, name: str, folder: _StrPath, names_mesh: bool) -> Case: ...
+def _restore_generated_mesh(geo: _StrPath, bytes: bytes) -> Mesh: ...
+def _restore_model_mesh(arrays: Mapping[str, Any]) -> Mesh: ...

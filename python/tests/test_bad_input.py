@@ -89,7 +89,8 @@ def test_gmsh_after_finalize_raises_input_error():
     gmsh = pytest.importorskip("gmsh")
     gmsh.initialize()
     gmsh.finalize()
-    with pytest.raises(internodes.InputError, match="no gmsh model to read .*gmsh.initialize()"):
+    with pytest.raises(internodes.InputError,
+                       match=r"gmsh is not initialized: call gmsh.initialize\(\)"):
         internodes.Mesh.from_gmsh()
 
 
@@ -117,3 +118,60 @@ def test_a_contact_problem_not_solved_is_a_status_as_in_the_cli(cli, tmp_path):
     with pytest.raises(internodes.NotSolvedError) as raised:
         result.raise_for_status()
     assert stderr.startswith(f"error: {raised.value} (see ")
+
+
+def test_an_unknown_mesh_parameter_is_refused_as_in_a_case_file(cli, tmp_path):
+    # `Level` for the script's `level`: gmsh would ignore it and mesh the default level.
+    geo = REPO / "geo" / "half_disc_on_block.geo"
+    case_file = tmp_path / "case.toml"
+    case_file.write_text(f'mesh = "{geo}"\ngeo_parameters = {{ Level = 2 }}\n'
+                         '[[body]]\nname = "disc"\nyoungs_modulus = 1.0\npoisson_ratio = 0.3\n')
+    expected = cli_error(cli, case_file, tmp_path)
+    prefix = f"case file {case_file}: "
+    assert expected.startswith(prefix) and "does not use a parameter 'Level'" in expected
+    with pytest.raises(internodes.InputError) as raised:
+        internodes.Mesh.from_geo(geo, {"Level": 2})
+    assert str(raised.value) == expected[len(prefix):]
+    with pytest.raises(internodes.InputError, match="expected a finite number"):
+        internodes.Mesh.from_geo(geo, {"level": float("nan")})
+
+
+def disc_dict(youngs_modulus=1e3, poisson_ratio=0.3, uy=-0.02, load_steps=(0.5, 1.0)):
+    return {
+        "contact": {"bodies": ["disc", "block"], "surfaces": ["disc_contact", "block_contact"],
+                    "load_steps": load_steps},
+        "body": [{"name": "disc", "youngs_modulus": youngs_modulus, "poisson_ratio": poisson_ratio,
+                  "dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": uy}]},
+                 {"name": "block", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
+                  "dirichlet": [{"group": "block_base", "ux": 0, "uy": 0}]}]}
+
+
+def test_numpy_scalars_and_arrays_are_numbers():
+    np = pytest.importorskip("numpy")
+    mesh = internodes.Mesh.from_msh(MESH)
+    plain = internodes.solve(internodes.Case.from_dict(disc_dict()), mesh=mesh)
+    numpy = internodes.solve(internodes.Case.from_dict(disc_dict(
+        youngs_modulus=np.int64(1000), poisson_ratio=np.array(0.3), uy=np.float64(-0.02),
+        load_steps=np.array([0.5, 1.0]))), mesh=mesh)
+    assert plain.summary["contact"]["force_primary"] == numpy.summary["contact"]["force_primary"]
+    # float32 holds 0.3 as 0.30000001192...: accepted, as that number.
+    case = internodes.Case.from_dict(disc_dict(poisson_ratio=np.float32(0.3), uy=np.float32(-0.02)))
+    assert internodes.solve(case, mesh=mesh).status == "converged"
+    geo = REPO / "geo" / "half_disc_on_block.geo"
+    assert internodes.Mesh.from_geo(geo, {"level": np.int64(0)}).dim == 2
+    assert internodes.Mesh.from_geo(geo, {"level": np.array(0.0)}).dim == 2
+
+
+@pytest.mark.parametrize("material, match", [
+    ({"youngs_modulus": 0.0}, "Young's modulus must be positive and finite, got 0"),
+    ({"youngs_modulus": -1e3}, "Young's modulus must be positive and finite, got -1000"),
+    ({"poisson_ratio": 0.5}, r"Poisson's ratio must lie in \(-1, 0.5\)"),
+    ({"poisson_ratio": -1.0}, r"Poisson's ratio must lie in \(-1, 0.5\)"),
+], ids=["E = 0", "E < 0", "nu = 0.5", "nu = -1"])
+def test_a_bad_material_is_refused_by_from_dict(material, match):
+    np = pytest.importorskip("numpy")
+    with pytest.raises(internodes.InputError, match=f"case file study: body 'disc': {match}"):
+        internodes.Case.from_dict(disc_dict(**material), name="study")
+    # NumPy values are checked alike.
+    with pytest.raises(internodes.InputError, match=match):
+        internodes.Case.from_dict(disc_dict(**{k: np.float64(v) for k, v in material.items()}))

@@ -9,6 +9,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+import pytest
 
 import internodes
 from conftest import REPO
@@ -76,3 +77,13 @@ def test_the_module_is_silent_by_default():
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert (done.stdout, done.stderr) == ("", "")
+
+
+def test_each_solve_has_its_own_threads_and_the_answer_does_not_depend_on_them():
+    mesh = internodes.Mesh.from_msh(REPO / "tests" / "fixtures" / "half_disc_on_block.msh")
+    case = internodes.Case.from_toml(REPO / "geo" / "half_disc_on_block.toml")
+    one, two = (internodes.solve(case, mesh=mesh, threads=n) for n in (1, 2))
+    assert one.summary["contact"]["force_primary"] == two.summary["contact"]["force_primary"]
+    assert np.array_equal(one.bodies["disc"].displacement, two.bodies["disc"].displacement)
+    with pytest.raises(ValueError, match="threads must be at least 1"):
+        internodes.solve(case, mesh=mesh, threads=0)

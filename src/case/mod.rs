@@ -6,4 +6,7 @@ mod error;
 mod schema;
 
 pub use error::CaseError;
-pub use schema::{BodySpec, Case, ContactSpec, DirichletSpec, HertzSpec, LoadSpec, MAX_LOAD_STEPS};
+pub use schema::{
+    BodySpec, Case, ContactSpec, DirichletSpec, GeoParameterError, HertzSpec, LoadSpec,
+    MAX_LOAD_STEPS, check_geo_parameters,
+};

@@ -224,6 +224,11 @@ impl Case {
                  or use body = \"cholesky\" or \"auto\")",
             ));
         }
+        // Each body's material now, not only when its problem is set up on a mesh: a study
+        // learns of a Young's modulus <= 0 when it builds the case.
+        for spec in &case.bodies {
+            case.material(spec)?;
+        }
         case.check_unique_bodies()?;
         case.check_geo_parameters()?;
         case.check_load_steps()?;
@@ -290,38 +295,8 @@ impl Case {
                 ),
             ));
         }
-        for (name, value) in &self.geo_parameters {
-            if !value.is_finite() {
-                return Err(self.invalid(
-                    format!("geo_parameters.{name}"),
-                    format!("expected a finite number, got {value}"),
-                ));
-            }
-        }
-        // Without the script, gmsh's own error says so when the run meshes it.
-        let Ok(script) = std::fs::read_to_string(&self.mesh) else {
-            return Ok(());
-        };
-        let used = geo_identifiers(&script);
-        for name in self.geo_parameters.keys() {
-            if !used.contains(name.as_str()) {
-                let defined = geo_defined_constants(&script);
-                return Err(self.invalid(
-                    format!("geo_parameters.{name}"),
-                    format!(
-                        "{} does not use a parameter '{name}', so gmsh would ignore it \
-                         (the parameters it defines: {})",
-                        self.mesh.display(),
-                        if defined.is_empty() {
-                            "none".to_string()
-                        } else {
-                            defined.join(", ")
-                        }
-                    ),
-                ));
-            }
-        }
-        Ok(())
+        check_geo_parameters(&self.mesh, &self.geo_parameters)
+            .map_err(|e| self.invalid(e.key, e.message))
     }
 
     /// Each load step is a whole contact solve, and its record goes into the summary: a list
@@ -771,6 +746,62 @@ fn in_range(value: f64) -> bool {
 /// The accepted range of [`in_range`], for messages.
 fn magnitude_range() -> String {
     format!("of magnitude at most {MAX_MAGNITUDE:e} (MAX_MAGNITUDE in src/case/schema.rs says why)")
+}
+
+/// A gmsh parameter that a `.geo` script cannot take: its key (`geo_parameters.NAME`) and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeoParameterError {
+    pub key: String,
+    pub message: String,
+}
+
+impl std::fmt::Display for GeoParameterError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.key, self.message)
+    }
+}
+
+impl std::error::Error for GeoParameterError {}
+
+/// The check of gmsh parameters (`-setnumber NAME VALUE`) for the script `geo`, wherever they
+/// are given (a case's `geo_parameters`, the Python module's `Mesh.from_geo`): each finite, and
+/// a name the script uses, since gmsh ignores a `-setnumber` the script never reads and meshes
+/// its defaults. A script that cannot be read passes (gmsh's own error says so when it meshes).
+pub fn check_geo_parameters(
+    geo: &Path,
+    parameters: &BTreeMap<String, f64>,
+) -> Result<(), GeoParameterError> {
+    for (name, value) in parameters {
+        if !value.is_finite() {
+            return Err(GeoParameterError {
+                key: format!("geo_parameters.{name}"),
+                message: format!("expected a finite number, got {value}"),
+            });
+        }
+    }
+    let Ok(script) = std::fs::read_to_string(geo) else {
+        return Ok(());
+    };
+    let used = geo_identifiers(&script);
+    for name in parameters.keys() {
+        if !used.contains(name.as_str()) {
+            let defined = geo_defined_constants(&script);
+            return Err(GeoParameterError {
+                key: format!("geo_parameters.{name}"),
+                message: format!(
+                    "{} does not use a parameter '{name}', so gmsh would ignore it \
+                     (the parameters it defines: {})",
+                    geo.display(),
+                    if defined.is_empty() {
+                        "none".to_string()
+                    } else {
+                        defined.join(", ")
+                    }
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The identifiers a gmsh script mentions outside `//` comments: a parameter the script never

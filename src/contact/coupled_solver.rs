@@ -148,9 +148,15 @@ impl BodyFactors {
                 false => KRYLOV_RTOL,
             };
             Interface::Krylov {
-                state: KrylovState::new(
-                    settings.verbose && settings.progress_line && std::io::stderr().is_terminal(),
-                ),
+                state: {
+                    let mut state = KrylovState::new(
+                        settings.verbose
+                            && settings.progress_line
+                            && std::io::stderr().is_terminal(),
+                    );
+                    state.cancel = settings.cancel.clone();
+                    state
+                },
                 tolerance,
                 max_iterations: contact.krylov_max_iterations,
             }

@@ -121,6 +121,8 @@ pub fn solve_contact<'m>(
     } else {
         (problem, solution, steps)
     };
+    // The retry and the checks go on after an error of their own: a cancelled one ends here.
+    solver.cancel.check()?;
     // 3. The other primary's forces, when a stiff primary was named or the case asks for
     //    them (a retry has compared the two already); 4. auto's transfer's, when another
     //    transfer was named.
@@ -143,6 +145,7 @@ pub fn solve_contact<'m>(
                     load_factors,
                     &mut log,
                 );
+                solver.cancel.check()?;
             }
         }
     }
@@ -395,6 +398,7 @@ fn solve_load_steps(
     let mut steps = Vec::new();
     let mut last: Option<ContactSolution> = None;
     for (k, &factor) in load_factors.iter().enumerate() {
+        solver.cancel.check()?;
         if load_factors.len() > 1 {
             log.say(format!(
                 "load step {}/{}: factor {factor}",

@@ -82,6 +82,7 @@ use thiserror::Error;
 use super::ContactError;
 use super::compliance::MultiplierKey;
 use super::system::{CoupledSystem, Coupling};
+use crate::cancel::Cancel;
 use crate::linalg::BodySolver;
 
 /// Relative residual `|r - S lambda| / |r|` the GMRES solve stops at with exact (Cholesky)
@@ -169,6 +170,8 @@ pub struct KrylovState {
     pub last: KrylovStats,
     /// Whether a solve over [`PROGRESS_AFTER`] rewrites a progress line on the terminal.
     pub progress: bool,
+    /// Checked at each GMRES iteration.
+    pub cancel: Cancel,
 }
 
 impl KrylovState {
@@ -396,6 +399,7 @@ pub fn solve(
             started: std::time::Instant::now(),
             progress: state.progress,
             tolerance,
+            cancel: state.cancel.clone(),
         };
         gmres(
             system,
@@ -485,6 +489,8 @@ struct Monitor {
     progress: bool,
     /// The relative residual asked for.
     tolerance: f64,
+    /// [`KrylovState::cancel`].
+    cancel: Cancel,
 }
 
 impl Monitor {
@@ -606,6 +612,7 @@ impl ArnoldiCycle<'_> {
         g[0] = beta;
         let mut used = 0;
         for j in 0..steps {
+            self.monitor.cancel.check()?;
             let zj = self.preconditioner.apply(&basis[j]);
             let (mut v, _) = product(self.system, self.bodies, &zj)?;
             stats.iterations += 1;

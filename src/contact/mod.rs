@@ -109,4 +109,7 @@ pub enum ContactError {
     },
     #[error(transparent)]
     Krylov(#[from] interface_krylov::KrylovError),
+    /// The solve's [`crate::cancel::Cancel`] token was cancelled.
+    #[error(transparent)]
+    Cancelled(#[from] crate::cancel::Cancelled),
 }

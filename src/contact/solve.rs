@@ -168,7 +168,7 @@ impl<'a> ContactSolver<'a> {
         let operators = pair(problem, [0.0; 3])?;
         Ok(Self {
             problem,
-            solver: *solver,
+            solver: solver.clone(),
             body1,
             body2,
             stats1,
@@ -238,6 +238,7 @@ impl<'a> ContactSolver<'a> {
         };
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.problem.settings.max_iterations {
+            self.solver.cancel.check()?;
             if let Some(end) = self.iteration(&mut state, iteration, load_factor)? {
                 status = end;
                 break;

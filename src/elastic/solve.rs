@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::{ElasticProblem, ElasticSolution, ProblemError, SolveStats};
+use crate::cancel::Cancel;
 use crate::fem::assembly::{assemble_stiffness, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::stress::cell_fields;
@@ -17,7 +18,7 @@ use crate::linalg::{
 use faer::sparse::SparseColMat;
 
 /// How to solve; every field has a documented default.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSettings {
     /// The body solver: `"auto"` (default), `"cholesky"` or `"cg-amg"` (PETSc; see
@@ -47,6 +48,11 @@ pub struct SolverSettings {
     /// `logging`, never to the terminal).
     #[serde(skip)]
     pub progress_line: bool,
+    /// Stops a contact solve at its next load step, active-set iteration or interface GMRES
+    /// iteration once cancelled, with `ContactError::Cancelled` (default: a token nobody
+    /// cancels; the Python module sets it on Ctrl-C).
+    #[serde(skip)]
+    pub cancel: Cancel,
 }
 
 impl SolverSettings {
@@ -71,6 +77,7 @@ impl Default for SolverSettings {
             residual_tolerance: 1e-8,
             verbose: true,
             progress_line: true,
+            cancel: Cancel::default(),
         }
     }
 }

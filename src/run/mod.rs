@@ -43,6 +43,19 @@ pub enum RunError {
     Output(#[from] OutputError),
 }
 
+impl RunError {
+    /// Whether the run stopped because its [`crate::cancel::Cancel`] token was cancelled.
+    pub fn is_cancelled(&self) -> bool {
+        matches!(
+            self,
+            RunError::Contact {
+                source: ContactError::Cancelled(_),
+                ..
+            }
+        )
+    }
+}
+
 /// What a run wrote.
 pub struct RunReport {
     pub output_dir: PathBuf,

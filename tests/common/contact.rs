@@ -21,7 +21,7 @@ pub fn solve_with(case: &CaseFile, loop_only: bool) -> Result<ContactSolution, S
         .expect("the case has a [contact] table");
     let settings = SolverSettings {
         verbose: false,
-        ..case.solver
+        ..case.solver.clone()
     };
     if loop_only {
         let mut solver = ContactSolver::new(&problem, &settings).map_err(|e| e.to_string())?;

@@ -1,0 +1,58 @@
+"""Every load step is reachable (`Result.steps`), and `raise_for_status()` fails on any step that
+failed, not only on the last one."""
+
+import numpy as np
+import pytest
+
+import internodes
+from conftest import REPO
+
+MESH = REPO / "tests" / "fixtures" / "half_disc_on_block.msh"
+
+
+def case(load_steps):
+    return internodes.Case.from_dict({
+        "contact": {"bodies": ["disc", "block"], "surfaces": ["disc_contact", "block_contact"],
+                    "load_steps": load_steps},
+        "body": [{"name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
+                  "dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02}]},
+                 {"name": "block", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
+                  "dirichlet": [{"group": "block_base", "ux": 0.0, "uy": 0.0}]}]})
+
+
+def test_each_step_has_its_own_record_as_in_the_summary():
+    result = internodes.solve(case([0.5, 1.0]), mesh=internodes.Mesh.from_msh(MESH))
+    steps, records = result.steps, result.summary["contact"]["steps"]
+    assert [s.step for s in steps] == [1, 2] and [s.load_factor for s in steps] == [0.5, 1.0]
+    for step, record in zip(steps, records):
+        assert step.status == record["status"] and step.accurate == record["accurate"]
+        assert step.failed_checks == record["failed_checks"]
+        assert np.array_equal(step.force_primary, record["force_primary"])
+        assert np.array_equal(step.force_secondary, record["force_secondary"])
+        assert step.iterations == record["iterations"] and step.hertz_a == record["hertz_a"]
+    # Half the approach, about half the force (Hertz: a little less than linear in 2D).
+    assert 0.3 < steps[0].force_primary[1] / steps[1].force_primary[1] < 0.5
+    assert steps[-1].status == result.status
+    result.raise_for_status()
+    assert "Step(1, load_factor=0.5, status=converged" in repr(steps[0])
+
+
+def test_a_failed_earlier_step_fails_raise_for_status():
+    # At 1% of the approach the contact zone spans too few spacings: that step's accuracy
+    # report fails its resolution check, while the last step, the answer, passes.
+    result = internodes.solve(case([0.01, 1.0]), mesh=internodes.Mesh.from_msh(MESH))
+    first, last = result.steps
+    assert (first.solved, first.accurate, first.failed_checks) == (True, False, ["resolution"])
+    assert (last.solved, last.accurate) == (True, True)
+    assert result.exit_code == 3  # the command line's status: the worst step's
+    with pytest.raises(internodes.NotSolvedError,
+                       match=r"accuracy report of an earlier one failed: step 1 \(load factor 0.01\): "
+                             r"converged, failed: resolution"):
+        result.raise_for_status()
+
+
+def test_a_case_without_contact_has_no_steps():
+    single = internodes.Case.from_dict({"body": [{
+        "name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
+        "dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02}]}]})
+    assert internodes.solve(single, mesh=internodes.Mesh.from_msh(MESH)).steps == []
