@@ -9,10 +9,11 @@
 #   libopenblas0-pthread   : an optimized BLAS for dolfinx and PETSc (the benchmarks time dolfinx's
 #                            solvers against ours; Debian's reference BLAS would slow MUMPS)
 #   python3-venv python3-pytest : the Python module's environment (build/venv) and its tests
+#   python3-meshio         : the Python module's to_meshio() export and its test
 #   fonts-dejavu-core      : the font of force_displacement.png (plotters draws text with a font
 #                            file read at run time; without it the run skips the PNG and warns)
 set -euo pipefail
-packages=(pkg-config libhdf5-dev libpetsc-real3.18-dev libopenmpi-dev libopenblas0-pthread fonts-dejavu-core gmsh python3-gmsh python3-dolfinx python3-h5py python3-scipy python3-matplotlib python3-venv python3-pytest)
+packages=(pkg-config libhdf5-dev libpetsc-real3.18-dev libopenmpi-dev libopenblas0-pthread fonts-dejavu-core gmsh python3-gmsh python3-dolfinx python3-h5py python3-scipy python3-matplotlib python3-venv python3-pytest python3-meshio)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

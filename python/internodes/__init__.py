@@ -17,6 +17,7 @@ import logging
 
 from ._internodes import *  # noqa: F403 (the native module's classes and solve())
 from ._internodes import __version__
+from .export import to_meshio
 
 # A library's logger stays silent until the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -7,6 +7,8 @@ from typing import Any, Mapping, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
+from .summary import Summary
+
 __all__ = [
     "__version__",
     "BodyResult",
@@ -194,8 +196,9 @@ class Result:
     """A solved case."""
 
     @property
-    def summary(self) -> dict[str, Any]:
-        """What summary.json holds (a new dict at each access)."""
+    def summary(self) -> Summary:
+        """What summary.json holds (a new dict at each access; its keys typed in
+        internodes.summary)."""
     @property
     def status(self) -> Optional[str]:
         """The contact status ("converged", "no-contact", "iteration-limit", ...), or None when

@@ -1,0 +1,174 @@
+"""Typed views of ``Result.summary`` (what ``summary.json`` holds), for editors and type checkers.
+
+At run time the summary is a plain ``dict``; these ``TypedDict`` classes only name its keys and
+their types, with what each means (docs/output.md has the file's description)::
+
+    from internodes.summary import Summary
+    summary: Summary = result.summary
+    reason = summary["contact"]["primary_choice"]["reason"]
+"""
+
+from typing import Optional, TypedDict
+
+
+class _CheckNote(TypedDict, total=False):
+    note: str
+    """What the figure was compared with, when that is not a node (an agreement check)."""
+
+
+class Check(_CheckNote):
+    """One residual check or accuracy indicator: its figure against its tolerance."""
+
+    name: str
+    """e.g. "penetration", "secondary sag", "primary agreement"."""
+    value: float
+    tolerance: float
+    passed: bool
+    body: Optional[str]
+    """The body of the worst node, where the check is nodal."""
+    node_tag: Optional[int]
+    """The gmsh tag of the worst node."""
+
+
+class Coverage(TypedDict, total=False):
+    """One source of error in what a user reads, and the indicators that estimated it."""
+
+    error: str
+    """"interface coupling", "contact zone resolution" or "bulk discretization"."""
+    affects: str
+    estimated_by: list[str]
+    """The indicators of this run that estimate it (names of `Check`)."""
+    not_estimated: str
+    """Present when something of it was not estimated: what, and how to estimate it."""
+
+
+class Solved(TypedDict):
+    """The residual checks of the discrete problem (the status is converged only if all pass)."""
+
+    passed: bool
+    checks: list[Check]
+
+
+class Accuracy(TypedDict):
+    """The accuracy report: its indicators, and which errors they cover."""
+
+    passed: bool
+    indicators: list[Check]
+    coverage: list[Coverage]
+
+
+class PrimaryChoice(TypedDict):
+    """Which body carries the multiplier, chosen how and why."""
+
+    mode: str
+    """"auto" or "explicit"."""
+    reason: str
+
+
+class TransferChoice(TypedDict):
+    """How the secondary's contact force is computed, and why."""
+
+    transfer: str
+    """"interpolation" or "conservative"."""
+    reason: str
+
+
+class HertzFit(TypedDict):
+    """The Hertz ellipse fitted to the primary's contact pressure."""
+
+    a: float
+    """Contact radius (3D) or half-width (2D)."""
+    p0: float
+    """Peak pressure."""
+    center: list[float]
+
+
+class LinearSolvers(TypedDict):
+    """The solvers that ran (auto resolved)."""
+
+    body: str
+    """"cholesky" or "cg-amg"."""
+    interface: str
+    """"krylov" or "schur"."""
+    krylov_failure: Optional[str]
+    """Why an auto solve left GMRES for the dense Schur complement, if it did."""
+
+
+class StepRecord(TypedDict):
+    """How one load step ended (also a row of force_displacement.csv)."""
+
+    step: int
+    load_factor: float
+    status: str
+    iterations: int
+    force_primary: list[float]
+    force_secondary: list[float]
+    force_imbalance: float
+    hertz_a: Optional[float]
+    hertz_p0: Optional[float]
+    seconds: float
+    accurate: bool
+    failed_checks: list[str]
+
+
+class Contact(TypedDict):
+    """The contact record: status, choices, checks, forces and history of the last load step."""
+
+    status: str
+    """"converged", "no-contact", "not-solved", "stalled", "unstable", "cycling" or
+    "iteration-limit"."""
+    primary: str
+    secondary: str
+    primary_choice: PrimaryChoice
+    transfer: TransferChoice
+    solved: Solved
+    accuracy: Accuracy
+    settings: dict[str, object]
+    """The [contact] settings used (docs/case-file.md)."""
+    linear_solvers: LinearSolvers
+    force_primary: list[float]
+    """Total contact force on the primary body."""
+    force_secondary: list[float]
+    force_imbalance: float
+    """|F1 + F2| / |F1|."""
+    active_primary: int
+    active_secondary: int
+    max_pressure: float
+    max_tangential_traction: float
+    hertz_fit: Optional[HertzFit]
+    iterations: list[dict[str, object]]
+    """The last load step's active-set iterations."""
+    steps: list[StepRecord]
+
+
+class Body(TypedDict):
+    """One body: material, sizes, reactions and its solve."""
+
+    name: str
+    youngs_modulus: float
+    poisson_ratio: float
+    num_nodes: int
+    num_cells: int
+    num_dofs: int
+    node_offset: int
+    cell_offset: int
+    reactions: dict[str, list[float]]
+    """The reaction force on each Dirichlet group."""
+    solve: dict[str, object]
+
+
+class _SummaryOptional(TypedDict, total=False):
+    contact: Contact
+    """Present when the case has a [contact] table."""
+    peak_memory_mb: float
+    """The process's peak resident memory, where Linux reports it."""
+
+
+class Summary(_SummaryOptional):
+    """What ``summary.json`` holds."""
+
+    case: str
+    mesh: str
+    dimension: int
+    bodies: list[Body]
+    timings: list[object]
