@@ -10,10 +10,10 @@ use internodes::cancel::Cancel;
 use internodes::case::Case;
 use internodes::contact::{ContactError, solve_contact};
 use internodes::elastic::SolverSettings;
-use internodes::mesh::read_msh;
+use internodes::mesh::{Mesh, read_msh};
 
-#[test]
-fn a_cancelled_token_stops_the_contact_solve() {
+/// The half-disc on the block, its mesh, and quiet solver settings with a fresh token.
+fn half_disc_with_a_token() -> (Case, Mesh, SolverSettings) {
     let (_dir, path) = half_disc_on_block().write();
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
@@ -22,6 +22,12 @@ fn a_cancelled_token_stops_the_contact_solve() {
         cancel: Cancel::new(),
         ..case.solver.clone()
     };
+    (case, mesh, settings)
+}
+
+#[test]
+fn a_cancelled_token_stops_the_contact_solve() {
+    let (case, mesh, settings) = half_disc_with_a_token();
     let steps = [0.25, 0.5, 0.75, 1.0];
     // Not cancelled: solved.
     let problem = case.contact_problem(&mesh).unwrap().unwrap();
@@ -36,14 +42,7 @@ fn a_cancelled_token_stops_the_contact_solve() {
 
 #[test]
 fn a_token_cancelled_from_another_thread_stops_a_running_solve() {
-    let (_dir, path) = half_disc_on_block().write();
-    let case = Case::load(&path).unwrap();
-    let mesh = read_msh(&case.mesh).unwrap();
-    let settings = SolverSettings {
-        verbose: false,
-        cancel: Cancel::new(),
-        ..case.solver.clone()
-    };
+    let (case, mesh, settings) = half_disc_with_a_token();
     // Many load steps, so that the solve outlasts the wait below by far.
     let steps: Vec<f64> = (1..=2000).map(|k| f64::from(k) / 2000.0).collect();
     let token = settings.cancel.clone();
