@@ -1,5 +1,5 @@
 //! Cancelling a solve from outside it: a [`Cancel`] token shared with the caller, which the
-//! solve checks at safe points (each load step, each active-set iteration, each interface GMRES
+//! solve checks at safe points (each load step, each active-set iteration, each coupled GMRES
 //! iteration) and answers with [`Cancelled`]. A cancelled solve leaves nothing behind: its
 //! error unwinds the solve like any other.
 

@@ -12,7 +12,7 @@ use internodes::case::{Case, CaseError};
 use internodes::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
 use internodes::fem::Material;
 use internodes::fem::loads::{PressureField, SurfaceLoad};
-use internodes::linalg::{AUTO_CG_AMG_MIN_DOFS_CONTACT, BodySolverKind};
+use internodes::linalg::BodySolverKind;
 use internodes::mesh::BodyMesh;
 
 fn material() -> Material {
@@ -106,14 +106,6 @@ fn auto_is_cholesky_for_small_bodies_and_in_2d() {
     );
     assert_eq!(
         BodySolverKind::Auto.resolve(2, 10_000_000),
-        BodySolverKind::Cholesky
-    );
-    assert_eq!(
-        BodySolverKind::Auto.resolve_for_contact(3, AUTO_CG_AMG_MIN_DOFS_CONTACT - 1),
-        BodySolverKind::Cholesky
-    );
-    assert_eq!(
-        BodySolverKind::Auto.resolve_for_contact(2, 10_000_000),
         BodySolverKind::Cholesky
     );
     assert_eq!(

@@ -54,7 +54,7 @@ class Cancelled(Exception):
 @final
 class Cancel:
     """A token that cancels the solves given it (solve(case, cancel=token)) from another thread,
-    at their next load step, active-set iteration or interface GMRES iteration. A cancelled
+    at their next load step, active-set iteration or coupled GMRES iteration. A cancelled
     token stays cancelled."""
 
     def __init__(self) -> None: ...

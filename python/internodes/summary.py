@@ -89,9 +89,12 @@ class LinearSolvers(TypedDict):
     body: str
     """"cholesky" or "cg-amg"."""
     interface: str
-    """"krylov" or "schur"."""
+    """"krylov" (one preconditioned GMRES on the whole coupled system) or "schur"."""
     krylov_failure: Optional[str]
     """Why an auto solve left GMRES for the dense Schur complement, if it did."""
+    body_applications: Optional[list[int]]
+    """Krylov path: applications of each body's preconditioner block over the whole solve
+    (AMG V-cycles with cg-amg bodies), [primary, secondary]."""
 
 
 class StepRecord(TypedDict):

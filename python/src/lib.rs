@@ -54,7 +54,7 @@ create_exception!(
     Cancelled,
     PyException,
     "Raised by solve() when its Cancel token was cancelled (from another thread): the solve \
-     stopped at its next load step, active-set iteration or interface GMRES iteration."
+     stopped at its next load step, active-set iteration or coupled GMRES iteration."
 );
 create_exception!(
     internodes,
@@ -616,7 +616,7 @@ fn solve(
 }
 
 /// A token that cancels the solves given it (`solve(case, cancel=token)`) from another thread:
-/// `token.cancel()` stops them at their next load step, active-set iteration or interface GMRES
+/// `token.cancel()` stops them at their next load step, active-set iteration or coupled GMRES
 /// iteration, and they raise `Cancelled`. A cancelled token stays cancelled.
 #[pyclass(module = "internodes", frozen)]
 struct Cancel {

@@ -1,21 +1,19 @@
 //! How the coupled system of an iteration is solved, behind one interface.
 //!
-//! - [`CoupledSolver::Krylov`]: each body's constrained stiffness is factored once
-//!   (sparse Cholesky; or CG + AMG set up once, with `[solver] body = "cg-amg"`: see
-//!   `crate::linalg::BodySolver`) for the whole contact solve, and every iteration solves
-//!   only the interface problem by block elimination:
-//!   `z = K^-1 f`, `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`,
-//!   the middle equation by preconditioned GMRES ([`super::interface_krylov`]): one solve per
-//!   body per product, nothing per multiplier, warm-started from the last iteration's
-//!   tractions.
-//! - [`CoupledSolver::Schur`]: the same elimination with `C K^-1 B = s C Y` formed densely
-//!   from each body's responses `Y_k` to the multipliers ([`super::compliance`]), computed
-//!   once per multiplier (`dim` solves per primary node) and reused by every later iteration
-//!   and load step; the Schur complement is factored by dense LU with partial pivoting
-//!   (interfaces have hundreds to a few thousand multipliers). Each iteration then costs two
-//!   single-column solves per body, plus `dim` solves per body for each node that becomes
-//!   active for the first time. With CG + AMG body solves each of those columns is a full CG
-//!   solve: `schur` then runs the Krylov path.
+//! Each body's solver is set up once for the whole contact solve (a sparse Cholesky factor, or
+//! PETSc's AMG: `crate::linalg::BodySolver`); then, per iteration:
+//!
+//! - [`CoupledSolver::Krylov`]: one restarted GMRES on the whole system, block-preconditioned
+//!   by one application of each body's solver and a half-space approximation of the interface
+//!   Schur complement ([`super::coupled_krylov`]), warm-started from the last solve.
+//! - [`CoupledSolver::Schur`]: the exact reference by elimination, `z = K^-1 f`,
+//!   `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`, with `C K^-1 B = s C Y`
+//!   formed densely from each body's responses `Y_k` to the multipliers
+//!   ([`super::compliance`]), computed once per multiplier (`dim` solves per primary node) and
+//!   reused by every later iteration and load step; the Schur complement is factored by dense
+//!   LU with partial pivoting (interfaces have hundreds to a few thousand multipliers). With
+//!   CG + AMG bodies each of those columns would be a whole CG solve: `schur` then runs the
+//!   Krylov path.
 //! - [`CoupledSolver::Auto`]: Krylov, and Schur after a GMRES failure (below).
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
@@ -23,33 +21,13 @@
 //! # Which one: `auto`
 //!
 //! `auto` (the default) runs the Krylov path and moves to the dense Schur complement for the
-//! rest of the solve at the first GMRES failure. The Krylov path is faster wherever it was
-//! measured; the dense path is exact whatever the conditioning of the interface problem,
-//! which GMRES needs: with a stiff body named primary on a compliant one (E ratio 1e4, 2D
-//! R/600 and 3D R/45 foreign meshes), the half-space preconditioner does not tame the
-//! interface problem, and GMRES stagnated or reached its cap in 16 of 180 such runs (with
-//! `krylov` an error that names it; with `auto` the dense path then solves them, as `schur`
-//! does). A failed GMRES solve costs at most its iteration cap in products, which is why the
-//! fallback is for the rest of the solve and not retried per iteration.
-//!
-//! Measured 2026-11-26 on this project's 2-core machine (shared, so within 2x), the contact
-//! benchmark's hemisphere on block in one step: wall seconds of the whole process and peak
-//! memory; every run converged after the same 8 (99k) and 9 (217k) active-set iterations,
-//! with the same active nodes and contact force to the 7 digits printed:
-//!
-//! | DOFs | schur + Cholesky | krylov + Cholesky | krylov + CG + AMG |
-//! |---|---|---|---|
-//! | 98,700 | 27 s, 1.7 GB | 19.6 s, 1.3 GB | 52 s, 0.6 GB |
-//! | 216,537 | 133 s, 4.4 GB | 42 s, 3.2 GB | 207 s, 1.2 GB |
-//!
-//! (schur from `validation/CONTACT_BENCHMARK.md` of the same day; the Krylov runs with the
-//! loose solves of `super::solve`, which cut GMRES iterations per active-set iteration from
-//! 15-25 to 2-10.) CG + AMG loses on time at these sizes: a product costs two CG solves, run
-//! one after the other because PETSc calls are serialized, where a factor costs two pairs of
-//! triangular solves. It wins on memory, which is what bounds the direct path: the factors
-//! grow like `n^(4/3)` (3.2 GB at 217k, 15 GB for one body of 677k DOFs), so `auto` bodies
-//! become CG + AMG from [`crate::linalg::AUTO_CG_AMG_MIN_DOFS_CONTACT`] dofs in the larger
-//! body (`BodySolverKind::resolve_for_contact`).
+//! rest of the solve at the first GMRES failure. The Krylov path costs per iteration about what
+//! one elastic solve of each body costs; the dense path is exact whatever the conditioning of
+//! the interface problem: with a stiff body named primary on a compliant one (E ratio 1e4), the
+//! half-space approximation may not tame it and GMRES may stagnate or reach its cap (with
+//! `krylov` an error that names it; with `auto` the dense path then solves it, as `schur`
+//! does). A failed GMRES solve costs at most its iteration cap, which is why the fallback is
+//! for the rest of the solve and not retried per iteration.
 
 use std::io::IsTerminal;
 
@@ -58,14 +36,14 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
 
 use super::compliance::SurfaceResponse;
-use super::interface_krylov::{
-    self, Bodies, KRYLOV_RTOL, KRYLOV_RTOL_OVER_BODY_RTOL, KrylovState, KrylovStats, Target,
-};
+use super::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
+use super::half_space::compliance_factor;
 use super::settings::{ContactSettings, CoupledSolver};
 use super::system::{CoupledSystem, Coupling};
 use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
+use crate::fem::Material;
 use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
 
 /// The solvers (Cholesky factors, or CG + AMG) of both bodies' constrained stiffness matrices,
@@ -74,8 +52,8 @@ use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
 pub struct BodyFactors {
     factor1: BodySolver,
     factor2: BodySolver,
-    /// CG's relative residual (`None` for factors).
-    body_rtol: Option<f64>,
+    /// The half-space compliance factor of the two materials (`super::half_space`).
+    compliance: f64,
     interface: Interface,
     /// The candidate nodes of each body, for the dense Schur path `auto` falls back to.
     fallback: Option<[Vec<usize>; 2]>,
@@ -95,9 +73,6 @@ enum Interface {
     },
     Krylov {
         state: KrylovState,
-        /// GMRES' relative residual target ([`KRYLOV_RTOL`], or
-        /// [`KRYLOV_RTOL_OVER_BODY_RTOL`] times CG's `rtol`).
-        tolerance: f64,
         /// GMRES' iteration cap per solve (`ContactSettings::krylov_max_iterations`).
         max_iterations: usize,
     },
@@ -114,11 +89,13 @@ impl Interface {
 
 impl BodyFactors {
     /// Sets up both bodies' solvers (`kind`: Cholesky or CG + AMG, resolved by the caller)
-    /// for the interface solve `contact.solver`; the response caches cover the candidate
-    /// surfaces.
+    /// for the coupled solve `contact.solver`; the response caches cover the candidate
+    /// surfaces. `materials` are the two bodies', for the half-space preconditioner.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         body1: &AssembledBody,
         body2: &AssembledBody,
+        materials: [&Material; 2],
         surface1: &ContactSurface,
         surface2: &ContactSurface,
         settings: &SolverSettings,
@@ -143,21 +120,10 @@ impl BodyFactors {
         let krylov = cg || matches!(method, CoupledSolver::Krylov | CoupledSolver::Auto);
         let sizes = [body1.f_c.len(), body2.f_c.len()];
         let interface = if krylov {
-            let tolerance = match cg {
-                true => KRYLOV_RTOL.max(KRYLOV_RTOL_OVER_BODY_RTOL * settings.rtol),
-                false => KRYLOV_RTOL,
-            };
+            let progress =
+                settings.verbose && settings.progress_line && std::io::stderr().is_terminal();
             Interface::Krylov {
-                state: {
-                    let mut state = KrylovState::new(
-                        settings.verbose
-                            && settings.progress_line
-                            && std::io::stderr().is_terminal(),
-                    );
-                    state.cancel = settings.cancel.clone();
-                    state
-                },
-                tolerance,
+                state: KrylovState::new(progress, settings.cancel.clone()),
                 max_iterations: contact.krylov_max_iterations,
             }
         } else {
@@ -168,7 +134,7 @@ impl BodyFactors {
         Ok(Self {
             factor1: factor1?,
             factor2: factor2?,
-            body_rtol: cg.then_some(settings.rtol),
+            compliance: compliance_factor(materials, dim),
             interface,
             fallback,
             fell_back: None,
@@ -191,57 +157,65 @@ impl BodyFactors {
         }
     }
 
-    /// Whether the interface problem is solved by GMRES (whose solves can stop short of
+    /// Whether the coupled system is solved by GMRES (whose solves can stop short of
     /// round-off on request: [`Self::solve`]).
     pub fn is_krylov(&self) -> bool {
         matches!(self.interface, Interface::Krylov { .. })
     }
 
+    /// Applications of each body's block of the Krylov preconditioner so far (`None` off the
+    /// Krylov path).
+    pub fn body_applications(&self) -> Option<[usize; 2]> {
+        match &self.interface {
+            Interface::Krylov { state, .. } => Some(state.body_applications),
+            Interface::Dense { .. } => None,
+        }
+    }
+
     /// Solves the coupled system of `coupling`; returns `x = [u1; u2; lambda / s]`.
     ///
-    /// `gap_tolerance` (a length), on the Krylov path only: GMRES may stop once every active
-    /// node's constraint holds its gap to within it, instead of at round-off; the caller
-    /// then owns the residual check. A GMRES failure under `auto` moves this and every later
-    /// iteration to the dense Schur complement ([`Self::fell_back`] says why).
+    /// On the Krylov path a [`Tightness::Loose`] solve stops at a relative residual the
+    /// caller's active-set decision needs, not at round-off; the caller then owns the residual
+    /// check. A GMRES failure under `auto` moves this and every later iteration to the dense
+    /// Schur complement ([`Self::fell_back`] says why).
     pub fn solve(
         &mut self,
         system: &CoupledSystem,
         coupling: &Coupling,
-        coordinates1: &[f64],
-        gap_tolerance: Option<f64>,
+        bodies: [&AssembledBody; 2],
+        tightness: Tightness,
     ) -> Result<Vec<f64>, ContactError> {
         self.last_krylov = None;
-        let (state, tolerance, max_iterations) = match &mut self.interface {
+        let (state, max_iterations) = match &mut self.interface {
             Interface::Dense {
                 response1,
                 response2,
             } => return solve_schur(system, &self.factor1, &self.factor2, response1, response2),
             Interface::Krylov {
                 state,
-                tolerance,
                 max_iterations,
-            } => (state, *tolerance, *max_iterations),
-        };
-        let bodies = Bodies {
-            solver1: &self.factor1,
-            solver2: &self.factor2,
-            rtol: self.body_rtol,
-        };
-        let target = Target {
-            relative: tolerance,
-            absolute: gap_tolerance.map_or(0.0, |gap| system.t * gap),
-            max_iterations,
+            } => (state, *max_iterations),
         };
         let dim = self.dim;
-        let solved =
-            interface_krylov::solve(system, coupling, coordinates1, dim, &bodies, state, target);
+        let solved = coupled_krylov::solve(
+            system,
+            coupling,
+            &bodies[0].coordinates,
+            dim,
+            self.compliance,
+            [&self.factor1, &self.factor2],
+            [&bodies[0].k_c, &bodies[1].k_c],
+            state,
+            tightness,
+            max_iterations,
+        );
         let stats = state.last;
         self.last_krylov = Some(stats);
         if self.verbose {
             // Over a progress line, if one was shown.
             let clear = if state.progress { "\r\x1b[2K" } else { "" };
             log::info!(
-                "{clear}    interface GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
+                "{clear}    coupled GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
                  (start {:.1e}, target {:.1e})",
                 stats.iterations,
                 stats.residual_products,
@@ -258,7 +232,7 @@ impl BodyFactors {
                 let sizes = [system.n1, system.n2];
                 self.interface = Interface::dense([&nodes1, &nodes2], dim, sizes);
                 self.fell_back = Some(failure.to_string());
-                self.solve(system, coupling, coordinates1, gap_tolerance)
+                self.solve(system, coupling, bodies, tightness)
             }
             (solved, fallback) => {
                 self.fallback = fallback;

@@ -12,8 +12,10 @@
 //! - the linear algebra of an iteration: `compliance.rs` (the bodies' responses to unit
 //!   tractions), `system.rs` (the coupled system of an active set), `interface.rs` (the
 //!   interface operators, built once over all candidates: the interpolation evaluated at each
-//!   node's closest point on the other surface, the contact normal), `interface_krylov.rs`
-//!   (the interface equation by GMRES), `coupled_solver.rs` (which solver, behind one call);
+//!   node's closest point on the other surface, the contact normal), `half_space.rs` (the
+//!   interface Schur complement approximated by two elastic half-spaces), `coupled_krylov.rs`
+//!   (the whole coupled system by one preconditioned GMRES), `coupled_solver.rs` (which
+//!   solver, behind one call);
 //! - what a solve returns: `certificate.rs` (the checks of an answer), `active_set.rs` (where
 //!   the loop starts, and its primal-dual update), `solution.rs`; `checks.rs` measures the
 //!   certificate independently of the loop's operators (the residuals that decide the status,
@@ -31,12 +33,13 @@ mod boundary;
 mod certificate;
 mod checks;
 mod compliance;
+mod coupled_krylov;
 mod coupled_solver;
 mod driver;
 mod gap;
+mod half_space;
 mod hertz;
 mod interface;
-mod interface_krylov;
 mod post;
 mod problem;
 pub mod projection;
@@ -50,8 +53,8 @@ pub mod system;
 
 pub use active_set::ActiveSet;
 pub use certificate::{Certificate, CertificateCheck, CheckKind, ErrorCoverage};
+pub use coupled_krylov::{KrylovError, KrylovFailure};
 pub use driver::{ContactRun, StepRecord, solve_contact};
-pub use interface_krylov::{KrylovError, KrylovFailure};
 pub use problem::{
     ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,
 };
@@ -104,11 +107,12 @@ pub enum ContactError {
     Inaccurate {
         residual: f64,
         tolerance: f64,
-        /// What bounds the residual when it is not round-off: the bodies' CG tolerance.
+        /// What bounds the residual when it is not round-off: the bodies' CG tolerance, on the
+        /// dense Schur fallback with CG + AMG bodies.
         advice: String,
     },
     #[error(transparent)]
-    Krylov(#[from] interface_krylov::KrylovError),
+    Krylov(#[from] coupled_krylov::KrylovError),
     /// The solve's [`crate::cancel::Cancel`] token was cancelled.
     #[error(transparent)]
     Cancelled(#[from] crate::cancel::Cancelled),

@@ -64,9 +64,9 @@ pub enum CoupledSolver {
     Schur,
     /// Sparse LU of the whole saddle-point matrix per iteration (reference).
     MonolithicLu,
-    /// Each body's solver set up once, the interface problem solved matrix-free by
-    /// preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies); a
-    /// GMRES solve that fails ends the contact solve with that error.
+    /// Each body's solver set up once, the whole coupled system solved by one
+    /// block-preconditioned GMRES per iteration (also what `schur` runs with CG + AMG bodies);
+    /// a GMRES solve that fails ends the contact solve with that error.
     Krylov,
 }
 
@@ -85,9 +85,9 @@ impl CoupledSolver {
 /// The largest `max_iterations` accepted.
 const MAX_ITERATIONS_CAP: usize = 1000;
 
-/// The largest `krylov_max_iterations` accepted: GMRES keeps at most 150 vectors of the
-/// interface's size between restarts, and each iteration is one solve per body, so a cap
-/// beyond this is a run of hours waiting for a failure.
+/// The largest `krylov_max_iterations` accepted: each iteration is one V-cycle per body,
+/// and the solves measured take at most a few dozen, so a cap beyond this is a run of hours
+/// waiting for a failure.
 const KRYLOV_MAX_ITERATIONS_CAP: usize = 10_000;
 
 /// Settings of the active-set loop and its certificate; every field has a documented default,
@@ -105,8 +105,8 @@ pub struct ContactSettings {
     pub solver: CoupledSolver,
     /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
     pub max_iterations: usize,
-    /// Cap on the interface GMRES iterations of one coupled solve (default 600; the solves
-    /// measured take 1 to 16 per active-set iteration, a few dozen when started cold).
+    /// Cap on the GMRES iterations of one coupled solve (default 600; the solves
+    /// measured take 0 to 30).
     /// Reaching it fails that solve: under `solver = "auto"` the solve and every later one
     /// move to the dense Schur complement (recorded in `summary.json`), under `"krylov"` the
     /// run ends with an error naming it. The same cap as PETSc's `ksp_max_it`: it bounds the

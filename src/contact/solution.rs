@@ -157,11 +157,16 @@ pub struct HertzFit {
 pub struct LinearSolvers {
     /// Each body's: `"cholesky"` or `"cg-amg"` (`"monolithic-lu"` factors the whole system).
     pub body: &'static str,
-    /// The interface problem's: `"krylov"`, `"schur"` or `"monolithic-lu"`.
+    /// The coupled system's: `"krylov"` (one preconditioned GMRES on the whole system),
+    /// `"schur"` (the dense interface Schur complement) or `"monolithic-lu"`.
     pub interface: &'static str,
     /// Why an `auto` solve left GMRES for the dense Schur complement (then `interface` is
     /// `"schur"` from that iteration on).
     pub krylov_failure: Option<String>,
+    /// On the Krylov path, the applications of each body's block of the preconditioner over
+    /// the whole solve, `[primary, secondary]`, all load steps: one AMG V-cycle each with
+    /// `"cg-amg"` bodies, one pair of triangular solves with `"cholesky"`.
+    pub body_applications: Option<[usize; 2]>,
 }
 
 /// Everything a contact solve produces.

@@ -69,8 +69,10 @@ use std::time::Instant;
 
 use super::active_set::{ActiveSet, Update};
 use super::checks::{certify, contact_status};
+use super::coupled_krylov::Tightness;
 use super::coupled_solver::{self, BodyFactors};
 use super::gap::{GapRow, gap_rows, geometric_gaps};
+use super::half_space::{compliance_factor, predicted_set};
 use super::interface::{Constraint, InterfaceOperators};
 use super::post::{self, LastIterate};
 use super::safeguard::{Safeguard, Step};
@@ -147,13 +149,22 @@ impl<'a> ContactSolver<'a> {
         let body1 = assemble(&problem.primary, &mut stats1, false)?;
         let body2 = assemble(&problem.secondary, &mut stats2, false)?;
         let dofs = body1.f_c.len().max(body2.f_c.len());
-        let kind = solver.body.resolve_for_contact(s1.dim, dofs);
+        let kind = solver.body.resolve(s1.dim, dofs);
         let factors = match problem.settings.solver {
             CoupledSolver::MonolithicLu => None,
             _ => {
                 let start = Instant::now();
-                let factors =
-                    BodyFactors::new(&body1, &body2, s1, s2, solver, kind, &problem.settings)?;
+                let materials = [&problem.primary.material, &problem.secondary.material];
+                let factors = BodyFactors::new(
+                    &body1,
+                    &body2,
+                    materials,
+                    s1,
+                    s2,
+                    solver,
+                    kind,
+                    &problem.settings,
+                )?;
                 if solver.verbose {
                     let what = match kind {
                         BodySolverKind::CgAmg => "CG + AMG set-up",
@@ -186,6 +197,7 @@ impl<'a> ContactSolver<'a> {
                 body: CoupledSolver::MonolithicLu.name(),
                 interface: CoupledSolver::MonolithicLu.name(),
                 krylov_failure: None,
+                body_applications: None,
             },
             Some(factors) => LinearSolvers {
                 body: self.body_solver.name(),
@@ -194,6 +206,7 @@ impl<'a> ContactSolver<'a> {
                     false => CoupledSolver::Schur.name(),
                 },
                 krylov_failure: factors.fell_back.clone(),
+                body_applications: factors.body_applications(),
             },
         }
     }
@@ -362,6 +375,15 @@ impl ContactSolver<'_> {
                 state.safeguard = Safeguard::default();
                 Step::Solve(state.active.clone())
             }
+            // The first iteration of a solve goes on with the set the half-space model
+            // predicts, rather than with every penetrating node.
+            Step::Solve(next)
+                if iteration == 1
+                    && !update.penetrating.is_empty()
+                    && problem.settings.formulation == Formulation::Frictionless =>
+            {
+                Step::Solve(self.predicted(&next, &update, &nodes, &solution, &coupling, &gaps))
+            }
             step => step,
         };
         let residual = solution.relative_residual;
@@ -377,6 +399,47 @@ impl ContactSolver<'_> {
             log::info!("{}", record.line());
         }
         Ok(state.advance(record, (coupling, solution), step))
+    }
+
+    /// The active set the half-space model predicts (`super::half_space::predicted_set`) from
+    /// the iterate `solution` on the active `nodes` with its `coupling`, over the nodes the
+    /// update keeps or adds (`next`) and those it removes; `next` itself if the model predicts
+    /// no contact.
+    fn predicted(
+        &self,
+        next: &BTreeSet<usize>,
+        update: &Update,
+        nodes: &[usize],
+        solution: &CoupledSolution,
+        coupling: &Coupling,
+        gaps: &[f64],
+    ) -> BTreeSet<usize> {
+        let problem = self.problem;
+        let s1 = &problem.primary_surface;
+        let mut pressure = vec![0.0; s1.len()];
+        for ((&i, t), n) in nodes.iter().zip(&solution.traction).zip(&coupling.normals) {
+            pressure[i] = -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]);
+        }
+        let mut candidates: BTreeSet<usize> = next.clone();
+        candidates.extend(update.tension.iter().map(|&(i, _)| i));
+        let candidates: Vec<usize> = candidates.into_iter().collect();
+        let materials = [&problem.primary.material, &problem.secondary.material];
+        let c0 = compliance_factor(materials, s1.dim);
+        let predicted: BTreeSet<usize> = predicted_set(s1, &candidates, gaps, &pressure, c0)
+            .into_iter()
+            .collect();
+        if self.solver.verbose {
+            log::info!(
+                "  half-space prediction: {} nodes active next (the update's {})",
+                predicted.len(),
+                next.len()
+            );
+        }
+        if predicted.is_empty() {
+            next.clone()
+        } else {
+            predicted
+        }
     }
 
     /// The tied corrections of the current operators at `solution`, whose geometric gaps are
@@ -411,8 +474,8 @@ impl ContactSolver<'_> {
     /// solve; the gaps of every primary candidate, geometric (the search) and linearized at
     /// the iterate (into `rows`), and how far the active nodes' pairing has slid; the
     /// primal-dual active set update. On the Krylov path the solve is first loose
-    /// ([`LOOSE_GAP`]) and solved again exactly when its update would keep the active set or
-    /// return to one seen before. The time of each phase is added to `seconds`.
+    /// ([`Tightness::Loose`]) and solved again tightly when its update would keep the active
+    /// set or return to one seen before: no answer, status or check rests on a loose solve. The time of each phase is added to `seconds`.
     #[allow(clippy::too_many_arguments)]
     fn iterate(
         &mut self,
@@ -428,13 +491,15 @@ impl ContactSolver<'_> {
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
         let nodes: Vec<usize> = active.iter().copied().collect();
         let mut loose = self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
-        let h = (nodes.iter().map(|&i| s1.spacing[i])).fold(f64::INFINITY, f64::min);
-        let loose_gap = LOOSE_GAP * settings.penetration_tolerance * h;
         let mut krylov_iterations = None;
         loop {
             let solution = timed(&mut seconds.solve, || {
-                let gap_tolerance = (loose && loose_gap.is_finite()).then_some(loose_gap);
-                self.coupled_solve(coupling, load_factor, gap_tolerance)
+                let tightness = if loose {
+                    Tightness::Loose
+                } else {
+                    Tightness::Tight
+                };
+                self.coupled_solve(coupling, load_factor, tightness)
             })?;
             if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
                 *krylov_iterations.get_or_insert(0) += stats.iterations;
@@ -512,29 +577,30 @@ impl ContactSolver<'_> {
         Ok(())
     }
 
-    /// The coupled system of `coupling`, solved and checked by its relative residual; or,
-    /// with a `gap_tolerance` (a length; Krylov path), solved until every active node's gap
-    /// is held to it, its residual only recorded.
+    /// The coupled system of `coupling`, solved and checked by its relative residual; or, a
+    /// [`Tightness::Loose`] solve on the Krylov path, its residual only recorded.
     fn coupled_solve(
         &mut self,
         coupling: &Coupling,
         load_factor: f64,
-        gap_tolerance: Option<f64>,
+        tightness: Tightness,
     ) -> Result<CoupledSolution, ContactError> {
         let dim = self.problem.primary_surface.dim;
         let system = CoupledSystem::assemble(&self.body1, &self.body2, coupling, dim, load_factor)?;
         let x = match self.factors.as_mut() {
             None => coupled_solver::solve_monolithic(&system, &self.body1, &self.body2)?,
             Some(factors) => {
-                factors.solve(&system, coupling, &self.body1.coordinates, gap_tolerance)?
+                factors.solve(&system, coupling, [&self.body1, &self.body2], tightness)?
             }
         };
-        let loose =
-            gap_tolerance.is_some() && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
+        let loose = tightness == Tightness::Loose
+            && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let residual = system.relative_residual(&self.body1, &self.body2, &x);
         if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
+            // CG solves to `rtol` remain only in the dense Schur fallback of `auto`.
+            let dense = !self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
             let advice = match self.body_solver {
-                BodySolverKind::CgAmg => format!(
+                BodySolverKind::CgAmg if dense => format!(
                     "; the bodies' CG + AMG solves stop at [solver] rtol = {:.0e}, which bounds \
                      it: lower rtol (default 1e-10) or raise residual_tolerance",
                     self.solver.rtol
@@ -564,15 +630,6 @@ struct Iterate {
     /// GMRES iterations of the solves (Krylov path).
     krylov_iterations: Option<usize>,
 }
-
-/// A loose interface solve holds every active node's gap to this fraction of the penetration
-/// tolerance `tol_p h` (the smallest spacing of the active nodes). The update only reads gaps
-/// against `tol_p h` (a node penetrating beyond it joins the active set) and the signs of the
-/// pressures, so an iterate that is about to change the active set needs no more: its exact
-/// solve would be thrown away with the set. The iteration that keeps the set, and so may
-/// end the loop, is solved again to round-off (from the loose answer) before it is judged:
-/// no answer, status or check rests on a loose solve.
-const LOOSE_GAP: f64 = 0.1;
 
 /// Runs `f`, adding its wall-clock seconds to `slot`.
 fn timed<T>(slot: &mut f64, f: impl FnOnce() -> T) -> T {

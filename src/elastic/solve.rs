@@ -48,7 +48,7 @@ pub struct SolverSettings {
     /// `logging`, never to the terminal).
     #[serde(skip)]
     pub progress_line: bool,
-    /// Stops a contact solve at its next load step, active-set iteration or interface GMRES
+    /// Stops a contact solve at its next load step, active-set iteration or coupled GMRES
     /// iteration once cancelled, with `ContactError::Cancelled` (default: a token nobody
     /// cancels; the Python module sets it on Ctrl-C).
     #[serde(skip)]

@@ -15,10 +15,12 @@
 //! 875,562 dofs (2026-11-26, fastest of 2 runs, same machine and load as below), so `auto`
 //! keeps Cholesky in 2D.
 //!
-//! A contact solve takes Cholesky for `auto` up to [`AUTO_CG_AMG_MIN_DOFS_CONTACT`] dofs in
-//! its larger body: it solves a few hundred right-hand sides (the interface GMRES products),
-//! which a factor does for the price of two triangular solves each and CG for a full
-//! iterative solve each; above, the factors no longer fit in memory.
+//! A contact solve resolves `auto` the same way on its larger body: its coupled Krylov solve
+//! applies each body's solver once per iteration, as one CG iteration does (a V-cycle, or the
+//! factor's two triangular solves), so the single-body crossover holds. Measured 2026-11-28 on
+//! the hemisphere on block, one step, 8 active-set iterations (whole process, a machine loaded
+//! by other work): 6.8 s against Cholesky's 5.9 s at 31k DOFs, 15.6 s and 0.62 GB against
+//! 18.0 s and 1.27 GB at 99k.
 
 use faer::sparse::SparseColMat;
 use serde::{Deserialize, Serialize};
@@ -64,15 +66,6 @@ pub enum BodySolverKind {
 /// factor's `n^2` work and `n^(4/3)` memory lose to CG + AMG's `O(n)`.
 pub const AUTO_CG_AMG_MIN_DOFS_3D: usize = 30_000;
 
-/// From this many dofs in the larger body on, `auto` solves the bodies of a 3D contact problem
-/// by CG + AMG (when built with PETSc). A contact solve spends a few hundred body solves
-/// (GMRES products), so a factor's cheap repeated solves win on time as long as the factors
-/// fit: on the hemisphere on block (`crate::contact::coupled_solver`'s table, 2026-11-26)
-/// Cholesky bodies took 42 s and 3.2 GB at 216,537 dofs (larger body 116,733) where CG + AMG
-/// took 207 s and 1.2 GB. Factor memory grows like `n^(4/3)`: about 8 to 9 GB for two bodies
-/// of this size, a third of this project's 24 GiB machine; one body of 676,719 dofs took 15 GB.
-pub const AUTO_CG_AMG_MIN_DOFS_CONTACT: usize = 250_000;
-
 /// Whether this binary can solve by CG + AMG.
 pub const CG_AMG_AVAILABLE: bool = cfg!(feature = "petsc");
 
@@ -82,20 +75,6 @@ impl BodySolverKind {
     pub fn resolve(self, dim: usize, num_dofs: usize) -> Self {
         match self {
             Self::Auto if CG_AMG_AVAILABLE && dim == 3 && num_dofs >= AUTO_CG_AMG_MIN_DOFS_3D => {
-                Self::CgAmg
-            }
-            Self::Auto => Self::Cholesky,
-            kind => kind,
-        }
-    }
-
-    /// The solver `auto` stands for in a contact solve whose larger body has `num_dofs`
-    /// dofs (see [`AUTO_CG_AMG_MIN_DOFS_CONTACT`]).
-    pub fn resolve_for_contact(self, dim: usize, num_dofs: usize) -> Self {
-        match self {
-            Self::Auto
-                if CG_AMG_AVAILABLE && dim == 3 && num_dofs >= AUTO_CG_AMG_MIN_DOFS_CONTACT =>
-            {
                 Self::CgAmg
             }
             Self::Auto => Self::Cholesky,
@@ -191,6 +170,20 @@ impl BodySolver {
                 }
                 Ok(most)
             }
+        }
+    }
+
+    /// `x = P^-1 r` for the body's preconditioner in a coupled Krylov solve: the factor's exact
+    /// solve, or one AMG V-cycle.
+    pub fn precondition(&self, r: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
+        match self {
+            Self::Cholesky(factor) => {
+                x.copy_from_slice(r);
+                factor.solve_in_place(x, 1);
+                Ok(())
+            }
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.precondition(r, x),
         }
     }
 }

@@ -1,17 +1,16 @@
 //! Sparse linear algebra: fill-reducing orderings and the Cholesky factorization of a body's
 //! stiffness, the iterative alternative (PETSc CG + AMG, cargo feature `petsc`), the choice
-//! between them, plus the residual check every solve reports.
+//! between them, restarted GMRES for the coupled contact system, plus the residual check every
+//! solve reports.
 
 mod body_solver;
 mod cholesky;
+pub mod gmres;
 mod ordering;
 #[cfg(feature = "petsc")]
 pub mod petsc;
 
-pub use body_solver::{
-    AUTO_CG_AMG_MIN_DOFS_3D, AUTO_CG_AMG_MIN_DOFS_CONTACT, BodySolver, BodySolverKind,
-    CG_AMG_AVAILABLE,
-};
+pub use body_solver::{AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE};
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
 
 use faer::sparse::SparseColMat;

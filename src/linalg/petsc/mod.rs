@@ -69,6 +69,12 @@ unsafe extern "C" {
         reason: *mut c_int,
         step: *mut *const c_char,
     ) -> c_int;
+    fn internodes_cgamg_precondition(
+        solver: *mut RawCgAmg,
+        rhs: *const f64,
+        x: *mut f64,
+        step: *mut *const c_char,
+    ) -> c_int;
     fn internodes_cgamg_destroy(solver: *mut RawCgAmg);
 }
 
@@ -281,6 +287,39 @@ impl CgAmg {
                 relative_residual,
             },
         ))
+    }
+}
+
+impl CgAmg {
+    /// `x = P^-1 rhs` for GAMG's preconditioner `P` alone: one V-cycle (the smoothers are
+    /// Chebyshev polynomials with eigenvalue bounds estimated once at set-up, so the map is the
+    /// same linear one at every call).
+    pub fn precondition(&self, rhs: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
+        if rhs.len() != self.n || x.len() != self.n {
+            return Err(LinalgError::Sizes(format!(
+                "a V-cycle on {} values into {} for {} unknowns",
+                rhs.len(),
+                x.len(),
+                self.n
+            )));
+        }
+        let mut step = std::ptr::null();
+        let code = {
+            let _lock = petsc()?;
+            // SAFETY: `rhs` and `x` hold `n` values, `raw` is alive, the lock is held.
+            unsafe {
+                internodes_cgamg_precondition(
+                    self.raw.as_ptr(),
+                    rhs.as_ptr(),
+                    x.as_mut_ptr(),
+                    &mut step,
+                )
+            }
+        };
+        match code {
+            0 => Ok(()),
+            _ => Err(petsc_error(step, code)),
+        }
     }
 }
 

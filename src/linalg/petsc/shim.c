@@ -189,6 +189,23 @@ int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int6
 
 /* Solves A x = rhs from x = 0 to the relative residual rtol: the iterations, the final residual
  * norm ||rhs - A x|| and the KSPConvergedReason (positive: converged). */
+/* One application of the preconditioner alone, x = P^-1 rhs: one GAMG V-cycle. */
+int internodes_cgamg_precondition(InternodesCgAmg *s, const double *rhs, double *x, const char **step)
+{
+    PetscScalar *data;
+    PC pc;
+
+    TRY(VecGetArray(s->b, &data));
+    memcpy(data, rhs, (size_t)s->n * sizeof(double));
+    TRY(VecRestoreArray(s->b, &data));
+    TRY(KSPGetPC(s->ksp, &pc));
+    TRY(PCApply(pc, s->b, s->x));
+    TRY(VecGetArray(s->x, &data));
+    memcpy(x, data, (size_t)s->n * sizeof(double));
+    TRY(VecRestoreArray(s->x, &data));
+    return 0;
+}
+
 int internodes_cgamg_solve(InternodesCgAmg *s, const double *rhs, double *x, double rtol,
                            int64_t *iterations, double *residual_norm, int *reason,
                            const char **step)

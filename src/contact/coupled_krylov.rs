@@ -1,0 +1,391 @@
+//! The coupled system of an active-set iteration solved as a whole by one preconditioned Krylov
+//! solve (`docs/method.md` 2.6):
+//!
+//! ```text
+//! A = [ K  B ]   x = [u; lambda / s],   A x = [f; g]      (super::system)
+//!     [ C  D ]
+//! ```
+//!
+//! by restarted GMRES (`crate::linalg::gmres`; `A` is not symmetric: the constraint rows are node
+//! to segment, the transfer is RBF-based), right-preconditioned by the block upper triangular
+//!
+//! ```text
+//! P = [ K~  B  ]     P^-1 [r_u; r_l]:   y_l = S~^-1 r_l,   y_u = K~^-1 (r_u - B y_l)
+//!     [ 0   S~ ]
+//! ```
+//!
+//! with `K~^-1` one application of each body's solver (`BodySolver::precondition`: one AMG
+//! V-cycle, or the exact solve of a Cholesky factor) and `S~` the half-space approximation of the
+//! Schur complement `S = D - C K^-1 B` (`super::half_space`). With exact blocks, `A P^-1 =
+//! [I 0; C K^-1  S S~^-1]`: its eigenvalues are 1 and those of `S S~^-1`, so GMRES needs about
+//! as many iterations as on the interface problem alone; with V-cycles, about as many as CG
+//! with the same V-cycle needs on one body, since the interface and the bulk are preconditioned
+//! by blocks of their own scale. Nothing is solved exactly inside the iteration: a product is
+//! one sparse matrix-vector product, and a preconditioner application one V-cycle per body, a
+//! dense triangular solve on the multipliers and the coupling blocks.
+//!
+//! # Start and stop
+//!
+//! Every solve starts from the last one: its displacements (scaled by the ratio of the load
+//! factors, since the loads enter linearly) and its tractions mapped by node and component,
+//! projected on each multiplier's direction, `lambda_k = (e_k . t_node) / s` (a multiplier
+//! that is new starts at 0). A solve stops when the true relative residual `|[f; g] - A x| /
+//! |[f; g]|` is at most [`Tightness::relative`]: [`TIGHT_RTOL`] for an answer that may be
+//! judged, [`LOOSE_RTOL`] for an iteration whose active set is about to change
+//! (`super::solve` decides). A solve that does not get there ends in a [`KrylovError`] naming
+//! why: the iteration cap, a restart cycle that did not reduce the true residual, or a
+//! non-finite value.
+
+use std::collections::HashMap;
+use std::fmt;
+
+use rayon::prelude::*;
+use thiserror::Error;
+
+use super::ContactError;
+use super::compliance::MultiplierKey;
+use super::half_space::HalfSpace;
+use super::system::{CoupledSystem, Coupling};
+use crate::cancel::Cancel;
+use crate::linalg::BodySolver;
+use crate::linalg::gmres::{self, GmresFailure, GmresSettings, GmresStats, Operators};
+
+/// Relative residual of a solve whose answer may end the loop and be certified. Why 1e-12:
+/// the answer then matches the dense Schur complement's to 1e-10 and better in forces,
+/// displacements and pressures on the fixtures of `tests/contact_solvers.rs` (which ask for
+/// 1e-8), and it is two orders above the round-off floor of the residual of a stiffness
+/// system (`eps |A| |x| / |b|`, 1e-14 to 1e-13 on the benchmark's meshes).
+pub const TIGHT_RTOL: f64 = 1e-12;
+
+/// Relative residual of a solve whose active set is about to change: the update only reads
+/// each gap against the penetration tolerance and each pressure's sign, so an iterate that is
+/// to be thrown away with its set needs no more (the forcing term of an inexact Newton method,
+/// held constant: the active-set loop is a semismooth Newton method, whose steps need only be
+/// solved as accurately as their decisions). An iteration that keeps its set is solved again
+/// to [`TIGHT_RTOL`] from the loose answer before it is judged: no answer rests on a loose
+/// solve. Why 1e-6: six orders below the load, the gaps are held to about 1e-6 of the
+/// displacement scale, far below the penetration tolerance (1e-3 to 1e-2 of the spacing), and
+/// it saves half the iterations of a tight solve.
+pub const LOOSE_RTOL: f64 = 1e-6;
+
+/// Krylov vectors kept before a restart: 50 vectors of the whole system, 0.4 GB at a million
+/// unknowns; a solve's iteration count stays below it (a restart costs one product).
+const RESTART: usize = 50;
+
+/// How tightly one solve is asked to converge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tightness {
+    /// To [`TIGHT_RTOL`].
+    Tight,
+    /// To [`LOOSE_RTOL`].
+    Loose,
+}
+
+impl Tightness {
+    pub fn relative(self) -> f64 {
+        match self {
+            Self::Tight => TIGHT_RTOL,
+            Self::Loose => LOOSE_RTOL,
+        }
+    }
+}
+
+/// Why the coupled Krylov solve stopped without converging.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KrylovFailure {
+    /// `[contact] krylov_max_iterations` iterations were spent.
+    IterationLimit,
+    /// A restart cycle did not reduce the true residual.
+    Stagnated,
+    /// A product or the preconditioner produced a non-finite value.
+    NotFinite,
+}
+
+impl From<GmresFailure> for KrylovFailure {
+    fn from(failure: GmresFailure) -> Self {
+        match failure {
+            GmresFailure::IterationLimit => Self::IterationLimit,
+            GmresFailure::Stagnated => Self::Stagnated,
+            GmresFailure::NotFinite => Self::NotFinite,
+        }
+    }
+}
+
+impl fmt::Display for KrylovFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::IterationLimit => {
+                "iteration limit reached: [contact] krylov_max_iterations; raise it, or let \
+                 solver = \"auto\" move to the dense Schur complement"
+            }
+            Self::Stagnated => "stagnated: a restart cycle did not reduce the true residual",
+            Self::NotFinite => "a non-finite value appeared",
+        })
+    }
+}
+
+/// The coupled Krylov solve failed.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error(
+    "coupled GMRES did not converge ({reason}) after {iterations} iterations: relative \
+     residual {residual:.2e} > {tolerance:.0e}"
+)]
+pub struct KrylovError {
+    pub reason: KrylovFailure,
+    pub iterations: usize,
+    pub residual: f64,
+    pub tolerance: f64,
+}
+
+/// What the last coupled Krylov solve did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct KrylovStats {
+    /// GMRES iterations (one product with `A` and one application of `P^-1` each).
+    pub iterations: usize,
+    /// Products spent on true residuals (the starting one and one per restart cycle).
+    pub residual_products: usize,
+    /// `|[f; g] - A x| / |[f; g]|` at the end.
+    pub relative_residual: f64,
+    /// The relative residual of the starting guess.
+    pub initial_residual: f64,
+    /// The relative residual it was asked for.
+    pub tolerance: f64,
+}
+
+/// What the Krylov path keeps between active-set iterations and load steps.
+#[derive(Default)]
+pub struct KrylovState {
+    /// `[u1; u2]` of the last solve and the load factor it was solved at.
+    displacements: Option<(f64, Vec<f64>)>,
+    /// Traction of the last solve per (primary node, component), unscaled.
+    tractions: HashMap<MultiplierKey, f64>,
+    /// The last solve's figures.
+    pub last: KrylovStats,
+    /// Applications of each body's block of the preconditioner so far (one V-cycle each with
+    /// CG + AMG bodies).
+    pub body_applications: [usize; 2],
+    /// Whether a solve over [`PROGRESS_AFTER`] rewrites a progress line on the terminal.
+    pub progress: bool,
+    /// Checked at each GMRES iteration.
+    pub cancel: Cancel,
+}
+
+impl KrylovState {
+    /// Nothing kept yet; `progress` as [`KrylovState::progress`].
+    pub fn new(progress: bool, cancel: Cancel) -> Self {
+        Self {
+            progress,
+            cancel,
+            ..Self::default()
+        }
+    }
+}
+
+/// A GMRES solve running longer than this (seconds) shows its progress on one line, when
+/// [`KrylovState::progress`] is set.
+const PROGRESS_AFTER: f64 = 2.0;
+
+/// Solves the coupled `system` of `coupling` to `tightness` from the last solve kept in
+/// `state`; returns `x = [u1; u2; lambda / s]`. `c0` is the half-space compliance factor
+/// (`super::half_space::compliance_factor`), `coordinates1` body 1's node coordinates.
+#[allow(clippy::too_many_arguments)]
+pub fn solve(
+    system: &CoupledSystem,
+    coupling: &Coupling,
+    coordinates1: &[f64],
+    dim: usize,
+    c0: f64,
+    bodies: [&BodySolver; 2],
+    [k1, k2]: [&faer::sparse::SparseColMat<usize, f64>; 2],
+    state: &mut KrylovState,
+    tightness: Tightness,
+    max_iterations: usize,
+) -> Result<Vec<f64>, ContactError> {
+    let rhs = system.rhs();
+    let mut x = starting_guess(system, state);
+    let rhs_norm = gmres::norm(&rhs);
+    let tolerance = tightness.relative();
+    let mut operators = Blocks {
+        system,
+        k: [k1, k2],
+        bodies,
+        schur: HalfSpace::new(system, coupling, coordinates1, dim, c0),
+        applications: [0, 0],
+        started: std::time::Instant::now(),
+        progress: state.progress,
+        tolerance,
+        rhs_norm,
+        cancel: &state.cancel,
+        scratch: vec![0.0; system.n1 + system.n2],
+    };
+    let settings = GmresSettings {
+        tolerance: tolerance * rhs_norm,
+        max_iterations,
+        restart: RESTART,
+    };
+    let outcome = gmres::solve(&mut operators, &rhs, &mut x, settings);
+    for (total, new) in state
+        .body_applications
+        .iter_mut()
+        .zip(operators.applications)
+    {
+        *total += new;
+    }
+    let stats = outcome?;
+    let relative = |r: f64| if rhs_norm > 0.0 { r / rhs_norm } else { r };
+    state.last = KrylovStats {
+        iterations: stats.iterations,
+        residual_products: stats.residual_products,
+        relative_residual: relative(stats.residual),
+        initial_residual: relative(stats.initial_residual),
+        tolerance,
+    };
+    if let Some(failure) = stats.failure {
+        return Err(ContactError::from(KrylovError {
+            reason: failure.into(),
+            iterations: stats.iterations,
+            residual: relative(stats.residual),
+            tolerance,
+        }));
+    }
+    keep(system, &x, state);
+    Ok(x)
+}
+
+/// The last solve's displacements (scaled to this load factor) and tractions, along each
+/// multiplier's direction; an uncoupled multiplier's exact value.
+fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
+    let n = system.n1 + system.n2;
+    let mut x = match &state.displacements {
+        Some((factor, u)) if *factor != 0.0 => {
+            let scale = system.load_factor / factor;
+            u.iter().map(|u| scale * u).collect()
+        }
+        _ => vec![0.0; n],
+    };
+    x.resize(n + system.m, 0.0);
+    for (k, column) in system.columns.iter().enumerate() {
+        if system.d[k] != 0.0 {
+            x[n + k] = system.g[k] / system.d[k];
+            continue;
+        }
+        let (mut along, mut weights) = (0.0, 0.0);
+        for (key, weight) in column {
+            along += weight * state.tractions.get(key).copied().unwrap_or(0.0);
+            weights += weight * weight;
+        }
+        if weights > 0.0 {
+            x[n + k] = along / (weights * system.s);
+        }
+    }
+    x
+}
+
+/// Keeps the displacements and tractions of `x` for the next solve's start.
+fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
+    let n = system.n1 + system.n2;
+    state.displacements = Some((system.load_factor, x[..n].to_vec()));
+    state.tractions.clear();
+    for (k, column) in system.columns.iter().enumerate() {
+        for (key, weight) in column {
+            state.tractions.insert(*key, system.s * x[n + k] * weight);
+        }
+    }
+}
+
+/// The operator `A` and the block preconditioner `P^-1` of the module doc.
+struct Blocks<'a> {
+    system: &'a CoupledSystem,
+    /// Each body's constrained stiffness (symmetric).
+    k: [&'a faer::sparse::SparseColMat<usize, f64>; 2],
+    bodies: [&'a BodySolver; 2],
+    schur: HalfSpace,
+    /// Applications of each body's block.
+    applications: [usize; 2],
+    started: std::time::Instant,
+    progress: bool,
+    tolerance: f64,
+    rhs_norm: f64,
+    cancel: &'a Cancel,
+    /// `r_u - B y_l` of an application of `P^-1`.
+    scratch: Vec<f64>,
+}
+
+impl Operators for Blocks<'_> {
+    type Error = ContactError;
+
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        let system = self.system;
+        let (n1, n) = (system.n1, system.n1 + system.n2);
+        let (out_u, out_l) = out.split_at_mut(n);
+        let (out1, out2) = out_u.split_at_mut(n1);
+        rayon::join(
+            || symmetric_product(self.k[0], &x[..n1], out1),
+            || symmetric_product(self.k[1], &x[n1..n], out2),
+        );
+        for ((o, d), l) in out_l.iter_mut().zip(&system.d).zip(&x[n..]) {
+            *o = d * l;
+        }
+        for &(row, k, value) in &system.b {
+            out[row] += value * x[n + k];
+        }
+        for &(k, col, value) in &system.c {
+            out[n + k] += value * x[col];
+        }
+        Ok(())
+    }
+
+    fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        self.cancel.check()?;
+        let system = self.system;
+        let (n1, n) = (system.n1, system.n1 + system.n2);
+        let (out_u, out_l) = out.split_at_mut(n);
+        self.schur.apply(&r[n..], out_l);
+        self.scratch.copy_from_slice(&r[..n]);
+        for &(row, k, value) in &system.b {
+            self.scratch[row] -= value * out_l[k];
+        }
+        let (w1, w2) = self.scratch.split_at(n1);
+        let (out1, out2) = out_u.split_at_mut(n1);
+        let (done1, done2) = rayon::join(
+            || self.bodies[0].precondition(w1, out1),
+            || self.bodies[1].precondition(w2, out2),
+        );
+        done1
+            .and(done2)
+            .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
+        self.applications[0] += 1;
+        self.applications[1] += 1;
+        Ok(())
+    }
+
+    fn progress(&mut self, stats: &GmresStats, estimate: f64) -> Result<(), ContactError> {
+        let seconds = self.started.elapsed().as_secs_f64();
+        if self.progress && seconds > PROGRESS_AFTER {
+            let estimate = if self.rhs_norm > 0.0 {
+                estimate / self.rhs_norm
+            } else {
+                estimate
+            };
+            eprint!(
+                "\r\x1b[2K    coupled GMRES: {} iterations, residual ~{estimate:.1e} (target \
+                 {:.1e}), {seconds:.1} s",
+                stats.iterations, self.tolerance
+            );
+        }
+        Ok(())
+    }
+}
+
+/// `out = K x` for a symmetric `K` stored by compressed columns: entry `j` is column `j` dotted
+/// with `x`, so the rows are independent and computed in parallel, each in a fixed order (the
+/// same result for any number of threads).
+fn symmetric_product(k: &faer::sparse::SparseColMat<usize, f64>, x: &[f64], out: &mut [f64]) {
+    let (symbolic, values) = k.parts();
+    let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+    out.par_iter_mut().enumerate().for_each(|(j, o)| {
+        *o = (col_ptr[j]..col_ptr[j + 1])
+            .map(|p| values[p] * x[row_idx[p]])
+            .sum();
+    });
+}
