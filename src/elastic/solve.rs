@@ -155,7 +155,10 @@ pub struct AssembledBody {
     /// multigrid needs (its near-null space).
     pub coordinates: Vec<f64>,
     pub pattern: SparsityPattern,
-    pub k: SparseColMat<usize, f64>,
+    /// The rows of the unconstrained `K` at the prescribed dofs, `(dof, [(column, value)])`:
+    /// all the reactions need of it. The whole `K` is not kept: at a million DOFs it is a
+    /// gigabyte beside `k_c` and the solver's own copies.
+    pub prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
     pub f: Vec<f64>,
     pub constraints: Constraints,
     pub k_c: SparseColMat<usize, f64>,
@@ -201,12 +204,25 @@ pub fn assemble(
     let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
         constraints.apply(&k, &f)
     });
+    // K is symmetric: the row of a dof is its column.
+    let prescribed_rows = {
+        let (symbolic, values) = k.parts();
+        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+        (0..symbolic.ncols())
+            .filter(|&d| constraints.is_fixed(d))
+            .map(|d| {
+                let row = (col_ptr[d]..col_ptr[d + 1]).map(|p| (row_idx[p], values[p]));
+                (d, row.collect())
+            })
+            .collect()
+    };
+    drop(k);
     let dim = body.dim;
     Ok(AssembledBody {
         dim,
         coordinates: body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect(),
         pattern,
-        k,
+        prescribed_rows,
         f,
         constraints,
         k_c,
@@ -225,7 +241,10 @@ pub fn reactions(
 ) -> Vec<(String, Vec<f64>)> {
     let body = problem.body;
     let dim = body.dim;
-    let r = crate::linalg::mat_vec(&system.k, u);
+    let mut r = vec![0.0; u.len()];
+    for (dof, row) in &system.prescribed_rows {
+        r[*dof] = row.iter().map(|&(j, value)| value * u[j]).sum();
+    }
     problem
         .dirichlet
         .iter()
