@@ -814,7 +814,7 @@ def aims_table(sizes: list[dict]) -> list[list[str]]:
             applications = "-"
             if "applications" in q or "applications_steps" in q:
                 applications = (_judged(q["applications"], AIM_APPLICATIONS, True, "") if "applications" in q
-                                else missing[0])
+                                else missing[0] if missing[0] != "-" else "n/a")
                 if "applications_steps" in q:
                     applications += f" (load steps {q['applications_steps']:.2f})"
             elif any(timed(r) for r in runs):
