@@ -44,7 +44,7 @@ use super::{ContactError, ContactSurface};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
 use crate::fem::Material;
-use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic};
+use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Ordering};
 
 /// The solvers (Cholesky factors, or CG + AMG) of both bodies' constrained stiffness matrices,
 /// and what the interface solve keeps between iterations: the bodies' responses to the
@@ -59,6 +59,8 @@ pub struct BodyFactors {
     fallback: Option<[Vec<usize>; 2]>,
     /// Why the interface solve left GMRES for the dense Schur complement, if it did.
     pub fell_back: Option<String>,
+    /// The fill-reducing ordering of Cholesky factors (also those of the fallback).
+    ordering: Ordering,
     /// The last Krylov solve's figures (`None` when the last solve was not a Krylov one).
     pub last_krylov: Option<KrylovStats>,
     dim: usize,
@@ -109,10 +111,7 @@ impl BodyFactors {
                 BodySolver::cg_amg(&body.k_c, body.dim, &body.coordinates, settings.rtol)
                     .map_err(|e| ContactError::Linalg(format!("CG + AMG of a body: {e}")))
             }
-            _ => CholeskySymbolic::new(&body.pattern, settings.ordering)
-                .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
-                .map(BodySolver::Cholesky)
-                .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}"))),
+            _ => cholesky(body, settings.ordering),
         };
         // The two set-ups are independent: side by side.
         let (factor1, factor2) = rayon::join(|| factor(body1), || factor(body2));
@@ -138,6 +137,7 @@ impl BodyFactors {
             interface,
             fallback,
             fell_back: None,
+            ordering: settings.ordering,
             last_krylov: None,
             dim,
             verbose: settings.verbose,
@@ -161,6 +161,11 @@ impl BodyFactors {
     /// round-off on request: [`Self::solve`]).
     pub fn is_krylov(&self) -> bool {
         matches!(self.interface, Interface::Krylov { .. })
+    }
+
+    /// The bodies' solver (Cholesky after a fallback from CG + AMG).
+    pub fn body_kind(&self) -> BodySolverKind {
+        self.factor1.kind()
     }
 
     /// Applications of each body's block of the Krylov preconditioner so far (`None` off the
@@ -226,8 +231,24 @@ impl BodyFactors {
         }
         match (solved, self.fallback.take()) {
             (Err(ContactError::Krylov(failure)), Some([nodes1, nodes2])) => {
+                // The dense Schur complement solves `dim` systems per body for each active
+                // node: with CG + AMG bodies each would be a whole CG solve, so the bodies are
+                // factored instead (a factor that does not fit in memory is an error naming it).
+                let factored = !matches!(self.factor1, BodySolver::Cholesky(_));
                 if self.verbose {
-                    log::info!("    {failure}: the dense Schur complement from here on");
+                    let how = if factored {
+                        "Cholesky factors of both bodies and "
+                    } else {
+                        ""
+                    };
+                    log::info!("    {failure}: {how}the dense Schur complement from here on");
+                }
+                if factored {
+                    let (factor1, factor2) = rayon::join(
+                        || cholesky(bodies[0], self.ordering),
+                        || cholesky(bodies[1], self.ordering),
+                    );
+                    (self.factor1, self.factor2) = (factor1?, factor2?);
                 }
                 let sizes = [system.n1, system.n2];
                 self.interface = Interface::dense([&nodes1, &nodes2], dim, sizes);
@@ -240,6 +261,14 @@ impl BodyFactors {
             }
         }
     }
+}
+
+/// The Cholesky factor of a body's constrained stiffness.
+fn cholesky(body: &AssembledBody, ordering: Ordering) -> Result<BodySolver, ContactError> {
+    CholeskySymbolic::new(&body.pattern, ordering)
+        .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
+        .map(BodySolver::Cholesky)
+        .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))
 }
 
 /// The coupled system solved by one sparse LU of its whole matrix.

@@ -102,15 +102,9 @@ pub enum ContactError {
     Linalg(String),
     #[error(
         "the coupled solve is inaccurate: relative residual {residual:.2e} > [solver] \
-         residual_tolerance {tolerance:.0e}{advice}"
+         residual_tolerance {tolerance:.0e}"
     )]
-    Inaccurate {
-        residual: f64,
-        tolerance: f64,
-        /// What bounds the residual when it is not round-off: the bodies' CG tolerance, on the
-        /// dense Schur fallback with CG + AMG bodies.
-        advice: String,
-    },
+    Inaccurate { residual: f64, tolerance: f64 },
     #[error(transparent)]
     Krylov(#[from] coupled_krylov::KrylovError),
     /// The solve's [`crate::cancel::Cancel`] token was cancelled.

@@ -118,8 +118,6 @@ pub struct ContactSolver<'a> {
     pub(super) stats1: SolveStats,
     pub(super) stats2: SolveStats,
     factors: Option<BodyFactors>,
-    /// The body solver `factors` holds (`auto` resolved).
-    body_solver: BodySolverKind,
     /// Paired for the slide of the last solve; a solve without a start pairs them again
     /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
@@ -185,7 +183,6 @@ impl<'a> ContactSolver<'a> {
             stats1,
             stats2,
             factors,
-            body_solver: kind,
             operators,
         })
     }
@@ -200,7 +197,7 @@ impl<'a> ContactSolver<'a> {
                 body_applications: None,
             },
             Some(factors) => LinearSolvers {
-                body: self.body_solver.name(),
+                body: factors.body_kind().name(),
                 interface: match factors.is_krylov() {
                     true => CoupledSolver::Krylov.name(),
                     false => CoupledSolver::Schur.name(),
@@ -597,20 +594,9 @@ impl ContactSolver<'_> {
             && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let residual = system.relative_residual(&self.body1, &self.body2, &x);
         if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
-            // CG solves to `rtol` remain only in the dense Schur fallback of `auto`.
-            let dense = !self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
-            let advice = match self.body_solver {
-                BodySolverKind::CgAmg if dense => format!(
-                    "; the bodies' CG + AMG solves stop at [solver] rtol = {:.0e}, which bounds \
-                     it: lower rtol (default 1e-10) or raise residual_tolerance",
-                    self.solver.rtol
-                ),
-                _ => String::new(),
-            };
             return Err(ContactError::Inaccurate {
                 residual,
                 tolerance: self.solver.residual_tolerance,
-                advice,
             });
         }
         Ok(system.solution(&x, coupling, dim, residual))
