@@ -287,7 +287,11 @@ pub fn predicted_set(
 /// the hemisphere on block at 99k DOFs (2026-11-28): with no margin the loop ended on 553 nodes
 /// instead of 558 (force 1.4e-5 lower), with 0.01 on 557, with 0.05 on the same 558 nodes and
 /// force to 1e-9 as without a prediction, in 5 iterations instead of 8 and 91 V-cycles per body
-/// instead of 143; 0.2 took 7 iterations.
+/// instead of 143; 0.2 took 7 iterations. 0.01 took 4 iterations in one step and 4 + 4 instead
+/// of 5 + 6 in two load steps, but ended on 557 nodes in one step, and its load steps then
+/// differed from independent solves by twice the settled gap tolerance
+/// (`tests/contact_load_steps.rs`): a margin that reproduces the loop's answer is worth an
+/// iteration or two.
 const PREDICTION_MARGIN: f64 = 0.05;
 
 /// Sweeps of [`predicted_set`]'s projected Gauss-Seidel (each `m^2` multiply-adds).
