@@ -229,7 +229,7 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
     outside is there the intersection of the two half-planes, and the force on a node at the
     vertex lies anywhere in the cone of the two normals. With one row only, the node's force is
     along one wall's normal, its next iterate on the other wall, and the iteration swings with
-    period two (the corner 1 to 3.3 spacings sideways, the force 0.877 to 0.956 at h 0.001 and a
+    period two (the corner 0.8 to 3.5 spacings sideways, the force 0.876 to 0.956 at h 0.001 and a
     2% approach), as internodes's loop does. Steps until no displacement changes by more than
     1e-6 delta (the force then known to about 1e-5; where rows switch between the walls the
     convergence is linear: about 300 steps at h 0.001, block spacing 0.7 h, a 4% approach). The first step, paired in the reference configuration (small sliding), is
