@@ -218,8 +218,8 @@ fn retry_with_other_primary<'m>(
 /// The retry's answer checked against the first one (`primary agreement`), when the first
 /// settled (converged, or not solved by a residual) with a passing accuracy report: then it is
 /// an answer of the other discretization, and a retry that contradicts it must not be
-/// certified (a 2D square's corner on a block: the first answer refused by its tension bound
-/// alone, right within 0.4%; the retry 15% off). The bound is `accuracy_tolerance` plus the
+/// certified: two discretizations of one problem that disagree cannot both be right
+/// (`docs/method.md` 4.2). The bound is `accuracy_tolerance` plus the
 /// first answer's own imbalance, which is how well that answer knows its force.
 fn agrees_with_first(
     first: &ContactSolution,
