@@ -105,37 +105,7 @@ impl HalfSpace {
             coupled.push(k);
             points.push((x, e, a));
         }
-        let radius = |a: f64| match dim {
-            3 => (a / std::f64::consts::PI).sqrt(),
-            _ => a / 2.0,
-        };
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for (x, _, _) in &points {
-            for c in 0..dim {
-                lo[c] = lo[c].min(x[c]);
-                hi[c] = hi[c].max(x[c]);
-            }
-        }
-        let diagonal = (0..dim)
-            .map(|c| (hi[c] - lo[c]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let largest = (points.iter().map(|p| radius(p.2))).fold(0.0, f64::max);
-        let length = 2.0 * diagonal + largest;
-        let kernel = |r: f64| {
-            if dim == 3 {
-                1.0 / r
-            } else {
-                -(r / length).ln()
-            }
-        };
-        let self_term = |a: f64| {
-            if dim == 3 {
-                2.0 / a
-            } else {
-                1.0 - (a / length).ln()
-            }
-        };
+        let kernel = Kernel::new(dim, points.iter().map(|(x, _, a)| (*x, *a)));
         let scale = system.t * system.s * c0;
         let p = Mat::<f64>::from_fn(points.len(), points.len(), |i, j| {
             let ((xi, ei, ai), (xj, ej, aj)) = (&points[i], &points[j]);
@@ -147,9 +117,9 @@ impl HalfSpace {
             // Distinct nodes of a mesh never coincide; the same node's components have
             // orthogonal directions, so only the self term is left.
             let g = if i == j || r == 0.0 {
-                self_term(radius(*ai))
+                kernel.own(*ai)
             } else {
-                kernel(r)
+                kernel.between(r)
             };
             scale * along * g * aj
         });
@@ -173,6 +143,63 @@ impl HalfSpace {
         for (i, &k) in self.coupled.iter().enumerate() {
             out[k] = rhs[(i, 0)];
         }
+    }
+}
+
+/// The half-space kernel `G` of the module doc on a set of surface points: `L` from their
+/// bounding box and areas.
+struct Kernel {
+    dim: usize,
+    length: f64,
+}
+
+impl Kernel {
+    /// The kernel of the points `(x, area)` in dimension `dim`.
+    fn new(dim: usize, points: impl Iterator<Item = ([f64; 3], f64)>) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let mut largest = 0.0_f64;
+        for (x, a) in points {
+            for c in 0..dim {
+                lo[c] = lo[c].min(x[c]);
+                hi[c] = hi[c].max(x[c]);
+            }
+            largest = largest.max(radius(dim, a));
+        }
+        let diagonal = (0..dim)
+            .map(|c| (hi[c] - lo[c]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        Self {
+            dim,
+            length: 2.0 * diagonal + largest,
+        }
+    }
+
+    /// `G` between two distinct points `r` apart.
+    fn between(&self, r: f64) -> f64 {
+        if self.dim == 3 {
+            1.0 / r
+        } else {
+            -(r / self.length).ln()
+        }
+    }
+
+    /// `G` of a point on itself: a uniformly loaded disc (segment) of `area`.
+    fn own(&self, area: f64) -> f64 {
+        let a = radius(self.dim, area);
+        if self.dim == 3 {
+            2.0 / a
+        } else {
+            1.0 - (a / self.length).ln()
+        }
+    }
+}
+
+/// The radius of a disc (3D) or half-width of a segment (2D) of `area`.
+fn radius(dim: usize, area: f64) -> f64 {
+    match dim {
+        3 => (area / std::f64::consts::PI).sqrt(),
+        _ => area / 2.0,
     }
 }
 
@@ -204,40 +231,18 @@ pub fn predicted_set(
 ) -> Vec<usize> {
     let m = candidates.len();
     let dim = surface.dim;
-    let radius = |a: f64| match dim {
-        3 => (a / std::f64::consts::PI).sqrt(),
-        _ => a / 2.0,
-    };
     let x = |i: usize| surface.coords[candidates[i]];
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for i in 0..m {
-        for c in 0..dim {
-            lo[c] = lo[c].min(x(i)[c]);
-            hi[c] = hi[c].max(x(i)[c]);
-        }
-    }
-    let diagonal = (0..dim)
-        .map(|c| (hi[c] - lo[c]).powi(2))
-        .sum::<f64>()
-        .sqrt();
     let area = |i: usize| surface.nodal_area[candidates[i]];
-    let largest = (0..m).map(|i| radius(area(i))).fold(0.0, f64::max);
-    let length = 2.0 * diagonal + largest;
+    let kernel = Kernel::new(dim, (0..m).map(|i| (x(i), area(i))));
     let g = |i: usize, j: usize| {
         if i == j {
-            return match dim {
-                3 => 2.0 / radius(area(i)),
-                _ => 1.0 - (radius(area(i)) / length).ln(),
-            };
+            return kernel.own(area(i));
         }
         let r = (0..3)
             .map(|c| (x(i)[c] - x(j)[c]).powi(2))
             .sum::<f64>()
             .sqrt();
-        match dim {
-            3 => 1.0 / r,
-            _ => -(r / length).ln(),
-        }
+        kernel.between(r)
     };
     // G is symmetric: row i holds both C's row (times A_j) and its column (times A_i).
     let kernel: Vec<f64> = (0..m * m).map(|k| g(k / m, k % m)).collect();
