@@ -86,10 +86,10 @@ pub fn certify(
 ) -> (Certificate, [Vec<f64>; 2]) {
     let settings = &problem.settings;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-    let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+    let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
     let sides: [Side; 2] = [
-        (s1, s2, u1, u2, &solution.contact_force1[..]),
-        (s2, s1, u2, u1, &solution.contact_force2[..]),
+        (s1, s2, u1, u2, &solution.contact_force[0][..]),
+        (s2, s1, u2, u1, &solution.contact_force[1][..]),
     ];
     let gaps = sides.map(|(own, other, u_own, u_other, _)| {
         geometric_gaps(own, other, Some(u_own), Some(u_other))
@@ -178,7 +178,7 @@ fn complementarity(
     active: &[usize],
 ) -> CertificateCheck {
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-    let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+    let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
     let held: Vec<f64> = match problem.settings.formulation {
         Formulation::Frictionless => (gap_rows(s1, s2, Some(u1), Some(u2)).into_iter())
             .map(|row| row.gap)
@@ -195,7 +195,9 @@ fn complementarity(
 
 /// Equilibrium: `|F1 + F2| / |F1|`, the total contact forces on the two bodies.
 fn equilibrium(solution: &CoupledSolution, dim: usize, tolerance: f64) -> CertificateCheck {
-    let [f1, f2] = solution.total_forces(dim);
+    let [f1, f2] = solution.total_forces(dim)[..] else {
+        unreachable!("a pair has two bodies")
+    };
     let norm = |f: [f64; 3]| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
     let imbalance = if norm(f1) > 0.0 {
         norm(std::array::from_fn(|c| f1[c] + f2[c])) / norm(f1)

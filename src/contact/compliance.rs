@@ -25,9 +25,15 @@ use std::collections::HashMap;
 use super::ContactError;
 use crate::linalg::BodySolver;
 
-/// Identifies a unit traction across iterations: the primary body node it acts at, and its
-/// component (always `Some`; `super::system::CoupledSystem::columns` combines them).
-pub type MultiplierKey = (usize, Option<usize>);
+/// Identifies a unit traction across iterations: its contact pair, the primary body node it
+/// acts at, and its component (`super::system::CoupledSystem::columns` combines them into
+/// multipliers).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct MultiplierKey {
+    pub pair: usize,
+    pub node: usize,
+    pub component: usize,
+}
 
 /// The responses `Y_k` of one body computed so far, on its candidate-surface dofs.
 pub struct SurfaceResponse {

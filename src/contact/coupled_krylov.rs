@@ -45,8 +45,9 @@ use thiserror::Error;
 use super::ContactError;
 use super::compliance::MultiplierKey;
 use super::half_space::HalfSpace;
-use super::system::{CoupledSystem, Coupling};
+use super::system::{CoupledSystem, Pair};
 use crate::cancel::Cancel;
+use crate::elastic::AssembledBody;
 use crate::linalg::BodySolver;
 use crate::linalg::gmres::{self, GmresFailure, GmresSettings, GmresStats, Operators};
 
@@ -158,15 +159,15 @@ pub struct KrylovStats {
 /// What the Krylov path keeps between active-set iterations and load steps.
 #[derive(Default)]
 pub struct KrylovState {
-    /// `[u1; u2]` of the last solve and the load factor it was solved at.
+    /// The bodies' displacements of the last solve and the load factor it was solved at.
     displacements: Option<(f64, Vec<f64>)>,
-    /// Traction of the last solve per (primary node, component), unscaled.
+    /// Traction of the last solve per (pair, primary node, component), unscaled.
     tractions: HashMap<MultiplierKey, f64>,
     /// The last solve's figures.
     pub last: KrylovStats,
     /// Applications of each body's block of the preconditioner so far (one V-cycle each with
     /// CG + AMG bodies).
-    pub body_applications: [usize; 2],
+    pub body_applications: Vec<usize>,
     /// Whether a solve over [`PROGRESS_AFTER`] rewrites a progress line on the terminal.
     pub progress: bool,
     /// Checked at each GMRES iteration.
@@ -188,38 +189,53 @@ impl KrylovState {
 /// [`KrylovState::progress`] is set.
 const PROGRESS_AFTER: f64 = 2.0;
 
-/// Solves the coupled `system` of `coupling` to `tightness` from the last solve kept in
-/// `state`; returns `x = [u1; u2; lambda / s]`. `c0` is the half-space compliance factor
-/// (`super::half_space::compliance_factor`), `coordinates1` body 1's node coordinates.
-#[allow(clippy::too_many_arguments)]
+/// What one coupled Krylov solve works on.
+pub struct KrylovProblem<'a> {
+    pub system: &'a CoupledSystem,
+    pub pairs: &'a [Pair<'a>],
+    /// Each body's constrained stiffness (the operator's diagonal blocks) and node
+    /// coordinates (the half-space model's points, on each pair's primary).
+    pub bodies: &'a [&'a AssembledBody],
+    /// Each body's solver, applied once per iteration as its block of the preconditioner.
+    pub solvers: &'a [BodySolver],
+    /// Each pair's half-space compliance factor (`super::half_space::compliance_factor`).
+    pub compliance: &'a [f64],
+    pub dim: usize,
+}
+
+/// Solves the coupled system of `problem` to `tightness` from the last solve kept in `state`;
+/// returns `x = [u_1; ...; u_N; lambda / s]`.
 pub fn solve(
-    system: &CoupledSystem,
-    coupling: &Coupling,
-    coordinates1: &[f64],
-    dim: usize,
-    c0: f64,
-    bodies: [&BodySolver; 2],
-    [k1, k2]: [&faer::sparse::SparseColMat<usize, f64>; 2],
+    problem: &KrylovProblem,
     state: &mut KrylovState,
     tightness: Tightness,
     max_iterations: usize,
 ) -> Result<Vec<f64>, ContactError> {
+    let system = problem.system;
     let rhs = system.rhs();
     let mut x = starting_guess(system, state);
     let rhs_norm = gmres::norm(&rhs);
     let tolerance = tightness.relative();
+    let schur = (problem.pairs.iter().enumerate())
+        .map(|(p, pair)| {
+            let coordinates = &problem.bodies[pair.primary].coordinates;
+            let c0 = problem.compliance[p];
+            HalfSpace::new(system, p, pair.coupling, coordinates, problem.dim, c0)
+        })
+        .collect();
+    let num_bodies = system.num_bodies();
     let mut operators = Blocks {
         system,
-        k: [k1, k2],
-        bodies,
-        schur: HalfSpace::new(system, coupling, coordinates1, dim, c0),
-        applications: [0, 0],
+        bodies: problem.bodies,
+        solvers: problem.solvers,
+        schur,
+        applications: vec![0; num_bodies],
         started: std::time::Instant::now(),
         progress: state.progress,
         tolerance,
         rhs_norm,
         cancel: &state.cancel,
-        scratch: vec![0.0; system.n1 + system.n2],
+        scratch: vec![0.0; system.num_displacements()],
     };
     let settings = GmresSettings {
         tolerance: tolerance * rhs_norm,
@@ -227,6 +243,7 @@ pub fn solve(
         restart: RESTART,
     };
     let outcome = gmres::solve(&mut operators, &rhs, &mut x, settings);
+    state.body_applications.resize(num_bodies, 0);
     for (total, new) in state
         .body_applications
         .iter_mut()
@@ -258,9 +275,9 @@ pub fn solve(
 /// The last solve's displacements (scaled to this load factor) and tractions, along each
 /// multiplier's direction; an uncoupled multiplier's exact value.
 fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
-    let n = system.n1 + system.n2;
+    let n = system.num_displacements();
     let mut x = match &state.displacements {
-        Some((factor, u)) if *factor != 0.0 => {
+        Some((factor, u)) if *factor != 0.0 && u.len() == n => {
             let scale = system.load_factor / factor;
             u.iter().map(|u| scale * u).collect()
         }
@@ -286,7 +303,7 @@ fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
 
 /// Keeps the displacements and tractions of `x` for the next solve's start.
 fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
-    let n = system.n1 + system.n2;
+    let n = system.num_displacements();
     state.displacements = Some((system.load_factor, x[..n].to_vec()));
     state.tractions.clear();
     for (k, column) in system.columns.iter().enumerate() {
@@ -299,12 +316,13 @@ fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
 /// The operator `A` and the block preconditioner `P^-1` of the module doc.
 struct Blocks<'a> {
     system: &'a CoupledSystem,
-    /// Each body's constrained stiffness (symmetric).
-    k: [&'a faer::sparse::SparseColMat<usize, f64>; 2],
-    bodies: [&'a BodySolver; 2],
-    schur: HalfSpace,
+    /// Each body's constrained stiffness (symmetric), `k_c`.
+    bodies: &'a [&'a AssembledBody],
+    solvers: &'a [BodySolver],
+    /// `S~` of each pair, on its multipliers: the pairs' blocks of the preconditioner.
+    schur: Vec<HalfSpace>,
     /// Applications of each body's block.
-    applications: [usize; 2],
+    applications: Vec<usize>,
     started: std::time::Instant,
     progress: bool,
     tolerance: f64,
@@ -319,13 +337,16 @@ impl Operators for Blocks<'_> {
 
     fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
         let system = self.system;
-        let (n1, n) = (system.n1, system.n1 + system.n2);
+        let n = system.num_displacements();
         let (out_u, out_l) = out.split_at_mut(n);
-        let (out1, out2) = out_u.split_at_mut(n1);
-        rayon::join(
-            || symmetric_product(self.k[0], &x[..n1], out1),
-            || symmetric_product(self.k[1], &x[n1..n], out2),
-        );
+        system
+            .body_parts(out_u)
+            .into_par_iter()
+            .zip(self.bodies)
+            .zip(system.offsets.par_windows(2))
+            .for_each(|((out, body), range)| {
+                symmetric_product(&body.k_c, &x[range[0]..range[1]], out)
+            });
         for ((o, d), l) in out_l.iter_mut().zip(&system.d).zip(&x[n..]) {
             *o = d * l;
         }
@@ -341,24 +362,26 @@ impl Operators for Blocks<'_> {
     fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
         self.cancel.check()?;
         let system = self.system;
-        let (n1, n) = (system.n1, system.n1 + system.n2);
+        let n = system.num_displacements();
         let (out_u, out_l) = out.split_at_mut(n);
-        self.schur.apply(&r[n..], out_l);
+        for (p, schur) in self.schur.iter().enumerate() {
+            let range = system.pair_multipliers(p);
+            schur.apply(&r[n + range.start..n + range.end], &mut out_l[range]);
+        }
         self.scratch.copy_from_slice(&r[..n]);
         for &(row, k, value) in &system.b {
             self.scratch[row] -= value * out_l[k];
         }
-        let (w1, w2) = self.scratch.split_at(n1);
-        let (out1, out2) = out_u.split_at_mut(n1);
-        let (done1, done2) = rayon::join(
-            || self.bodies[0].precondition(w1, out1),
-            || self.bodies[1].precondition(w2, out2),
-        );
-        done1
-            .and(done2)
+        system
+            .body_parts(out_u)
+            .into_par_iter()
+            .zip(self.solvers)
+            .zip(system.offsets.par_windows(2))
+            .try_for_each(|((out, solver), range)| {
+                solver.precondition(&self.scratch[range[0]..range[1]], out)
+            })
             .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
-        self.applications[0] += 1;
-        self.applications[1] += 1;
+        self.applications.iter_mut().for_each(|a| *a += 1);
         Ok(())
     }
 

@@ -1,4 +1,5 @@
-//! How the coupled system of an iteration is solved, behind one interface.
+//! How the coupled system of an iteration is solved, behind one interface, for any number of
+//! bodies and pairs.
 //!
 //! Each body's solver is set up once for the whole contact solve (a sparse Cholesky factor, or
 //! PETSc's AMG: `crate::linalg::BodySolver`); then, per iteration:
@@ -34,29 +35,27 @@ use std::io::IsTerminal;
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
+use super::ContactError;
 use super::compliance::SurfaceResponse;
 use super::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
-use super::half_space::compliance_factor;
 use super::settings::{ContactSettings, CoupledSolver};
-use super::system::{CoupledSystem, Coupling};
-use super::{ContactError, ContactSurface};
+use super::system::{CoupledSystem, Pair};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
-use crate::fem::Material;
 use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Ordering};
 
-/// The solvers (Cholesky factors, or CG + AMG) of both bodies' constrained stiffness matrices,
+/// The solvers (Cholesky factors, or CG + AMG) of every body's constrained stiffness matrix,
 /// and what the interface solve keeps between iterations: the bodies' responses to the
 /// multipliers computed so far (dense Schur), or the warm start (Krylov).
 pub struct BodyFactors {
-    factor1: BodySolver,
-    factor2: BodySolver,
-    /// The half-space compliance factor of the two materials (`super::half_space`).
-    compliance: f64,
+    solvers: Vec<BodySolver>,
+    /// The half-space compliance factor of each pair's two materials (`super::half_space`).
+    compliance: Vec<f64>,
     interface: Interface,
     /// The candidate nodes of each body, for the dense Schur path `auto` falls back to.
-    fallback: Option<[Vec<usize>; 2]>,
+    fallback: Option<Vec<Vec<usize>>>,
     /// Why the interface solve left GMRES for the dense Schur complement, if it did.
     pub fell_back: Option<String>,
     /// The fill-reducing ordering of Cholesky factors (also those of the fallback).
@@ -69,10 +68,8 @@ pub struct BodyFactors {
 
 /// How the interface problem is solved, with what it keeps between iterations.
 enum Interface {
-    Dense {
-        response1: SurfaceResponse,
-        response2: SurfaceResponse,
-    },
+    /// Each body's responses to the unit tractions, on its candidate surfaces.
+    Dense { responses: Vec<SurfaceResponse> },
     Krylov {
         state: KrylovState,
         /// GMRES' iteration cap per solve (`ContactSettings::krylov_max_iterations`).
@@ -81,43 +78,44 @@ enum Interface {
 }
 
 impl Interface {
-    fn dense(nodes: [&[usize]; 2], dim: usize, sizes: [usize; 2]) -> Self {
-        Self::Dense {
-            response1: SurfaceResponse::new(nodes[0], dim, sizes[0]),
-            response2: SurfaceResponse::new(nodes[1], dim, sizes[1]),
-        }
+    fn dense(candidates: &[Vec<usize>], bodies: &[&AssembledBody]) -> Self {
+        let responses = (candidates.iter().zip(bodies))
+            .map(|(nodes, body)| SurfaceResponse::new(nodes, body.dim, body.f_c.len()))
+            .collect();
+        Self::Dense { responses }
     }
 }
 
 impl BodyFactors {
-    /// Sets up both bodies' solvers (`kind`: Cholesky or CG + AMG, resolved by the caller)
-    /// for the coupled solve `contact.solver`; the response caches cover the candidate
-    /// surfaces. `materials` are the two bodies', for the half-space preconditioner.
-    #[allow(clippy::too_many_arguments)]
+    /// Sets up every body's solver (`kind`: Cholesky or CG + AMG, resolved by the caller) for
+    /// the coupled solve `contact.solver`. `candidates` are each body's candidate nodes (over
+    /// all its pairs), which the response caches of the dense path cover; `compliance` each
+    /// pair's half-space compliance factor (`super::half_space::compliance_factor`), for the
+    /// Krylov path's preconditioner.
     pub fn new(
-        body1: &AssembledBody,
-        body2: &AssembledBody,
-        materials: [&Material; 2],
-        surface1: &ContactSurface,
-        surface2: &ContactSurface,
+        bodies: &[&AssembledBody],
+        candidates: Vec<Vec<usize>>,
+        compliance: Vec<f64>,
         settings: &SolverSettings,
         kind: BodySolverKind,
         contact: &ContactSettings,
     ) -> Result<Self, ContactError> {
         let method = contact.solver;
-        let dim = surface1.dim;
-        let factor = |body: &AssembledBody| match kind {
+        let dim = bodies.first().map_or(3, |body| body.dim);
+        let factor = |body: &&AssembledBody| match kind {
             BodySolverKind::CgAmg => {
                 BodySolver::cg_amg(&body.k_c, body.dim, &body.coordinates, settings.rtol)
                     .map_err(|e| ContactError::Linalg(format!("CG + AMG of a body: {e}")))
             }
             _ => cholesky(body, settings.ordering),
         };
-        // The two set-ups are independent: side by side.
-        let (factor1, factor2) = rayon::join(|| factor(body1), || factor(body2));
+        // The set-ups are independent: side by side.
+        let solvers = bodies
+            .par_iter()
+            .map(factor)
+            .collect::<Result<Vec<_>, _>>()?;
         let cg = kind == BodySolverKind::CgAmg;
         let krylov = cg || matches!(method, CoupledSolver::Krylov | CoupledSolver::Auto);
-        let sizes = [body1.f_c.len(), body2.f_c.len()];
         let interface = if krylov {
             let progress =
                 settings.verbose && settings.progress_line && std::io::stderr().is_terminal();
@@ -126,14 +124,12 @@ impl BodyFactors {
                 max_iterations: contact.krylov_max_iterations,
             }
         } else {
-            Interface::dense([&surface1.nodes, &surface2.nodes], dim, sizes)
+            Interface::dense(&candidates, bodies)
         };
-        let fallback = (method == CoupledSolver::Auto)
-            .then(|| [surface1.nodes.clone(), surface2.nodes.clone()]);
+        let fallback = (method == CoupledSolver::Auto).then_some(candidates);
         Ok(Self {
-            factor1: factor1?,
-            factor2: factor2?,
-            compliance: compliance_factor(materials, dim),
+            solvers,
+            compliance,
             interface,
             fallback,
             fell_back: None,
@@ -147,13 +143,8 @@ impl BodyFactors {
     /// Forgets the bodies' responses to the multipliers: the interface operators changed.
     /// (The Krylov warm start is kept: tractions mapped by node stay a good first guess.)
     pub fn forget_responses(&mut self) {
-        if let Interface::Dense {
-            response1,
-            response2,
-        } = &mut self.interface
-        {
-            response1.clear();
-            response2.clear();
+        if let Interface::Dense { responses } = &mut self.interface {
+            responses.iter_mut().for_each(SurfaceResponse::clear);
         }
     }
 
@@ -165,19 +156,22 @@ impl BodyFactors {
 
     /// The bodies' solver (Cholesky after a fallback from CG + AMG).
     pub fn body_kind(&self) -> BodySolverKind {
-        self.factor1.kind()
+        self.solvers
+            .first()
+            .map_or(BodySolverKind::Cholesky, BodySolver::kind)
     }
 
     /// Applications of each body's block of the Krylov preconditioner so far (`None` off the
     /// Krylov path).
-    pub fn body_applications(&self) -> Option<[usize; 2]> {
+    pub fn body_applications(&self) -> Option<Vec<usize>> {
         match &self.interface {
-            Interface::Krylov { state, .. } => Some(state.body_applications),
+            Interface::Krylov { state, .. } => Some(state.body_applications.clone()),
             Interface::Dense { .. } => None,
         }
     }
 
-    /// Solves the coupled system of `coupling`; returns `x = [u1; u2; lambda / s]`.
+    /// Solves the coupled system of `pairs` on `bodies`; returns `x = [u_1; ...; u_N; lambda
+    /// / s]`.
     ///
     /// On the Krylov path a [`Tightness::Loose`] solve stops at a relative residual the
     /// caller's active-set decision needs, not at round-off; the caller then owns the residual
@@ -186,34 +180,27 @@ impl BodyFactors {
     pub fn solve(
         &mut self,
         system: &CoupledSystem,
-        coupling: &Coupling,
-        bodies: [&AssembledBody; 2],
+        pairs: &[Pair],
+        bodies: &[&AssembledBody],
         tightness: Tightness,
     ) -> Result<Vec<f64>, ContactError> {
         self.last_krylov = None;
         let (state, max_iterations) = match &mut self.interface {
-            Interface::Dense {
-                response1,
-                response2,
-            } => return solve_schur(system, &self.factor1, &self.factor2, response1, response2),
+            Interface::Dense { responses } => return solve_schur(system, &self.solvers, responses),
             Interface::Krylov {
                 state,
                 max_iterations,
             } => (state, *max_iterations),
         };
-        let dim = self.dim;
-        let solved = coupled_krylov::solve(
+        let problem = coupled_krylov::KrylovProblem {
             system,
-            coupling,
-            &bodies[0].coordinates,
-            dim,
-            self.compliance,
-            [&self.factor1, &self.factor2],
-            [&bodies[0].k_c, &bodies[1].k_c],
-            state,
-            tightness,
-            max_iterations,
-        );
+            pairs,
+            bodies,
+            solvers: &self.solvers,
+            compliance: &self.compliance,
+            dim: self.dim,
+        };
+        let solved = coupled_krylov::solve(&problem, state, tightness, max_iterations);
         let stats = state.last;
         self.last_krylov = Some(stats);
         if self.verbose {
@@ -230,30 +217,28 @@ impl BodyFactors {
             );
         }
         match (solved, self.fallback.take()) {
-            (Err(ContactError::Krylov(failure)), Some([nodes1, nodes2])) => {
+            (Err(ContactError::Krylov(failure)), Some(candidates)) => {
                 // The dense Schur complement solves `dim` systems per body for each active
                 // node: with CG + AMG bodies each would be a whole CG solve, so the bodies are
                 // factored instead (a factor that does not fit in memory is an error naming it).
-                let factored = !matches!(self.factor1, BodySolver::Cholesky(_));
+                let factored = !matches!(self.solvers.first(), Some(BodySolver::Cholesky(_)));
                 if self.verbose {
                     let how = if factored {
-                        "Cholesky factors of both bodies and "
+                        "Cholesky factors of the bodies and "
                     } else {
                         ""
                     };
                     log::info!("    {failure}: {how}the dense Schur complement from here on");
                 }
                 if factored {
-                    let (factor1, factor2) = rayon::join(
-                        || cholesky(bodies[0], self.ordering),
-                        || cholesky(bodies[1], self.ordering),
-                    );
-                    (self.factor1, self.factor2) = (factor1?, factor2?);
+                    let ordering = self.ordering;
+                    self.solvers = (bodies.par_iter())
+                        .map(|body| cholesky(body, ordering))
+                        .collect::<Result<Vec<_>, _>>()?;
                 }
-                let sizes = [system.n1, system.n2];
-                self.interface = Interface::dense([&nodes1, &nodes2], dim, sizes);
+                self.interface = Interface::dense(&candidates, bodies);
                 self.fell_back = Some(failure.to_string());
-                self.solve(system, coupling, bodies, tightness)
+                self.solve(system, pairs, bodies, tightness)
             }
             (solved, fallback) => {
                 self.fallback = fallback;
@@ -274,10 +259,9 @@ fn cholesky(body: &AssembledBody, ordering: Ordering) -> Result<BodySolver, Cont
 /// The coupled system solved by one sparse LU of its whole matrix.
 pub fn solve_monolithic(
     system: &CoupledSystem,
-    body1: &AssembledBody,
-    body2: &AssembledBody,
+    bodies: &[&AssembledBody],
 ) -> Result<Vec<f64>, ContactError> {
-    let matrix = system.matrix(body1, body2)?;
+    let matrix = system.matrix(bodies)?;
     let lu_error =
         |e: String| ContactError::Linalg(format!("sparse LU of the coupled system: {e}"));
     let symbolic =
@@ -296,28 +280,21 @@ fn body_solve_error(e: crate::linalg::LinalgError) -> ContactError {
 
 fn solve_schur(
     system: &CoupledSystem,
-    factor1: &BodySolver,
-    factor2: &BodySolver,
-    response1: &mut SurfaceResponse,
-    response2: &mut SurfaceResponse,
+    solvers: &[BodySolver],
+    responses: &mut [SurfaceResponse],
 ) -> Result<Vec<f64>, ContactError> {
-    let (n1, n2, m) = (system.n1, system.n2, system.m);
+    let (n, m) = (system.num_displacements(), system.m);
 
     // z = K^-1 f.
-    let mut z1 = system.f[..n1].to_vec();
-    let mut z2 = system.f[n1..].to_vec();
-    solve_both([factor1, factor2], [&mut z1, &mut z2])?;
+    let mut z = system.f.clone();
+    solve_bodies(system, solvers, &mut z)?;
 
     // S = D - s C Y from the responses Y (the new ones computed first), and r = g - C z.
-    extend_responses(
-        system,
-        [factor1, factor2],
-        [&mut *response1, &mut *response2],
-    )?;
-    let schur = schur_complement(system, [&*response1, &*response2]);
+    extend_responses(system, solvers, responses)?;
+    let schur = schur_complement(system, responses);
     let mut r = DVector::from_column_slice(&system.g);
     for &(k, col, value) in &system.c {
-        r[k] -= value * if col < n1 { z1[col] } else { z2[col - n1] };
+        r[k] -= value * z[col];
     }
     let lambda = if m > 0 {
         schur.lu().solve(&r).ok_or_else(|| {
@@ -328,65 +305,66 @@ fn solve_schur(
     };
 
     // u = z - K^-1 (B lambda).
-    let mut w1 = vec![0.0; n1];
-    let mut w2 = vec![0.0; n2];
+    let mut w = vec![0.0; n];
     for &(row, k, value) in &system.b {
-        if row < n1 {
-            w1[row] += value * lambda[k];
-        } else {
-            w2[row - n1] += value * lambda[k];
-        }
+        w[row] += value * lambda[k];
     }
-    solve_both([factor1, factor2], [&mut w1, &mut w2])?;
-    let mut x: Vec<f64> = z1.iter().zip(&w1).map(|(z, w)| z - w).collect();
-    x.extend(z2.iter().zip(&w2).map(|(z, w)| z - w));
+    solve_bodies(system, solvers, &mut w)?;
+    let mut x: Vec<f64> = z.iter().zip(&w).map(|(z, w)| z - w).collect();
     x.extend(lambda.iter());
     Ok(x)
 }
 
-/// `K1^-1 w1` and `K2^-1 w2` in place; the bodies are independent, so side by side.
-fn solve_both(factors: [&BodySolver; 2], [w1, w2]: [&mut Vec<f64>; 2]) -> Result<(), ContactError> {
-    let (done1, done2) = rayon::join(
-        || factors[0].solve_in_place(w1, 1),
-        || factors[1].solve_in_place(w2, 1),
-    );
-    done1.and(done2).map(|_| ()).map_err(body_solve_error)
+/// `K_k^-1 w_k` in place on each body's part of `w`; the bodies are independent, so side by
+/// side.
+fn solve_bodies(
+    system: &CoupledSystem,
+    solvers: &[BodySolver],
+    w: &mut [f64],
+) -> Result<(), ContactError> {
+    system
+        .body_parts(w)
+        .into_par_iter()
+        .zip(solvers)
+        .try_for_each(|(part, solver)| solver.solve_in_place(part, 1).map(|_| ()))
+        .map_err(body_solve_error)
 }
 
 /// Each body's responses to the unit forces of `system` not seen before (`super::compliance`).
 fn extend_responses(
     system: &CoupledSystem,
-    factors: [&BodySolver; 2],
-    [response1, response2]: [&mut SurfaceResponse; 2],
+    solvers: &[BodySolver],
+    responses: &mut [SurfaceResponse],
 ) -> Result<(), ContactError> {
-    let n1 = system.n1;
     let new = |response: &SurfaceResponse, body: usize| {
+        let dofs = system.body_dofs(body);
         (system.unit_loads.iter())
             .filter(|(key, _)| !response.contains(key))
-            .map(|(key, load)| {
-                let on_body = load.iter().filter_map(|&(row, value)| match body {
-                    0 if row < n1 => Some((row, value)),
-                    1 if row >= n1 => Some((row - n1, value)),
-                    _ => None,
-                });
-                (*key, on_body.collect())
+            .filter_map(|(key, load)| {
+                let on_body: Vec<(usize, f64)> = (load.iter())
+                    .filter(|(row, _)| dofs.contains(row))
+                    .map(|&(row, value)| (row - dofs.start, value))
+                    .collect();
+                (!on_body.is_empty()).then_some((*key, on_body))
             })
             .collect::<Vec<_>>()
     };
-    let (new1, new2) = (new(response1, 0), new(response2, 1));
-    let (done1, done2) = rayon::join(
-        || response1.extend(factors[0], &new1),
-        || response2.extend(factors[1], &new2),
-    );
-    done1.and(done2)
+    let loads: Vec<_> = (responses.iter().enumerate())
+        .map(|(body, response)| new(response, body))
+        .collect();
+    (responses.par_iter_mut())
+        .zip(solvers)
+        .zip(&loads)
+        .try_for_each(|((response, solver), loads)| response.extend(solver, loads))
 }
 
 /// The interface Schur complement `S = D - s C Y`, with `C` and each body's responses `Y` as
 /// dense blocks on the dofs `C` reads.
-fn schur_complement(system: &CoupledSystem, responses: [&SurfaceResponse; 2]) -> DMatrix<f64> {
-    let (n1, n2, m, s) = (system.n1, system.n2, system.m, system.s);
+fn schur_complement(system: &CoupledSystem, responses: &[SurfaceResponse]) -> DMatrix<f64> {
+    let (m, s) = (system.m, system.s);
     let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
-    for (response, dofs) in responses.into_iter().zip([0..n1, n1..n1 + n2]) {
+    for (body, response) in responses.iter().enumerate() {
+        let dofs = system.body_dofs(body);
         let mut read: Vec<usize> = (system.c.iter())
             .filter(|e| dofs.contains(&e.1))
             .map(|e| e.1 - dofs.start)
@@ -409,6 +387,10 @@ fn schur_complement(system: &CoupledSystem, responses: [&SurfaceResponse; 2]) ->
         let mut part = vec![0.0; read.len()];
         for (k, column) in system.columns.iter().enumerate() {
             for (key, weight) in column {
+                if !response.contains(key) {
+                    // A unit force that does not reach this body: no response.
+                    continue;
+                }
                 response.gather(key, &rows, &mut part);
                 let mut y_k = y.column_mut(k);
                 for (value, p) in y_k.iter_mut().zip(&part) {
@@ -419,4 +401,249 @@ fn schur_complement(system: &CoupledSystem, responses: [&SurfaceResponse; 2]) ->
         schur -= (c * y) * s;
     }
     schur
+}
+
+#[cfg(test)]
+mod tests {
+    //! The coupled system of several bodies and pairs against an exact reference: blocks
+    //! side by side, tied where they touch on matching nodes, are one block. Three unit squares
+    //! in a row (bodies 0, 1, 2; pairs 0-1 and 2-1, body 1 the secondary of both), clamped at
+    //! the base and pressed down at the top, give the displacements of the 3 x 1 block meshed
+    //! alike; a fourth body in no pair gives its own elastic solution.
+
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::contact::Formulation;
+    use crate::contact::half_space::compliance_factor;
+    use crate::contact::system::Coupling;
+    use crate::elastic::{DirichletCondition, ElasticProblem, SolveStats, assemble, solve};
+    use crate::fem::Material;
+    use crate::mesh::{BodyMesh, FacetGroup};
+
+    const NX: usize = 4;
+    const NY: usize = 6;
+
+    /// `nx` x `NY` squares of side `1/NX` (P1 triangles) from `x0`, height 1, with the groups
+    /// `base`, `top`, `left` and `right` (facets, outward right-hand normals).
+    fn grid(name: &str, x0: f64, nx: usize) -> BodyMesh {
+        let node = |i: usize, j: usize| i + j * (nx + 1);
+        let h = 1.0 / NX as f64;
+        let mut coords = Vec::new();
+        for j in 0..=NY {
+            for i in 0..=nx {
+                coords.push([x0 + i as f64 * h, j as f64 / NY as f64, 0.0]);
+            }
+        }
+        let mut cells = Vec::new();
+        for j in 0..NY {
+            for i in 0..nx {
+                let [a, b, c, d] = [
+                    node(i, j),
+                    node(i + 1, j),
+                    node(i + 1, j + 1),
+                    node(i, j + 1),
+                ];
+                cells.extend([a, b, c, a, c, d]);
+            }
+        }
+        let cell = |i: usize, j: usize, t: usize| 2 * (i + j * nx) + t;
+        let group = |tag: i32, facets: Vec<[usize; 2]>, facet_cells: Vec<usize>| FacetGroup {
+            physical_tag: tag,
+            facets: facets.concat(),
+            facet_cells,
+            interior_facets: Vec::new(),
+        };
+        let mut groups = BTreeMap::new();
+        let along = 0..nx;
+        let up = 0..NY;
+        groups.insert(
+            "base".into(),
+            group(
+                1,
+                along
+                    .clone()
+                    .map(|i| [node(i, 0), node(i + 1, 0)])
+                    .collect(),
+                along.clone().map(|i| cell(i, 0, 0)).collect(),
+            ),
+        );
+        groups.insert(
+            "top".into(),
+            group(
+                2,
+                along
+                    .clone()
+                    .map(|i| [node(i + 1, NY), node(i, NY)])
+                    .collect(),
+                along.map(|i| cell(i, NY - 1, 1)).collect(),
+            ),
+        );
+        groups.insert(
+            "right".into(),
+            group(
+                3,
+                up.clone().map(|j| [node(nx, j), node(nx, j + 1)]).collect(),
+                up.clone().map(|j| cell(nx - 1, j, 0)).collect(),
+            ),
+        );
+        groups.insert(
+            "left".into(),
+            group(
+                4,
+                up.clone().map(|j| [node(0, j + 1), node(0, j)]).collect(),
+                up.map(|j| cell(0, j, 1)).collect(),
+            ),
+        );
+        BodyMesh {
+            name: name.into(),
+            physical_tag: 0,
+            dim: 2,
+            node_tags: (1..=coords.len() as u64).collect(),
+            cell_tags: (1..=(cells.len() / 3) as u64).collect(),
+            coords,
+            cells,
+            boundary_groups: groups,
+            point_groups: BTreeMap::new(),
+        }
+    }
+
+    /// Clamped base, top pushed down by `push`.
+    fn problem(mesh: &BodyMesh, push: f64) -> ElasticProblem<'_> {
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let held = |group: &str, components| DirichletCondition {
+            group: group.into(),
+            components,
+        };
+        let dirichlet = vec![
+            held("base", [Some(0.0), Some(0.0), None]),
+            held("top", [None, Some(-push), None]),
+        ];
+        ElasticProblem::new(mesh, material, dirichlet, Vec::new(), None).unwrap()
+    }
+
+    /// Tied coupling of the column `i1` of `primary` (nx1 squares wide) with the column `i2` of
+    /// the secondary, on matching nodes.
+    fn tied(nx1: usize, i1: usize, nx2: usize, i2: usize, normal: f64) -> Coupling {
+        let h = 1.0 / NY as f64;
+        let area = |j: usize| if j == 0 || j == NY { h / 2.0 } else { h };
+        let primary_nodes: Vec<usize> = (0..=NY).map(|j| i1 + j * (nx1 + 1)).collect();
+        let secondary: Vec<usize> = (0..=NY).map(|j| i2 + j * (nx2 + 1)).collect();
+        Coupling {
+            formulation: Formulation::Tied,
+            normals: vec![[normal, 0.0, 0.0]; NY + 1],
+            areas1: (0..=NY).map(area).collect(),
+            r12: secondary.iter().map(|&n| vec![(n, 1.0)]).collect(),
+            loads2: (0..=NY).map(|j| vec![(secondary[j], area(j))]).collect(),
+            gaps: vec![[0.0; 3]; NY + 1],
+            primary_nodes,
+        }
+    }
+
+    #[test]
+    fn bodies_tied_side_by_side_are_one_body_on_every_path() {
+        let meshes = [
+            grid("left", 0.0, NX),
+            grid("middle", 1.0, NX),
+            grid("right", 2.0, NX),
+            grid("alone", 5.0, NX),
+        ];
+        let pushes = [0.01, 0.01, 0.01, 0.02];
+        let mut stats = SolveStats::default();
+        let bodies: Vec<AssembledBody> = (meshes.iter().zip(pushes))
+            .map(|(mesh, push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
+            .collect();
+        let bodies: Vec<&AssembledBody> = bodies.iter().collect();
+        let couplings = [tied(NX, NX, NX, 0, 1.0), tied(NX, 0, NX, NX, -1.0)];
+        let pairs = [
+            Pair {
+                primary: 0,
+                secondary: 1,
+                coupling: &couplings[0],
+            },
+            Pair {
+                primary: 2,
+                secondary: 1,
+                coupling: &couplings[1],
+            },
+        ];
+        let system = CoupledSystem::assemble(&bodies, &pairs, 2, 1.0).unwrap();
+
+        // The references: the 3 x 1 block, and the fourth body alone.
+        let settings = SolverSettings {
+            verbose: false,
+            ..SolverSettings::default()
+        };
+        let whole_mesh = grid("whole", 0.0, 3 * NX);
+        let whole = solve(&problem(&whole_mesh, 0.01), &settings)
+            .unwrap()
+            .displacement;
+        let alone = solve(&problem(&meshes[3], 0.02), &settings)
+            .unwrap()
+            .displacement;
+        let scale = whole.iter().map(|u| u.abs()).fold(0.0, f64::max);
+        let check = |path: &str, x: &[f64]| {
+            let solution = system.solution(x, &pairs, 2, 0.0);
+            for (k, u) in solution.u[..3].iter().enumerate() {
+                for j in 0..=NY {
+                    for i in 0..=NX {
+                        for c in 0..2 {
+                            let ours = u[2 * (i + j * (NX + 1)) + c];
+                            let exact = whole[2 * (NX * k + i + j * (3 * NX + 1)) + c];
+                            assert!(
+                                (ours - exact).abs() <= 1e-9 * scale,
+                                "{path}: body {k} node ({i}, {j}) component {c}: {ours} vs {exact}"
+                            );
+                        }
+                    }
+                }
+            }
+            let off = (solution.u[3].iter().zip(&alone)).map(|(a, b)| (a - b).abs());
+            assert!(
+                off.fold(0.0, f64::max) <= 1e-9 * scale,
+                "{path}: the body in no pair"
+            );
+            // Each pair's tractions balance between its bodies: no force is lost.
+            let forces = solution.total_forces(2);
+            let sum: f64 = forces.iter().map(|f| f[0].abs() + f[1].abs()).sum();
+            for c in 0..2 {
+                let net: f64 = forces.iter().map(|f| f[c]).sum();
+                assert!(net.abs() <= 1e-9 * sum.max(1.0), "{path}: net force {net}");
+            }
+        };
+
+        check(
+            "monolithic LU",
+            &solve_monolithic(&system, &bodies).unwrap(),
+        );
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let compliance = vec![compliance_factor([&material, &material], 2); 2];
+        let candidates = vec![
+            (0..=NY).map(|j| NX + j * (NX + 1)).collect::<Vec<_>>(),
+            (0..=NY)
+                .flat_map(|j| [j * (NX + 1), NX + j * (NX + 1)])
+                .collect(),
+            (0..=NY).map(|j| j * (NX + 1)).collect(),
+            Vec::new(),
+        ];
+        for solver in [CoupledSolver::Schur, CoupledSolver::Krylov] {
+            let contact = ContactSettings {
+                solver,
+                ..ContactSettings::default()
+            };
+            let mut factors = BodyFactors::new(
+                &bodies,
+                candidates.clone(),
+                compliance.clone(),
+                &settings,
+                BodySolverKind::Cholesky,
+                &contact,
+            )
+            .unwrap();
+            let x = factors
+                .solve(&system, &pairs, &bodies, Tightness::Tight)
+                .unwrap();
+            check(solver.name(), &x);
+        }
+    }
 }

@@ -31,8 +31,10 @@
 //! body over the whole solve with `c0` as above, and with it multiplied by 0.001, 0.1, 10 and
 //! 1000: 189 against 479, 253, 346 and 824.
 //!
-//! A multiplier that only restates a Dirichlet condition (`D_kk != 0`, no coupling) keeps its
-//! exact block `D_kk`. `S~` is dense and factored by LU once per active-set iteration (`m` is
+//! With several contact pairs, `S~` is block diagonal, one such block per pair: one pair's
+//! tractions reach another pair's gaps only through the far field of a body they share, a
+//! coupling of lower order that the Krylov iteration absorbs. A multiplier that only restates a
+//! Dirichlet condition (`D_kk != 0`, no coupling) keeps its exact block `D_kk`. `S~` is dense and factored by LU once per active-set iteration (`m` is
 //! hundreds to a few thousand: `m^3 / 3` multiply-adds, 4e8 for the 1048 multipliers of the
 //! largest active set at the contact benchmark's 99k DOFs).
 
@@ -47,10 +49,10 @@ use crate::fem::Material;
 
 /// The half-space approximation of the Schur complement, LU-factored.
 pub struct HalfSpace {
-    /// The multipliers it acts on (`D_kk = 0`).
+    /// The pair's multipliers it acts on (`D_kk = 0`), numbered within the pair.
     coupled: Vec<usize>,
     lu: faer::linalg::solvers::PartialPivLu<f64>,
-    /// `D_kk` of every multiplier (non-zero on the uncoupled ones).
+    /// `D_kk` of every multiplier of the pair (non-zero on the uncoupled ones).
     diagonal: Vec<f64>,
 }
 
@@ -70,10 +72,13 @@ pub fn compliance_factor(materials: [&Material; 2], dim: usize) -> f64 {
 }
 
 impl HalfSpace {
-    /// `S~` on the multipliers of `system`, the active primary nodes at `coordinates` (body 1's,
-    /// `dim` per node), with the compliance factor `c0` ([`compliance_factor`]).
+    /// `S~` on the multipliers of pair `pair` of `system`, whose `coupling` has its active
+    /// primary nodes at `coordinates` (the primary body's, `dim` per node), with the
+    /// compliance factor `c0` ([`compliance_factor`]). It acts on the pair's multipliers alone
+    /// (numbered from 0): the pairs' blocks of the preconditioner are independent.
     pub fn new(
         system: &CoupledSystem,
+        pair: usize,
         coupling: &Coupling,
         coordinates: &[f64],
         dim: usize,
@@ -82,26 +87,27 @@ impl HalfSpace {
         let area: HashMap<usize, f64> = (coupling.primary_nodes.iter().copied())
             .zip(coupling.areas1.iter().copied())
             .collect();
+        let multipliers = system.pair_multipliers(pair);
+        let diagonal = system.d[multipliers.clone()].to_vec();
         // Node, direction and area of each coupled multiplier (its column of B combines the
         // components of one node's traction).
         let mut coupled = Vec::new();
         let mut points = Vec::new();
-        for (k, column) in system.columns.iter().enumerate() {
-            let Some(((node, _), _)) = column.first() else {
+        for (k, column) in system.columns[multipliers].iter().enumerate() {
+            let Some((key, _)) = column.first() else {
                 continue;
             };
-            if system.d[k] != 0.0 {
+            if diagonal[k] != 0.0 {
                 continue;
             }
             let mut e = [0.0; 3];
-            for ((_, c), weight) in column {
-                if let Some(c) = c {
-                    e[*c] = *weight;
-                }
+            for (key, weight) in column {
+                e[key.component] = *weight;
             }
+            let node = key.node;
             let mut x = [0.0; 3];
             x[..dim].copy_from_slice(&coordinates[dim * node..dim * node + dim]);
-            let a = area.get(node).copied().unwrap_or(0.0);
+            let a = area.get(&node).copied().unwrap_or(0.0);
             coupled.push(k);
             points.push((x, e, a));
         }
@@ -126,11 +132,11 @@ impl HalfSpace {
         Self {
             coupled,
             lu: p.partial_piv_lu(),
-            diagonal: system.d.clone(),
+            diagonal,
         }
     }
 
-    /// `out = S~^-1 v` on every multiplier.
+    /// `out = S~^-1 v` on every multiplier of the pair.
     pub fn apply(&self, v: &[f64], out: &mut [f64]) {
         for ((o, x), d) in out.iter_mut().zip(v).zip(&self.diagonal) {
             *o = if *d != 0.0 { x / d } else { 0.0 };

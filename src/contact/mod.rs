@@ -9,8 +9,9 @@
 //!   an iterate);
 //! - `settings.rs` (every setting, its default and range) and `problem.rs` (the two bodies,
 //!   their surfaces, which one is primary, which transfer);
-//! - the linear algebra of an iteration: `compliance.rs` (the bodies' responses to unit
-//!   tractions), `system.rs` (the coupled system of an active set), `interface.rs` (the
+//! - the linear algebra of an iteration, written for any number of bodies and pairs (the loop
+//!   still drives one pair): `compliance.rs` (the bodies' responses to unit tractions),
+//!   `system.rs` (the coupled system of an active set), `interface.rs` (the
 //!   interface operators, built once over all candidates: the interpolation evaluated at each
 //!   node's closest point on the other surface, the contact normal), `half_space.rs` (the
 //!   interface Schur complement approximated by two elastic half-spaces), `coupled_krylov.rs`

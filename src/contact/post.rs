@@ -48,34 +48,39 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let dim = s1.dim;
     let [gaps1, gaps2] = gaps;
-    let primary_fields = surface_fields(s1, &solution.contact_force1, gaps1, |s| {
+    let primary_fields = surface_fields(s1, &solution.contact_force[0], gaps1, |s| {
         active_set.nodes.contains(&s)
     });
-    let mut secondary_fields = surface_fields(s2, &solution.contact_force2, gaps2, |_| false);
+    let mut secondary_fields = surface_fields(s2, &solution.contact_force[1], gaps2, |_| false);
     let touching = problem.settings.secondary_penetration_tolerance;
     secondary_fields.active = secondary_in_contact(s2, &secondary_fields, touching);
-    let [force_primary, force_secondary] = solution.total_forces(dim);
+    let [force_primary, force_secondary] = solution.total_forces(dim)[..] else {
+        unreachable!("a pair has two bodies")
+    };
     let force_imbalance = certificate
         .checks
         .iter()
         .find(|c| c.name == CheckKind::Equilibrium)
         .map_or(f64::NAN, |c| c.value);
     let hertz_primary = hertz::fit(s1, &primary_fields);
-    let max_tangential_traction = max_tangential(&solution.traction, &coupling.normals);
+    let max_tangential_traction = max_tangential(&solution.traction[0], &coupling.normals);
     let residual = solution.relative_residual;
+    let Ok([u1, u2]) = <[Vec<f64>; 2]>::try_from(solution.u) else {
+        unreachable!("a pair has two bodies")
+    };
     let primary = body_solution(
         &problem.primary,
         (body1, stats1),
-        solution.u1,
-        &solution.contact_force1,
+        u1,
+        &solution.contact_force[0],
         load_factor,
         residual,
     );
     let secondary = body_solution(
         &problem.secondary,
         (body2, stats2),
-        solution.u2,
-        &solution.contact_force2,
+        u2,
+        &solution.contact_force[1],
         load_factor,
         residual,
     );

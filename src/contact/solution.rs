@@ -166,7 +166,7 @@ pub struct LinearSolvers {
     /// On the Krylov path, the applications of each body's block of the preconditioner over
     /// the whole solve, `[primary, secondary]`, all load steps: one AMG V-cycle each with
     /// `"cg-amg"` bodies, one pair of triangular solves with `"cholesky"`.
-    pub body_applications: Option<[usize; 2]>,
+    pub body_applications: Option<Vec<usize>>,
 }
 
 /// Everything a contact solve produces.

@@ -80,7 +80,7 @@ use super::settings::CoupledSolver;
 use super::solution::{
     ContactSolution, ContactStatus, IterationRecord, LinearSolvers, PhaseSeconds,
 };
-use super::system::{CoupledSolution, CoupledSystem, Coupling};
+use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
 use crate::linalg::BodySolverKind;
@@ -154,11 +154,9 @@ impl<'a> ContactSolver<'a> {
                 let start = Instant::now();
                 let materials = [&problem.primary.material, &problem.secondary.material];
                 let factors = BodyFactors::new(
-                    &body1,
-                    &body2,
-                    materials,
-                    s1,
-                    s2,
+                    &[&body1, &body2],
+                    vec![s1.nodes.clone(), s2.nodes.clone()],
+                    vec![compliance_factor(materials, s1.dim)],
                     solver,
                     kind,
                     &problem.settings,
@@ -414,7 +412,11 @@ impl ContactSolver<'_> {
         let problem = self.problem;
         let s1 = &problem.primary_surface;
         let mut pressure = vec![0.0; s1.len()];
-        for ((&i, t), n) in nodes.iter().zip(&solution.traction).zip(&coupling.normals) {
+        for ((&i, t), n) in nodes
+            .iter()
+            .zip(&solution.traction[0])
+            .zip(&coupling.normals)
+        {
             pressure[i] = -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]);
         }
         let mut candidates: BTreeSet<usize> = next.clone();
@@ -446,7 +448,7 @@ impl ContactSolver<'_> {
             &self.problem.primary_surface,
             &self.problem.secondary_surface,
         );
-        let jumps = (self.operators).jumps(s1, s2, &solution.u1, &solution.u2);
+        let jumps = (self.operators).jumps(s1, s2, &solution.u[0], &solution.u[1]);
         let linear = self.operators.linearized_gaps(&jumps);
         gaps.iter().zip(&linear).map(|(g, l)| g - l).collect()
     }
@@ -501,7 +503,7 @@ impl ContactSolver<'_> {
             if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
                 *krylov_iterations.get_or_insert(0) += stats.iterations;
             }
-            let (u1, u2) = (&solution.u1[..], &solution.u2[..]);
+            let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
             let (gaps, linear, slid) = timed(&mut seconds.search, || {
                 let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
                 *rows = gap_rows(s1, s2, Some(u1), Some(u2));
@@ -515,7 +517,7 @@ impl ContactSolver<'_> {
                 Formulation::Tied => gaps.clone(),
             };
             let update = timed(&mut seconds.checks, || {
-                let (traction, normals) = (&solution.traction, &coupling.normals);
+                let (traction, normals) = (&solution.traction[0], &coupling.normals);
                 let pinned = &safeguard.pinned;
                 Update::new(problem, &nodes, traction, normals, [&gaps, &held], pinned)
             });
@@ -583,23 +585,27 @@ impl ContactSolver<'_> {
         tightness: Tightness,
     ) -> Result<CoupledSolution, ContactError> {
         let dim = self.problem.primary_surface.dim;
-        let system = CoupledSystem::assemble(&self.body1, &self.body2, coupling, dim, load_factor)?;
+        let bodies = [&self.body1, &self.body2];
+        let pairs = [Pair {
+            primary: 0,
+            secondary: 1,
+            coupling,
+        }];
+        let system = CoupledSystem::assemble(&bodies, &pairs, dim, load_factor)?;
         let x = match self.factors.as_mut() {
-            None => coupled_solver::solve_monolithic(&system, &self.body1, &self.body2)?,
-            Some(factors) => {
-                factors.solve(&system, coupling, [&self.body1, &self.body2], tightness)?
-            }
+            None => coupled_solver::solve_monolithic(&system, &bodies)?,
+            Some(factors) => factors.solve(&system, &pairs, &bodies, tightness)?,
         };
         let loose = tightness == Tightness::Loose
             && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
-        let residual = system.relative_residual(&self.body1, &self.body2, &x);
+        let residual = system.relative_residual(&bodies, &x);
         if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
             return Err(ContactError::Inaccurate {
                 residual,
                 tolerance: self.solver.residual_tolerance,
             });
         }
-        Ok(system.solution(&x, coupling, dim, residual))
+        Ok(system.solution(&x, &pairs, dim, residual))
     }
 }
 

@@ -1,5 +1,9 @@
 //! The linear system of one active-set iteration (`docs/method.md`, section 2.5), assembled in
-//! one place.
+//! one place, for any number of bodies and contact pairs.
+//!
+//! Pair `p` couples its primary body `a` (which carries the multiplier `lambda_p`, the contact
+//! traction on `a` at the pair's active nodes `I_p`) and its secondary body `b` (which receives
+//! `lambda_b = -R_ba lambda_p` on its candidate surface). For one pair of bodies 1 and 2:
 //!
 //! ```text
 //! [ K1        0        -M1 (rows I) ] [u1    ]   [f1]
@@ -7,21 +11,28 @@
 //! [ I (cols I)  -R12          0     ] [lambda]   [d ]
 //! ```
 //!
-//! `K_k`, `f_k` are Dirichlet-constrained (rows and columns of prescribed dofs hold only their
-//! diagonal, and carry no coupling). `lambda` is the traction on body 1 at its active nodes I;
-//! body 2 receives `lambda_2 = -R21 lambda` on its whole candidate surface. `M1`, `M2` are the
-//! lumped interface mass matrices (`super::surface`). Tied: one vector multiplier per node and the vector
-//! constraint `u1 - R12 u2 = d`. Frictionless: `lambda = lambda_n n1`, one scalar per node, and
-//! only the normal constraint `n1 . (u1 - R12 u2) = n1 . d`.
+//! and with more bodies and pairs, one block row per body and one per pair: body `k`'s row
+//! holds `K_k` and the columns of every pair it is in (`-M_a` where it is the primary, `M_b
+//! R_ba` where it is the secondary); pair `p`'s row holds its constraint on its two bodies'
+//! columns. The bodies are coupled only through the pairs: a body in no pair is its own block.
 //!
-//! A multiplier whose constraint only restates a Dirichlet condition of body 1 (tied: its dof
-//! is prescribed; frictionless: every dof of its node is) is dropped: its row becomes
+//! `K_k`, `f_k` are Dirichlet-constrained (rows and columns of prescribed dofs hold only their
+//! diagonal, and carry no coupling). `M_a`, `M_b` are the lumped interface mass matrices
+//! (`super::surface`). Tied: one vector multiplier per node and the vector constraint `u_a -
+//! R_ab u_b = d`. Frictionless: `lambda = lambda_n n_a`, one scalar per node, and only the
+//! normal constraint `n_a . (u_a - R_ab u_b) = n_a . d`.
+//!
+//! A multiplier whose constraint only restates a Dirichlet condition of its primary body (tied:
+//! its dof is prescribed; frictionless: every dof of its node is) is dropped: its row becomes
 //! `lambda = 0` and it acts on neither body. Keeping it would leave an empty column, since the
 //! rows of prescribed dofs carry no coupling.
 //!
 //! Scaling: the multiplier columns are multiplied by `s = k / m` and the constraint rows by `k`,
-//! with `k` the largest diagonal entry of `K1` and `K2` and `m` that of `M1`, so that every block has
-//! the magnitude of `K`; the solution is unscaled on return.
+//! with `k` the largest diagonal entry of the bodies' `K` and `m` the largest lumped mass of an
+//! active primary node, so that every block has the magnitude of `K`; the solution is unscaled
+//! on return.
+
+use std::ops::Range;
 
 use faer::sparse::{SparseColMat, Triplet};
 
@@ -30,16 +41,16 @@ use super::{ContactError, Formulation};
 use crate::elastic::AssembledBody;
 use crate::linalg::mat_vec;
 
-/// The interface operators of one iteration, on the active primary nodes I (built by
-/// `super::interface::InterfaceOperators::coupling`).
+/// The interface operators of one pair in one iteration, on its active primary nodes I (built
+/// by `super::interface::InterfaceOperators::coupling`).
 pub struct Coupling {
     pub formulation: Formulation,
     /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
-    /// Normal at each active node (pointing out of body 1). Frictionless: the normal of the
-    /// secondary facet the node is held on, the direction of both its constraint row (the
-    /// gradient of its gap, `super::gap`) and its traction `lambda_n n`. Tied: the
-    /// contact normal along which the gap is held.
+    /// Normal at each active node (pointing out of the primary). Frictionless: the normal of
+    /// the secondary facet the node is held on, the direction of both its constraint row (the
+    /// gradient of its gap, `super::gap`) and its traction `lambda_n n`. Tied: the contact
+    /// normal along which the gap is held.
     pub normals: Vec<[f64; 3]>,
     /// Lumped interface mass of each active node: its area `A_i`.
     pub areas1: Vec<f64>,
@@ -47,35 +58,45 @@ pub struct Coupling {
     /// (tied) or the P1 weights of the secondary facet it projects onto (frictionless).
     pub r12: Vec<Vec<(usize, f64)>>,
     /// Column of `M2 R21` of each active node: `(secondary body node, A2_j R21[j, i])`, the
-    /// force a unit traction at node `i` puts on body 2's nodes (with the sign of `lambda_2 =
-    /// -R21 lambda` applied by the system).
+    /// force a unit traction at node `i` puts on the secondary's nodes (with the sign of
+    /// `lambda_2 = -R21 lambda` applied by the system).
     pub loads2: Vec<Vec<(usize, f64)>>,
     /// Gap each active node is held at, as a vector along its contact normal.
     pub gaps: Vec<[f64; 3]>,
 }
 
+/// One contact pair of a coupled system: its two bodies (indices into the system's bodies) and
+/// its coupling.
+#[derive(Clone, Copy)]
+pub struct Pair<'a> {
+    pub primary: usize,
+    pub secondary: usize,
+    pub coupling: &'a Coupling,
+}
+
 /// The solution of one iteration.
 pub struct CoupledSolution {
-    pub u1: Vec<f64>,
-    pub u2: Vec<f64>,
-    /// Traction on body 1 at I, one vector per node (for frictionless, `lambda_n n1`).
-    pub traction: Vec<[f64; 3]>,
-    /// Forces the interface applies to each body's dofs: `M1 lambda`, `-M2 R21 lambda`.
-    pub contact_force1: Vec<f64>,
-    pub contact_force2: Vec<f64>,
+    /// Displacements of each body.
+    pub u: Vec<Vec<f64>>,
+    /// Traction on each pair's primary at its active nodes, one vector per node (for
+    /// frictionless, `lambda_n n`).
+    pub traction: Vec<Vec<[f64; 3]>>,
+    /// Forces the interfaces apply to each body's dofs: `M_a lambda` on a primary, `-M_b R_ba
+    /// lambda` on a secondary, summed over the body's pairs.
+    pub contact_force: Vec<Vec<f64>>,
     pub relative_residual: f64,
 }
 
 impl CoupledSolution {
-    /// The total contact force on each body, `[F1, F2]` (components beyond `dim` are 0).
-    pub fn total_forces(&self, dim: usize) -> [[f64; 3]; 2] {
+    /// The total contact force on each body (components beyond `dim` are 0).
+    pub fn total_forces(&self, dim: usize) -> Vec<[f64; 3]> {
         let total = |force: &[f64]| -> [f64; 3] {
             std::array::from_fn(|c| match c < dim {
                 true => force.iter().skip(c).step_by(dim).sum(),
                 false => 0.0,
             })
         };
-        [total(&self.contact_force1), total(&self.contact_force2)]
+        self.contact_force.iter().map(|f| total(f)).collect()
     }
 }
 
@@ -87,14 +108,15 @@ impl Coupling {
         }
     }
 
-    /// Whether multiplier `col` restates a Dirichlet condition of body 1 (see the module doc).
-    fn is_dropped(&self, col: usize, body1: &AssembledBody, dim: usize) -> bool {
+    /// Whether multiplier `col` restates a Dirichlet condition of the `primary` (see the
+    /// module doc).
+    fn is_dropped(&self, col: usize, primary: &AssembledBody, dim: usize) -> bool {
         match self.formulation {
-            Formulation::Tied => body1
+            Formulation::Tied => primary
                 .constraints
                 .is_fixed(dim * self.primary_nodes[col / dim] + col % dim),
             Formulation::Frictionless => (0..dim).all(|c| {
-                body1
+                primary
                     .constraints
                     .is_fixed(dim * self.primary_nodes[col] + c)
             }),
@@ -112,15 +134,23 @@ impl Coupling {
 }
 
 /// The coupled system of one iteration, kept in blocks so that it can be solved either as one
-/// sparse matrix or through the bodies' own factorizations:
+/// sparse matrix or through the bodies' own solvers:
 ///
 /// ```text
-/// [ K  B ] [u     ]   [f]      K = diag(K1, K2) (constrained), B the scaled coupling columns,
-/// [ C  D ] [lambda] = [g]      C the scaled constraint rows, D = t on dropped multipliers
+/// [ K  B ] [u     ]   [f]      K = diag(K_1 .. K_N) (constrained), B the scaled coupling
+/// [ C  D ] [lambda] = [g]      columns, C the scaled constraint rows, D = t on dropped
+///                              multipliers
 /// ```
+///
+/// The unknowns are the bodies' displacements one body after another, then the pairs'
+/// multipliers one pair after another.
 pub struct CoupledSystem {
-    pub n1: usize,
-    pub n2: usize,
+    /// Body `k`'s dofs are the unknowns `offsets[k]..offsets[k + 1]`; the multipliers follow
+    /// `offsets[N]`.
+    pub offsets: Vec<usize>,
+    /// Pair `p`'s multipliers are `multiplier_offsets[p]..multiplier_offsets[p + 1]` of the
+    /// multiplier block.
+    pub multiplier_offsets: Vec<usize>,
     /// Number of multipliers.
     pub m: usize,
     /// The column of `B` of each multiplier over `s`, as a combination of the unit forces of
@@ -130,84 +160,129 @@ pub struct CoupledSystem {
     /// nothing else).
     pub columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// The force that a unit traction of one component at one active primary node puts on
-    /// the bodies (rows `< n1 + n2`, unscaled).
+    /// the bodies (rows `< offsets[N]`, unscaled).
     pub unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
     /// Multiplier scaling: the unknown is `lambda / s`.
     pub s: f64,
     /// Constraint row scaling: a row's residual is `t` times the gap error of its node.
     pub t: f64,
-    /// Entries `(row < n1 + n2, multiplier, value)` of B.
+    /// Entries `(row < offsets[N], multiplier, value)` of B.
     pub b: Vec<(usize, usize, f64)>,
-    /// Entries `(multiplier, column < n1 + n2, value)` of C.
+    /// Entries `(multiplier, column < offsets[N], value)` of C.
     pub c: Vec<(usize, usize, f64)>,
     /// Diagonal of D.
     pub d: Vec<f64>,
-    /// `[f1; f2]` (constrained) and `g`.
+    /// The bodies' `f_k` (constrained), one after another, and `g`.
     pub f: Vec<f64>,
-    /// The factor `f` is scaled by: `f = load_factor [f1(1); f2(1)]`.
+    /// The factor `f` is scaled by: `f = load_factor [f_1(1); ...; f_N(1)]`.
     pub load_factor: f64,
     pub g: Vec<f64>,
 }
 
 impl CoupledSystem {
-    /// Assembles the blocks of the coupled system (`docs/method.md` 2.5), with the loads and
-    /// prescribed displacements scaled by `load_factor`.
+    /// Assembles the blocks of the coupled system of `bodies` and `pairs` (`docs/method.md`
+    /// 2.5), with the loads and prescribed displacements scaled by `load_factor`.
     pub fn assemble(
-        body1: &AssembledBody,
-        body2: &AssembledBody,
-        coupling: &Coupling,
+        bodies: &[&AssembledBody],
+        pairs: &[Pair],
         dim: usize,
         load_factor: f64,
     ) -> Result<Self, ContactError> {
-        let n1 = body1.f_c.len();
-        let n2 = body2.f_c.len();
-        let m = coupling.num_multipliers(dim);
-        let k_scale = diagonal_max(&body1.k_c).max(diagonal_max(&body2.k_c));
-        let m_scale = coupling.areas1.iter().cloned().fold(0.0, f64::max);
+        let mut offsets = vec![0];
+        for body in bodies {
+            offsets.push(offsets.last().unwrap() + body.f_c.len());
+        }
+        let mut multiplier_offsets = vec![0];
+        for pair in pairs {
+            let count = pair.coupling.num_multipliers(dim);
+            multiplier_offsets.push(multiplier_offsets.last().unwrap() + count);
+        }
+        let m = *multiplier_offsets.last().unwrap();
+        let k_scale = bodies
+            .iter()
+            .map(|b| diagonal_max(&b.k_c))
+            .fold(0.0, f64::max);
+        let m_scale = (pairs.iter())
+            .flat_map(|pair| pair.coupling.areas1.iter().copied())
+            .fold(0.0, f64::max);
         if m > 0 && m_scale <= 0.0 {
             return Err(ContactError::EmptyInterfaceMass);
         }
         let s = if m > 0 { k_scale / m_scale } else { 1.0 };
         let t = k_scale;
-        let dropped: Vec<bool> = (0..m)
-            .map(|col| coupling.is_dropped(col, body1, dim))
-            .collect();
-        let columns = CouplingColumns::assemble(body1, body2, coupling, dim, &dropped, s);
-        let (c_entries, g) = constraint_rows(coupling, dim, n1, &dropped, t);
-        let d: Vec<f64> = dropped.iter().map(|&x| if x { t } else { 0.0 }).collect();
+        let mut blocks = PairBlocks::new(m);
+        for (p, pair) in pairs.iter().enumerate() {
+            let place = Placement {
+                pair: p,
+                first_multiplier: multiplier_offsets[p],
+                primary: offsets[pair.primary],
+                secondary: offsets[pair.secondary],
+            };
+            let [primary, secondary] = [bodies[pair.primary], bodies[pair.secondary]];
+            blocks.add(pair.coupling, primary, secondary, &place, dim, s, t);
+        }
         // Loads and prescribed displacements scale the constrained right-hand side linearly.
-        let f: Vec<f64> = body1
-            .f_c
-            .iter()
-            .chain(&body2.f_c)
-            .map(|v| load_factor * v)
+        let f: Vec<f64> = (bodies.iter())
+            .flat_map(|body| body.f_c.iter().map(|v| load_factor * v))
             .collect();
         Ok(Self {
-            n1,
-            n2,
+            offsets,
+            multiplier_offsets,
             m,
-            columns: columns.columns,
-            unit_loads: columns.unit_loads,
+            columns: blocks.columns,
+            unit_loads: blocks.unit_loads,
             s,
             t,
-            b: columns.b,
-            c: c_entries,
-            d,
+            b: blocks.b,
+            c: blocks.c,
+            d: blocks.d,
             f,
             load_factor,
-            g,
+            g: blocks.g,
         })
     }
 
-    /// The whole matrix, for the monolithic solve and the residual check of every solve.
+    /// The number of bodies.
+    pub fn num_bodies(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// The unknowns of body `k`.
+    pub fn body_dofs(&self, k: usize) -> Range<usize> {
+        self.offsets[k]..self.offsets[k + 1]
+    }
+
+    /// The displacement unknowns of all bodies (the multipliers follow).
+    pub fn num_displacements(&self) -> usize {
+        *self.offsets.last().expect("offsets start with 0")
+    }
+
+    /// The bodies' part of `v` (a vector of the system's unknowns, or of its displacements
+    /// alone) cut into one slice per body.
+    pub fn body_parts<'v>(&self, v: &'v mut [f64]) -> Vec<&'v mut [f64]> {
+        let mut rest = &mut v[..self.num_displacements()];
+        let mut parts = Vec::with_capacity(self.num_bodies());
+        for k in 0..self.num_bodies() {
+            let (part, tail) = rest.split_at_mut(self.body_dofs(k).len());
+            parts.push(part);
+            rest = tail;
+        }
+        parts
+    }
+
+    /// The multipliers of pair `p`, within the multiplier block.
+    pub fn pair_multipliers(&self, p: usize) -> Range<usize> {
+        self.multiplier_offsets[p]..self.multiplier_offsets[p + 1]
+    }
+
+    /// The whole matrix, for the monolithic solve.
     pub fn matrix(
         &self,
-        body1: &AssembledBody,
-        body2: &AssembledBody,
+        bodies: &[&AssembledBody],
     ) -> Result<SparseColMat<usize, f64>, ContactError> {
-        let (n1, n) = (self.n1, self.n1 + self.n2);
+        let n = self.num_displacements();
         let mut triplets = Vec::new();
-        for (body, offset) in [(body1, 0), (body2, n1)] {
+        for (body, &offset) in bodies.iter().zip(&self.offsets) {
             let (symbolic, values) = body.k_c.parts();
             let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
             for j in 0..symbolic.ncols() {
@@ -233,15 +308,12 @@ impl CoupledSystem {
 
     /// `||A x - [f; g]|| / ||[f; g]||` for the whole matrix `A` of [`Self::matrix`], applied
     /// block by block without assembling it.
-    pub fn relative_residual(
-        &self,
-        body1: &AssembledBody,
-        body2: &AssembledBody,
-        x: &[f64],
-    ) -> f64 {
-        let (n1, n) = (self.n1, self.n1 + self.n2);
-        let mut ax = mat_vec(&body1.k_c, &x[..n1]);
-        ax.extend(mat_vec(&body2.k_c, &x[n1..n]));
+    pub fn relative_residual(&self, bodies: &[&AssembledBody], x: &[f64]) -> f64 {
+        let n = self.num_displacements();
+        let mut ax = Vec::with_capacity(n + self.m);
+        for (k, body) in bodies.iter().enumerate() {
+            ax.extend(mat_vec(&body.k_c, &x[self.body_dofs(k)]));
+        }
         ax.extend(self.d.iter().zip(&x[n..]).map(|(d, l)| d * l));
         for &(row, k, value) in &self.b {
             ax[row] += value * x[n + k];
@@ -263,133 +335,157 @@ impl CoupledSystem {
         rhs
     }
 
-    /// Unscales the solution `x = [u1; u2; lambda / s]` and forms the tractions and the
-    /// interface forces.
+    /// Unscales the solution `x = [u_1; ...; u_N; lambda / s]` and forms each pair's tractions
+    /// and each body's interface forces.
     pub fn solution(
         &self,
         x: &[f64],
-        coupling: &Coupling,
+        pairs: &[Pair],
         dim: usize,
         relative_residual: f64,
     ) -> CoupledSolution {
-        let (n1, n2) = (self.n1, self.n2);
-        let traction: Vec<[f64; 3]> = (0..coupling.primary_nodes.len())
-            .map(|k| {
-                let mut lambda = [0.0; 3];
-                for (c, value) in lambda.iter_mut().enumerate().take(dim) {
-                    let (col, weight) = coupling.multiplier_terms(k, c, dim);
-                    *value = self.s * x[n1 + n2 + col] * weight;
-                }
-                lambda
-            })
+        let n = self.num_displacements();
+        let u: Vec<Vec<f64>> = (0..self.num_bodies())
+            .map(|k| x[self.body_dofs(k)].to_vec())
             .collect();
-        let mut contact_force1 = vec![0.0; n1];
-        let mut contact_force2 = vec![0.0; n2];
-        for (k, lambda) in traction.iter().enumerate() {
-            let node = coupling.primary_nodes[k];
-            for c in 0..dim {
-                contact_force1[dim * node + c] += coupling.areas1[k] * lambda[c];
-                for &(node2, load) in &coupling.loads2[k] {
-                    contact_force2[dim * node2 + c] -= load * lambda[c];
+        let mut contact_force: Vec<Vec<f64>> = u.iter().map(|u| vec![0.0; u.len()]).collect();
+        let mut traction = Vec::with_capacity(pairs.len());
+        for (p, pair) in pairs.iter().enumerate() {
+            let coupling = pair.coupling;
+            let multipliers = &x[n + self.multiplier_offsets[p]..];
+            let on_pair: Vec<[f64; 3]> = (0..coupling.primary_nodes.len())
+                .map(|k| {
+                    let mut lambda = [0.0; 3];
+                    for (c, value) in lambda.iter_mut().enumerate().take(dim) {
+                        let (col, weight) = coupling.multiplier_terms(k, c, dim);
+                        *value = self.s * multipliers[col] * weight;
+                    }
+                    lambda
+                })
+                .collect();
+            for (k, lambda) in on_pair.iter().enumerate() {
+                let node = coupling.primary_nodes[k];
+                for c in 0..dim {
+                    contact_force[pair.primary][dim * node + c] += coupling.areas1[k] * lambda[c];
+                    for &(node2, load) in &coupling.loads2[k] {
+                        contact_force[pair.secondary][dim * node2 + c] -= load * lambda[c];
+                    }
                 }
             }
+            traction.push(on_pair);
         }
         CoupledSolution {
-            u1: x[..n1].to_vec(),
-            u2: x[n1..n1 + n2].to_vec(),
+            u,
             traction,
-            contact_force1,
-            contact_force2,
+            contact_force,
             relative_residual,
         }
     }
 }
 
-/// The coupling columns of the multipliers: `-M1 lambda` on body 1, `+M2 R21 lambda` on body
-/// 2, one unit force per active node and component, combined per multiplier.
-struct CouplingColumns {
+/// Where one pair's blocks go in the system: its index, its first multiplier, and the first
+/// unknown of its primary and secondary bodies.
+struct Placement {
+    pair: usize,
+    first_multiplier: usize,
+    primary: usize,
+    secondary: usize,
+}
+
+/// The coupling blocks of the pairs, added one pair at a time.
+struct PairBlocks {
     /// [`CoupledSystem::b`].
     b: Vec<(usize, usize, f64)>,
     /// [`CoupledSystem::columns`].
     columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// [`CoupledSystem::unit_loads`].
     unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
+    /// [`CoupledSystem::c`].
+    c: Vec<(usize, usize, f64)>,
+    /// [`CoupledSystem::d`].
+    d: Vec<f64>,
+    /// [`CoupledSystem::g`].
+    g: Vec<f64>,
 }
 
-impl CouplingColumns {
-    /// The columns of the multipliers not `dropped`, scaled by `s`; rows of prescribed dofs
-    /// carry no coupling.
-    fn assemble(
-        body1: &AssembledBody,
-        body2: &AssembledBody,
+impl PairBlocks {
+    fn new(m: usize) -> Self {
+        Self {
+            b: Vec::new(),
+            columns: vec![Vec::new(); m],
+            unit_loads: Vec::new(),
+            c: Vec::new(),
+            d: vec![0.0; m],
+            g: vec![0.0; m],
+        }
+    }
+
+    /// The blocks of one pair at `place`, its columns scaled by `s` and its rows by `t`:
+    /// `-M_a lambda` on the primary and `+M_b R_ba lambda` on the secondary, one unit force
+    /// per active node and component combined per multiplier; the constraint `u_a - R_ab u_b =
+    /// d` (tied) or its normal component (frictionless). Rows of prescribed dofs carry no
+    /// coupling; a dropped multiplier gets `D = t` and nothing else.
+    #[allow(clippy::too_many_arguments)]
+    fn add(
+        &mut self,
         coupling: &Coupling,
+        primary: &AssembledBody,
+        secondary: &AssembledBody,
+        place: &Placement,
         dim: usize,
-        dropped: &[bool],
         s: f64,
-    ) -> Self {
-        let n1 = body1.f_c.len();
-        let free1 = |dof: usize| !body1.constraints.is_fixed(dof);
-        let free2 = |dof: usize| !body2.constraints.is_fixed(dof);
-        let mut b = Vec::new();
-        let mut columns = vec![Vec::new(); dropped.len()];
-        let mut unit_loads = Vec::new();
+        t: f64,
+    ) {
+        let first = place.first_multiplier;
+        let count = coupling.num_multipliers(dim);
+        let dropped: Vec<bool> = (0..count)
+            .map(|col| coupling.is_dropped(col, primary, dim))
+            .collect();
+        for (col, _) in dropped.iter().enumerate().filter(|(_, dropped)| **dropped) {
+            self.d[first + col] = t;
+        }
+        let free1 = |dof: usize| !primary.constraints.is_fixed(dof);
+        let free2 = |dof: usize| !secondary.constraints.is_fixed(dof);
         for (k, &node) in coupling.primary_nodes.iter().enumerate() {
             for c in 0..dim {
                 let (col, weight) = coupling.multiplier_terms(k, c, dim);
                 if dropped[col] || weight == 0.0 {
                     continue;
                 }
+                let multiplier = first + col;
+                // The column: the unit force of component c at the node, on both bodies.
                 let mut load = Vec::new();
                 let dof = dim * node + c;
                 if free1(dof) {
-                    load.push((dof, -coupling.areas1[k]));
+                    load.push((place.primary + dof, -coupling.areas1[k]));
                 }
                 for &(node2, value) in &coupling.loads2[k] {
                     let dof2 = dim * node2 + c;
                     if free2(dof2) {
-                        load.push((n1 + dof2, value));
+                        load.push((place.secondary + dof2, value));
                     }
                 }
-                b.extend(load.iter().map(|&(row, v)| (row, col, s * v * weight)));
-                let key = (node, Some(c));
-                columns[col].push((key, weight));
-                unit_loads.push((key, load));
+                self.b.extend(
+                    load.iter()
+                        .map(|&(row, v)| (row, multiplier, s * v * weight)),
+                );
+                let key = MultiplierKey {
+                    pair: place.pair,
+                    node,
+                    component: c,
+                };
+                self.columns[multiplier].push((key, weight));
+                self.unit_loads.push((key, load));
+                // The row: the gap of component c between the node and its secondary point.
+                self.c.push((multiplier, place.primary + dof, t * weight));
+                for &(node2, w) in &coupling.r12[k] {
+                    let column = place.secondary + dim * node2 + c;
+                    self.c.push((multiplier, column, -t * w * weight));
+                }
+                self.g[multiplier] += t * weight * coupling.gaps[k][c];
             }
-        }
-        Self {
-            b,
-            columns,
-            unit_loads,
         }
     }
-}
-
-/// The constraint rows `C` and right-hand side `g`, scaled by `t`: `u1 - R12 u2 = d` (tied),
-/// or its normal component (frictionless), for the multipliers not `dropped`; body 2's dofs
-/// follow body 1's `n1`.
-fn constraint_rows(
-    coupling: &Coupling,
-    dim: usize,
-    n1: usize,
-    dropped: &[bool],
-    t: f64,
-) -> (Vec<(usize, usize, f64)>, Vec<f64>) {
-    let mut c_entries = Vec::new();
-    let mut g = vec![0.0; dropped.len()];
-    for (a, &node) in coupling.primary_nodes.iter().enumerate() {
-        for c in 0..dim {
-            let (row, weight) = coupling.multiplier_terms(a, c, dim);
-            if dropped[row] || weight == 0.0 {
-                continue;
-            }
-            c_entries.push((row, dim * node + c, t * weight));
-            for &(node2, w) in &coupling.r12[a] {
-                c_entries.push((row, n1 + dim * node2 + c, -t * w * weight));
-            }
-            g[row] += t * weight * coupling.gaps[a][c];
-        }
-    }
-    (c_entries, g)
 }
 
 fn diagonal_max(k: &SparseColMat<usize, f64>) -> f64 {
