@@ -80,7 +80,9 @@ fn main() {
             let body = case.body_mesh(&mesh, spec).unwrap_or_else(exit);
             let problem = case.elastic_problem(body, spec).unwrap_or_else(exit);
             let system = assemble(&problem, &mut SolveStats::default(), false).unwrap();
-            let symbolic = CholeskySymbolic::new(&system.pattern, case.solver.ordering).unwrap();
+            let symbolic =
+                CholeskySymbolic::new(&system.graph, system.k_c.symbolic(), case.solver.ordering)
+                    .unwrap();
             let factor = Cholesky::factorize(symbolic, &system.k_c).unwrap();
             (body, problem, system, factor)
         })
@@ -101,8 +103,12 @@ fn main() {
                     keep(&name("K"), threads, k.val());
 
                     let (seconds, _) = timed(|| {
-                        let symbolic =
-                            CholeskySymbolic::new(&system.pattern, case.solver.ordering).unwrap();
+                        let symbolic = CholeskySymbolic::new(
+                            &system.graph,
+                            system.k_c.symbolic(),
+                            case.solver.ordering,
+                        )
+                        .unwrap();
                         Cholesky::factorize(symbolic, &system.k_c).unwrap()
                     });
                     record(name("Cholesky (ordering + numeric)"), threads, seconds);

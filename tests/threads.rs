@@ -145,8 +145,12 @@ fn cholesky_solves_are_identical_for_any_thread_count() {
         .collect();
     let solve = |threads: usize| {
         with_threads(threads, || {
-            let symbolic =
-                CholeskySymbolic::new(&system.pattern, Ordering::NestedDissection).unwrap();
+            let symbolic = CholeskySymbolic::new(
+                &system.graph,
+                system.k_c.symbolic(),
+                Ordering::NestedDissection,
+            )
+            .unwrap();
             let factor = Cholesky::factorize(symbolic, &system.k_c).unwrap();
             let mut one = system.f_c.clone();
             factor.solve_in_place(&mut one, 1);

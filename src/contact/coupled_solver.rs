@@ -250,7 +250,7 @@ impl BodyFactors {
 
 /// The Cholesky factor of a body's constrained stiffness.
 fn cholesky(body: &AssembledBody, ordering: Ordering) -> Result<BodySolver, ContactError> {
-    CholeskySymbolic::new(&body.pattern, ordering)
+    CholeskySymbolic::new(&body.graph, body.k_c.symbolic(), ordering)
         .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
         .map(BodySolver::Cholesky)
         .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))

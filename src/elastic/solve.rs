@@ -10,7 +10,7 @@ use crate::cancel::Cancel;
 use crate::fem::assembly::{assemble_stiffness, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::stress::cell_fields;
-use crate::fem::{Constraints, SparsityPattern};
+use crate::fem::{Constraints, NodeGraph};
 use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
     relative_residual,
@@ -154,7 +154,8 @@ pub struct AssembledBody {
     /// Node coordinates, `dim` per node: the rigid-body modes an iterative solver's
     /// multigrid needs (its near-null space).
     pub coordinates: Vec<f64>,
-    pub pattern: SparsityPattern,
+    /// The node graph of `k_c`'s pattern (for a fill-reducing ordering).
+    pub graph: NodeGraph,
     /// The rows of the unconstrained `K` at the prescribed dofs, `(dof, [(column, value)])`:
     /// all the reactions need of it. The whole `K` is not kept: at a million DOFs it is a
     /// gigabyte beside `k_c` and the solver's own copies.
@@ -182,6 +183,8 @@ pub fn assemble(
         assemble_stiffness(body, &problem.material, &pattern)
     });
     stats.stiffness_nnz = pattern.nnz();
+    // K holds the pattern now; the solvers need only its node graph besides.
+    let graph = pattern.into_graph();
 
     // 2. Load vector f: surface loads and body force.
     let f = timed(stats, verbose, "assemble loads", || {
@@ -198,13 +201,11 @@ pub fn assemble(
         f
     });
 
-    // 3. Dirichlet conditions, eliminated symmetrically on the same pattern.
+    // 3. Dirichlet conditions, eliminated symmetrically on the same pattern, in K's storage;
+    //    the rows of K at the prescribed dofs are kept first, for the reactions (K is
+    //    symmetric: the row of a dof is its column).
     let constraints = constraints(problem)?;
     stats.num_prescribed_dofs = constraints.num_fixed();
-    let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
-        constraints.apply(&k, &f)
-    });
-    // K is symmetric: the row of a dof is its column.
     let prescribed_rows = {
         let (symbolic, values) = k.parts();
         let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
@@ -216,12 +217,14 @@ pub fn assemble(
             })
             .collect()
     };
-    drop(k);
+    let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
+        constraints.apply(k, &f)
+    });
     let dim = body.dim;
     Ok(AssembledBody {
         dim,
         coordinates: body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect(),
-        pattern,
+        graph,
         prescribed_rows,
         f,
         constraints,
@@ -278,7 +281,7 @@ pub fn solve(
     };
     let mut stats = SolveStats::default();
     let system = assemble(problem, &mut stats, verbose)?;
-    let (pattern, k_c, f_c) = (&system.pattern, &system.k_c, &system.f_c);
+    let (graph, k_c, f_c) = (&system.graph, &system.k_c, &system.f_c);
 
     // 4. The body solver: Cholesky (symbolic, then numeric) or CG + AMG (matrix and multigrid
     //    hierarchy). Both take K_c as it is: Dirichlet rows and columns zeroed with K_dd kept on
@@ -294,7 +297,7 @@ pub fn solve(
         .map_err(linalg)?,
         _ => {
             let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
-                CholeskySymbolic::new(pattern, settings.ordering)
+                CholeskySymbolic::new(graph, k_c.symbolic(), settings.ordering)
             })
             .map_err(linalg)?;
             stats.factor_nnz = symbolic.factor_nnz();

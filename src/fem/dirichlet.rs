@@ -44,15 +44,15 @@ impl Constraints {
         self.prescribed.iter().filter(|v| v.is_some()).count()
     }
 
-    /// The constrained system `(K_c, f_c)` on the pattern of `k`.
+    /// The constrained system `(K_c, f_c)` of `(k, f)`, on the pattern of `k`, whose storage it
+    /// takes over: a copy would double the largest allocation of a solve.
     pub fn apply(
         &self,
-        k: &SparseColMat<usize, f64>,
+        k: SparseColMat<usize, f64>,
         f: &[f64],
     ) -> (SparseColMat<usize, f64>, Vec<f64>) {
-        let (symbolic, values) = k.parts();
+        let (symbolic, mut values) = k.into_parts();
         let mut rhs = f.to_vec();
-        let mut constrained = values.to_vec();
         let col_ptr = symbolic.col_ptr();
         let row_idx = symbolic.row_idx();
         for j in 0..symbolic.ncols() {
@@ -65,19 +65,13 @@ impl Constraints {
                         if self.prescribed[i].is_none() {
                             rhs[i] -= values[p] * g;
                         }
-                        constrained[p] = 0.0;
+                        values[p] = 0.0;
                     }
                 } else if self.prescribed[i].is_some() {
-                    constrained[p] = 0.0;
+                    values[p] = 0.0;
                 }
             }
         }
-        (
-            SparseColMat::new(
-                symbolic.to_owned().expect("pattern fits in memory"),
-                constrained,
-            ),
-            rhs,
-        )
+        (SparseColMat::new(symbolic, values), rhs)
     }
 }

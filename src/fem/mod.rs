@@ -19,4 +19,4 @@ pub mod stress;
 
 pub use dirichlet::Constraints;
 pub use material::{Material, MaterialError};
-pub use sparsity::SparsityPattern;
+pub use sparsity::{NodeGraph, SparsityPattern};

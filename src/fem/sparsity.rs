@@ -8,13 +8,36 @@
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
-/// Compressed-column pattern of a finite element matrix, with the node graph it came from.
+/// The node graph of a pattern: which nodes the elements couple, and the unknowns per node.
+/// All a fill-reducing ordering needs (`crate::linalg::ordering`), `block^2` times smaller
+/// than the pattern itself.
 #[derive(Debug, Clone)]
-pub struct SparsityPattern {
+pub struct NodeGraph {
     block: usize,
     /// Neighbours of each node, including itself, sorted (CSR layout).
     neighbour_ptr: Vec<usize>,
     neighbours: Vec<usize>,
+}
+
+impl NodeGraph {
+    pub fn num_nodes(&self) -> usize {
+        self.neighbour_ptr.len() - 1
+    }
+
+    pub fn block(&self) -> usize {
+        self.block
+    }
+
+    /// Neighbours of node `a`, including `a`, sorted.
+    pub fn neighbours(&self, a: usize) -> &[usize] {
+        &self.neighbours[self.neighbour_ptr[a]..self.neighbour_ptr[a + 1]]
+    }
+}
+
+/// Compressed-column pattern of a finite element matrix, with the node graph it came from.
+#[derive(Debug, Clone)]
+pub struct SparsityPattern {
+    graph: NodeGraph,
     symbolic: SymbolicSparseColMat<usize>,
 }
 
@@ -75,11 +98,23 @@ impl SparsityPattern {
         }
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         Self {
-            block,
-            neighbour_ptr,
-            neighbours,
+            graph: NodeGraph {
+                block,
+                neighbour_ptr,
+                neighbours,
+            },
             symbolic,
         }
+    }
+
+    /// The node graph alone, for a matrix that has taken a copy of the pattern: the
+    /// dof-level pattern is the bulk of the memory (8 bytes per stored entry).
+    pub fn into_graph(self) -> NodeGraph {
+        self.graph
+    }
+
+    pub fn graph(&self) -> &NodeGraph {
+        &self.graph
     }
 
     pub fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
@@ -91,22 +126,22 @@ impl SparsityPattern {
     }
 
     pub fn num_nodes(&self) -> usize {
-        self.neighbour_ptr.len() - 1
+        self.graph.num_nodes()
     }
 
     pub fn block(&self) -> usize {
-        self.block
+        self.graph.block
     }
 
     /// Neighbours of node `a`, including `a`, sorted.
     pub fn neighbours(&self, a: usize) -> &[usize] {
-        &self.neighbours[self.neighbour_ptr[a]..self.neighbour_ptr[a + 1]]
+        self.graph.neighbours(a)
     }
 
     /// Adds a dense element matrix (column-major, `block * nodes.len()` square, unknowns
     /// interleaved per node) into `values`, the value array of this pattern.
     pub fn add_element(&self, nodes: &[usize], element: &[f64], values: &mut [f64]) {
-        let block = self.block;
+        let block = self.graph.block;
         let n = block * nodes.len();
         debug_assert_eq!(element.len(), n * n);
         let col_ptr = self.symbolic.col_ptr();

@@ -39,18 +39,18 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
-use faer::sparse::SparseColMat;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
+use faer::sparse::{SparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::LinalgError;
 use super::ordering::nested_dissection;
-use crate::fem::SparsityPattern;
+use crate::fem::NodeGraph;
 
 /// Fill-reducing ordering of the unknowns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -78,21 +78,24 @@ pub struct CholeskySymbolic {
 }
 
 impl CholeskySymbolic {
-    pub fn new(pattern: &SparsityPattern, ordering: Ordering) -> Result<Self, LinalgError> {
+    /// The analysis of the matrices with the compressed-column pattern `symbolic`, whose node
+    /// graph is `graph` (nested dissection orders the graph).
+    pub fn new(
+        graph: &NodeGraph,
+        symbolic: SymbolicSparseColMatRef<'_, usize>,
+        ordering: Ordering,
+    ) -> Result<Self, LinalgError> {
         let params = CholeskySymbolicParams::default();
         let inner = match ordering {
-            Ordering::Amd => factorize_symbolic_cholesky(
-                pattern.symbolic(),
-                Side::Lower,
-                SymmetricOrdering::Amd,
-                params,
-            ),
+            Ordering::Amd => {
+                factorize_symbolic_cholesky(symbolic, Side::Lower, SymmetricOrdering::Amd, params)
+            }
             Ordering::NestedDissection => {
-                let (forward, inverse) = nested_dissection(pattern)?;
+                let (forward, inverse) = nested_dissection(graph)?;
                 let n = forward.len();
                 let perm = PermRef::new_checked(&forward, &inverse, n);
                 factorize_symbolic_cholesky(
-                    pattern.symbolic(),
+                    symbolic,
                     Side::Lower,
                     SymmetricOrdering::Custom(perm),
                     params,

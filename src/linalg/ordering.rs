@@ -10,20 +10,18 @@ use std::ptr;
 use std::sync::{Mutex, PoisonError};
 
 use super::LinalgError;
-use crate::fem::SparsityPattern;
+use crate::fem::NodeGraph;
 
-/// Nested-dissection permutation `(forward, inverse)` of the unknowns of `pattern`:
-/// `forward[new] = old`, `inverse[old] = new`.
-pub fn nested_dissection(
-    pattern: &SparsityPattern,
-) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
-    let n = pattern.num_nodes();
-    let block = pattern.block();
+/// Nested-dissection permutation `(forward, inverse)` of the unknowns of the pattern whose node
+/// graph is `graph`: `forward[new] = old`, `inverse[old] = new`.
+pub fn nested_dissection(graph: &NodeGraph) -> Result<(Vec<usize>, Vec<usize>), LinalgError> {
+    let n = graph.num_nodes();
+    let block = graph.block();
     let mut xadj: Vec<metis_sys::idx_t> = Vec::with_capacity(n + 1);
     let mut adjncy: Vec<metis_sys::idx_t> = Vec::new();
     xadj.push(0);
     for a in 0..n {
-        for &b in pattern.neighbours(a) {
+        for &b in graph.neighbours(a) {
             if b != a {
                 adjncy.push(to_idx(b)?);
             }
@@ -79,6 +77,7 @@ fn to_idx(k: usize) -> Result<metis_sys::idx_t, LinalgError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fem::SparsityPattern;
 
     #[test]
     fn orderings_computed_at_the_same_time_equal_one_computed_alone() {
@@ -93,10 +92,10 @@ mod tests {
             })
             .collect();
         let pattern = SparsityPattern::new((m + 1) * (m + 1), &quads, 4, 2);
-        let alone = nested_dissection(&pattern).unwrap();
+        let alone = nested_dissection(pattern.graph()).unwrap();
         let together: Vec<_> = std::thread::scope(|s| {
             let handles: Vec<_> = (0..4)
-                .map(|_| s.spawn(|| nested_dissection(&pattern).unwrap()))
+                .map(|_| s.spawn(|| nested_dissection(pattern.graph()).unwrap()))
                 .collect();
             handles.into_iter().map(|h| h.join().unwrap()).collect()
         });
