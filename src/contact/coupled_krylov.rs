@@ -350,7 +350,7 @@ impl Operators for Blocks<'_> {
         for ((o, d), l) in out_l.iter_mut().zip(&system.d).zip(&x[n..]) {
             *o = d * l;
         }
-        for &(row, k, value) in &system.b {
+        for (row, k, value) in system.b_entries() {
             out[row] += value * x[n + k];
         }
         for &(k, col, value) in &system.c {
@@ -369,7 +369,7 @@ impl Operators for Blocks<'_> {
             schur.apply(&r[n + range.start..n + range.end], &mut out_l[range]);
         }
         self.scratch.copy_from_slice(&r[..n]);
-        for &(row, k, value) in &system.b {
+        for (row, k, value) in system.b_entries() {
             self.scratch[row] -= value * out_l[k];
         }
         system

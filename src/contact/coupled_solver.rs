@@ -306,7 +306,7 @@ fn solve_schur(
 
     // u = z - K^-1 (B lambda).
     let mut w = vec![0.0; n];
-    for &(row, k, value) in &system.b {
+    for (row, k, value) in system.b_entries() {
         w[row] += value * lambda[k];
     }
     solve_bodies(system, solvers, &mut w)?;
@@ -339,13 +339,13 @@ fn extend_responses(
     let new = |response: &SurfaceResponse, body: usize| {
         let dofs = system.body_dofs(body);
         (system.unit_loads.iter())
-            .filter(|(key, _)| !response.contains(key))
-            .filter_map(|(key, load)| {
-                let on_body: Vec<(usize, f64)> = (load.iter())
+            .filter(|unit| !response.contains(&unit.key))
+            .filter_map(|unit| {
+                let on_body: Vec<(usize, f64)> = (unit.load.iter())
                     .filter(|(row, _)| dofs.contains(row))
                     .map(|&(row, value)| (row - dofs.start, value))
                     .collect();
-                (!on_body.is_empty()).then_some((*key, on_body))
+                (!on_body.is_empty()).then_some((unit.key, on_body))
             })
             .collect::<Vec<_>>()
     };

@@ -160,14 +160,14 @@ pub struct CoupledSystem {
     /// nothing else).
     pub columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// The force that a unit traction of one component at one active primary node puts on
-    /// the bodies (rows `< offsets[N]`, unscaled).
-    pub unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
+    /// the bodies, with the multiplier it belongs to: `B` itself, kept once
+    /// ([`Self::b_entries`]). Through the interpolation transfer a unit load reaches most of
+    /// the facing secondary surface, so these are the bulk of the system's coupling memory.
+    pub unit_loads: Vec<UnitLoad>,
     /// Multiplier scaling: the unknown is `lambda / s`.
     pub s: f64,
     /// Constraint row scaling: a row's residual is `t` times the gap error of its node.
     pub t: f64,
-    /// Entries `(row < offsets[N], multiplier, value)` of B.
-    pub b: Vec<(usize, usize, f64)>,
     /// Entries `(multiplier, column < offsets[N], value)` of C.
     pub c: Vec<(usize, usize, f64)>,
     /// Diagonal of D.
@@ -219,7 +219,7 @@ impl CoupledSystem {
                 secondary: offsets[pair.secondary],
             };
             let [primary, secondary] = [bodies[pair.primary], bodies[pair.secondary]];
-            blocks.add(pair.coupling, primary, secondary, &place, dim, s, t);
+            blocks.add(pair.coupling, primary, secondary, &place, dim, t);
         }
         // Loads and prescribed displacements scale the constrained right-hand side linearly.
         let f: Vec<f64> = (bodies.iter())
@@ -233,12 +233,20 @@ impl CoupledSystem {
             unit_loads: blocks.unit_loads,
             s,
             t,
-            b: blocks.b,
             c: blocks.c,
             d: blocks.d,
             f,
             load_factor,
             g: blocks.g,
+        })
+    }
+
+    /// The entries `(row < offsets[N], multiplier, value)` of `B`: each unit load times `s`
+    /// and its weight in its multiplier.
+    pub fn b_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        let s = self.s;
+        self.unit_loads.iter().flat_map(move |unit| {
+            (unit.load.iter()).map(move |&(row, v)| (row, unit.multiplier, s * v * unit.weight))
         })
     }
 
@@ -293,7 +301,7 @@ impl CoupledSystem {
                 }
             }
         }
-        triplets.extend(self.b.iter().map(|&(i, k, v)| Triplet::new(i, n + k, v)));
+        triplets.extend(self.b_entries().map(|(i, k, v)| Triplet::new(i, n + k, v)));
         triplets.extend(self.c.iter().map(|&(k, j, v)| Triplet::new(n + k, j, v)));
         triplets.extend(
             self.d
@@ -315,7 +323,7 @@ impl CoupledSystem {
             ax.extend(mat_vec(&body.k_c, &x[self.body_dofs(k)]));
         }
         ax.extend(self.d.iter().zip(&x[n..]).map(|(d, l)| d * l));
-        for &(row, k, value) in &self.b {
+        for (row, k, value) in self.b_entries() {
             ax[row] += value * x[n + k];
         }
         for &(k, col, value) in &self.c {
@@ -392,14 +400,22 @@ struct Placement {
     secondary: usize,
 }
 
+/// The force a unit traction of one component at one active primary node puts on the bodies.
+pub struct UnitLoad {
+    pub key: MultiplierKey,
+    /// The multiplier whose column it is part of, and its weight there.
+    pub multiplier: usize,
+    pub weight: f64,
+    /// `(row < offsets[N], force)`, unscaled; rows of prescribed dofs left out.
+    pub load: Vec<(usize, f64)>,
+}
+
 /// The coupling blocks of the pairs, added one pair at a time.
 struct PairBlocks {
-    /// [`CoupledSystem::b`].
-    b: Vec<(usize, usize, f64)>,
     /// [`CoupledSystem::columns`].
     columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// [`CoupledSystem::unit_loads`].
-    unit_loads: Vec<(MultiplierKey, Vec<(usize, f64)>)>,
+    unit_loads: Vec<UnitLoad>,
     /// [`CoupledSystem::c`].
     c: Vec<(usize, usize, f64)>,
     /// [`CoupledSystem::d`].
@@ -411,7 +427,6 @@ struct PairBlocks {
 impl PairBlocks {
     fn new(m: usize) -> Self {
         Self {
-            b: Vec::new(),
             columns: vec![Vec::new(); m],
             unit_loads: Vec::new(),
             c: Vec::new(),
@@ -420,12 +435,12 @@ impl PairBlocks {
         }
     }
 
-    /// The blocks of one pair at `place`, its columns scaled by `s` and its rows by `t`:
+    /// The blocks of one pair at `place`, its rows scaled by `t` (its columns are scaled by `s`
+    /// as they are read, [`CoupledSystem::b_entries`]):
     /// `-M_a lambda` on the primary and `+M_b R_ba lambda` on the secondary, one unit force
     /// per active node and component combined per multiplier; the constraint `u_a - R_ab u_b =
     /// d` (tied) or its normal component (frictionless). Rows of prescribed dofs carry no
     /// coupling; a dropped multiplier gets `D = t` and nothing else.
-    #[allow(clippy::too_many_arguments)]
     fn add(
         &mut self,
         coupling: &Coupling,
@@ -433,7 +448,6 @@ impl PairBlocks {
         secondary: &AssembledBody,
         place: &Placement,
         dim: usize,
-        s: f64,
         t: f64,
     ) {
         let first = place.first_multiplier;
@@ -465,17 +479,18 @@ impl PairBlocks {
                         load.push((place.secondary + dof2, value));
                     }
                 }
-                self.b.extend(
-                    load.iter()
-                        .map(|&(row, v)| (row, multiplier, s * v * weight)),
-                );
                 let key = MultiplierKey {
                     pair: place.pair,
                     node,
                     component: c,
                 };
                 self.columns[multiplier].push((key, weight));
-                self.unit_loads.push((key, load));
+                self.unit_loads.push(UnitLoad {
+                    key,
+                    multiplier,
+                    weight,
+                    load,
+                });
                 // The row: the gap of component c between the node and its secondary point.
                 self.c.push((multiplier, place.primary + dof, t * weight));
                 for &(node2, w) in &coupling.r12[k] {
