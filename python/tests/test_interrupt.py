@@ -24,8 +24,11 @@ PARAMETERS = {"h_c": 0.01, "r_c": 0.16, "h_far": 0.5, "d_far": 1.0}
 # Solves the case, says when it is about to, and reports how the solve ended (and when), then
 # whether the process's threads are those of before the solve, and that a second solve runs.
 SCRIPT = """
-import json, logging, os, sys, time
+import json, logging, os, signal, sys, time
 import internodes
+# Python keeps SIGINT ignored when it starts so (a shell's background job, as CI may be): stand
+# for an interactive session, where Ctrl-C raises KeyboardInterrupt.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 if sys.argv[1] == "logging":
     logging.basicConfig(level=logging.INFO, stream=sys.stdout, format="log: %%(message)s")
 mesh = internodes.Mesh.from_geo(%(geo)r, %(parameters)r)
