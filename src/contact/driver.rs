@@ -136,9 +136,14 @@ pub fn solve_contact<'m>(
                 Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
             };
             if due {
+                // The other discretization is the better one when it is auto's choice.
+                let reference_is_better = match alternative {
+                    Alternative::OtherPrimary => other_primary == OtherPrimary::CheckAgreement,
+                    Alternative::AutoTransfer => true,
+                };
                 solution = check_against(
                     &problem,
-                    alternative,
+                    (alternative, reference_is_better),
                     solution,
                     &mut steps,
                     solver,
@@ -253,21 +258,40 @@ enum Alternative {
     AutoTransfer,
 }
 
+/// How far an answer may be from the truth for each unit of its distance to a better
+/// discretization of the same problem. The distance `d` between the answer `F` and the better
+/// one `R` estimates `F`'s error only up to `R`'s own: `|F - T| <= d + |R - T|`; with `R` at most
+/// `theta` times as far from the truth as `F`, `|F - T| <= d / (1 - theta)`. `theta = 0.2`: on
+/// the foreign meshes (`validation/foreign_meshes.py`), wherever a stiff block named primary
+/// was more than 0.1% off the rigid-flat force, the compliant body's answer as primary was at
+/// most 0.09 times as far off (41 pairs, 2026-11-28). Without the factor, a stiff block named
+/// primary on a sphere (3D, R/25) passed its agreement check 0.999% from the sphere's answer with
+/// a 1% tolerance while 1.01% off the reference.
+const ERROR_PER_DISTANCE_TO_BETTER: f64 = 1.25;
+
 /// Every load step again with the `alternative` discretization, and an agreement check of each
 /// step's force against it (`primary agreement` or `transfer agreement`): in the last step's
 /// accuracy report, and in every step's record (the force-displacement curve is an answer
-/// too). The answer kept is the named choice's.
+/// too). The answer kept is the named choice's. When the alternative is the better
+/// discretization (`reference_is_better`: auto's primary or transfer, the named one not), the
+/// distance to it may be at most the accuracy tolerance over
+/// [`ERROR_PER_DISTANCE_TO_BETTER`]; otherwise the tolerance itself (the answer checked is
+/// the better one, its error at most the distance).
 fn check_against(
     problem: &ContactProblem,
-    alternative: Alternative,
+    (alternative, reference_is_better): (Alternative, bool),
     mut solution: ContactSolution,
     steps: &mut [StepRecord],
     solver: &SolverSettings,
     load_factors: &[f64],
     log: &mut Log,
 ) -> ContactSolution {
+    let per_distance = match reference_is_better {
+        true => ERROR_PER_DISTANCE_TO_BETTER,
+        false => 1.0,
+    };
     let (tolerance, formulation) = (
-        problem.settings.accuracy_tolerance,
+        problem.settings.accuracy_tolerance / per_distance,
         problem.settings.formulation,
     );
     let other = OtherSolve::new(problem, alternative);
