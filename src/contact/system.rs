@@ -314,9 +314,9 @@ impl CoupledSystem {
             .map_err(|e| ContactError::Linalg(format!("assembling the coupled system: {e:?}")))
     }
 
-    /// `||A x - [f; g]|| / ||[f; g]||` for the whole matrix `A` of [`Self::matrix`], applied
-    /// block by block without assembling it.
-    pub fn relative_residual(&self, bodies: &[&AssembledBody], x: &[f64]) -> f64 {
+    /// `[f; g] - A x` for the whole matrix `A` of [`Self::matrix`], applied block by block
+    /// without assembling it.
+    pub fn residual(&self, bodies: &[&AssembledBody], x: &[f64]) -> Vec<f64> {
         let n = self.num_displacements();
         let mut ax = Vec::with_capacity(n + self.m);
         for (k, body) in bodies.iter().enumerate() {
@@ -330,9 +330,14 @@ impl CoupledSystem {
             ax[n + k] += value * x[col];
         }
         let rhs = self.rhs();
-        let norm = |v: &mut dyn Iterator<Item = f64>| v.map(|e| e * e).sum::<f64>().sqrt();
-        let r = norm(&mut ax.iter().zip(&rhs).map(|(a, b)| a - b));
-        let nb = norm(&mut rhs.iter().copied());
+        rhs.iter().zip(&ax).map(|(b, a)| b - a).collect()
+    }
+
+    /// `||A x - [f; g]|| / ||[f; g]||` ([`Self::residual`]).
+    pub fn relative_residual(&self, bodies: &[&AssembledBody], x: &[f64]) -> f64 {
+        let norm = |v: &[f64]| v.iter().map(|e| e * e).sum::<f64>().sqrt();
+        let r = norm(&self.residual(bodies, x));
+        let nb = norm(&self.rhs());
         if nb > 0.0 { r / nb } else { r }
     }
 
