@@ -254,3 +254,145 @@ fn a_contact_run_is_identical_for_any_thread_count() {
         ],
     );
 }
+
+/// V-cycles of CG + AMG (feature `petsc`): applied from several threads at once, to distinct
+/// objects (which run at the same time) or to one object (which take turns), they give the
+/// same bits as applied one after another.
+#[cfg(feature = "petsc")]
+mod v_cycles {
+    use super::*;
+    use internodes::linalg::BodySolver;
+    use std::sync::Barrier;
+
+    /// The clamped cube's `K_c` on an `n^3` grid with its CG + AMG solver.
+    fn cube_solver(n: usize) -> BodySolver {
+        let body = jittered_cube(n);
+        let problem = clamped_cube(&body);
+        let mut stats = SolveStats::default();
+        let system = assemble(&problem, &mut stats, false).expect("assembly");
+        BodySolver::cg_amg(&system.k_c, system.dim, &system.coordinates, 1e-10).expect("set-up")
+    }
+
+    /// The `k`-th right-hand side of `n` values: reproducible, different for every `k`.
+    fn rhs(n: usize, k: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| ((i * 7919 + k * 104_729) % 1000) as f64 / 500.0 - 1.0)
+            .collect()
+    }
+
+    /// The bits of `x = P^-1 rhs(k)` for each `k` of `ks`, one after another.
+    fn apply_all(solver: &BodySolver, n: usize, ks: impl Iterator<Item = usize>) -> Vec<Vec<u64>> {
+        ks.map(|k| {
+            let mut x = vec![0.0; n];
+            solver.precondition(&rhs(n, k), &mut x).expect("a V-cycle");
+            bits(&x)
+        })
+        .collect()
+    }
+
+    const APPLICATIONS: usize = 300;
+
+    #[test]
+    fn v_cycles_of_two_bodies_at_once_match_them_one_after_another() {
+        let bodies = [cube_solver(12), cube_solver(9)];
+        // Without options of PETSc's own, the V-cycles do run at once (else they take turns).
+        if std::env::var_os("PETSC_OPTIONS").is_none() {
+            assert!(internodes::linalg::petsc::concurrent_v_cycles());
+        }
+        let sizes = [3 * 13 * 13 * 13, 3 * 10 * 10 * 10];
+        // Fresh objects first: their first V-cycles, too, run at once.
+        let mut rounds = Vec::new();
+        let mut sequential = Vec::new();
+        for round in 0..3 {
+            if round == 1 {
+                sequential = (0..2)
+                    .map(|b| apply_all(&bodies[b], sizes[b], 0..APPLICATIONS))
+                    .collect();
+            }
+            let start = Barrier::new(2);
+            let concurrent: Vec<_> = std::thread::scope(|scope| {
+                let handles: Vec<_> = (0..2)
+                    .map(|b| {
+                        let (solver, start) = (&bodies[b], &start);
+                        scope.spawn(move || {
+                            start.wait();
+                            apply_all(solver, sizes[b], 0..APPLICATIONS)
+                        })
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().unwrap()).collect()
+            });
+            rounds.push(concurrent);
+        }
+        for (round, concurrent) in rounds.iter().enumerate() {
+            for b in 0..2 {
+                for (k, (c, s)) in concurrent[b].iter().zip(&sequential[b]).enumerate() {
+                    assert!(
+                        c == s,
+                        "round {round}, body {b}, application {k}: bits differ"
+                    );
+                }
+            }
+        }
+        // And through rayon::join, as the coupled Krylov solve calls them.
+        let (x0, x1) = rayon::join(
+            || apply_all(&bodies[0], sizes[0], 0..APPLICATIONS),
+            || apply_all(&bodies[1], sizes[1], 0..APPLICATIONS),
+        );
+        assert!(x0 == sequential[0] && x1 == sequential[1]);
+    }
+
+    #[test]
+    fn v_cycles_of_one_body_from_several_threads_match_them_one_after_another() {
+        const THREADS: usize = 4;
+        const EACH: usize = 75;
+        let solver = cube_solver(10);
+        let n = 3 * 11 * 11 * 11;
+        let sequential = apply_all(&solver, n, 0..THREADS * EACH);
+        let start = Barrier::new(THREADS);
+        let concurrent: Vec<Vec<Vec<u64>>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..THREADS)
+                .map(|t| {
+                    let (solver, start) = (&solver, &start);
+                    scope.spawn(move || {
+                        start.wait();
+                        apply_all(solver, n, (0..EACH).map(|j| j * THREADS + t))
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        for (t, results) in concurrent.iter().enumerate() {
+            for (j, x) in results.iter().enumerate() {
+                let k = j * THREADS + t;
+                assert!(
+                    *x == sequential[k],
+                    "thread {t}, application {k}: bits differ"
+                );
+            }
+        }
+    }
+
+    /// Set-ups, solves and destruction of other objects while V-cycles run: the exclusive
+    /// calls wait for the V-cycles, and the V-cycles' bits do not change.
+    #[test]
+    fn v_cycles_beside_set_ups_and_solves_match_them_alone() {
+        let body = cube_solver(9);
+        let n = 3 * 10 * 10 * 10;
+        let sequential = apply_all(&body, n, 0..APPLICATIONS);
+        let concurrent = std::thread::scope(|scope| {
+            let cycles = scope.spawn(|| apply_all(&body, n, 0..APPLICATIONS));
+            scope.spawn(|| {
+                for _ in 0..3 {
+                    let other = cube_solver(6);
+                    let mut u = rhs(3 * 7 * 7 * 7, 1);
+                    other.solve_in_place(&mut u, 1).expect("a CG solve");
+                    let mut x = vec![0.0; u.len()];
+                    other.precondition(&u, &mut x).expect("a V-cycle");
+                }
+            });
+            cycles.join().unwrap()
+        });
+        assert!(concurrent == sequential);
+    }
+}

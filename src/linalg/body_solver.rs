@@ -134,8 +134,8 @@ impl BodySolver {
     /// `K x = rhs`; returns the most CG iterations a column took (0 for Cholesky).
     ///
     /// Cholesky solves the columns in parallel blocks ([`Cholesky::solve_in_place`]); CG one
-    /// after the other (PETSc calls are serialized), to the relative residual it was set up
-    /// with.
+    /// after the other (each CG solve holds PETSc exclusively), to the relative residual it was
+    /// set up with.
     pub fn solve_in_place(&self, rhs: &mut [f64], num_rhs: usize) -> Result<usize, LinalgError> {
         self.solve_in_place_within(rhs, num_rhs, None)
     }
@@ -174,7 +174,9 @@ impl BodySolver {
     }
 
     /// `x = P^-1 r` for the body's preconditioner in a coupled Krylov solve: the factor's exact
-    /// solve, or one AMG V-cycle.
+    /// solve, or one AMG V-cycle. Called from several threads, V-cycles of different bodies
+    /// run at the same time (the one PETSc call that does not wait for all others:
+    /// [`super::petsc`]'s "PETSc in a Rust process"); those of one body take turns.
     pub fn precondition(&self, r: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
         match self {
             Self::Cholesky(factor) => {

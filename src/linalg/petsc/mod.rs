@@ -19,15 +19,47 @@
 //!   PETSc's, lets Open MPI put a backtrace printer on SIGSEGV, SIGBUS and SIGFPE where no
 //!   handler was set; it re-raises the signal.) PETSc is never finalized (the process ends
 //!   instead; PETSc's objects are destroyed with their Rust owners).
-//! - PETSc is not thread-safe, and `cargo test` and rayon call from several threads: every
-//!   call into PETSc, destruction included, holds one global mutex. Two bodies solved "side
-//!   by side" by rayon therefore take turns.
+//! - PETSc is not thread-safe (Debian's 3.18 is built without `PETSC_HAVE_THREADSAFETY`), and
+//!   `cargo test` and rayon call from several threads. One global `RwLock` orders the calls:
+//!   initialization, [`CgAmg::new`] (set-up), [`CgAmg::solve_within`] (CG) and destruction
+//!   hold it exclusively; [`CgAmg::precondition`] (one V-cycle, `PCApply`) holds it shared,
+//!   plus a mutex of its object, so that the V-cycles of two bodies in a coupled Krylov
+//!   solve (`rayon::join`) run at the same time, while one object is never applied from two
+//!   threads at once and nothing else runs beside an application.
+//! - Why concurrent `PCApply` on distinct objects is safe (read in PETSc 3.18.5's source:
+//!   `PCApply` -> `PCApply_MG` -> `PCMGMCycle_Private` -> `KSPSolve` of the Chebyshev/Jacobi
+//!   smoothers and of the coarse level's preonly + block Jacobi + LU, `MatMult`/
+//!   `MatMultAdd`/`MatMultTranspose` of `SeqAIJ`, `MatSolve` of the `SeqAIJ` factor): an
+//!   application writes its own objects' memory (vectors, work vectors, object states and
+//!   reference counts, `ksp->reason`) and, process-wide, only
+//!   - `petsc_TotalFlops` (`PetscLogFlops`, a plain `+=`): increments may be lost; nothing
+//!     reads it without `-log_view`;
+//!   - `static PetscInt level` of `src/ksp/ksp/interface/itfunc.c` (`++`/`--` in `KSPSetUp`,
+//!     `KSPSetUpOnBlocks`, `KSPSolve_Private`): it may drift, and is read only when a KSP has
+//!     `KSPSetErrorIfNotConverged`, which the shim never sets (the option
+//!     `-ksp_error_if_not_converged` could: see options below).
+//!
+//!   What it reads of process-wide state is written only at initialization or set-up: the
+//!   log handler pointers of `PetscLogEventBegin`/`End` (null: logging never starts; the
+//!   build is optimized, `PetscFunctionBegin` pushes no stack and `CHKMEMQ` returns at once),
+//!   `PetscInfo`'s flags, the malloc hooks (`PetscMalloc` is `posix_memalign`), and the
+//!   options database: each smoother `KSPSolve` looks up `-<prefix>ksp_converged_reason` in
+//!   its hash table, built by the first lookup at initialization. A lookup that finds its
+//!   option marks it used and takes a viewer shared by all objects (stdout's); so when the
+//!   database holds any option besides ours (`PETSC_OPTIONS`, `PETSC_OPTIONS_YAML`, a
+//!   `.petscrc`), applications stay exclusive, as every call was before. The first
+//!   application of an object still finishes its set-up (the coarse LU factor, through
+//!   `PCSetUp`, `MatGetFactor`, `MatGetOrdering` and the event log's deactivation stack):
+//!   the shim's create applies the V-cycle once, under the exclusive lock. The
+//!   `PetscFPTrapPush` stack and `PetscCitationsRegister` are reached only in set-up
+//!   (Chebyshev's eigenvalue estimate in `KSPSetUp`); no MPI call is on the path on
+//!   `PETSC_COMM_SELF`.
 //! - Objects are created on a communicator given by the caller ([`Communicator::solo`] today),
 //!   so that a distributed version changes the set-up, not this solver.
 
 use std::ffi::{CStr, c_char, c_int};
 use std::ptr::NonNull;
-use std::sync::{Mutex, MutexGuard, OnceLock, PoisonError};
+use std::sync::{Mutex, OnceLock, PoisonError, RwLock, RwLockWriteGuard};
 
 use faer::sparse::SparseColMat;
 
@@ -43,6 +75,7 @@ struct RawCgAmg {
 
 unsafe extern "C" {
     fn internodes_petsc_initialize(step: *mut *const c_char) -> c_int;
+    fn internodes_petsc_options_are_ours(ours: *mut c_int, step: *mut *const c_char) -> c_int;
     fn internodes_petsc_comm_self() -> MpiFint;
     fn internodes_petsc_error_text(code: c_int) -> *const c_char;
     fn internodes_ksp_reason_name(reason: c_int) -> *const c_char;
@@ -78,10 +111,19 @@ unsafe extern "C" {
     fn internodes_cgamg_destroy(solver: *mut RawCgAmg);
 }
 
-/// Serializes every PETSc call of the process.
-static PETSC: Mutex<()> = Mutex::new(());
-/// The outcome of PETSc's initialization (made once, under [`PETSC`]).
-static INITIALIZED: OnceLock<Result<(), (String, i32)>> = OnceLock::new();
+/// Orders every PETSc call of the process: V-cycles ([`CgAmg::precondition`]) take it shared,
+/// every other call exclusively (see the module's doc).
+static PETSC: RwLock<()> = RwLock::new(());
+/// The outcome of PETSc's initialization (made once, under [`PETSC`] held exclusively): on
+/// success, whether V-cycles of distinct objects may run at once (no option in PETSc's
+/// database but ours).
+static INITIALIZED: OnceLock<Result<bool, (String, i32)>> = OnceLock::new();
+
+/// Whether V-cycles ([`CgAmg::precondition`]) of distinct objects run at the same time: PETSc
+/// is initialized and its options database holds no option but ours (see the module's doc).
+pub fn concurrent_v_cycles() -> bool {
+    matches!(INITIALIZED.get(), Some(Ok(true)))
+}
 
 /// A C string from the shim (static storage) as Rust text.
 fn text(s: *const c_char) -> String {
@@ -101,22 +143,28 @@ fn petsc_error(step: *const c_char, code: c_int) -> LinalgError {
     }
 }
 
-/// The PETSc lock, with PETSc initialized. A poisoned lock is taken anyway: a panic cannot
-/// happen inside a PETSc call (they return codes), so PETSc's state is whole.
-fn petsc() -> Result<MutexGuard<'static, ()>, LinalgError> {
-    let guard = PETSC.lock().unwrap_or_else(PoisonError::into_inner);
+/// The PETSc lock held exclusively, with PETSc initialized. A poisoned lock is taken anyway:
+/// a panic cannot happen inside a PETSc call (they return codes), so PETSc's state is whole.
+fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
+    let guard = PETSC.write().unwrap_or_else(PoisonError::into_inner);
     let outcome = INITIALIZED.get_or_init(|| {
         let mut step = std::ptr::null();
-        // SAFETY: called once per process, under the lock.
+        // SAFETY: called once per process, under the exclusive lock.
         let code = unsafe { internodes_petsc_initialize(&mut step) };
+        if code != 0 {
+            return Err((text(step), code));
+        }
+        let mut ours = 0;
+        // SAFETY: PETSc is initialized; the exclusive lock is held.
+        let code = unsafe { internodes_petsc_options_are_ours(&mut ours, &mut step) };
         if code == 0 {
-            Ok(())
+            Ok(ours != 0)
         } else {
             Err((text(step), code))
         }
     });
     match outcome {
-        Ok(()) => Ok(guard),
+        Ok(_) => Ok(guard),
         Err((step, code)) => Err(LinalgError::Petsc {
             step: format!("initializing PETSc: {step}"),
             code: *code,
@@ -152,11 +200,19 @@ pub struct CgAmg {
     n: usize,
     /// The relative residual [`Self::solve`] stops at.
     rtol: f64,
+    /// Held by [`Self::precondition`] under the shared [`PETSC`] lock: the object's vectors
+    /// and its hierarchy's work vectors are written by every V-cycle.
+    applying: Mutex<()>,
 }
 
-// SAFETY: the PETSc objects behind `raw` are only touched under the global PETSc lock.
+// SAFETY: the PETSc objects behind `raw` belong to no thread; they are touched only under
+// the global PETSc lock (see below).
 unsafe impl Send for CgAmg {}
-// SAFETY: as above; `solve(&self)` takes the lock.
+// SAFETY: every `&self` method that calls PETSc holds the global lock exclusively, except
+// `precondition`, which holds it shared and also `self.applying`: so the objects behind one
+// `raw` are touched by one thread at a time, and beside an application run only applications
+// of other objects, which write process-wide state only as the module's doc shows to be
+// harmless (PETSc 3.18's `PCApply` of a set-up GAMG hierarchy).
 unsafe impl Sync for CgAmg {}
 
 /// The iteration cap of a solve: CG + GAMG takes 21 to 26 iterations at rtol 1e-10 on the
@@ -223,7 +279,12 @@ impl CgAmg {
             return Err(petsc_error(step, code));
         }
         let raw = NonNull::new(raw).ok_or_else(|| petsc_error(step, 0))?;
-        Ok(Self { raw, n, rtol })
+        Ok(Self {
+            raw,
+            n,
+            rtol,
+            applying: Mutex::new(()),
+        })
     }
 
     /// Solves `K x = rhs` from `x = 0`. Fails with [`LinalgError::NotConverged`] unless CG
@@ -294,6 +355,10 @@ impl CgAmg {
     /// `x = P^-1 rhs` for GAMG's preconditioner `P` alone: one V-cycle (the smoothers are
     /// Chebyshev polynomials with eigenvalue bounds estimated once at set-up, so the map is the
     /// same linear one at every call).
+    ///
+    /// V-cycles of distinct objects run at the same time when called from several threads
+    /// (unless PETSc's options database holds options of its own: see the module's doc); those
+    /// of one object take turns.
     pub fn precondition(&self, rhs: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
         if rhs.len() != self.n || x.len() != self.n {
             return Err(LinalgError::Sizes(format!(
@@ -305,8 +370,15 @@ impl CgAmg {
         }
         let mut step = std::ptr::null();
         let code = {
-            let _lock = petsc()?;
-            // SAFETY: `rhs` and `x` hold `n` values, `raw` is alive, the lock is held.
+            // PETSc is initialized (`self` exists). `applying` is taken under the shared lock,
+            // never the other way round, and released first (reverse order of declaration).
+            let concurrent = concurrent_v_cycles();
+            let _exclusive = if concurrent { None } else { Some(petsc()?) };
+            let _shared = concurrent.then(|| PETSC.read().unwrap_or_else(PoisonError::into_inner));
+            let _own =
+                concurrent.then(|| self.applying.lock().unwrap_or_else(PoisonError::into_inner));
+            // SAFETY: `rhs` and `x` hold `n` values, `raw` is alive, and either PETSc is held
+            // exclusively or it is held shared with this object's mutex (see `impl Sync`).
             unsafe {
                 internodes_cgamg_precondition(
                     self.raw.as_ptr(),
@@ -326,7 +398,7 @@ impl CgAmg {
 impl Drop for CgAmg {
     fn drop(&mut self) {
         // The lock is taken even if initialization had failed (it cannot have: `self` exists).
-        let _lock = PETSC.lock().unwrap_or_else(PoisonError::into_inner);
+        let _lock = PETSC.write().unwrap_or_else(PoisonError::into_inner);
         // SAFETY: `raw` came from the shim's create and is destroyed once.
         unsafe { internodes_cgamg_destroy(self.raw.as_ptr()) };
     }

@@ -2,7 +2,8 @@
  * The C side of internodes' PETSc body solver: conjugate gradients preconditioned by
  * smoothed-aggregation algebraic multigrid (KSPCG + PCGAMG) on one body's stiffness matrix.
  * Compiled by build.rs only with the cargo feature `petsc`; src/linalg/petsc/mod.rs is its only
- * caller and serializes every call (PETSc is not thread-safe).
+ * caller and serializes every call (PETSc is not thread-safe), except that
+ * internodes_cgamg_precondition may run on distinct objects at once (the audit is in mod.rs).
  *
  * Every function returns 0 or a PETSc error code; on error `*step` names the call that failed
  * (a static string). PETSc's own error printing is replaced by PetscReturnErrorHandler at
@@ -42,6 +43,24 @@ int internodes_petsc_initialize(const char **step)
     TRY(PetscOptionsSetValue(NULL, "-no_signal_handler", NULL));
     TRY(PetscInitializeNoArguments());
     TRY(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    return 0;
+}
+
+/* Whether the options database holds exactly what internodes_petsc_initialize put there
+ * (-no_signal_handler): 1 if so, 0 if anything else came in (the PETSC_OPTIONS or
+ * PETSC_OPTIONS_YAML environment variables, a .petscrc file). Options such as
+ * -ksp_converged_reason or -info make a V-cycle print through viewers shared by all objects;
+ * the caller then keeps every application exclusive. */
+int internodes_petsc_options_are_ours(int *ours, const char **step)
+{
+    char *all = NULL;
+    TRY(PetscOptionsGetAll(NULL, &all));
+    size_t start = 0, end = strlen(all);
+    while (start < end && all[start] == ' ') start++;
+    while (end > start && all[end - 1] == ' ') end--;
+    *ours = (end - start == strlen("-no_signal_handler") &&
+             !strncmp(all + start, "-no_signal_handler", end - start));
+    PetscFree(all);
     return 0;
 }
 
@@ -151,6 +170,13 @@ static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, co
     TRY(KSPSetFromOptions(s->ksp));
     TRY(KSPSetUp(s->ksp));
     TRY(MatCreateVecs(s->a, &s->x, &s->b));
+    /* One V-cycle now, while the caller holds PETSc exclusively: PETSc finishes the set-up on
+     * the first application (the coarse level's block Jacobi factors its LU in
+     * PCSetUpOnBlocks, through PCSetUp, MatGetFactor and MatGetOrdering, which touch
+     * process-wide registries and the event log). After it, an application writes only this
+     * object's memory, which internodes_cgamg_precondition relies on (see mod.rs). */
+    TRY(VecSet(s->b, 1.0));
+    TRY(PCApply(pc, s->b, s->x));
     return 0;
 }
 
@@ -189,7 +215,9 @@ int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int6
 
 /* Solves A x = rhs from x = 0 to the relative residual rtol: the iterations, the final residual
  * norm ||rhs - A x|| and the KSPConvergedReason (positive: converged). */
-/* One application of the preconditioner alone, x = P^-1 rhs: one GAMG V-cycle. */
+/* One application of the preconditioner alone, x = P^-1 rhs: one GAMG V-cycle. The caller may
+ * run this on distinct objects from several threads at once (never on one object twice at
+ * once, and never beside any other PETSc call): see "PETSc in a Rust process" in mod.rs. */
 int internodes_cgamg_precondition(InternodesCgAmg *s, const double *rhs, double *x, const char **step)
 {
     PetscScalar *data;
