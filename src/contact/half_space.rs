@@ -43,6 +43,7 @@ use std::collections::HashMap;
 use faer::Mat;
 use faer::prelude::*;
 
+use super::compliance::MultiplierKey;
 use super::ContactSurface;
 use super::system::{CoupledSystem, Coupling};
 use crate::fem::Material;
@@ -100,11 +101,15 @@ impl HalfSpace {
             if diagonal[k] != 0.0 {
                 continue;
             }
+            let MultiplierKey::Traction { node, .. } = *key else {
+                continue;
+            };
             let mut e = [0.0; 3];
             for (key, weight) in column {
-                e[key.component] = *weight;
+                if let MultiplierKey::Traction { component, .. } = *key {
+                    e[component] = *weight;
+                }
             }
-            let node = key.node;
             let mut x = [0.0; 3];
             x[..dim].copy_from_slice(&coordinates[dim * node..dim * node + dim]);
             let a = area.get(&node).copied().unwrap_or(0.0);

@@ -118,6 +118,9 @@ pub struct ContactSolver<'a> {
     pub(super) stats1: SolveStats,
     pub(super) stats2: SolveStats,
     factors: Option<BodyFactors>,
+    /// The force-controlled components `(body, index into its rigid columns)` that nothing but
+    /// the contact holds (body 0 the primary): with no node in contact the system is singular.
+    held_by_contact: Vec<(usize, usize)>,
     /// Paired for the slide of the last solve; a solve without a start pairs them again
     /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
@@ -134,6 +137,18 @@ fn pair(problem: &ContactProblem, slid: [f64; 3]) -> Result<InterfaceOperators, 
         problem.transfer().transfer == Transfer::Conservative,
         slid,
     )
+}
+
+/// The nodes of a body whose displacements the constraint rows read: its candidate surface's,
+/// and the nodes a force-controlled group's row reads (its column `k`).
+fn read_nodes(surface: &ContactSurface, body: &AssembledBody) -> Vec<usize> {
+    let mut nodes = surface.nodes.clone();
+    for rigid in &body.rigid {
+        nodes.extend(rigid.column.iter().map(|&(dof, _)| dof / body.dim));
+    }
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
 }
 
 impl<'a> ContactSolver<'a> {
@@ -155,7 +170,7 @@ impl<'a> ContactSolver<'a> {
                 let materials = [&problem.primary.material, &problem.secondary.material];
                 let factors = BodyFactors::new(
                     &[&body1, &body2],
-                    vec![s1.nodes.clone(), s2.nodes.clone()],
+                    vec![read_nodes(s1, &body1), read_nodes(s2, &body2)],
                     vec![compliance_factor(materials, s1.dim)],
                     solver,
                     kind,
@@ -173,6 +188,12 @@ impl<'a> ContactSolver<'a> {
             }
         };
         let operators = pair(problem, [0.0; 3])?;
+        let held_by_contact =
+            coupled_solver::held_by_contacts_only(&[&body1, &body2], factors.as_ref(), solver.ordering)?
+                .into_iter()
+                .enumerate()
+                .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
+                .collect();
         Ok(Self {
             problem,
             solver: solver.clone(),
@@ -181,6 +202,7 @@ impl<'a> ContactSolver<'a> {
             stats1,
             stats2,
             factors,
+            held_by_contact,
             operators,
         })
     }
@@ -243,6 +265,7 @@ impl<'a> ContactSolver<'a> {
             safeguard: Safeguard::default(),
             history: Vec::new(),
             last: None,
+            first_contact: false,
         };
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.problem.settings.max_iterations {
@@ -282,6 +305,9 @@ struct LoopState {
     last: Option<(Coupling, CoupledSolution)>,
     /// The active set `last` was solved on (`active` moves on to the next one).
     solved: BTreeSet<usize>,
+    /// Whether the loop has put a body that only its contacts hold in contact at its closest
+    /// node ([`ContactSolver::first_contact`]).
+    first_contact: bool,
 }
 
 impl LoopState {
@@ -317,6 +343,9 @@ impl ContactSolver<'_> {
     ) -> Result<Option<ContactStatus>, ContactError> {
         let problem = self.problem;
         let mut seconds = PhaseSeconds::default();
+        if state.active.is_empty() {
+            self.first_contact(state)?;
+        }
         // 1. The coupling of the active set: rows and columns of the fixed operators.
         let nodes: Vec<usize> = state.active.iter().copied().collect();
         let coupling = timed(&mut seconds.operators, || {
@@ -394,6 +423,50 @@ impl ContactSolver<'_> {
             log::info!("{}", record.line());
         }
         Ok(state.advance(record, (coupling, solution), step))
+    }
+
+    /// Puts the primary candidate closest to the other surface in contact when the active set
+    /// is empty and a body is held along a force-controlled component by nothing but the
+    /// contact: with no node in contact its system is singular (the force would move it
+    /// without bound), and the closest node is where it touches first. If the loop lets go of
+    /// that contact again, the force pulls the body off: an error that names it.
+    fn first_contact(&self, state: &mut LoopState) -> Result<(), ContactError> {
+        let Some(&(body, index)) = self.held_by_contact.first() else {
+            return Ok(());
+        };
+        let (name, assembled) = match body {
+            0 => (&self.problem.primary.body.name, &self.body1),
+            _ => (&self.problem.secondary.body.name, &self.body2),
+        };
+        let rigid = &assembled.rigid[index];
+        if state.first_contact {
+            return Err(ContactError::PulledAway {
+                body: name.clone(),
+                group: rigid.group.clone(),
+                component: ["x", "y", "z"][rigid.component],
+            });
+        }
+        let (s1, s2) = (&self.problem.primary_surface, &self.problem.secondary_surface);
+        let u = state.last.as_ref().map(|(_, solution)| &solution.u);
+        let gaps = match u {
+            Some(u) => geometric_gaps(s1, s2, Some(&u[0]), Some(&u[1])),
+            None => geometric_gaps(s1, s2, None, None),
+        };
+        let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
+        if let Some(node) = closest {
+            if self.solver.verbose {
+                log::info!(
+                    "  '{name}' is held along {} only by the contact: node {} (gap {:.3e}) is \
+                     its first contact",
+                    ["x", "y", "z"][rigid.component],
+                    s1.tags[node],
+                    gaps[node]
+                );
+            }
+            state.active.insert(node);
+            state.first_contact = true;
+        }
+        Ok(())
     }
 
     /// The active set the half-space model predicts (`super::half_space::predicted_set`) from
@@ -605,7 +678,7 @@ impl ContactSolver<'_> {
                 tolerance: self.solver.residual_tolerance,
             });
         }
-        Ok(system.solution(&x, &pairs, dim, residual))
+        Ok(system.solution(&x, &bodies, &pairs, dim, residual))
     }
 }
 
