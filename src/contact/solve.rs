@@ -72,7 +72,7 @@ use super::checks::{certify, contact_status};
 use super::coupled_krylov::Tightness;
 use super::coupled_solver::{self, BodyFactors};
 use super::gap::{GapRow, gap_rows, geometric_gaps};
-use super::half_space::{compliance_factor, predicted_set};
+use super::half_space::{compliance_factor, force_controlled_set, predicted_set};
 use super::interface::{Constraint, InterfaceOperators};
 use super::post::{self, LastIterate};
 use super::safeguard::{Safeguard, Step};
@@ -256,6 +256,7 @@ impl<'a> ContactSolver<'a> {
         if start.is_none() && self.operators.slid != [0.0; 3] {
             self.pair_again([0.0; 3])?;
         }
+        let cold = start.is_none();
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
         let mut state = LoopState {
             solved: start.nodes.clone(),
@@ -265,6 +266,7 @@ impl<'a> ContactSolver<'a> {
             safeguard: Safeguard::default(),
             history: Vec::new(),
             last: None,
+            cold,
             first_contact: false,
         };
         let mut status = ContactStatus::IterationLimit;
@@ -305,8 +307,10 @@ struct LoopState {
     last: Option<(Coupling, CoupledSolution)>,
     /// The active set `last` was solved on (`active` moves on to the next one).
     solved: BTreeSet<usize>,
-    /// Whether the loop has put a body that only its contacts hold in contact at its closest
-    /// node ([`ContactSolver::first_contact`]).
+    /// Whether the solve started without an active set from an earlier one.
+    cold: bool,
+    /// Whether the loop has chosen where a body that only its contacts hold touches first
+    /// ([`ContactSolver::first_contact`]).
     first_contact: bool,
 }
 
@@ -343,8 +347,8 @@ impl ContactSolver<'_> {
     ) -> Result<Option<ContactStatus>, ContactError> {
         let problem = self.problem;
         let mut seconds = PhaseSeconds::default();
-        if state.active.is_empty() {
-            self.first_contact(state)?;
+        if state.active.is_empty() || (iteration == 1 && state.cold) {
+            self.first_contact(state, load_factor)?;
         }
         // 1. The coupling of the active set: rows and columns of the fixed operators.
         let nodes: Vec<usize> = state.active.iter().copied().collect();
@@ -425,12 +429,15 @@ impl ContactSolver<'_> {
         Ok(state.advance(record, (coupling, solution), step))
     }
 
-    /// Puts the primary candidate closest to the other surface in contact when the active set
-    /// is empty and a body is held along a force-controlled component by nothing but the
-    /// contact: with no node in contact its system is singular (the force would move it
-    /// without bound), and the closest node is where it touches first. If the loop lets go of
-    /// that contact again, the force pulls the body off: an error that names it.
-    fn first_contact(&self, state: &mut LoopState) -> Result<(), ContactError> {
+    /// Where a body that nothing but the contact holds along a force-controlled component
+    /// touches first, when the loop starts cold or has no node in contact: with no node in
+    /// contact its system is singular (the force would move it without bound), and from the
+    /// nodes that merely touch (a sphere's pole) the first iterate would carry the whole force
+    /// on them. The active set becomes the half-space model's zone for the force
+    /// (`super::half_space::force_controlled_set`), or the closest node if the model finds
+    /// none. If the loop lets go of every contact after that, the force pulls the body off: an
+    /// error that names it.
+    fn first_contact(&self, state: &mut LoopState, load_factor: f64) -> Result<(), ContactError> {
         let Some(&(body, index)) = self.held_by_contact.first() else {
             return Ok(());
         };
@@ -439,33 +446,52 @@ impl ContactSolver<'_> {
             _ => (&self.problem.secondary.body.name, &self.body2),
         };
         let rigid = &assembled.rigid[index];
+        let component = ["x", "y", "z"][rigid.component];
         if state.first_contact {
-            return Err(ContactError::PulledAway {
-                body: name.clone(),
-                group: rigid.group.clone(),
-                component: ["x", "y", "z"][rigid.component],
-            });
+            if state.active.is_empty() {
+                return Err(ContactError::PulledAway {
+                    body: name.clone(),
+                    group: rigid.group.clone(),
+                    component,
+                });
+            }
+            return Ok(());
         }
-        let (s1, s2) = (&self.problem.primary_surface, &self.problem.secondary_surface);
-        let u = state.last.as_ref().map(|(_, solution)| &solution.u);
-        let gaps = match u {
+        let problem = self.problem;
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let gaps = match state.last.as_ref().map(|(_, solution)| &solution.u) {
             Some(u) => geometric_gaps(s1, s2, Some(&u[0]), Some(&u[1])),
             None => geometric_gaps(s1, s2, None, None),
         };
-        let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
-        if let Some(node) = closest {
-            if self.solver.verbose {
-                log::info!(
-                    "  '{name}' is held along {} only by the contact: node {} (gap {:.3e}) is \
-                     its first contact",
-                    ["x", "y", "z"][rigid.component],
-                    s1.tags[node],
-                    gaps[node]
-                );
-            }
-            state.active.insert(node);
-            state.first_contact = true;
+        // The force the contact carries along the components nothing else holds.
+        let force = (self.held_by_contact.iter())
+            .map(|&(k, r)| {
+                let rigid = match k {
+                    0 => &self.body1.rigid[r],
+                    _ => &self.body2.rigid[r],
+                };
+                (load_factor * (rigid.force + rigid.applied)).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt();
+        let materials = [&problem.primary.material, &problem.secondary.material];
+        let c0 = compliance_factor(materials, s1.dim);
+        let mut zone: BTreeSet<usize> = force_controlled_set(s1, &gaps, force, c0)
+            .into_iter()
+            .collect();
+        if zone.is_empty() {
+            let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
+            zone.extend(closest);
         }
+        if self.solver.verbose {
+            log::info!(
+                "  '{name}' is held along {component} only by the contact: it starts on the {} \
+                 nodes where two half-spaces would carry its force {force:.6e}",
+                zone.len()
+            );
+        }
+        state.active = zone;
+        state.first_contact = true;
         Ok(())
     }
 
