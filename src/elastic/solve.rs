@@ -570,7 +570,10 @@ pub fn solve(
     // the cell fields.
     drop(solver);
     let (mut u, w) = (columns[..n].to_vec(), &columns[n..]);
-    let a = rigid_displacements(problem, &system, &u, w)?;
+    let a = match r {
+        0 => Vec::new(),
+        _ => rigid_displacements(problem, &system, &u, w)?,
+    };
     let mut rhs = f_c.clone();
     for (j, (rigid, a)) in system.rigid.iter().zip(&a).enumerate() {
         u.iter_mut().zip(&w[j * n..]).for_each(|(u, w)| *u -= w * a);
