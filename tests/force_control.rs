@@ -268,3 +268,15 @@ fn malformed_forces_are_refused() {
         &["'disc_top'", "fy"],
     );
 }
+
+#[test]
+fn two_bodies_held_only_by_their_contact_are_refused() {
+    let case = half_disc_pressed_by(-1.0).with_body("block", |body| {
+        Body {
+            dirichlet: vec![Dirichlet::on("block_base").ux(0.0)],
+            ..body
+        }
+        .force(Force::vertical("block_base", 2, 1.0))
+    });
+    assert_refused(&case, &["'disc'", "'block'", "held by nothing"]);
+}

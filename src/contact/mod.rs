@@ -110,6 +110,12 @@ pub enum ContactError {
         group: String,
         component: &'static str,
     },
+    #[error(
+        "bodies '{first}' and '{second}' are both held only by their contact along a \
+         force-controlled component: together they are held by nothing. Hold one of them \
+         (a displacement) along it"
+    )]
+    NothingHolds { first: String, second: String },
     #[error("{0}")]
     Linalg(String),
     #[error(

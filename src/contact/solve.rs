@@ -193,7 +193,13 @@ impl<'a> ContactSolver<'a> {
                 .into_iter()
                 .enumerate()
                 .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
-                .collect();
+                .collect::<Vec<_>>();
+        if held_by_contact.iter().any(|h| h.0 == 0) && held_by_contact.iter().any(|h| h.0 == 1) {
+            return Err(ContactError::NothingHolds {
+                first: problem.primary.body.name.clone(),
+                second: problem.secondary.body.name.clone(),
+            });
+        }
         Ok(Self {
             problem,
             solver: solver.clone(),

@@ -192,7 +192,8 @@ pub struct CoupledSystem {
     /// Diagonal of D.
     pub d: Vec<f64>,
     /// Off-diagonal entries `(row, column, value)` of D: the couplings between the
-    /// force-controlled components of one body.
+    /// force-controlled components of one body, and between a multiplier and the
+    /// force-controlled displacement of a contact node it reads or loads (module doc).
     pub d_coupled: Vec<(usize, usize, f64)>,
     /// The multiplier of each body's first force-controlled component: body `k`'s `r`-th
     /// `RigidColumn` is multiplier `rigid_offsets[k] + r`; they follow every pair's
