@@ -7,7 +7,7 @@ from typing import Any, Mapping, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-from .summary import Summary
+from .summary import ForcedDisplacement, Summary
 
 __all__ = [
     "__version__",
@@ -189,6 +189,8 @@ class Step:
     force_imbalance: float
     hertz_a: Optional[float]
     hertz_p0: Optional[float]
+    forced: list[ForcedDisplacement]
+    """Each force-controlled group's force at this step and the displacement it gave."""
     seconds: float
 
 @final

@@ -97,6 +97,19 @@ class LinearSolvers(TypedDict):
     (AMG V-cycles with cg-amg bodies), [primary, secondary]."""
 
 
+class ForcedDisplacement(TypedDict):
+    """A force-controlled group ([[body.force]]) at one load step."""
+
+    body: str
+    group: str
+    component: str
+    """"x", "y" or "z"."""
+    force: float
+    """The prescribed force times the step's load factor."""
+    displacement: float
+    """The group's displacement along the component: what the force gave."""
+
+
 class StepRecord(TypedDict):
     """How one load step ended (also a row of force_displacement.csv)."""
 
@@ -109,6 +122,8 @@ class StepRecord(TypedDict):
     force_imbalance: float
     hertz_a: Optional[float]
     hertz_p0: Optional[float]
+    forced: list[ForcedDisplacement]
+    """Each force-controlled group's force and the displacement it gave."""
     seconds: float
     accurate: bool
     failed_checks: list[str]

@@ -1117,6 +1117,9 @@ struct Step {
     /// The Hertz fit of the primary pressure (contact radius or half-width, peak), if any.
     hertz_a: Option<f64>,
     hertz_p0: Option<f64>,
+    /// Each force-controlled group's force at this step and the displacement it gave: a
+    /// `list` of `dict`s with the keys `body`, `group`, `component`, `force`, `displacement`.
+    forced: Py<PyAny>,
     seconds: f64,
 }
 
@@ -1136,6 +1139,19 @@ impl Step {
             force_imbalance: record.force_imbalance,
             hertz_a: record.hertz_a,
             hertz_p0: record.hertz_p0,
+            forced: {
+                let list = PyList::empty(py);
+                for forced in &record.forced {
+                    let dict = PyDict::new(py);
+                    dict.set_item("body", &forced.body)?;
+                    dict.set_item("group", &forced.group)?;
+                    dict.set_item("component", forced.component)?;
+                    dict.set_item("force", forced.force)?;
+                    dict.set_item("displacement", forced.displacement)?;
+                    list.append(dict)?;
+                }
+                list.into_any().unbind()
+            },
             seconds: record.seconds,
         })
     }

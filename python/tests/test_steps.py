@@ -10,12 +10,14 @@ from conftest import REPO
 MESH = REPO / "tests" / "fixtures" / "half_disc_on_block.msh"
 
 
-def case(load_steps):
+def case(load_steps, disc_top=None):
+    """The half-disc pressed onto the block, its top held by `disc_top` (default: pushed down by
+    0.02)."""
+    disc_top = disc_top or {"dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02}]}
     return internodes.Case.from_dict({
         "contact": {"bodies": ["disc", "block"], "surfaces": ["disc_contact", "block_contact"],
                     "load_steps": load_steps},
-        "body": [{"name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
-                  "dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02}]},
+        "body": [{"name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3, **disc_top},
                  {"name": "block", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
                   "dirichlet": [{"group": "block_base", "ux": 0.0, "uy": 0.0}]}]})
 
@@ -56,3 +58,24 @@ def test_a_case_without_contact_has_no_steps():
         "name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
         "dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02}]}]})
     assert internodes.solve(single, mesh=internodes.Mesh.from_msh(MESH)).steps == []
+
+
+def test_each_step_gives_the_displacement_of_its_force():
+    # The disc's top loaded by a force instead of a displacement: each step records the force
+    # (ramped by the load factor) and how far the top moved under it, as the summary does.
+    forced = case([0.5, 1.0], {"dirichlet": [{"group": "disc_top", "ux": 0.0}],
+                               "force": [{"group": "disc_top", "fy": -5.0}]})
+    result = internodes.solve(forced, mesh=internodes.Mesh.from_msh(MESH))
+    result.raise_for_status()
+    records = result.summary["contact"]["steps"]
+    for step, record in zip(result.steps, records):
+        assert step.forced == record["forced"]
+        (moved,) = step.forced
+        assert (moved["body"], moved["group"], moved["component"]) == ("disc", "disc_top", "y")
+        assert moved["force"] == -5.0 * step.load_factor
+        # The contact carries the whole force: nothing else holds the disc along y.
+        assert np.isclose(step.force_primary[1], -moved["force"], rtol=1e-8)
+    # Half the force, less than half the approach (Hertz: the approach grows faster than linear
+    # in the force's square root, and the bulk adds a linear part).
+    half, full = (s.forced[0]["displacement"] for s in result.steps)
+    assert full < half < 0 and 0.4 < half / full < 0.6

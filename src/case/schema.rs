@@ -7,7 +7,9 @@ use serde::Deserialize;
 
 use super::CaseError;
 use crate::contact::{ContactProblem, ContactSettings, ContactSide, ContactSurface, PrimaryChoice};
-use crate::elastic::{DirichletCondition, ElasticProblem, LoadCondition, SolverSettings};
+use crate::elastic::{
+    DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, SolverSettings,
+};
 use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
 use crate::linalg::{BodySolverKind, CG_AMG_AVAILABLE};
@@ -124,6 +126,9 @@ pub struct BodySpec {
     pub body_force: Option<Vec<f64>>,
     #[serde(default)]
     pub dirichlet: Vec<DirichletSpec>,
+    /// Force-controlled groups (`[[body.force]]`).
+    #[serde(default, rename = "force")]
+    pub forces: Vec<ForceSpec>,
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadSpec>,
 }
@@ -136,6 +141,18 @@ pub struct DirichletSpec {
     pub ux: Option<f64>,
     pub uy: Option<f64>,
     pub uz: Option<f64>,
+}
+
+/// A prescribed total force on a group, per component; omitted components are not
+/// force-controlled. Along each given component the group moves rigidly, by a displacement the
+/// solve finds, such that the force it passes to the body is the given one (a loading plate).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    pub group: String,
+    pub fx: Option<f64>,
+    pub fy: Option<f64>,
+    pub fz: Option<f64>,
 }
 
 /// A surface load: exactly one of `traction`, `pressure`, `hertz_pressure`.
@@ -515,12 +532,20 @@ impl Case {
             .as_deref()
             .map(|b| values.vector(b, "body_force"))
             .transpose()?;
-        ElasticProblem::new(body, material, dirichlet, loads, body_force).map_err(|source| {
-            CaseError::Problem {
+        values.check_force_values(&spec.forces)?;
+        let forces = spec
+            .forces
+            .iter()
+            .map(|f| ForceCondition {
+                group: f.group.clone(),
+                components: [f.fx, f.fy, f.fz],
+            })
+            .collect();
+        ElasticProblem::with_forces(body, material, dirichlet, forces, loads, body_force)
+            .map_err(|source| CaseError::Problem {
                 path: self.path.clone(),
                 source,
-            }
-        })
+            })
     }
 
     /// The body's material, its Young's modulus also within the range [`MAX_MAGNITUDE`] allows.
@@ -651,6 +676,20 @@ impl BodyValues<'_> {
                 if let Some(value) = value.filter(|&v| !in_range(v)) {
                     return Err(self.invalid(
                         &format!("Dirichlet condition on '{}', {key}", d.group),
+                        format!("expected a finite number {}, got {value:e}", self.range),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn check_force_values(&self, forces: &[ForceSpec]) -> Result<(), CaseError> {
+        for f in forces {
+            for (key, value) in ["fx", "fy", "fz"].iter().zip([f.fx, f.fy, f.fz]) {
+                if let Some(value) = value.filter(|&v| !in_range(v)) {
+                    return Err(self.invalid(
+                        &format!("force on '{}', {key}", f.group),
                         format!("expected a finite number {}, got {value:e}", self.range),
                     ));
                 }

@@ -19,20 +19,30 @@
 //! `M2 R21 e_k` loads every secondary node the interpolation reaches, nearly the whole facing
 //! surface (the rows of `R12` and columns of `R21` are dense over it), so a dof-by-dof
 //! compliance needs about `dim` times the facing secondary nodes in solves.
+//!
+//! A force-controlled group's unknown displacement `a` is handled like a multiplier: its
+//! column `k` (`crate::elastic::RigidColumn`) is a unit load of its own, whose response is
+//! kept beside the tractions' on the dofs its row reads.
 
 use std::collections::HashMap;
 
 use super::ContactError;
 use crate::linalg::BodySolver;
 
-/// Identifies a unit traction across iterations: its contact pair, the primary body node it
-/// acts at, and its component (`super::system::CoupledSystem::columns` combines them into
-/// multipliers).
+/// Identifies a unit load across iterations (`super::system::CoupledSystem::columns` combines
+/// them into the columns of the multiplier block).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct MultiplierKey {
-    pub pair: usize,
-    pub node: usize,
-    pub component: usize,
+pub enum MultiplierKey {
+    /// A unit traction of `component` at the primary body node `node` of contact pair `pair`.
+    Traction {
+        pair: usize,
+        node: usize,
+        component: usize,
+    },
+    /// The displacement of the force-controlled component `index` of body `body`
+    /// (`crate::elastic::RigidColumn`), whose column in the body's rows is `k`: `K_c u + k a =
+    /// f_c`.
+    Rigid { body: usize, index: usize },
 }
 
 /// The responses `Y_k` of one body computed so far, on its candidate-surface dofs.

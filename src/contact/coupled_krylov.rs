@@ -229,6 +229,7 @@ pub fn solve(
         bodies: problem.bodies,
         solvers: problem.solvers,
         schur,
+        rigid: RigidBlock::new(system),
         applications: vec![0; num_bodies],
         started: std::time::Instant::now(),
         progress: state.progress,
@@ -285,7 +286,7 @@ fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
     };
     x.resize(n + system.m, 0.0);
     for (k, column) in system.columns.iter().enumerate() {
-        if system.d[k] != 0.0 {
+        if column.is_empty() && system.d[k] != 0.0 {
             x[n + k] = system.g[k] / system.d[k];
             continue;
         }
@@ -321,6 +322,8 @@ struct Blocks<'a> {
     solvers: &'a [BodySolver],
     /// `S~` of each pair, on its multipliers: the pairs' blocks of the preconditioner.
     schur: Vec<HalfSpace>,
+    /// `S~` of the force-controlled displacements: their block of `D`.
+    rigid: RigidBlock,
     /// Applications of each body's block.
     applications: Vec<usize>,
     started: std::time::Instant,
@@ -350,6 +353,9 @@ impl Operators for Blocks<'_> {
         for ((o, d), l) in out_l.iter_mut().zip(&system.d).zip(&x[n..]) {
             *o = d * l;
         }
+        for &(k, l, value) in &system.d_coupled {
+            out_l[k] += value * x[n + l];
+        }
         for (row, k, value) in system.b_entries() {
             out[row] += value * x[n + k];
         }
@@ -368,6 +374,7 @@ impl Operators for Blocks<'_> {
             let range = system.pair_multipliers(p);
             schur.apply(&r[n + range.start..n + range.end], &mut out_l[range]);
         }
+        self.rigid.apply(&r[n..], out_l);
         self.scratch.copy_from_slice(&r[..n]);
         for (row, k, value) in system.b_entries() {
             self.scratch[row] -= value * out_l[k];
@@ -400,6 +407,55 @@ impl Operators for Blocks<'_> {
             );
         }
         Ok(())
+    }
+}
+
+/// The preconditioner's block of the force-controlled displacements `a`: their block `D_aa`
+/// of `D` (`d` and the couplings of one body's components), solved densely.
+///
+/// Their Schur complement is `D_aa - k^T K^-1 k` less what the contacts add: for a body that
+/// only its contacts hold along `a`, the body's part of it is zero and what is left is the
+/// contact stiffness, which changes with the active set. `D_aa` leaves out the coupling
+/// through `k` and the contacts, a perturbation of rank at most two per force-controlled
+/// component of the preconditioned operator (`A P^-1` is the identity plus it where the other
+/// blocks are exact), which GMRES resolves in that many more iterations.
+struct RigidBlock {
+    /// The first rigid unknown, within the multiplier block.
+    first: usize,
+    /// The LU of `D_aa` (`None` without force control).
+    lu: Option<nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+}
+
+impl RigidBlock {
+    fn new(system: &CoupledSystem) -> Self {
+        let first = system.rigid_offsets[0];
+        let count = system.m - first;
+        if count == 0 {
+            return Self { first, lu: None };
+        }
+        let mut block = nalgebra::DMatrix::<f64>::zeros(count, count);
+        for i in 0..count {
+            block[(i, i)] = system.d[first + i];
+        }
+        for &(k, l, value) in &system.d_coupled {
+            if k >= first && l >= first {
+                block[(k - first, l - first)] += value;
+            }
+        }
+        Self {
+            first,
+            lu: Some(block.lu()),
+        }
+    }
+
+    /// `out[a] = D_aa^-1 r[a]` over the rigid unknowns of the multiplier block.
+    fn apply(&self, r: &[f64], out: &mut [f64]) {
+        let Some(lu) = &self.lu else {
+            return;
+        };
+        let rhs = nalgebra::DVector::from_column_slice(&r[self.first..]);
+        let y = lu.solve(&rhs).unwrap_or(rhs);
+        out[self.first..].copy_from_slice(y.as_slice());
     }
 }
 

@@ -250,6 +250,43 @@ impl BodyFactors {
     }
 }
 
+/// The force-controlled components (indices into `body.rigid`) of each body that nothing but
+/// its contacts holds (`crate::elastic::unheld_components`): the body's own stiffness along
+/// them needs `K_c^-1 k` of each, solved by the body's solver in `factors`, or by a Cholesky
+/// factor made for the purpose (the monolithic path has no body solvers).
+pub fn held_by_contacts_only(
+    bodies: &[&AssembledBody],
+    factors: Option<&BodyFactors>,
+    ordering: Ordering,
+) -> Result<Vec<Vec<usize>>, ContactError> {
+    let mut held = Vec::with_capacity(bodies.len());
+    for (k, body) in bodies.iter().enumerate() {
+        if body.rigid.is_empty() {
+            held.push(Vec::new());
+            continue;
+        }
+        let own;
+        let solver = match factors {
+            Some(factors) => &factors.solvers[k],
+            None => {
+                own = cholesky(body, ordering)?;
+                &own
+            }
+        };
+        let n = body.f_c.len();
+        let mut w = vec![0.0; n * body.rigid.len()];
+        for (j, rigid) in body.rigid.iter().enumerate() {
+            rigid.column.iter().for_each(|&(dof, v)| w[j * n + dof] = v);
+        }
+        solver
+            .solve_in_place(&mut w, body.rigid.len())
+            .map_err(body_solve_error)?;
+        let stiffness = crate::elastic::rigid_stiffness(body, &w);
+        held.push(crate::elastic::unheld_components(body, &stiffness));
+    }
+    Ok(held)
+}
+
 /// The Cholesky factor of a body's constrained stiffness.
 fn cholesky(body: &AssembledBody, ordering: Ordering) -> Result<BodySolver, ContactError> {
     CholeskySymbolic::new(&body.graph, body.k_c.symbolic(), ordering)
@@ -383,6 +420,9 @@ fn extend_responses(
 fn schur_complement(system: &CoupledSystem, responses: &[SurfaceResponse]) -> DMatrix<f64> {
     let (m, s) = (system.m, system.s);
     let mut schur = DMatrix::<f64>::from_diagonal(&DVector::from_column_slice(&system.d));
+    for &(k, l, value) in &system.d_coupled {
+        schur[(k, l)] += value;
+    }
     for (body, response) in responses.iter().enumerate() {
         let dofs = system.body_dofs(body);
         let mut read: Vec<usize> = (system.c.iter())
@@ -603,7 +643,7 @@ mod tests {
             .displacement;
         let scale = whole.iter().map(|u| u.abs()).fold(0.0, f64::max);
         let check = |path: &str, x: &[f64]| {
-            let solution = system.solution(x, &pairs, 2, 0.0);
+            let solution = system.solution(x, &bodies, &pairs, 2, 0.0);
             for (k, u) in solution.u[..3].iter().enumerate() {
                 for j in 0..=NY {
                     for i in 0..=NX {

@@ -27,7 +27,7 @@ use super::certificate::CheckKind;
 use super::checks::agreement;
 use super::{
     CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus,
-    OtherPrimary, Transfer,
+    ForcedDisplacement, OtherPrimary, Transfer,
 };
 use crate::elastic::SolverSettings;
 
@@ -44,6 +44,8 @@ pub struct StepRecord {
     pub force_imbalance: f64,
     pub hertz_a: Option<f64>,
     pub hertz_p0: Option<f64>,
+    /// The displacement of each force-controlled group (the approach a force gave).
+    pub forced: Vec<ForcedDisplacement>,
     pub seconds: f64,
     /// Whether the step's accuracy report passed.
     pub accurate: bool,
@@ -448,6 +450,7 @@ fn solve_load_steps(
             force_imbalance: solution.force_imbalance,
             hertz_a: solution.hertz_primary.map(|h| h.a),
             hertz_p0: solution.hertz_primary.map(|h| h.p0),
+            forced: solution.forced.clone(),
             seconds,
             accurate: solution.certificate.accurate(),
             failed_checks: solution.certificate.failed(),

@@ -43,6 +43,7 @@ use std::collections::HashMap;
 use faer::Mat;
 use faer::prelude::*;
 
+use super::compliance::MultiplierKey;
 use super::ContactSurface;
 use super::system::{CoupledSystem, Coupling};
 use crate::fem::Material;
@@ -100,11 +101,15 @@ impl HalfSpace {
             if diagonal[k] != 0.0 {
                 continue;
             }
+            let MultiplierKey::Traction { node, .. } = *key else {
+                continue;
+            };
             let mut e = [0.0; 3];
             for (key, weight) in column {
-                e[key.component] = *weight;
+                if let MultiplierKey::Traction { component, .. } = *key {
+                    e[component] = *weight;
+                }
             }
-            let node = key.node;
             let mut x = [0.0; 3];
             x[..dim].copy_from_slice(&coordinates[dim * node..dim * node + dim]);
             let a = area.get(&node).copied().unwrap_or(0.0);
@@ -235,6 +240,108 @@ pub fn predicted_set(
     p0: &[f64],
     c0: f64,
 ) -> Vec<usize> {
+    let (p, r) = half_space_contact(surface, candidates, gaps, p0, c0);
+    (0..candidates.len())
+        .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * surface.spacing[candidates[i]])
+        .map(|i| candidates[i])
+        .collect()
+}
+
+/// The active set the half-space model predicts for a body held only by its contact and
+/// pressed onto it by a total normal force `force`: [`predicted_set`]'s model from no pressure,
+/// with the gaps `gaps - delta` of a rigid approach `delta` found such that the pressures carry
+/// the force, `sum A_i p_i = force`. The force grows with `delta` (more overlap, more
+/// pressure), so `delta` is bracketed by doubling from the first touch and then found by the
+/// Illinois variant of regula falsi to [`FORCE_TOLERANCE`] of the force.
+///
+/// Why: a force-controlled body has no approach of its own until its contact carries the
+/// force. Started from the nodes that touch (the pole of a sphere), the first iterate
+/// concentrates the whole force on them: in 3D a point load sinks the body several times its
+/// final approach (an R/67 hemisphere on a block, 3 times), and the linearized gaps at that
+/// iterate leave the loop unstable. Started from this set, the first iterate is about the
+/// answer (see `tests/force_control.rs`).
+pub fn force_controlled_set(
+    surface: &ContactSurface,
+    gaps: &[f64],
+    force: f64,
+    c0: f64,
+) -> Vec<usize> {
+    let no_pressure = vec![0.0; surface.len()];
+    let first_touch = gaps.iter().copied().fold(f64::INFINITY, f64::min);
+    let spacing = surface.spacing.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(force > 0.0) || !first_touch.is_finite() || !(spacing > 0.0) {
+        return Vec::new();
+    }
+    // The model's pressures at the approach `delta`: only candidates that overlap can carry
+    // any (the compliance only opens gaps), so the others are left out.
+    let solve = |delta: f64| {
+        let candidates: Vec<usize> = (0..surface.len()).filter(|&i| gaps[i] < delta).collect();
+        let shifted: Vec<f64> = gaps.iter().map(|g| g - delta).collect();
+        let (p, r) = half_space_contact(surface, &candidates, &shifted, &no_pressure, c0);
+        let carried: f64 = (candidates.iter().zip(&p))
+            .map(|(&i, p)| surface.nodal_area[i] * p)
+            .sum();
+        (candidates, p, r, carried)
+    };
+    let (mut low, mut high) = (first_touch, first_touch + spacing);
+    let (mut f_low, mut f_high) = (-force, solve(high).3 - force);
+    let mut doublings = 0;
+    while f_high < 0.0 && doublings < FORCE_BRACKETING {
+        (low, f_low) = (high, f_high);
+        high = first_touch + 2.0 * (high - first_touch);
+        f_high = solve(high).3 - force;
+        doublings += 1;
+    }
+    // Regula falsi keeping the bracket [low, high]; `high` carries at least the force, and
+    // is the answer (the prediction errs on the large side, as `PREDICTION_MARGIN` says).
+    let mut side = 0;
+    let steps = if f_high <= FORCE_TOLERANCE * force { 0 } else { FORCE_STEPS };
+    for _ in 0..steps {
+        let delta = (low * f_high - high * f_low) / (f_high - f_low);
+        let f = solve(delta).3 - force;
+        if f.abs() <= FORCE_TOLERANCE * force {
+            high = delta;
+            break;
+        }
+        if f > 0.0 {
+            (high, f_high) = (delta, f);
+            if side == 1 {
+                f_low /= 2.0;
+            }
+            side = 1;
+        } else {
+            (low, f_low) = (delta, f);
+            if side == -1 {
+                f_high /= 2.0;
+            }
+            side = -1;
+        }
+    }
+    let (candidates, p, r, _) = solve(high);
+    (0..candidates.len())
+        .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * surface.spacing[candidates[i]])
+        .map(|i| candidates[i])
+        .collect()
+}
+
+/// [`force_controlled_set`] finds the force to this fraction.
+const FORCE_TOLERANCE: f64 = 1e-3;
+
+/// [`force_controlled_set`] doubles the approach at most this many times to bracket the force.
+const FORCE_BRACKETING: usize = 40;
+
+/// [`force_controlled_set`]'s regula falsi steps at most.
+const FORCE_STEPS: usize = 60;
+
+/// The pressures `p` and model gaps `r` of the half-space contact problem of
+/// [`predicted_set`] on `candidates`.
+fn half_space_contact(
+    surface: &ContactSurface,
+    candidates: &[usize],
+    gaps: &[f64],
+    p0: &[f64],
+    c0: f64,
+) -> (Vec<f64>, Vec<f64>) {
     let m = candidates.len();
     let dim = surface.dim;
     let x = |i: usize| surface.coords[candidates[i]];
@@ -284,10 +391,7 @@ pub fn predicted_set(
             break;
         }
     }
-    (0..m)
-        .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * surface.spacing[candidates[i]])
-        .map(|i| candidates[i])
-        .collect()
+    (p, r)
 }
 
 /// [`predicted_set`] also keeps the candidates whose model gap is below this fraction of their

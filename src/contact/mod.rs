@@ -61,8 +61,8 @@ pub use problem::{
 };
 pub use settings::{ContactSettings, CoupledSolver, Formulation, SettingsError, Transfer};
 pub use solution::{
-    ContactSolution, ContactStatus, HertzFit, IterationRecord, LinearSolvers, PhaseSeconds,
-    SurfaceFields,
+    ContactSolution, ContactStatus, ForcedDisplacement, HertzFit, IterationRecord, LinearSolvers,
+    PhaseSeconds, SurfaceFields,
 };
 pub use solve::ContactSolver;
 pub use surface::{ContactSurface, SurfaceError};
@@ -99,6 +99,23 @@ pub enum ContactError {
     },
     #[error("the active primary facets have no area: the interface mass matrix is zero")]
     EmptyInterfaceMass,
+    #[error(
+        "body '{body}' is held along {component} by nothing but its contacts (its group \
+         '{group}' is force-controlled along {component}), and the force pulls it off the \
+         other body: nothing balances it. Check the force's sign, or hold the body along \
+         {component} elsewhere"
+    )]
+    PulledAway {
+        body: String,
+        group: String,
+        component: &'static str,
+    },
+    #[error(
+        "bodies '{first}' and '{second}' are both held only by their contact along a \
+         force-controlled component: together they are held by nothing. Hold one of them \
+         (a displacement) along it"
+    )]
+    NothingHolds { first: String, second: String },
     #[error("{0}")]
     Linalg(String),
     #[error(

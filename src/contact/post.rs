@@ -4,7 +4,8 @@
 use super::active_set::ActiveSet;
 use super::certificate::{Certificate, CheckKind};
 use super::solution::{
-    ContactSolution, ContactStatus, IterationRecord, LinearSolvers, SurfaceFields,
+    ContactSolution, ContactStatus, ForcedDisplacement, IterationRecord, LinearSolvers,
+    SurfaceFields,
 };
 use super::system::{CoupledSolution, Coupling};
 use super::{ContactError, ContactProblem, ContactSurface, hertz};
@@ -65,6 +66,19 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
     let hertz_primary = hertz::fit(s1, &primary_fields);
     let max_tangential_traction = max_tangential(&solution.traction[0], &coupling.normals);
     let residual = solution.relative_residual;
+    let forced = (problem.primary.body.name.as_str(), body1, &solution.rigid[0]);
+    let forced = [forced, (&problem.secondary.body.name, body2, &solution.rigid[1])]
+        .into_iter()
+        .flat_map(|(name, body, a)| {
+            body.rigid.iter().zip(a).map(move |(rigid, &a)| ForcedDisplacement {
+                body: name.to_string(),
+                group: rigid.group.clone(),
+                component: ["x", "y", "z"][rigid.component],
+                force: load_factor * rigid.force,
+                displacement: a,
+            })
+        })
+        .collect();
     let Ok([u1, u2]) = <[Vec<f64>; 2]>::try_from(solution.u) else {
         unreachable!("a pair has two bodies")
     };
@@ -99,6 +113,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         certificate,
         hertz_primary,
         load_factor,
+        forced,
         active_set,
     })
 }

@@ -190,8 +190,23 @@ pub struct ContactSolution {
     pub hertz_primary: Option<HertzFit>,
     /// The factor the loads and prescribed displacements were scaled by.
     pub load_factor: f64,
+    /// The displacement of each force-controlled component, primary's first.
+    pub forced: Vec<ForcedDisplacement>,
     /// The active set at the end, from which a next load step starts.
     pub active_set: ActiveSet,
+}
+
+/// How far a force-controlled group moved under its force (`[[body.force]]`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ForcedDisplacement {
+    pub body: String,
+    pub group: String,
+    /// `"x"`, `"y"` or `"z"`.
+    pub component: &'static str,
+    /// The force at this load step: the prescribed one times the load factor.
+    pub force: f64,
+    /// The group's displacement along the component: the solve's unknown.
+    pub displacement: f64,
 }
 
 impl ContactSolution {

@@ -72,7 +72,7 @@ use super::checks::{certify, contact_status};
 use super::coupled_krylov::Tightness;
 use super::coupled_solver::{self, BodyFactors};
 use super::gap::{GapRow, gap_rows, geometric_gaps};
-use super::half_space::{compliance_factor, predicted_set};
+use super::half_space::{compliance_factor, force_controlled_set, predicted_set};
 use super::interface::{Constraint, InterfaceOperators};
 use super::post::{self, LastIterate};
 use super::safeguard::{Safeguard, Step};
@@ -118,6 +118,9 @@ pub struct ContactSolver<'a> {
     pub(super) stats1: SolveStats,
     pub(super) stats2: SolveStats,
     factors: Option<BodyFactors>,
+    /// The force-controlled components `(body, index into its rigid columns)` that nothing but
+    /// the contact holds (body 0 the primary): with no node in contact the system is singular.
+    held_by_contact: Vec<(usize, usize)>,
     /// Paired for the slide of the last solve; a solve without a start pairs them again
     /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
@@ -134,6 +137,18 @@ fn pair(problem: &ContactProblem, slid: [f64; 3]) -> Result<InterfaceOperators, 
         problem.transfer().transfer == Transfer::Conservative,
         slid,
     )
+}
+
+/// The nodes of a body whose displacements the constraint rows read: its candidate surface's,
+/// and the nodes a force-controlled group's row reads (its column `k`).
+fn read_nodes(surface: &ContactSurface, body: &AssembledBody) -> Vec<usize> {
+    let mut nodes = surface.nodes.clone();
+    for rigid in &body.rigid {
+        nodes.extend(rigid.column.iter().map(|&(dof, _)| dof / body.dim));
+    }
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
 }
 
 impl<'a> ContactSolver<'a> {
@@ -155,7 +170,7 @@ impl<'a> ContactSolver<'a> {
                 let materials = [&problem.primary.material, &problem.secondary.material];
                 let factors = BodyFactors::new(
                     &[&body1, &body2],
-                    vec![s1.nodes.clone(), s2.nodes.clone()],
+                    vec![read_nodes(s1, &body1), read_nodes(s2, &body2)],
                     vec![compliance_factor(materials, s1.dim)],
                     solver,
                     kind,
@@ -173,6 +188,18 @@ impl<'a> ContactSolver<'a> {
             }
         };
         let operators = pair(problem, [0.0; 3])?;
+        let held_by_contact =
+            coupled_solver::held_by_contacts_only(&[&body1, &body2], factors.as_ref(), solver.ordering)?
+                .into_iter()
+                .enumerate()
+                .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
+                .collect::<Vec<_>>();
+        if held_by_contact.iter().any(|h| h.0 == 0) && held_by_contact.iter().any(|h| h.0 == 1) {
+            return Err(ContactError::NothingHolds {
+                first: problem.primary.body.name.clone(),
+                second: problem.secondary.body.name.clone(),
+            });
+        }
         Ok(Self {
             problem,
             solver: solver.clone(),
@@ -181,6 +208,7 @@ impl<'a> ContactSolver<'a> {
             stats1,
             stats2,
             factors,
+            held_by_contact,
             operators,
         })
     }
@@ -234,6 +262,7 @@ impl<'a> ContactSolver<'a> {
         if start.is_none() && self.operators.slid != [0.0; 3] {
             self.pair_again([0.0; 3])?;
         }
+        let cold = start.is_none();
         let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
         let mut state = LoopState {
             solved: start.nodes.clone(),
@@ -243,6 +272,8 @@ impl<'a> ContactSolver<'a> {
             safeguard: Safeguard::default(),
             history: Vec::new(),
             last: None,
+            cold,
+            first_contact: false,
         };
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.problem.settings.max_iterations {
@@ -282,6 +313,11 @@ struct LoopState {
     last: Option<(Coupling, CoupledSolution)>,
     /// The active set `last` was solved on (`active` moves on to the next one).
     solved: BTreeSet<usize>,
+    /// Whether the solve started without an active set from an earlier one.
+    cold: bool,
+    /// Whether the loop has chosen where a body that only its contacts hold touches first
+    /// ([`ContactSolver::first_contact`]).
+    first_contact: bool,
 }
 
 impl LoopState {
@@ -317,6 +353,9 @@ impl ContactSolver<'_> {
     ) -> Result<Option<ContactStatus>, ContactError> {
         let problem = self.problem;
         let mut seconds = PhaseSeconds::default();
+        if state.active.is_empty() || (iteration == 1 && state.cold) {
+            self.first_contact(state, load_factor)?;
+        }
         // 1. The coupling of the active set: rows and columns of the fixed operators.
         let nodes: Vec<usize> = state.active.iter().copied().collect();
         let coupling = timed(&mut seconds.operators, || {
@@ -394,6 +433,72 @@ impl ContactSolver<'_> {
             log::info!("{}", record.line());
         }
         Ok(state.advance(record, (coupling, solution), step))
+    }
+
+    /// Where a body that nothing but the contact holds along a force-controlled component
+    /// touches first, when the loop starts cold or has no node in contact: with no node in
+    /// contact its system is singular (the force would move it without bound), and from the
+    /// nodes that merely touch (a sphere's pole) the first iterate would carry the whole force
+    /// on them. The active set becomes the half-space model's zone for the force
+    /// (`super::half_space::force_controlled_set`), or the closest node if the model finds
+    /// none. If the loop lets go of every contact after that, the force pulls the body off: an
+    /// error that names it.
+    fn first_contact(&self, state: &mut LoopState, load_factor: f64) -> Result<(), ContactError> {
+        let Some(&(body, index)) = self.held_by_contact.first() else {
+            return Ok(());
+        };
+        let (name, assembled) = match body {
+            0 => (&self.problem.primary.body.name, &self.body1),
+            _ => (&self.problem.secondary.body.name, &self.body2),
+        };
+        let rigid = &assembled.rigid[index];
+        let component = ["x", "y", "z"][rigid.component];
+        if state.first_contact {
+            if state.active.is_empty() {
+                return Err(ContactError::PulledAway {
+                    body: name.clone(),
+                    group: rigid.group.clone(),
+                    component,
+                });
+            }
+            return Ok(());
+        }
+        let problem = self.problem;
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let gaps = match state.last.as_ref().map(|(_, solution)| &solution.u) {
+            Some(u) => geometric_gaps(s1, s2, Some(&u[0]), Some(&u[1])),
+            None => geometric_gaps(s1, s2, None, None),
+        };
+        // The force the contact carries along the components nothing else holds.
+        let force = (self.held_by_contact.iter())
+            .map(|&(k, r)| {
+                let rigid = match k {
+                    0 => &self.body1.rigid[r],
+                    _ => &self.body2.rigid[r],
+                };
+                (load_factor * (rigid.force + rigid.applied)).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt();
+        let materials = [&problem.primary.material, &problem.secondary.material];
+        let c0 = compliance_factor(materials, s1.dim);
+        let mut zone: BTreeSet<usize> = force_controlled_set(s1, &gaps, force, c0)
+            .into_iter()
+            .collect();
+        if zone.is_empty() {
+            let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
+            zone.extend(closest);
+        }
+        if self.solver.verbose {
+            log::info!(
+                "  '{name}' is held along {component} only by the contact: it starts on the {} \
+                 nodes where two half-spaces would carry its force {force:.6e}",
+                zone.len()
+            );
+        }
+        state.active = zone;
+        state.first_contact = true;
+        Ok(())
     }
 
     /// The active set the half-space model predicts (`super::half_space::predicted_set`) from
@@ -605,7 +710,7 @@ impl ContactSolver<'_> {
                 tolerance: self.solver.residual_tolerance,
             });
         }
-        Ok(system.solution(&x, &pairs, dim, residual))
+        Ok(system.solution(&x, &bodies, &pairs, dim, residual))
     }
 }
 

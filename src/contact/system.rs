@@ -27,11 +27,27 @@
 //! `lambda = 0` and it acts on neither body. Keeping it would leave an empty column, since the
 //! rows of prescribed dofs carry no coupling.
 //!
+//! A force-controlled group (`crate::elastic::RigidColumn`) adds one unknown per controlled
+//! component after all the pairs' multipliers: its displacement `a`, with its column `k` in
+//! its body's rows, the same `k` as its row, `d` (and the couplings to the body's other such
+//! components) in `D`, and the prescribed force in `g`:
+//!
+//! ```text
+//! [ K_k  ...  k   ] [u_k]   [f_k              ]
+//! [ k^T  ...  d   ] [a  ] = [s (force + applied)]
+//! ```
+//!
+//! A contact node in such a group moves with `a`: its constraint row reads `a`, and the force a
+//! multiplier puts on it enters the group's reaction, both through entries of `D` between the
+//! multiplier and `a` (`d_coupled`).
+//!
 //! Scaling: the multiplier columns are multiplied by `s = k / m` and the constraint rows by `k`,
 //! with `k` the largest diagonal entry of the bodies' `K` and `m` the largest lumped mass of an
 //! active primary node, so that every block has the magnitude of `K`; the solution is unscaled
-//! on return.
+//! on return. A rigid unknown is a displacement, of the scale of `u`: it is not scaled (its
+//! unit load carries the weight `1 / s`, which cancels the multipliers' `s`).
 
+use std::collections::HashMap;
 use std::ops::Range;
 
 use faer::sparse::{SparseColMat, Triplet};
@@ -84,6 +100,9 @@ pub struct CoupledSolution {
     /// Forces the interfaces apply to each body's dofs: `M_a lambda` on a primary, `-M_b R_ba
     /// lambda` on a secondary, summed over the body's pairs.
     pub contact_force: Vec<Vec<f64>>,
+    /// Each body's force-controlled displacements, one per `RigidColumn` of the body (they
+    /// are also in `u`, at the group's dofs).
+    pub rigid: Vec<Vec<f64>>,
     pub relative_residual: f64,
 }
 
@@ -111,15 +130,15 @@ impl Coupling {
     /// Whether multiplier `col` restates a Dirichlet condition of the `primary` (see the
     /// module doc).
     fn is_dropped(&self, col: usize, primary: &AssembledBody, dim: usize) -> bool {
+        let prescribed = |dof: usize| {
+            primary.constraints.is_fixed(dof)
+                && !(primary.rigid.iter()).any(|rigid| rigid.dofs.contains(&dof))
+        };
         match self.formulation {
-            Formulation::Tied => primary
-                .constraints
-                .is_fixed(dim * self.primary_nodes[col / dim] + col % dim),
-            Formulation::Frictionless => (0..dim).all(|c| {
-                primary
-                    .constraints
-                    .is_fixed(dim * self.primary_nodes[col] + c)
-            }),
+            Formulation::Tied => prescribed(dim * self.primary_nodes[col / dim] + col % dim),
+            Formulation::Frictionless => {
+                (0..dim).all(|c| prescribed(dim * self.primary_nodes[col] + c))
+            }
         }
     }
 
@@ -172,6 +191,14 @@ pub struct CoupledSystem {
     pub c: Vec<(usize, usize, f64)>,
     /// Diagonal of D.
     pub d: Vec<f64>,
+    /// Off-diagonal entries `(row, column, value)` of D: the couplings between the
+    /// force-controlled components of one body, and between a multiplier and the
+    /// force-controlled displacement of a contact node it reads or loads (module doc).
+    pub d_coupled: Vec<(usize, usize, f64)>,
+    /// The multiplier of each body's first force-controlled component: body `k`'s `r`-th
+    /// `RigidColumn` is multiplier `rigid_offsets[k] + r`; they follow every pair's
+    /// multipliers.
+    pub rigid_offsets: Vec<usize>,
     /// The bodies' `f_k` (constrained), one after another, and `g`.
     pub f: Vec<f64>,
     /// The factor `f` is scaled by: `f = load_factor [f_1(1); ...; f_N(1)]`.
@@ -197,7 +224,12 @@ impl CoupledSystem {
             let count = pair.coupling.num_multipliers(dim);
             multiplier_offsets.push(multiplier_offsets.last().unwrap() + count);
         }
-        let m = *multiplier_offsets.last().unwrap();
+        let m_pairs = *multiplier_offsets.last().unwrap();
+        let mut rigid_offsets = vec![m_pairs];
+        for body in bodies {
+            rigid_offsets.push(rigid_offsets.last().unwrap() + body.rigid.len());
+        }
+        let m = *rigid_offsets.last().unwrap();
         let k_scale = bodies
             .iter()
             .map(|b| diagonal_max(&b.k_c))
@@ -205,10 +237,10 @@ impl CoupledSystem {
         let m_scale = (pairs.iter())
             .flat_map(|pair| pair.coupling.areas1.iter().copied())
             .fold(0.0, f64::max);
-        if m > 0 && m_scale <= 0.0 {
+        if m_pairs > 0 && m_scale <= 0.0 {
             return Err(ContactError::EmptyInterfaceMass);
         }
-        let s = if m > 0 { k_scale / m_scale } else { 1.0 };
+        let s = if m_pairs > 0 { k_scale / m_scale } else { 1.0 };
         let t = k_scale;
         let mut blocks = PairBlocks::new(m);
         for (p, pair) in pairs.iter().enumerate() {
@@ -217,9 +249,15 @@ impl CoupledSystem {
                 first_multiplier: multiplier_offsets[p],
                 primary: offsets[pair.primary],
                 secondary: offsets[pair.secondary],
+                primary_rigid: rigid_offsets[pair.primary],
+                secondary_rigid: rigid_offsets[pair.secondary],
             };
             let [primary, secondary] = [bodies[pair.primary], bodies[pair.secondary]];
-            blocks.add(pair.coupling, primary, secondary, &place, dim, t);
+            blocks.add(pair.coupling, primary, secondary, &place, dim, s, t);
+        }
+        for (k, body) in bodies.iter().enumerate() {
+            let first = rigid_offsets[k];
+            blocks.add_rigid(k, body, first, offsets[k], s, load_factor);
         }
         // Loads and prescribed displacements scale the constrained right-hand side linearly.
         let f: Vec<f64> = (bodies.iter())
@@ -235,6 +273,8 @@ impl CoupledSystem {
             t,
             c: blocks.c,
             d: blocks.d,
+            d_coupled: blocks.d_coupled,
+            rigid_offsets,
             f,
             load_factor,
             g: blocks.g,
@@ -310,6 +350,9 @@ impl CoupledSystem {
                 .filter(|(_, v)| **v != 0.0)
                 .map(|(k, &v)| Triplet::new(n + k, n + k, v)),
         );
+        triplets.extend(
+            (self.d_coupled.iter()).map(|&(k, l, v)| Triplet::new(n + k, n + l, v)),
+        );
         SparseColMat::<usize, f64>::try_new_from_triplets(n + self.m, n + self.m, &triplets)
             .map_err(|e| ContactError::Linalg(format!("assembling the coupled system: {e:?}")))
     }
@@ -323,6 +366,9 @@ impl CoupledSystem {
             ax.extend(mat_vec(&body.k_c, &x[self.body_dofs(k)]));
         }
         ax.extend(self.d.iter().zip(&x[n..]).map(|(d, l)| d * l));
+        for &(k, l, value) in &self.d_coupled {
+            ax[n + k] += value * x[n + l];
+        }
         for (row, k, value) in self.b_entries() {
             ax[row] += value * x[n + k];
         }
@@ -350,16 +396,29 @@ impl CoupledSystem {
 
     /// Unscales the solution `x = [u_1; ...; u_N; lambda / s]` and forms each pair's tractions
     /// and each body's interface forces.
+    ///
+    /// A force-controlled group's displacement `a` is put at its dofs of `u` (where `x` holds
+    /// 0, the value `K_c` holds them at).
     pub fn solution(
         &self,
         x: &[f64],
+        bodies: &[&AssembledBody],
         pairs: &[Pair],
         dim: usize,
         relative_residual: f64,
     ) -> CoupledSolution {
         let n = self.num_displacements();
+        let rigid: Vec<Vec<f64>> = (0..self.num_bodies())
+            .map(|k| x[n + self.rigid_offsets[k]..n + self.rigid_offsets[k + 1]].to_vec())
+            .collect();
         let u: Vec<Vec<f64>> = (0..self.num_bodies())
-            .map(|k| x[self.body_dofs(k)].to_vec())
+            .map(|k| {
+                let mut u = x[self.body_dofs(k)].to_vec();
+                for (column, a) in bodies[k].rigid.iter().zip(&rigid[k]) {
+                    column.dofs.iter().for_each(|&dof| u[dof] = *a);
+                }
+                u
+            })
             .collect();
         let mut contact_force: Vec<Vec<f64>> = u.iter().map(|u| vec![0.0; u.len()]).collect();
         let mut traction = Vec::with_capacity(pairs.len());
@@ -391,6 +450,7 @@ impl CoupledSystem {
             u,
             traction,
             contact_force,
+            rigid,
             relative_residual,
         }
     }
@@ -403,6 +463,9 @@ struct Placement {
     first_multiplier: usize,
     primary: usize,
     secondary: usize,
+    /// The first rigid unknown (multiplier) of the primary and of the secondary.
+    primary_rigid: usize,
+    secondary_rigid: usize,
 }
 
 /// The force a unit traction of one component at one active primary node puts on the bodies.
@@ -425,6 +488,8 @@ struct PairBlocks {
     c: Vec<(usize, usize, f64)>,
     /// [`CoupledSystem::d`].
     d: Vec<f64>,
+    /// [`CoupledSystem::d_coupled`].
+    d_coupled: Vec<(usize, usize, f64)>,
     /// [`CoupledSystem::g`].
     g: Vec<f64>,
 }
@@ -436,6 +501,7 @@ impl PairBlocks {
             unit_loads: Vec::new(),
             c: Vec::new(),
             d: vec![0.0; m],
+            d_coupled: Vec::new(),
             g: vec![0.0; m],
         }
     }
@@ -445,7 +511,12 @@ impl PairBlocks {
     /// `-M_a lambda` on the primary and `+M_b R_ba lambda` on the secondary, one unit force
     /// per active node and component combined per multiplier; the constraint `u_a - R_ab u_b =
     /// d` (tied) or its normal component (frictionless). Rows of prescribed dofs carry no
-    /// coupling; a dropped multiplier gets `D = t` and nothing else.
+    /// coupling; a dropped multiplier gets `D = t` and nothing else. At a dof of a
+    /// force-controlled group the displacement is the group's unknown `a`, so the constraint's
+    /// coefficient there and the force on it (which the group's reaction includes) go to the
+    /// entries of `D` between the multiplier and `a` (scaled by `t` and `s` as the row and
+    /// column they stand for).
+    #[allow(clippy::too_many_arguments)]
     fn add(
         &mut self,
         coupling: &Coupling,
@@ -453,6 +524,7 @@ impl PairBlocks {
         secondary: &AssembledBody,
         place: &Placement,
         dim: usize,
+        s: f64,
         t: f64,
     ) {
         let first = place.first_multiplier;
@@ -463,8 +535,10 @@ impl PairBlocks {
         for (col, _) in dropped.iter().enumerate().filter(|(_, dropped)| **dropped) {
             self.d[first + col] = t;
         }
-        let free1 = |dof: usize| !primary.constraints.is_fixed(dof);
-        let free2 = |dof: usize| !secondary.constraints.is_fixed(dof);
+        let sides = [
+            Side::new(primary, place.primary, place.primary_rigid),
+            Side::new(secondary, place.secondary, place.secondary_rigid),
+        ];
         for (k, &node) in coupling.primary_nodes.iter().enumerate() {
             for c in 0..dim {
                 let (col, weight) = coupling.multiplier_terms(k, c, dim);
@@ -475,16 +549,19 @@ impl PairBlocks {
                 // The column: the unit force of component c at the node, on both bodies.
                 let mut load = Vec::new();
                 let dof = dim * node + c;
-                if free1(dof) {
-                    load.push((place.primary + dof, -coupling.areas1[k]));
-                }
-                for &(node2, value) in &coupling.loads2[k] {
-                    let dof2 = dim * node2 + c;
-                    if free2(dof2) {
-                        load.push((place.secondary + dof2, value));
+                let forces = std::iter::once((0, dof, -coupling.areas1[k])).chain(
+                    (coupling.loads2[k].iter()).map(|&(node2, value)| (1, dim * node2 + c, value)),
+                );
+                for (side, dof, value) in forces {
+                    match sides[side].unknown(dof) {
+                        Unknown::Free(row) => load.push((row, value)),
+                        Unknown::Forced(a) => {
+                            self.d_coupled.push((a, multiplier, s * value * weight));
+                        }
+                        Unknown::Prescribed => {}
                     }
                 }
-                let key = MultiplierKey {
+                let key = MultiplierKey::Traction {
                     pair: place.pair,
                     node,
                     component: c,
@@ -497,13 +574,97 @@ impl PairBlocks {
                     load,
                 });
                 // The row: the gap of component c between the node and its secondary point.
-                self.c.push((multiplier, place.primary + dof, t * weight));
-                for &(node2, w) in &coupling.r12[k] {
-                    let column = place.secondary + dim * node2 + c;
-                    self.c.push((multiplier, column, -t * w * weight));
+                let reads = std::iter::once((0, dof, t * weight)).chain(
+                    (coupling.r12[k].iter())
+                        .map(|&(node2, w)| (1, dim * node2 + c, -t * w * weight)),
+                );
+                for (side, dof, value) in reads {
+                    match sides[side].unknown(dof) {
+                        Unknown::Forced(a) => self.d_coupled.push((multiplier, a, value)),
+                        // A prescribed dof's unknown holds its value (`K_c`'s row is its
+                        // diagonal).
+                        _ => self.c.push((multiplier, sides[side].offset + dof, value)),
+                    }
                 }
                 self.g[multiplier] += t * weight * coupling.gaps[k][c];
             }
+        }
+    }
+}
+
+/// What stands for a body dof in the coupled system.
+enum Unknown {
+    /// Its own unknown: this row of the system.
+    Free(usize),
+    /// A force-controlled group's displacement: this multiplier.
+    Forced(usize),
+    /// A Dirichlet value.
+    Prescribed,
+}
+
+/// One body of a pair as the pair's blocks see it.
+struct Side<'a> {
+    body: &'a AssembledBody,
+    /// Its first unknown.
+    offset: usize,
+    /// The rigid unknown of each of its force-controlled dofs.
+    forced: HashMap<usize, usize>,
+}
+
+impl<'a> Side<'a> {
+    /// `body`, its unknowns from `offset`, its rigid unknowns from multiplier `first_rigid`.
+    fn new(body: &'a AssembledBody, offset: usize, first_rigid: usize) -> Self {
+        let forced = (body.rigid.iter().enumerate())
+            .flat_map(|(r, rigid)| rigid.dofs.iter().map(move |&dof| (dof, first_rigid + r)))
+            .collect();
+        Self {
+            body,
+            offset,
+            forced,
+        }
+    }
+
+    fn unknown(&self, dof: usize) -> Unknown {
+        if !self.body.constraints.is_fixed(dof) {
+            Unknown::Free(self.offset + dof)
+        } else if let Some(&a) = self.forced.get(&dof) {
+            Unknown::Forced(a)
+        } else {
+            Unknown::Prescribed
+        }
+    }
+}
+
+impl PairBlocks {
+    /// The blocks of `body`'s force-controlled components (the module doc), body `k` of the
+    /// system, its unknowns from `offset`, its rigid unknowns from multiplier `first`; `s` is
+    /// the multipliers' scaling (which the weight `1 / s` cancels) and `load_factor` scales
+    /// the force.
+    fn add_rigid(
+        &mut self,
+        k: usize,
+        body: &AssembledBody,
+        first: usize,
+        offset: usize,
+        s: f64,
+        load_factor: f64,
+    ) {
+        for (r, rigid) in body.rigid.iter().enumerate() {
+            let multiplier = first + r;
+            let key = MultiplierKey::Rigid { body: k, index: r };
+            self.columns[multiplier].push((key, 1.0 / s));
+            let load: Vec<(usize, f64)> =
+                (rigid.column.iter()).map(|&(dof, v)| (offset + dof, v)).collect();
+            self.c.extend(load.iter().map(|&(row, v)| (multiplier, row, v)));
+            self.unit_loads.push(UnitLoad {
+                key,
+                multiplier,
+                weight: 1.0 / s,
+                load,
+            });
+            self.d[multiplier] = rigid.diagonal;
+            (self.d_coupled).extend(rigid.coupled.iter().map(|&(b, v)| (multiplier, first + b, v)));
+            self.g[multiplier] = load_factor * (rigid.force + rigid.applied);
         }
     }
 }

@@ -4,6 +4,11 @@ mod problem;
 mod solution;
 mod solve;
 
-pub use problem::{DirichletCondition, ElasticProblem, LoadCondition, ProblemError};
+pub use problem::{
+    DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, ProblemError,
+};
 pub use solution::{ElasticSolution, SolveStats};
-pub use solve::{AssembledBody, SolveError, SolverSettings, assemble, reactions, solve};
+pub use solve::{
+    AssembledBody, RigidColumn, SolveError, SolverSettings, assemble, reactions, rigid_stiffness,
+    solve, unheld_components,
+};

@@ -13,6 +13,16 @@ pub struct DirichletCondition {
     pub components: [Option<f64>; 3],
 }
 
+/// A prescribed total force on a group, along some components (`None` = not force-controlled).
+/// Along each given component the group's nodes move together, by one displacement that is an
+/// unknown of the solve (a rigid loading plate), and the force the group passes to the body is
+/// the given one: the group's reaction `sum (K u - f)` over its dofs of that component.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceCondition {
+    pub group: String,
+    pub components: [Option<f64>; 3],
+}
+
 /// A surface load on a boundary group.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadCondition {
@@ -27,6 +37,8 @@ pub struct ElasticProblem<'m> {
     pub body: &'m BodyMesh,
     pub material: Material,
     pub dirichlet: Vec<DirichletCondition>,
+    /// Force-controlled groups ([`ElasticProblem::with_forces`]; none by default).
+    pub forces: Vec<ForceCondition>,
     pub loads: Vec<LoadCondition>,
     pub body_force: Option<[f64; 3]>,
 }
@@ -66,6 +78,24 @@ pub enum ProblemError {
         "body '{body}': the Dirichlet conditions leave {count} rigid-body motion(s) free, so its stiffness is singular; constrain more components or groups"
     )]
     FreeRigidModes { body: String, count: usize },
+    #[error(
+        "body '{body}': node {node_tag} component {component} is force-controlled by group \
+         '{group}' and also {other}; a component of a node is either prescribed or \
+         force-controlled, by one group"
+    )]
+    ForcedTwice {
+        body: String,
+        group: String,
+        node_tag: u64,
+        component: usize,
+        other: String,
+    },
+    #[error(
+        "force on group '{group}' of body '{body}' gives no component (give fx, fy or fz)"
+    )]
+    NoForceComponent { body: String, group: String },
+    #[error("force on group '{group}' of body '{body}' gives fz, but the mesh is 2D")]
+    ForceComponentOutOfRange { body: String, group: String },
     #[error("body '{body}': {what} is not finite")]
     NotFinite { body: String, what: String },
 }
@@ -78,10 +108,26 @@ impl<'m> ElasticProblem<'m> {
         loads: Vec<LoadCondition>,
         body_force: Option<[f64; 3]>,
     ) -> Result<Self, ProblemError> {
+        Self::with_forces(body, material, dirichlet, Vec::new(), loads, body_force)
+    }
+
+    /// [`Self::new`] with force-controlled groups `forces`. Their components count as held in
+    /// the rigid-mode check: each moves by an unknown of its own, which the solve finds from
+    /// the force (a single body must then be held along it by something else too; a body in
+    /// contact may be held by its contacts).
+    pub fn with_forces(
+        body: &'m BodyMesh,
+        material: Material,
+        dirichlet: Vec<DirichletCondition>,
+        forces: Vec<ForceCondition>,
+        loads: Vec<LoadCondition>,
+        body_force: Option<[f64; 3]>,
+    ) -> Result<Self, ProblemError> {
         let problem = Self {
             body,
             material,
             dirichlet,
+            forces,
             loads,
             body_force,
         };
@@ -107,6 +153,29 @@ impl<'m> ElasticProblem<'m> {
                 return Err(unknown(&l.group));
             }
         }
+        for f in &self.forces {
+            if self.body.group_nodes(&f.group).is_none() {
+                return Err(unknown(&f.group));
+            }
+            if f.components.iter().all(Option::is_none) {
+                return Err(ProblemError::NoForceComponent {
+                    body: name(),
+                    group: f.group.clone(),
+                });
+            }
+            if self.body.dim == 2 && f.components[2].is_some() {
+                return Err(ProblemError::ForceComponentOutOfRange {
+                    body: name(),
+                    group: f.group.clone(),
+                });
+            }
+            if f.components.iter().flatten().any(|v| !v.is_finite()) {
+                return Err(ProblemError::NotFinite {
+                    body: name(),
+                    what: format!("the force on '{}'", f.group),
+                });
+            }
+        }
         for d in &self.dirichlet {
             if d.components.iter().all(Option::is_none) {
                 return Err(ProblemError::NoComponent {
@@ -127,7 +196,7 @@ impl<'m> ElasticProblem<'m> {
                 });
             }
         }
-        if self.dirichlet.is_empty() {
+        if self.dirichlet.is_empty() && self.forces.is_empty() {
             return Err(ProblemError::NoDirichlet { body: name() });
         }
         let constraints = super::solve::constraints(self)?;

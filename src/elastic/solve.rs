@@ -1,5 +1,6 @@
 //! One body, `K u = f`, solved by sparse Cholesky or by CG + AMG (`crate::linalg::BodySolver`).
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -98,6 +99,16 @@ pub enum SolveError {
         residual: f64,
         tolerance: f64,
     },
+    #[error(
+        "body '{body}' is held along {component} by nothing but the force-controlled group \
+         '{group}': alone, nothing balances that force; prescribe a displacement along \
+         {component} somewhere, or put the body in contact"
+    )]
+    Unheld {
+        body: String,
+        group: String,
+        component: &'static str,
+    },
 }
 
 /// The prescribed dofs and values of a problem; conflicting values on shared nodes are errors.
@@ -126,7 +137,62 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
             }
         }
     }
+    // A force-controlled dof is held at 0 in `K_c`: its displacement is the group's unknown,
+    // which enters through its column (`RigidColumn`).
+    let mut forced_by: HashMap<usize, String> = HashMap::new();
+    for forced in forced_components(problem) {
+        for &dof in &forced.dofs {
+            if let Some(value) = constraints.value(dof) {
+                let other = match forced_by.get(&dof) {
+                    Some(group) => format!("by group '{group}'"),
+                    None => format!("prescribed {value} by a Dirichlet condition"),
+                };
+                return Err(ProblemError::ForcedTwice {
+                    body: body.name.clone(),
+                    group: forced.group.clone(),
+                    node_tag: body.node_tags[dof / dim],
+                    component: forced.component,
+                    other,
+                });
+            }
+            constraints
+                .prescribe(dof, 0.0)
+                .expect("the dof was free: checked above");
+            forced_by.insert(dof, forced.group.clone());
+        }
+    }
     Ok(constraints)
+}
+
+/// One force-controlled component of a group: its dofs (one per node of the group) and force.
+pub(crate) struct ForcedComponent {
+    pub group: String,
+    pub component: usize,
+    pub force: f64,
+    pub dofs: Vec<usize>,
+}
+
+/// The force-controlled components of `problem`, group after group, component after component.
+pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent> {
+    let body = problem.body;
+    let dim = body.dim;
+    let mut out = Vec::new();
+    for condition in &problem.forces {
+        let nodes = body
+            .group_nodes(&condition.group)
+            .expect("groups are checked first");
+        for (component, force) in condition.components.iter().enumerate().take(dim) {
+            if let Some(force) = *force {
+                out.push(ForcedComponent {
+                    group: condition.group.clone(),
+                    component,
+                    force,
+                    dofs: nodes.iter().map(|&node| dim * node + component).collect(),
+                });
+            }
+        }
+    }
+    out
 }
 
 /// Runs `f`, records its duration under `name`, and reports it when verbose.
@@ -164,6 +230,90 @@ pub struct AssembledBody {
     pub constraints: Constraints,
     pub k_c: SparseColMat<usize, f64>,
     pub f_c: Vec<f64>,
+    /// The force-controlled components of the body, in the order of
+    /// [`forced_components`]: their dofs are held at 0 in `k_c` and move by unknowns of the
+    /// contact solve.
+    pub rigid: Vec<RigidColumn>,
+}
+
+/// A force-controlled component of a group (`super::ForceCondition`) in the constrained
+/// system. Its dofs `G` move together by one unknown `a` and are held at 0 in `K_c`; with `e`
+/// the indicator of `G` and `s` the load factor (loads, prescribed values and forces scale
+/// alike), the body's equations are
+///
+/// ```text
+/// K_c u + k a               = s f_c(1)       k = K_FG e (free rows F)
+/// k^T u + d a + sum_b c_b b = s (force + applied)
+/// ```
+///
+/// with `d = e^T K_GG e`, `c_b = e^T K_GH e_H` for the body's other force-controlled components
+/// `b` (dofs `H`), and `applied = e^T f_G - e^T K_GD g_D` (the loads on `G` and the pull of the
+/// prescribed dofs `D`). The second equation is the group's reaction `e^T (K u - f)_G` set to
+/// the force. `K` is symmetric, so `k` is both the column of `a` and its row.
+#[derive(Debug, Clone)]
+pub struct RigidColumn {
+    pub group: String,
+    pub component: usize,
+    pub force: f64,
+    pub dofs: Vec<usize>,
+    /// `k`: `(free dof, value)`, by dof.
+    pub column: Vec<(usize, f64)>,
+    pub diagonal: f64,
+    /// `(b, c_b)`: the couplings to the body's other force-controlled components.
+    pub coupled: Vec<(usize, f64)>,
+    pub applied: f64,
+}
+
+/// The [`RigidColumn`]s of `forced`, read from the rows of the unconstrained `K` at the
+/// prescribed dofs and from `f`.
+fn rigid_columns(
+    forced: Vec<ForcedComponent>,
+    prescribed_rows: &[(usize, Vec<(usize, f64)>)],
+    constraints: &Constraints,
+    f: &[f64],
+) -> Vec<RigidColumn> {
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for (r, component) in forced.iter().enumerate() {
+        owner.extend(component.dofs.iter().map(|&dof| (dof, r)));
+    }
+    let row = |dof: usize| {
+        let at = prescribed_rows
+            .binary_search_by_key(&dof, |(d, _)| *d)
+            .expect("a forced dof is prescribed");
+        &prescribed_rows[at].1
+    };
+    (forced.into_iter().enumerate())
+        .map(|(r, component)| {
+            let mut column: HashMap<usize, f64> = HashMap::new();
+            let mut coupled: HashMap<usize, f64> = HashMap::new();
+            let (mut diagonal, mut applied) = (0.0, 0.0);
+            for &d in &component.dofs {
+                applied += f[d];
+                for &(j, value) in row(d) {
+                    match (constraints.value(j), owner.get(&j)) {
+                        (None, _) => *column.entry(j).or_default() += value,
+                        (Some(_), Some(&b)) if b == r => diagonal += value,
+                        (Some(_), Some(&b)) => *coupled.entry(b).or_default() += value,
+                        (Some(g), None) => applied -= value * g,
+                    }
+                }
+            }
+            let mut column: Vec<(usize, f64)> = column.into_iter().collect();
+            column.sort_unstable_by_key(|e| e.0);
+            let mut coupled: Vec<(usize, f64)> = coupled.into_iter().collect();
+            coupled.sort_unstable_by_key(|e| e.0);
+            RigidColumn {
+                group: component.group,
+                component: component.component,
+                force: component.force,
+                dofs: component.dofs,
+                column,
+                diagonal,
+                coupled,
+                applied,
+            }
+        })
+        .collect()
 }
 
 /// Assembles `K`, `f` and applies the Dirichlet conditions, timing each phase into `stats`.
@@ -206,7 +356,7 @@ pub fn assemble(
     //    symmetric: the row of a dof is its column).
     let constraints = constraints(problem)?;
     stats.num_prescribed_dofs = constraints.num_fixed();
-    let prescribed_rows = {
+    let prescribed_rows: Vec<(usize, Vec<(usize, f64)>)> = {
         let (symbolic, values) = k.parts();
         let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
         (0..symbolic.ncols())
@@ -220,6 +370,12 @@ pub fn assemble(
     let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
         constraints.apply(k, &f)
     });
+    let rigid = rigid_columns(
+        forced_components(problem),
+        &prescribed_rows,
+        &constraints,
+        &f,
+    );
     let dim = body.dim;
     Ok(AssembledBody {
         dim,
@@ -230,11 +386,14 @@ pub fn assemble(
         constraints,
         k_c,
         f_c,
+        rigid,
     })
 }
 
-/// Reaction of each Dirichlet group: `sum (K u - s f - f_other)` over its prescribed dofs, with
-/// `s` the load factor and `f_other` forces not in `f` (contact forces; empty for a single body).
+/// Reaction of each Dirichlet and force-controlled group: `sum (K u - s f - f_other)` over its
+/// prescribed and force-controlled dofs, with `s` the load factor and `f_other` forces not in
+/// `f` (contact forces; empty for a single body). A group named by both kinds of condition has
+/// one entry.
 pub fn reactions(
     problem: &ElasticProblem,
     system: &AssembledBody,
@@ -248,24 +407,98 @@ pub fn reactions(
     for (dof, row) in &system.prescribed_rows {
         r[*dof] = row.iter().map(|&(j, value)| value * u[j]).sum();
     }
-    problem
-        .dirichlet
-        .iter()
-        .map(|condition| {
-            let nodes = body
-                .group_nodes(&condition.group)
-                .expect("groups are checked first");
+    let mut groups: Vec<(&String, [bool; 3])> = Vec::new();
+    let conditions = (problem.dirichlet.iter().map(|d| (&d.group, d.components)))
+        .chain(problem.forces.iter().map(|f| (&f.group, f.components)));
+    for (group, components) in conditions {
+        let held = components.map(|c| c.is_some());
+        match groups.iter_mut().find(|(g, _)| *g == group) {
+            Some((_, mask)) => (0..3).for_each(|c| mask[c] |= held[c]),
+            None => groups.push((group, held)),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(group, mask)| {
+            let nodes = body.group_nodes(group).expect("groups are checked first");
             let mut total = vec![0.0; dim];
             for node in nodes {
-                for c in (0..dim).filter(|&c| condition.components[c].is_some()) {
+                for c in (0..dim).filter(|&c| mask[c]) {
                     let d = dim * node + c;
                     total[c] +=
                         r[d] - load_factor * system.f[d] - f_other.get(d).copied().unwrap_or(0.0);
                 }
             }
-            (condition.group.clone(), total)
+            (group.clone(), total)
         })
         .collect()
+}
+
+/// A force-controlled component whose body offers less stiffness than this fraction of the
+/// group's own (`S_ii` of [`rigid_stiffness`] against `d_i`) is held by nothing but the group:
+/// the body is free to move along it. Round-off leaves `S_ii` at about `1e-16 d_i cond(K_c)`
+/// where the body is free (at most `1e-10 d_i` for the conditionings seen), and a body held
+/// by anything is many orders above it.
+const UNHELD_STIFFNESS: f64 = 1e-8;
+
+/// The body's own stiffness along its force-controlled components, `S = D_aa - k^T W` (the
+/// Schur complement of `K_c` in the bordered matrix of `RigidColumn`), given `W = K_c^-1 [k_1
+/// .. k_r]` (the columns one after another).
+pub fn rigid_stiffness(system: &AssembledBody, w: &[f64]) -> nalgebra::DMatrix<f64> {
+    let r = system.rigid.len();
+    let n = system.f_c.len();
+    let mut s = nalgebra::DMatrix::<f64>::zeros(r, r);
+    for (i, rigid) in system.rigid.iter().enumerate() {
+        s[(i, i)] += rigid.diagonal;
+        for &(j, c) in &rigid.coupled {
+            s[(i, j)] += c;
+        }
+        for j in 0..r {
+            let w = &w[j * n..(j + 1) * n];
+            s[(i, j)] -= rigid.column.iter().map(|&(dof, k)| k * w[dof]).sum::<f64>();
+        }
+    }
+    s
+}
+
+/// The force-controlled components (indices into `system.rigid`) that nothing but their group
+/// holds, given their [`rigid_stiffness`] `s`.
+pub fn unheld_components(system: &AssembledBody, s: &nalgebra::DMatrix<f64>) -> Vec<usize> {
+    (system.rigid.iter().enumerate())
+        .filter(|(i, rigid)| !(s[(*i, *i)] > UNHELD_STIFFNESS * rigid.diagonal))
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// The displacements `a` of a single body's force-controlled components (step 5 of
+/// [`solve`]): `u0` is `K_c^-1 f_c`, `w` the columns `K_c^-1 k_j` one after another.
+fn rigid_displacements(
+    problem: &ElasticProblem,
+    system: &AssembledBody,
+    u0: &[f64],
+    w: &[f64],
+) -> Result<Vec<f64>, SolveError> {
+    let s = rigid_stiffness(system, w);
+    let unheld = |i: usize| {
+        let rigid = &system.rigid[i];
+        SolveError::Unheld {
+            body: problem.body.name.clone(),
+            group: rigid.group.clone(),
+            component: ["x", "y", "z"][rigid.component],
+        }
+    };
+    if let Some(&i) = unheld_components(system, &s).first() {
+        return Err(unheld(i));
+    }
+    let b = nalgebra::DVector::from_iterator(
+        system.rigid.len(),
+        (system.rigid.iter()).map(|rigid| {
+            let pull = rigid.column.iter().map(|&(dof, k)| k * u0[dof]).sum::<f64>();
+            rigid.force + rigid.applied - pull
+        }),
+    );
+    let a = s.lu().solve(&b).ok_or_else(|| unheld(0))?;
+    Ok(a.iter().copied().collect())
 }
 
 /// Solves the elastic problem of one body.
@@ -311,14 +544,23 @@ pub fn solve(
     };
     stats.body_solver = Some(solver.kind());
 
-    // 5. Solve and check the residual of the constrained system.
-    let mut u = f_c.clone();
+    // 5. Solve and check the residual of the constrained system. Force-controlled components
+    //    (`RigidColumn`) border it: with `W = K_c^-1 [k_1 .. k_r]` and `u0 = K_c^-1 f_c`, their
+    //    displacements solve `(D_aa - k^T W) a = (force + applied) - k^T u0`, and `u = u0 - W a`.
+    let r = system.rigid.len();
+    let n = f_c.len();
+    let mut columns = f_c.clone();
+    for rigid in &system.rigid {
+        let mut k = vec![0.0; n];
+        rigid.column.iter().for_each(|&(dof, v)| k[dof] = v);
+        columns.extend(k);
+    }
     let phase = match solver.kind() {
         BodySolverKind::CgAmg => "CG + AMG solve",
         _ => "triangular solves",
     };
     let iterations = timed(&mut stats, verbose, phase, || {
-        solver.solve_in_place(&mut u, 1)
+        solver.solve_in_place(&mut columns, 1 + r)
     })
     .map_err(linalg)?;
     if solver.kind() == BodySolverKind::CgAmg {
@@ -327,13 +569,26 @@ pub fn solve(
     // The factor or multigrid hierarchy can be the largest object of the run: freed before
     // the cell fields.
     drop(solver);
-    stats.relative_residual = relative_residual(k_c, &u, f_c);
+    let (mut u, w) = (columns[..n].to_vec(), &columns[n..]);
+    let a = match r {
+        0 => Vec::new(),
+        _ => rigid_displacements(problem, &system, &u, w)?,
+    };
+    let mut rhs = f_c.clone();
+    for (j, (rigid, a)) in system.rigid.iter().zip(&a).enumerate() {
+        u.iter_mut().zip(&w[j * n..]).for_each(|(u, w)| *u -= w * a);
+        rigid.column.iter().for_each(|&(dof, v)| rhs[dof] -= v * a);
+    }
+    stats.relative_residual = relative_residual(k_c, &u, &rhs);
     if stats.relative_residual.is_nan() || stats.relative_residual > settings.residual_tolerance {
         return Err(SolveError::Inaccurate {
             body: body.name.clone(),
             residual: stats.relative_residual,
             tolerance: settings.residual_tolerance,
         });
+    }
+    for (rigid, a) in system.rigid.iter().zip(&a) {
+        rigid.dofs.iter().for_each(|&dof| u[dof] = *a);
     }
 
     // 6. Reactions and cell fields.

@@ -46,7 +46,8 @@ pub const PLOT_SIZE: (u32, u32) = (1200, 540);
 /// (half-width in 2D) of each step's Hertz fit. `approach` is the imposed approach at load
 /// factor 1 (the largest difference between the two bodies' prescribed displacements); where
 /// no displacement is imposed (0: the bodies are loaded by forces) the x axis is the load
-/// factor.
+/// factor. In a force-controlled run (`[[body.force]]`) the x axis is the displacement the
+/// first force-controlled group moved by, an output of each step.
 pub fn write_force_displacement_png(
     path: &Path,
     title: &str,
@@ -63,13 +64,24 @@ pub fn write_force_displacement_png(
     } else {
         (1.0, "load factor (no displacement imposed)".to_string())
     };
+    let forced = steps.first().and_then(|s| s.forced.first());
+    let (x, x_desc): (Box<dyn Fn(&StepRecord) -> f64>, String) = match forced {
+        Some(f) => (
+            Box::new(|s: &StepRecord| s.forced[0].displacement.abs()),
+            format!(
+                "displacement |u{}| of '{}' on '{}' (force-controlled)",
+                f.component, f.group, f.body
+            ),
+        ),
+        None => (Box::new(move |s: &StepRecord| scale * s.load_factor), x_desc),
+    };
     let norm = |f: &[f64]| f.iter().map(|c| c * c).sum::<f64>().sqrt();
     // Only solved points: a line from the origin to a single step would read as a linear law.
     let force: Vec<(f64, f64)> = (steps.iter())
-        .map(|s| (scale * s.load_factor, norm(&s.force_primary)))
+        .map(|s| (x(s), norm(&s.force_primary)))
         .collect();
     let radius: Vec<(f64, f64)> = (steps.iter())
-        .filter_map(|s| s.hertz_a.map(|a| (scale * s.load_factor, a)))
+        .filter_map(|s| s.hertz_a.map(|a| (x(s), a)))
         .collect();
 
     let root = BitMapBackend::new(path, PLOT_SIZE).into_drawing_area();

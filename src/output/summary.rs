@@ -233,7 +233,16 @@ pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
     for axis in &axes[..dim] {
         text += &format!(",contact_force_{axis}");
     }
-    text += ",force_imbalance,hertz_a,hertz_p0,seconds,failed_checks\n";
+    text += ",force_imbalance,hertz_a,hertz_p0";
+    for forced in steps.first().map_or(&[][..], |s| &s.forced[..]) {
+        text += &format!(
+            ",{body}.{group}.f{c},{body}.{group}.u{c}",
+            body = forced.body,
+            group = forced.group,
+            c = forced.component
+        );
+    }
+    text += ",seconds,failed_checks\n";
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
     for s in steps {
         text += &format!(
@@ -247,10 +256,16 @@ pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
             text += &format!(",{f:.10e}");
         }
         text += &format!(
-            ",{:.3e},{},{},{:.3},{}\n",
+            ",{:.3e},{},{}",
             s.force_imbalance,
             optional(s.hertz_a),
             optional(s.hertz_p0),
+        );
+        for forced in &s.forced {
+            text += &format!(",{:.10e},{:.10e}", forced.force, forced.displacement);
+        }
+        text += &format!(
+            ",{:.3},{}\n",
             s.seconds,
             (s.failed_checks.iter().map(|c| c.name()))
                 .collect::<Vec<_>>()

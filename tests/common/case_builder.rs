@@ -63,8 +63,40 @@ pub struct Body {
     pub body_force: Option<Vec<f64>>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dirichlet: Vec<Dirichlet>,
+    #[serde(rename = "force", skip_serializing_if = "Vec::is_empty")]
+    pub forces: Vec<Force>,
     #[serde(rename = "load", skip_serializing_if = "Vec::is_empty")]
     pub loads: Vec<Load>,
+}
+
+/// A `[[body.force]]` table: the total force on `group` along the given components, along
+/// which the group moves rigidly.
+#[derive(Debug, Clone, Serialize)]
+pub struct Force {
+    pub group: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fx: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fy: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fz: Option<f64>,
+}
+
+impl Force {
+    /// The force `value` along the vertical axis of a `dim`-dimensional mesh (y in 2D, z in 3D).
+    pub fn vertical(group: &str, dim: usize, value: f64) -> Self {
+        let mut force = Self {
+            group: group.to_string(),
+            fx: None,
+            fy: None,
+            fz: None,
+        };
+        match dim {
+            2 => force.fy = Some(value),
+            _ => force.fz = Some(value),
+        }
+        force
+    }
 }
 
 /// A `[[body.dirichlet]]` table: the prescribed components on `group`, the others free.
@@ -261,6 +293,7 @@ impl Body {
             poisson_ratio,
             body_force: None,
             dirichlet: Vec::new(),
+            forces: Vec::new(),
             loads: Vec::new(),
         }
     }
@@ -272,6 +305,11 @@ impl Body {
 
     pub fn load(mut self, load: Load) -> Self {
         self.loads.push(load);
+        self
+    }
+
+    pub fn force(mut self, force: Force) -> Self {
+        self.forces.push(force);
         self
     }
 
