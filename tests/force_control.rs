@@ -135,7 +135,10 @@ fn a_force_gives_back_the_displacement_that_gave_it_3d() {
 fn load_steps_ramp_the_force() {
     let one_step = solve(&half_disc_pressed_by(-5.0)).unwrap();
     let stepped = solve(&half_disc_pressed_by(-5.0).load_steps(&[0.5, 1.0])).unwrap();
-    let (a, b) = (one_step.forced[0].displacement, stepped.forced[0].displacement);
+    let (a, b) = (
+        one_step.forced[0].displacement,
+        stepped.forced[0].displacement,
+    );
     assert!((a - b).abs() <= SETTLED, "one step {a}, two steps {b}");
     assert_eq!(stepped.forced[0].force, -5.0);
     assert_eq!(stepped.active_set.nodes, one_step.active_set.nodes);
@@ -145,7 +148,7 @@ fn load_steps_ramp_the_force() {
 /// down by `top` (a displacement or a force), solved alone.
 fn block_pushed(top: impl FnOnce(Body) -> Body) -> CaseFile {
     CaseFile::on_fixture("block_2d.msh").body(top(
-        Body::new("block", 1000.0, 0.3).dirichlet(Dirichlet::clamped("block_base", 2)),
+        Body::new("block", 1000.0, 0.3).dirichlet(Dirichlet::clamped("block_base", 2))
     ))
 }
 
@@ -232,11 +235,16 @@ fn a_force_that_pulls_the_body_off_its_contact_is_an_error() {
 
 #[test]
 fn a_component_both_prescribed_and_force_controlled_is_refused() {
-    let case = half_disc_on_block("half_disc_on_block.msh")
-        .with_body("disc", |body| body.force(Force::vertical("disc_top", 2, -1.0)));
+    let case = half_disc_on_block("half_disc_on_block.msh").with_body("disc", |body| {
+        body.force(Force::vertical("disc_top", 2, -1.0))
+    });
     assert_refused(
         &case,
-        &["body 'disc'", "force-controlled by group 'disc_top'", "Dirichlet"],
+        &[
+            "body 'disc'",
+            "force-controlled by group 'disc_top'",
+            "Dirichlet",
+        ],
     );
 }
 
@@ -254,17 +262,29 @@ fn malformed_forces_are_refused() {
         fy: None,
         fz: None,
     };
-    assert_refused(&with_force(force("disc_top")), &["'disc_top'", "no component"]);
     assert_refused(
-        &with_force(Force { fz: Some(-1.0), ..force("disc_top") }),
+        &with_force(force("disc_top")),
+        &["'disc_top'", "no component"],
+    );
+    assert_refused(
+        &with_force(Force {
+            fz: Some(-1.0),
+            ..force("disc_top")
+        }),
         &["'disc_top'", "fz", "2D"],
     );
     assert_refused(
-        &with_force(Force { fy: Some(-1.0), ..force("no_such_group") }),
+        &with_force(Force {
+            fy: Some(-1.0),
+            ..force("no_such_group")
+        }),
         &["'no_such_group'"],
     );
     assert_refused(
-        &with_force(Force { fy: Some(f64::INFINITY), ..force("disc_top") }),
+        &with_force(Force {
+            fy: Some(f64::INFINITY),
+            ..force("disc_top")
+        }),
         &["'disc_top'", "fy"],
     );
 }

@@ -541,11 +541,12 @@ impl Case {
                 components: [f.fx, f.fy, f.fz],
             })
             .collect();
-        ElasticProblem::with_forces(body, material, dirichlet, forces, loads, body_force)
-            .map_err(|source| CaseError::Problem {
+        ElasticProblem::with_forces(body, material, dirichlet, forces, loads, body_force).map_err(
+            |source| CaseError::Problem {
                 path: self.path.clone(),
                 source,
-            })
+            },
+        )
     }
 
     /// The body's material, its Young's modulus also within the range [`MAX_MAGNITUDE`] allows.

@@ -43,8 +43,8 @@ use std::collections::HashMap;
 use faer::Mat;
 use faer::prelude::*;
 
-use super::compliance::MultiplierKey;
 use super::ContactSurface;
+use super::compliance::MultiplierKey;
 use super::system::{CoupledSystem, Coupling};
 use crate::fem::Material;
 
@@ -268,8 +268,16 @@ pub fn force_controlled_set(
 ) -> Vec<usize> {
     let no_pressure = vec![0.0; surface.len()];
     let first_touch = gaps.iter().copied().fold(f64::INFINITY, f64::min);
-    let spacing = surface.spacing.iter().copied().fold(f64::INFINITY, f64::min);
-    if !(force > 0.0) || !first_touch.is_finite() || !(spacing > 0.0) {
+    let spacing = surface
+        .spacing
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    // NaN-safe: a force or spacing that is not a positive number predicts nothing.
+    if force.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        || !first_touch.is_finite()
+        || spacing.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    {
         return Vec::new();
     }
     // The model's pressures at the approach `delta`: only candidates that overlap can carry
@@ -295,7 +303,11 @@ pub fn force_controlled_set(
     // Regula falsi keeping the bracket [low, high]; `high` carries at least the force, and
     // is the answer (the prediction errs on the large side, as `PREDICTION_MARGIN` says).
     let mut side = 0;
-    let steps = if f_high <= FORCE_TOLERANCE * force { 0 } else { FORCE_STEPS };
+    let steps = if f_high <= FORCE_TOLERANCE * force {
+        0
+    } else {
+        FORCE_STEPS
+    };
     for _ in 0..steps {
         let delta = (low * f_high - high * f_low) / (f_high - f_low);
         let f = solve(delta).3 - force;

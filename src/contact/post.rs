@@ -66,19 +66,29 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
     let hertz_primary = hertz::fit(s1, &primary_fields);
     let max_tangential_traction = max_tangential(&solution.traction[0], &coupling.normals);
     let residual = solution.relative_residual;
-    let forced = (problem.primary.body.name.as_str(), body1, &solution.rigid[0]);
-    let forced = [forced, (&problem.secondary.body.name, body2, &solution.rigid[1])]
-        .into_iter()
-        .flat_map(|(name, body, a)| {
-            body.rigid.iter().zip(a).map(move |(rigid, &a)| ForcedDisplacement {
+    let forced = (
+        problem.primary.body.name.as_str(),
+        body1,
+        &solution.rigid[0],
+    );
+    let forced = [
+        forced,
+        (&problem.secondary.body.name, body2, &solution.rigid[1]),
+    ]
+    .into_iter()
+    .flat_map(|(name, body, a)| {
+        body.rigid
+            .iter()
+            .zip(a)
+            .map(move |(rigid, &a)| ForcedDisplacement {
                 body: name.to_string(),
                 group: rigid.group.clone(),
                 component: ["x", "y", "z"][rigid.component],
                 force: load_factor * rigid.force,
                 displacement: a,
             })
-        })
-        .collect();
+    })
+    .collect();
     let Ok([u1, u2]) = <[Vec<f64>; 2]>::try_from(solution.u) else {
         unreachable!("a pair has two bodies")
     };

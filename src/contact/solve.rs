@@ -188,12 +188,15 @@ impl<'a> ContactSolver<'a> {
             }
         };
         let operators = pair(problem, [0.0; 3])?;
-        let held_by_contact =
-            coupled_solver::held_by_contacts_only(&[&body1, &body2], factors.as_ref(), solver.ordering)?
-                .into_iter()
-                .enumerate()
-                .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
-                .collect::<Vec<_>>();
+        let held_by_contact = coupled_solver::held_by_contacts_only(
+            &[&body1, &body2],
+            factors.as_ref(),
+            solver.ordering,
+        )?
+        .into_iter()
+        .enumerate()
+        .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
+        .collect::<Vec<_>>();
         if held_by_contact.iter().any(|h| h.0 == 0) && held_by_contact.iter().any(|h| h.0 == 1) {
             return Err(ContactError::NothingHolds {
                 first: problem.primary.body.name.clone(),

@@ -350,9 +350,7 @@ impl CoupledSystem {
                 .filter(|(_, v)| **v != 0.0)
                 .map(|(k, &v)| Triplet::new(n + k, n + k, v)),
         );
-        triplets.extend(
-            (self.d_coupled.iter()).map(|&(k, l, v)| Triplet::new(n + k, n + l, v)),
-        );
+        triplets.extend((self.d_coupled.iter()).map(|&(k, l, v)| Triplet::new(n + k, n + l, v)));
         SparseColMat::<usize, f64>::try_new_from_triplets(n + self.m, n + self.m, &triplets)
             .map_err(|e| ContactError::Linalg(format!("assembling the coupled system: {e:?}")))
     }
@@ -653,9 +651,11 @@ impl PairBlocks {
             let multiplier = first + r;
             let key = MultiplierKey::Rigid { body: k, index: r };
             self.columns[multiplier].push((key, 1.0 / s));
-            let load: Vec<(usize, f64)> =
-                (rigid.column.iter()).map(|&(dof, v)| (offset + dof, v)).collect();
-            self.c.extend(load.iter().map(|&(row, v)| (multiplier, row, v)));
+            let load: Vec<(usize, f64)> = (rigid.column.iter())
+                .map(|&(dof, v)| (offset + dof, v))
+                .collect();
+            self.c
+                .extend(load.iter().map(|&(row, v)| (multiplier, row, v)));
             self.unit_loads.push(UnitLoad {
                 key,
                 multiplier,
@@ -663,7 +663,12 @@ impl PairBlocks {
                 load,
             });
             self.d[multiplier] = rigid.diagonal;
-            (self.d_coupled).extend(rigid.coupled.iter().map(|&(b, v)| (multiplier, first + b, v)));
+            (self.d_coupled).extend(
+                rigid
+                    .coupled
+                    .iter()
+                    .map(|&(b, v)| (multiplier, first + b, v)),
+            );
             self.g[multiplier] = load_factor * (rigid.force + rigid.applied);
         }
     }

@@ -90,9 +90,7 @@ pub enum ProblemError {
         component: usize,
         other: String,
     },
-    #[error(
-        "force on group '{group}' of body '{body}' gives no component (give fx, fy or fz)"
-    )]
+    #[error("force on group '{group}' of body '{body}' gives no component (give fx, fy or fz)")]
     NoForceComponent { body: String, group: String },
     #[error("force on group '{group}' of body '{body}' gives fz, but the mesh is 2D")]
     ForceComponentOutOfRange { body: String, group: String },

@@ -465,7 +465,11 @@ pub fn rigid_stiffness(system: &AssembledBody, w: &[f64]) -> nalgebra::DMatrix<f
 /// holds, given their [`rigid_stiffness`] `s`.
 pub fn unheld_components(system: &AssembledBody, s: &nalgebra::DMatrix<f64>) -> Vec<usize> {
     (system.rigid.iter().enumerate())
-        .filter(|(i, rigid)| !(s[(*i, *i)] > UNHELD_STIFFNESS * rigid.diagonal))
+        // NaN-safe: a stiffness that is not clearly above the bound holds nothing.
+        .filter(|(i, rigid)| {
+            let held = s[(*i, *i)].partial_cmp(&(UNHELD_STIFFNESS * rigid.diagonal));
+            held != Some(std::cmp::Ordering::Greater)
+        })
         .map(|(i, _)| i)
         .collect()
 }
@@ -493,7 +497,11 @@ fn rigid_displacements(
     let b = nalgebra::DVector::from_iterator(
         system.rigid.len(),
         (system.rigid.iter()).map(|rigid| {
-            let pull = rigid.column.iter().map(|&(dof, k)| k * u0[dof]).sum::<f64>();
+            let pull = rigid
+                .column
+                .iter()
+                .map(|&(dof, k)| k * u0[dof])
+                .sum::<f64>();
             rigid.force + rigid.applied - pull
         }),
     );

@@ -65,15 +65,16 @@ pub fn write_force_displacement_png(
         (1.0, "load factor (no displacement imposed)".to_string())
     };
     let forced = steps.first().and_then(|s| s.forced.first());
-    let (x, x_desc): (Box<dyn Fn(&StepRecord) -> f64>, String) = match forced {
-        Some(f) => (
-            Box::new(|s: &StepRecord| s.forced[0].displacement.abs()),
-            format!(
-                "displacement |u{}| of '{}' on '{}' (force-controlled)",
-                f.component, f.group, f.body
-            ),
+    let x_desc = match forced {
+        Some(f) => format!(
+            "displacement |u{}| of '{}' on '{}' (force-controlled)",
+            f.component, f.group, f.body
         ),
-        None => (Box::new(move |s: &StepRecord| scale * s.load_factor), x_desc),
+        None => x_desc,
+    };
+    let x = |s: &StepRecord| match s.forced.first() {
+        Some(f) if forced.is_some() => f.displacement.abs(),
+        _ => scale * s.load_factor,
     };
     let norm = |f: &[f64]| f.iter().map(|c| c * c).sum::<f64>().sqrt();
     // Only solved points: a line from the origin to a single step would read as a linear law.
