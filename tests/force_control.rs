@@ -300,3 +300,16 @@ fn two_bodies_held_only_by_their_contact_are_refused() {
     });
     assert_refused(&case, &["'disc'", "'block'", "held by nothing"]);
 }
+
+#[test]
+fn the_example_case_file_reads() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("geo/hemisphere_pressed_by_force.toml");
+    let case = internodes::case::Case::load(&path).expect("the example case");
+    let sphere = &case.bodies[0];
+    assert_eq!(sphere.forces.len(), 1);
+    assert_eq!(
+        (sphere.forces[0].group.as_str(), sphere.forces[0].fz),
+        ("sphere_top", Some(-0.8))
+    );
+}
