@@ -313,3 +313,38 @@ fn the_example_case_file_reads() {
         ("sphere_top", Some(-0.8))
     );
 }
+
+#[test]
+fn a_force_on_the_contact_face_itself_gives_back_its_displacement() {
+    // The upper block's contact face is the loading plate: every active node of the primary
+    // moves with the plate, so each constraint row reads the plate's displacement and each
+    // multiplier's force enters the plate's reaction (the entries of D between them).
+    use common::contact::{pinned_at_corners, stacked_blocks};
+    let upper_face = |condition: Dirichlet| {
+        pinned_at_corners(stacked_blocks(2), 2).with_body("upper", |body| Body {
+            dirichlet: (body.dirichlet.into_iter())
+                .filter(|d| d.group != "upper_top")
+                .chain([condition])
+                .collect(),
+            ..body
+        })
+    };
+    let reference = solve(&upper_face(Dirichlet::on("upper_contact").uy(-0.01))).unwrap();
+    assert_eq!(reference.status, ContactStatus::Converged);
+    let force = reaction(&reference, "upper_contact")[1];
+    assert!(force < 0.0, "{force}");
+    let run = solve(
+        &upper_face(Dirichlet::on("upper_corner").ux(0.0)).with_body("upper", |body| {
+            body.force(Force::vertical("upper_contact", 2, force))
+        }),
+    )
+    .unwrap();
+    assert_eq!(run.status, ContactStatus::Converged);
+    assert!(
+        (run.forced[0].displacement + 0.01).abs() <= SETTLED,
+        "{:?}",
+        run.forced
+    );
+    assert!((reaction(&run, "upper_contact")[1] - force).abs() <= 1e-8 * force.abs());
+    assert_eq!(run.active_set.nodes, reference.active_set.nodes);
+}
