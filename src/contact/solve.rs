@@ -83,6 +83,7 @@ use super::solution::{
 use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
+use crate::fem::rigid_modes::{RigidModes, free_rigid_motions};
 use crate::linalg::BodySolverKind;
 
 /// When the surfaces have slid ([`InterfaceOperators::slide`]) this many spacings of the
@@ -121,6 +122,10 @@ pub struct ContactSolver<'a> {
     /// The force-controlled components `(body, index into its rigid columns)` that nothing but
     /// the contact holds (body 0 the primary): with no node in contact the system is singular.
     held_by_contact: Vec<(usize, usize)>,
+    /// The body (0 the primary) that only the contact holds along some rigid motions, with
+    /// those motions (combinations of `crate::fem::rigid_modes::RigidModes`, one per column):
+    /// the motions its Dirichlet supports leave free.
+    free_motions: Option<(usize, nalgebra::DMatrix<f64>)>,
     /// Paired for the slide of the last solve; a solve without a start pairs them again
     /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
@@ -203,6 +208,18 @@ impl<'a> ContactSolver<'a> {
                 second: problem.secondary.body.name.clone(),
             });
         }
+        let free_motions = held_by_contact.first().map(|&(k, _)| {
+            let (elastic, body) = match k {
+                0 => (&problem.primary, &body1),
+                _ => (&problem.secondary, &body2),
+            };
+            let mut supports = body.constraints.clone();
+            for rigid in &body.rigid {
+                rigid.dofs.iter().for_each(|&dof| supports.release(dof));
+            }
+            let coords = &elastic.body.coords;
+            (k, free_rigid_motions(coords, body.dim, &supports))
+        });
         Ok(Self {
             problem,
             solver: solver.clone(),
@@ -212,6 +229,7 @@ impl<'a> ContactSolver<'a> {
             stats2,
             factors,
             held_by_contact,
+            free_motions,
             operators,
         })
     }
@@ -364,6 +382,7 @@ impl ContactSolver<'_> {
         let coupling = timed(&mut seconds.operators, || {
             self.coupling(&nodes, &state.rows, &state.corrections)
         });
+        self.check_held(&coupling, &nodes)?;
         // 2-4. The coupled solve, the gaps at the iterate, the active set update.
         let iterate = self.iterate(
             &coupling,
@@ -458,10 +477,13 @@ impl ContactSolver<'_> {
         let component = ["x", "y", "z"][rigid.component];
         if state.first_contact {
             if state.active.is_empty() {
-                return Err(ContactError::PulledAway {
-                    body: name.clone(),
-                    group: rigid.group.clone(),
-                    component,
+                return Err(match rigid.pin {
+                    true => ContactError::FloatsAway { body: name.clone() },
+                    false => ContactError::PulledAway {
+                        body: name.clone(),
+                        group: rigid.group.clone(),
+                        component,
+                    },
                 });
             }
             return Ok(());
@@ -472,14 +494,18 @@ impl ContactSolver<'_> {
             Some(u) => geometric_gaps(s1, s2, Some(&u[0]), Some(&u[1])),
             None => geometric_gaps(s1, s2, None, None),
         };
-        // The force the contact carries along the components nothing else holds.
-        let force = (self.held_by_contact.iter())
-            .map(|&(k, r)| {
-                let rigid = match k {
-                    0 => &self.body1.rigid[r],
-                    _ => &self.body2.rigid[r],
-                };
-                (load_factor * (rigid.force + rigid.applied)).powi(2)
+        // The force the contact carries, at most: the resultant of the body's loads and of the
+        // forces on its force-controlled groups (its supports may carry part of it; the zone
+        // then errs on the large side, which the loop corrects).
+        let dim = assembled.dim;
+        let force = (0..dim)
+            .map(|c| {
+                let on_groups: f64 = (assembled.rigid.iter())
+                    .filter(|rigid| !rigid.pin && rigid.component == c)
+                    .map(|rigid| rigid.force)
+                    .sum();
+                let loads: f64 = assembled.f.iter().skip(c).step_by(dim).sum();
+                (load_factor * (on_groups + loads)).powi(2)
             })
             .sum::<f64>()
             .sqrt();
@@ -501,6 +527,63 @@ impl ContactSolver<'_> {
         }
         state.active = zone;
         state.first_contact = true;
+        Ok(())
+    }
+
+    /// An error unless the contact of the active `nodes` (with their `coupling`) holds the
+    /// body that only the contact holds along the motions its supports leave free: each
+    /// motion must move some active node along a direction its constraint holds (the normal;
+    /// every direction for tied contact). Without it the coupled system is singular along that
+    /// motion, and a Krylov solve may still return one of its infinitely many answers.
+    ///
+    /// The test: with `h_i = [d . r_j(x_i)]_j` for each held direction `d` at each active node
+    /// `x_i` and the free motions `V`, the Gram matrix `sum (h_i V)^T (h_i V)` must have no
+    /// eigenvalue below `1e-8` of the number of rows (each `h_i` has a unit translation part,
+    /// and the rotations are scaled by the body's size).
+    fn check_held(&self, coupling: &Coupling, nodes: &[usize]) -> Result<(), ContactError> {
+        let Some((body, motions)) = &self.free_motions else {
+            return Ok(());
+        };
+        let free = motions.ncols();
+        if free == 0 || nodes.is_empty() {
+            return Ok(());
+        }
+        let problem = self.problem;
+        let elastic = match body {
+            0 => &problem.primary,
+            _ => &problem.secondary,
+        };
+        let dim = elastic.body.dim;
+        let modes = RigidModes::new(&elastic.body.coords, dim);
+        let mut gram = nalgebra::DMatrix::<f64>::zeros(free, free);
+        let mut rows = 0.0;
+        for (k, &i) in nodes.iter().enumerate() {
+            let at = modes.at(&problem.primary_surface.coords[i]);
+            let directions: Vec<[f64; 3]> = match problem.settings.formulation {
+                Formulation::Frictionless => vec![coupling.normals[k]],
+                Formulation::Tied => (0..dim)
+                    .map(|c| std::array::from_fn(|j| f64::from(u8::from(j == c))))
+                    .collect(),
+            };
+            for d in directions {
+                let h = nalgebra::DVector::from_iterator(
+                    at.len(),
+                    at.iter().map(|r| (0..3).map(|c| d[c] * r[c]).sum::<f64>()),
+                );
+                let hv = motions.transpose() * h;
+                gram += &hv * hv.transpose();
+                rows += 1.0;
+            }
+        }
+        let eigenvalues = nalgebra::SymmetricEigen::new(gram).eigenvalues;
+        let unheld = eigenvalues.iter().filter(|&&e| e <= 1e-8 * rows).count();
+        if unheld > 0 {
+            return Err(ContactError::NotHeld {
+                body: elastic.body.name.clone(),
+                free: unheld,
+                active: nodes.len(),
+            });
+        }
         Ok(())
     }
 
