@@ -122,3 +122,63 @@ fn a_free_block_on_frictionless_contact_is_refused_by_name() {
         assert!(stderr.contains(word), "no {word:?} in {stderr}");
     }
 }
+
+#[test]
+fn a_block_held_only_sideways_rests_on_its_contact_3d() {
+    // Pinned sideways at two corners: its vertical motion and the two tilts are free, and the
+    // flat contact holds all three.
+    let case = stacked_blocks(3)
+        .support("lower", Dirichlet::on("lower_corner_a").ux(0.0).uy(0.0))
+        .support("lower", Dirichlet::on("lower_corner_b").uy(0.0))
+        .with_body("upper", |body| {
+            Body {
+                dirichlet: vec![
+                    Dirichlet::on("upper_corner_a").ux(0.0).uy(0.0),
+                    Dirichlet::on("upper_corner_b").uy(0.0),
+                ],
+                ..body
+            }
+            .load(Load::pressure("upper_top", PRESSURE))
+        });
+    let (_dir, summary) = run(&case);
+    let contact = &summary["contact"];
+    assert_eq!(contact["status"], "converged", "{contact}");
+    let mesh = read_fixture("two_blocks_3d.msh");
+    let upper = mesh.bodies.iter().find(|b| b.name == "upper").unwrap();
+    let top = upper.group_nodes("upper_top").unwrap();
+    let extent = |c: usize| {
+        let v: Vec<f64> = top.iter().map(|&n| upper.coords[n][c]).collect();
+        v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
+    };
+    let load = PRESSURE * extent(0) * extent(1);
+    let carried = contact["force_primary"][2].as_f64().unwrap();
+    assert!(
+        (carried - load).abs() <= 1e-8 * load,
+        "{carried} against {load}"
+    );
+}
+
+#[test]
+fn a_half_disc_free_to_turn_about_its_centre_is_refused() {
+    // Held sideways along its flat top only: it may turn about the top's midpoint, its centre,
+    // and a frictionless contact on its round surface cannot hold that.
+    let case = common::half_disc_on_block("half_disc_on_block.msh").with_body("disc", |body| {
+        Body {
+            dirichlet: vec![Dirichlet::on("disc_top").ux(0.0)],
+            ..body
+        }
+        .load(Load::pressure("disc_top", 2.5))
+    });
+    let (_dir, path) = case.write();
+    let output = run_solve(&path);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    for word in [
+        "body 'disc'",
+        "does not hold it",
+        "1 of its rigid motions",
+        "round body",
+    ] {
+        assert!(stderr.contains(word), "no {word:?} in {stderr}");
+    }
+}

@@ -32,11 +32,6 @@ impl Constraints {
         }
     }
 
-    /// Frees `dof` again.
-    pub fn release(&mut self, dof: usize) {
-        self.prescribed[dof] = None;
-    }
-
     pub fn value(&self, dof: usize) -> Option<f64> {
         self.prescribed[dof]
     }
