@@ -357,7 +357,8 @@ impl Case {
     pub fn check_bodies(&self, mesh: &Mesh) -> Result<(), CaseError> {
         for spec in &self.bodies {
             let body = self.body_mesh(mesh, spec)?;
-            let groups = spec.dirichlet.iter().map(|d| &d.group);
+            let groups = (spec.dirichlet.iter().map(|d| &d.group))
+                .chain(spec.forces.iter().map(|f| &f.group));
             for group in groups.chain(spec.loads.iter().map(|l| &l.group)) {
                 let context = format!("body '{}'", spec.name);
                 self.check_unambiguous(mesh, &context, group)?;
@@ -501,12 +502,15 @@ impl Case {
         })
     }
 
-    /// The elastic problem of one body: material, Dirichlet conditions, loads, body force.
+    /// The elastic problem of one body: material, Dirichlet conditions, forces, loads, body
+    /// force. A body of the `[contact]` may be left free to move by its supports
+    /// (`ElasticProblem::floating`); any other must be held.
     pub fn elastic_problem<'m>(
         &self,
         body: &'m BodyMesh,
         spec: &BodySpec,
     ) -> Result<ElasticProblem<'m>, CaseError> {
+        let in_contact = (self.contact.as_ref()).is_some_and(|c| c.bodies.contains(&spec.name));
         let values = BodyValues {
             case: self,
             body: &spec.name,
@@ -541,12 +545,16 @@ impl Case {
                 components: [f.fx, f.fy, f.fz],
             })
             .collect();
-        ElasticProblem::with_forces(body, material, dirichlet, forces, loads, body_force).map_err(
-            |source| CaseError::Problem {
+        let problem = match in_contact {
+            true => ElasticProblem::floating,
+            false => ElasticProblem::with_forces,
+        };
+        problem(body, material, dirichlet, forces, loads, body_force).map_err(|source| {
+            CaseError::Problem {
                 path: self.path.clone(),
                 source,
-            },
-        )
+            }
+        })
     }
 
     /// The body's material, its Young's modulus also within the range [`MAX_MAGNITUDE`] allows.

@@ -111,6 +111,23 @@ pub enum ContactError {
         component: &'static str,
     },
     #[error(
+        "body '{body}' is held by its contact alone (its supports leave it free to move), and \
+         its loads pull it off the other body: nothing balances them. Check the loads' signs, \
+         or support the body"
+    )]
+    FloatsAway { body: String },
+    #[error(
+        "body '{body}' is held by its contact alone along {free} of its rigid motions, and the \
+         contact at this iteration's {active} active nodes does not hold it there \
+         (frictionless contact cannot hold a sliding along a flat contact surface or the \
+         rotation of a round body; nothing else does): support the body along them"
+    )]
+    NotHeld {
+        body: String,
+        free: usize,
+        active: usize,
+    },
+    #[error(
         "bodies '{first}' and '{second}' are both held only by their contact along a \
          force-controlled component: together they are held by nothing. Hold one of them \
          (a displacement) along it"

@@ -80,6 +80,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         body.rigid
             .iter()
             .zip(a)
+            .filter(|(rigid, _)| !rigid.pin)
             .map(move |(rigid, &a)| ForcedDisplacement {
                 body: name.to_string(),
                 group: rigid.group.clone(),

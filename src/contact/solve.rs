@@ -64,7 +64,7 @@
 //! surface on two solves in a row, the second not contracting (or followed by an interface
 //! system that cannot be solved accurately), is [`ContactStatus::Unstable`].
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 use std::time::Instant;
 
 use super::active_set::{ActiveSet, Update};
@@ -83,7 +83,55 @@ use super::solution::{
 use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer};
 use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
+use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::BodySolverKind;
+
+/// [`ContactSolver::check_held`]: a free motion is held when the Gram matrix's eigenvalue along
+/// it, per row, exceeds this. Measured (2026-11-28): a block resting flat, its rotation 0.15; a
+/// half-disc turning about its centre, with the disc's own normals 0 (2D) and a hemisphere's
+/// 3e-8 to 6e-8 (3D: P1 vertex normals are radial to about 2e-4); along the flat block's
+/// normals the hemisphere's turn still reads 3e-6 to 3e-4, which is why the body's own normals
+/// are tested too. A rotation held by a zone 2% of the body's size across reads about 3e-5.
+const HELD_PER_ROW: f64 = 1e-6;
+
+/// The rigid motions (combinations of [`RigidModes`], one per column) that `body`'s supports
+/// leave free: those that vanish on its prescribed dofs and move each force-controlled group
+/// uniformly along its component (the group is one plate); its rigid-mode pins hold nothing.
+/// They are the null space of the Gram matrix of those conditions' rows.
+fn motions_left_free(coords: &[[f64; 3]], body: &AssembledBody) -> nalgebra::DMatrix<f64> {
+    let dim = body.dim;
+    let modes = RigidModes::new(coords, dim);
+    let count = modes.count();
+    let value = |dof: usize| -> Vec<f64> {
+        let at = modes.at(&coords[dof / dim]);
+        at.iter().map(|m| m[dof % dim]).collect()
+    };
+    let mut gram = nalgebra::DMatrix::<f64>::zeros(count, count);
+    let mut add = |row: Vec<f64>| {
+        let row = nalgebra::DVector::from_vec(row);
+        gram += &row * row.transpose();
+    };
+    let rigid: HashMap<usize, usize> = (body.rigid.iter().enumerate())
+        .flat_map(|(r, rigid)| rigid.dofs.iter().map(move |&dof| (dof, r)))
+        .collect();
+    for dof in (0..body.f_c.len()).filter(|&d| body.constraints.is_fixed(d)) {
+        if !rigid.contains_key(&dof) {
+            add(value(dof));
+        }
+    }
+    for group in body.rigid.iter().filter(|rigid| !rigid.pin) {
+        let first = value(group.dofs[0]);
+        for &dof in &group.dofs[1..] {
+            add(value(dof).iter().zip(&first).map(|(a, b)| a - b).collect());
+        }
+    }
+    let eigen = nalgebra::SymmetricEigen::new(gram);
+    let largest = eigen.eigenvalues.iter().cloned().fold(0.0, f64::max);
+    let free: Vec<usize> = (0..count)
+        .filter(|&i| eigen.eigenvalues[i] <= 1e-10 * largest || largest == 0.0)
+        .collect();
+    nalgebra::DMatrix::from_fn(count, free.len(), |r, c| eigen.eigenvectors[(r, free[c])])
+}
 
 /// When the surfaces have slid ([`InterfaceOperators::slide`]) this many spacings of the
 /// active nodes away from the pairing of the operators, they are paired again once the active
@@ -121,6 +169,10 @@ pub struct ContactSolver<'a> {
     /// The force-controlled components `(body, index into its rigid columns)` that nothing but
     /// the contact holds (body 0 the primary): with no node in contact the system is singular.
     held_by_contact: Vec<(usize, usize)>,
+    /// The body (0 the primary) that only the contact holds along some rigid motions, with
+    /// those motions (combinations of `crate::fem::rigid_modes::RigidModes`, one per column):
+    /// the motions its Dirichlet supports leave free.
+    free_motions: Option<(usize, nalgebra::DMatrix<f64>)>,
     /// Paired for the slide of the last solve; a solve without a start pairs them again
     /// unslid, so that it does not depend on earlier solves.
     operators: InterfaceOperators,
@@ -203,6 +255,13 @@ impl<'a> ContactSolver<'a> {
                 second: problem.secondary.body.name.clone(),
             });
         }
+        let free_motions = held_by_contact.first().map(|&(k, _)| {
+            let (elastic, body) = match k {
+                0 => (&problem.primary, &body1),
+                _ => (&problem.secondary, &body2),
+            };
+            (k, motions_left_free(&elastic.body.coords, body))
+        });
         Ok(Self {
             problem,
             solver: solver.clone(),
@@ -212,6 +271,7 @@ impl<'a> ContactSolver<'a> {
             stats2,
             factors,
             held_by_contact,
+            free_motions,
             operators,
         })
     }
@@ -364,6 +424,7 @@ impl ContactSolver<'_> {
         let coupling = timed(&mut seconds.operators, || {
             self.coupling(&nodes, &state.rows, &state.corrections)
         });
+        self.check_held(&coupling, &nodes)?;
         // 2-4. The coupled solve, the gaps at the iterate, the active set update.
         let iterate = self.iterate(
             &coupling,
@@ -458,10 +519,13 @@ impl ContactSolver<'_> {
         let component = ["x", "y", "z"][rigid.component];
         if state.first_contact {
             if state.active.is_empty() {
-                return Err(ContactError::PulledAway {
-                    body: name.clone(),
-                    group: rigid.group.clone(),
-                    component,
+                return Err(match rigid.pin {
+                    true => ContactError::FloatsAway { body: name.clone() },
+                    false => ContactError::PulledAway {
+                        body: name.clone(),
+                        group: rigid.group.clone(),
+                        component,
+                    },
                 });
             }
             return Ok(());
@@ -472,14 +536,18 @@ impl ContactSolver<'_> {
             Some(u) => geometric_gaps(s1, s2, Some(&u[0]), Some(&u[1])),
             None => geometric_gaps(s1, s2, None, None),
         };
-        // The force the contact carries along the components nothing else holds.
-        let force = (self.held_by_contact.iter())
-            .map(|&(k, r)| {
-                let rigid = match k {
-                    0 => &self.body1.rigid[r],
-                    _ => &self.body2.rigid[r],
-                };
-                (load_factor * (rigid.force + rigid.applied)).powi(2)
+        // The force the contact carries, at most: the resultant of the body's loads and of the
+        // forces on its force-controlled groups (its supports may carry part of it; the zone
+        // then errs on the large side, which the loop corrects).
+        let dim = assembled.dim;
+        let force = (0..dim)
+            .map(|c| {
+                let on_groups: f64 = (assembled.rigid.iter())
+                    .filter(|rigid| !rigid.pin && rigid.component == c)
+                    .map(|rigid| rigid.force)
+                    .sum();
+                let loads: f64 = assembled.f.iter().skip(c).step_by(dim).sum();
+                (load_factor * (on_groups + loads)).powi(2)
             })
             .sum::<f64>()
             .sqrt();
@@ -501,6 +569,105 @@ impl ContactSolver<'_> {
         }
         state.active = zone;
         state.first_contact = true;
+        Ok(())
+    }
+
+    /// An error unless the contact of the active `nodes` (with their `coupling`) holds the
+    /// body that only the contact holds along the motions its supports leave free: each
+    /// motion must move some active node along a direction its constraint holds (the normal;
+    /// every direction for tied contact). Without it the coupled system is singular along that
+    /// motion, and a Krylov solve may still return one of its infinitely many answers.
+    ///
+    /// The test: with `h_i = [d . r_j(x_i)]_j` for each held direction `d` at each active node
+    /// `x_i` and the free motions `V`, the Gram matrix `sum (h_i V)^T (h_i V)` must have no
+    /// eigenvalue below [`HELD_PER_ROW`] times the number of rows (each `h_i` has a unit
+    /// translation part, and the rotations are scaled by the body's size).
+    fn check_held(&self, coupling: &Coupling, nodes: &[usize]) -> Result<(), ContactError> {
+        let Some((body, motions)) = &self.free_motions else {
+            return Ok(());
+        };
+        let free = motions.ncols();
+        if free == 0 || nodes.is_empty() {
+            return Ok(());
+        }
+        let problem = self.problem;
+        let elastic = match body {
+            0 => &problem.primary,
+            _ => &problem.secondary,
+        };
+        let dim = elastic.body.dim;
+        let modes = RigidModes::new(&elastic.body.coords, dim);
+        let s1 = &problem.primary_surface;
+        // The directions each active node holds. Frictionless: its normal, taken once as the
+        // secondary facet's (the constraint's) and once as the primary surface's own: a round
+        // body turning about its centre moves its nodes along the other body's normal but
+        // maps its surface onto itself, so only its own normals show that nothing holds it.
+        let own: Vec<[f64; 3]> = match body {
+            0 => nodes.iter().map(|&i| s1.normals[i]).collect(),
+            // The secondary's own normal where each active node touches it: its nodes'
+            // normals weighted as the constraint row weighs them.
+            _ => {
+                let s2 = &problem.secondary_surface;
+                let surface_index: HashMap<usize, usize> =
+                    s2.nodes.iter().enumerate().map(|(s, &n)| (n, s)).collect();
+                (coupling.r12.iter())
+                    .map(|row| {
+                        let mut n = [0.0; 3];
+                        for &(node, w) in row {
+                            if let Some(&s) = surface_index.get(&node) {
+                                (0..3).for_each(|c| n[c] += w * s2.normals[s][c]);
+                            }
+                        }
+                        let length = (0..3).map(|c| n[c] * n[c]).sum::<f64>().sqrt();
+                        n.map(|v| if length > 0.0 { v / length } else { 0.0 })
+                    })
+                    .collect()
+            }
+        };
+        let direction_sets: Vec<Vec<Vec<[f64; 3]>>> = match problem.settings.formulation {
+            Formulation::Frictionless => vec![
+                (0..nodes.len())
+                    .map(|k| vec![coupling.normals[k]])
+                    .collect(),
+                own.into_iter().map(|n| vec![n]).collect(),
+            ],
+            Formulation::Tied => vec![
+                (0..nodes.len())
+                    .map(|_| {
+                        (0..dim)
+                            .map(|c| std::array::from_fn(|j| f64::from(u8::from(j == c))))
+                            .collect()
+                    })
+                    .collect(),
+            ],
+        };
+        let mut unheld = 0;
+        for directions in direction_sets {
+            let mut gram = nalgebra::DMatrix::<f64>::zeros(free, free);
+            let mut rows = 0.0;
+            for (&i, at_node) in nodes.iter().zip(directions) {
+                let at = modes.at(&s1.coords[i]);
+                for d in at_node {
+                    let h = nalgebra::DVector::from_iterator(
+                        at.len(),
+                        at.iter().map(|r| (0..3).map(|c| d[c] * r[c]).sum::<f64>()),
+                    );
+                    let hv = motions.transpose() * h;
+                    gram += &hv * hv.transpose();
+                    rows += 1.0;
+                }
+            }
+            let eigenvalues = nalgebra::SymmetricEigen::new(gram).eigenvalues;
+            let held = |e: &&f64| **e > HELD_PER_ROW * rows;
+            unheld = unheld.max(eigenvalues.iter().filter(|e| !held(e)).count());
+        }
+        if unheld > 0 {
+            return Err(ContactError::NotHeld {
+                body: elastic.body.name.clone(),
+                free: unheld,
+                active: nodes.len(),
+            });
+        }
         Ok(())
     }
 

@@ -39,6 +39,11 @@ pub struct ElasticProblem<'m> {
     pub dirichlet: Vec<DirichletCondition>,
     /// Force-controlled groups ([`ElasticProblem::with_forces`]; none by default).
     pub forces: Vec<ForceCondition>,
+    /// Rigid-mode pins `(node, component)` of a body in contact that its supports do not hold
+    /// ([`ElasticProblem::floating`]; none otherwise): dofs whose displacements are unknowns
+    /// with zero force, like a force-controlled group of one node with no force. They keep
+    /// `K_c` regular and leave the body exactly as free as without them.
+    pub pins: Vec<(usize, usize)>,
     pub loads: Vec<LoadCondition>,
     pub body_force: Option<[f64; 3]>,
 }
@@ -126,10 +131,65 @@ impl<'m> ElasticProblem<'m> {
             material,
             dirichlet,
             forces,
+            pins: Vec::new(),
             loads,
             body_force,
         };
         problem.check()?;
+        Ok(problem)
+    }
+
+    /// [`Self::with_forces`] for a body in contact, which its supports may leave free to move
+    /// (a floating body): the rigid motions they leave free are pinned ([`Self::pins`]) at
+    /// dofs of three nodes far apart (the farthest from the centroid, the farthest from it,
+    /// and in 3D the farthest from the line through both), each dof kept if it removes a
+    /// free motion. The contacts must then hold those motions (the contact solve checks it).
+    pub fn floating(
+        body: &'m BodyMesh,
+        material: Material,
+        dirichlet: Vec<DirichletCondition>,
+        forces: Vec<ForceCondition>,
+        loads: Vec<LoadCondition>,
+        body_force: Option<[f64; 3]>,
+    ) -> Result<Self, ProblemError> {
+        let mut problem = Self {
+            body,
+            material,
+            dirichlet,
+            forces,
+            pins: Vec::new(),
+            loads,
+            body_force,
+        };
+        match problem.check() {
+            Ok(()) => return Ok(problem),
+            Err(ProblemError::NoDirichlet { .. } | ProblemError::FreeRigidModes { .. }) => {}
+            Err(other) => return Err(other),
+        }
+        let mut constraints = super::solve::constraints(&problem)?;
+        let (coords, dim) = (&body.coords, body.dim);
+        let mut free = crate::fem::rigid_modes::free_rigid_modes(coords, dim, &constraints);
+        for node in far_apart_nodes(coords, dim) {
+            for c in 0..dim {
+                let dof = dim * node + c;
+                if free == 0 || constraints.is_fixed(dof) {
+                    continue;
+                }
+                let mut trial = constraints.clone();
+                trial.prescribe(dof, 0.0).expect("a free dof");
+                let left = crate::fem::rigid_modes::free_rigid_modes(coords, dim, &trial);
+                if left < free {
+                    (constraints, free) = (trial, left);
+                    problem.pins.push((node, c));
+                }
+            }
+        }
+        if free > 0 {
+            return Err(ProblemError::FreeRigidModes {
+                body: body.name.clone(),
+                count: free,
+            });
+        }
         Ok(problem)
     }
 
@@ -194,7 +254,7 @@ impl<'m> ElasticProblem<'m> {
                 });
             }
         }
-        if self.dirichlet.is_empty() && self.forces.is_empty() {
+        if self.dirichlet.is_empty() && self.forces.is_empty() && self.pins.is_empty() {
             return Err(ProblemError::NoDirichlet { body: name() });
         }
         let constraints = super::solve::constraints(self)?;
@@ -211,4 +271,35 @@ impl<'m> ElasticProblem<'m> {
         }
         Ok(())
     }
+}
+
+/// Three nodes far apart, for pins: the farthest from the centroid, the farthest from that
+/// one, and (3D) the farthest from the line through both.
+fn far_apart_nodes(coords: &[[f64; 3]], dim: usize) -> Vec<usize> {
+    let distance =
+        |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
+    let n = coords.len() as f64;
+    let centre: [f64; 3] = std::array::from_fn(|k| coords.iter().map(|x| x[k]).sum::<f64>() / n);
+    let farthest = |from: &dyn Fn(&[f64; 3]) -> f64| {
+        (0..coords.len()).max_by(|&a, &b| from(&coords[a]).total_cmp(&from(&coords[b])))
+    };
+    let Some(a) = farthest(&|x| distance(x, &centre)) else {
+        return Vec::new();
+    };
+    let Some(b) = farthest(&|x| distance(x, &coords[a])) else {
+        return vec![a];
+    };
+    let mut nodes = vec![a, b];
+    if dim == 3 {
+        let (pa, pb) = (coords[a], coords[b]);
+        let axis: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
+        let length = distance(&pa, &pb).max(f64::MIN_POSITIVE);
+        let off_line = |x: &[f64; 3]| {
+            let r: [f64; 3] = std::array::from_fn(|k| x[k] - pa[k]);
+            let along = (0..3).map(|k| r[k] * axis[k]).sum::<f64>() / length;
+            ((0..3).map(|k| r[k] * r[k]).sum::<f64>() - along * along).max(0.0)
+        };
+        nodes.extend(farthest(&off_line));
+    }
+    nodes
 }

@@ -164,12 +164,14 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
     Ok(constraints)
 }
 
-/// One force-controlled component of a group: its dofs (one per node of the group) and force.
+/// One force-controlled component of a group: its dofs (one per node of the group) and force;
+/// or a rigid-mode pin (`ElasticProblem::pins`), one dof with no force.
 pub(crate) struct ForcedComponent {
     pub group: String,
     pub component: usize,
     pub force: f64,
     pub dofs: Vec<usize>,
+    pub pin: bool,
 }
 
 /// The force-controlled components of `problem`, group after group, component after component.
@@ -188,9 +190,19 @@ pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent
                     component,
                     force,
                     dofs: nodes.iter().map(|&node| dim * node + component).collect(),
+                    pin: false,
                 });
             }
         }
+    }
+    for &(node, component) in &problem.pins {
+        out.push(ForcedComponent {
+            group: format!("rigid-mode pin at node {}", body.node_tags[node]),
+            component,
+            force: 0.0,
+            dofs: vec![dim * node + component],
+            pin: true,
+        });
     }
     out
 }
@@ -262,6 +274,8 @@ pub struct RigidColumn {
     /// `(b, c_b)`: the couplings to the body's other force-controlled components.
     pub coupled: Vec<(usize, f64)>,
     pub applied: f64,
+    /// A rigid-mode pin of a floating body (`ElasticProblem::pins`), not a group of the case.
+    pub pin: bool,
 }
 
 /// The [`RigidColumn`]s of `forced`, read from the rows of the unconstrained `K` at the
@@ -311,6 +325,7 @@ fn rigid_columns(
                 diagonal,
                 coupled,
                 applied,
+                pin: component.pin,
             }
         })
         .collect()

@@ -8,61 +8,101 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::Constraints;
 
-/// The rigid-body modes as dof vectors (interleaved, `dim` per node), centred on the centroid
-/// and scaled by the body size so that all have comparable norms: 3 in 2D, 6 in 3D.
-pub fn rigid_body_modes(coords: &[[f64; 3]], dim: usize) -> Vec<Vec<f64>> {
-    let n = coords.len();
-    let mut centre = [0.0; 3];
-    for x in coords {
-        for k in 0..3 {
-            centre[k] += x[k] / n as f64;
+/// The rigid-body motions of one body, centred on its centroid and scaled by its size so that
+/// all have comparable norms: 3 in 2D (two translations, the rotation about z), 6 in 3D.
+pub struct RigidModes {
+    dim: usize,
+    centre: [f64; 3],
+    size: f64,
+}
+
+impl RigidModes {
+    pub fn new(coords: &[[f64; 3]], dim: usize) -> Self {
+        let n = coords.len();
+        let mut centre = [0.0; 3];
+        for x in coords {
+            for k in 0..3 {
+                centre[k] += x[k] / n as f64;
+            }
         }
+        let size = coords
+            .iter()
+            .map(|x| {
+                (0..3)
+                    .map(|k| (x[k] - centre[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+        Self { dim, centre, size }
     }
-    let size = coords
-        .iter()
-        .map(|x| {
-            (0..3)
-                .map(|k| (x[k] - centre[k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .fold(0.0, f64::max)
-        .max(f64::MIN_POSITIVE);
-    let rotations: &[[f64; 3]] = if dim == 2 {
-        &[[0.0, 0.0, 1.0]]
-    } else {
-        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-    };
-    let mut modes = Vec::new();
-    for t in 0..dim {
-        let mut m = vec![0.0; dim * n];
-        for a in 0..n {
-            m[dim * a + t] = 1.0;
+
+    /// The number of motions: 3 in 2D, 6 in 3D.
+    pub fn count(&self) -> usize {
+        if self.dim == 2 { 3 } else { 6 }
+    }
+
+    /// The displacement of each motion at the point `x` (components past `dim` are 0).
+    pub fn at(&self, x: &[f64; 3]) -> Vec<[f64; 3]> {
+        let rotations: &[[f64; 3]] = if self.dim == 2 {
+            &[[0.0, 0.0, 1.0]]
+        } else {
+            &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+        };
+        let mut modes = Vec::with_capacity(self.count());
+        for t in 0..self.dim {
+            let mut m = [0.0; 3];
+            m[t] = 1.0;
+            modes.push(m);
         }
-        modes.push(m);
-    }
-    for w in rotations {
-        let mut m = vec![0.0; dim * n];
-        for (a, x) in coords.iter().enumerate() {
-            let r: Vec<f64> = (0..3).map(|k| (x[k] - centre[k]) / size).collect();
+        let r: [f64; 3] = std::array::from_fn(|k| (x[k] - self.centre[k]) / self.size);
+        for w in rotations {
             let v = [
                 w[1] * r[2] - w[2] * r[1],
                 w[2] * r[0] - w[0] * r[2],
                 w[0] * r[1] - w[1] * r[0],
             ];
-            m[dim * a..dim * a + dim].copy_from_slice(&v[..dim]);
+            let mut m = [0.0; 3];
+            m[..self.dim].copy_from_slice(&v[..self.dim]);
+            modes.push(m);
         }
-        modes.push(m);
+        modes
     }
-    modes
 }
 
-/// How many independent rigid-body motions the constraints leave free (0 when the constrained
-/// stiffness is non-singular).
-///
-/// The Gram matrix `G_ij = sum_{d fixed} r_i[d] r_j[d]` of the modes restricted to the fixed
-/// dofs is singular along every motion that the constraints do not see.
-pub fn free_rigid_modes(coords: &[[f64; 3]], dim: usize, constraints: &Constraints) -> usize {
+/// The rigid-body modes ([`RigidModes`]) as dof vectors (interleaved, `dim` per node).
+pub fn rigid_body_modes(coords: &[[f64; 3]], dim: usize) -> Vec<Vec<f64>> {
+    let modes = RigidModes::new(coords, dim);
+    let mut vectors = vec![vec![0.0; dim * coords.len()]; modes.count()];
+    for (a, x) in coords.iter().enumerate() {
+        for (vector, m) in vectors.iter_mut().zip(modes.at(x)) {
+            vector[dim * a..dim * a + dim].copy_from_slice(&m[..dim]);
+        }
+    }
+    vectors
+}
+
+/// The rigid-body motions (combinations of [`RigidModes`], one per column) that the fixed dofs
+/// of `constraints` do not hold: the eigenvectors of the Gram matrix of the modes restricted
+/// to the fixed dofs whose eigenvalues vanish.
+pub fn free_rigid_motions(
+    coords: &[[f64; 3]],
+    dim: usize,
+    constraints: &Constraints,
+) -> DMatrix<f64> {
+    let (gram, largest) = gram(coords, dim, constraints);
+    let eigen = SymmetricEigen::new(gram);
+    let free: Vec<usize> = (0..eigen.eigenvalues.len())
+        .filter(|&i| eigen.eigenvalues[i] <= 1e-10 * largest || largest == 0.0)
+        .collect();
+    DMatrix::from_fn(eigen.eigenvectors.nrows(), free.len(), |r, c| {
+        eigen.eigenvectors[(r, free[c])]
+    })
+}
+
+/// The Gram matrix of the rigid modes on the fixed dofs, and its largest eigenvalue.
+fn gram(coords: &[[f64; 3]], dim: usize, constraints: &Constraints) -> (DMatrix<f64>, f64) {
     let modes = rigid_body_modes(coords, dim);
     let m = modes.len();
     let mut gram = DMatrix::<f64>::zeros(m, m);
@@ -73,10 +113,19 @@ pub fn free_rigid_modes(coords: &[[f64; 3]], dim: usize, constraints: &Constrain
             }
         }
     }
-    let eigenvalues = SymmetricEigen::new(gram).eigenvalues;
-    let largest = eigenvalues.iter().cloned().fold(0.0, f64::max);
-    eigenvalues
+    let largest = SymmetricEigen::new(gram.clone())
+        .eigenvalues
         .iter()
-        .filter(|&&e| e <= 1e-10 * largest || largest == 0.0)
-        .count()
+        .cloned()
+        .fold(0.0, f64::max);
+    (gram, largest)
+}
+
+/// How many independent rigid-body motions the constraints leave free (0 when the constrained
+/// stiffness is non-singular).
+///
+/// The Gram matrix `G_ij = sum_{d fixed} r_i[d] r_j[d]` of the modes restricted to the fixed
+/// dofs is singular along every motion that the constraints do not see.
+pub fn free_rigid_modes(coords: &[[f64; 3]], dim: usize, constraints: &Constraints) -> usize {
+    free_rigid_motions(coords, dim, constraints).ncols()
 }
