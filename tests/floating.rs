@@ -10,7 +10,7 @@ mod common;
 use common::case_builder::{Body, CaseFile, Dirichlet, Load};
 use common::contact::stacked_blocks;
 use common::hostile::displacement_by_tag;
-use common::{read_fixture, run_solve};
+use common::{read_fixture, run_solve, run_to_summary};
 
 const PRESSURE: f64 = 10.0;
 
@@ -26,16 +26,6 @@ fn floating_upper(upper: Vec<Dirichlet>) -> CaseFile {
             }
             .load(Load::pressure("upper_top", PRESSURE))
         })
-}
-
-/// Runs `case` through the CLI: its output folder (kept alive by the guard) and summary.
-fn run(case: &CaseFile) -> (tempfile::TempDir, serde_json::Value) {
-    let (dir, path) = case.write();
-    let output = run_solve(&path);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{stderr}");
-    let text = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
-    (dir, serde_json::from_str(&text).unwrap())
 }
 
 /// The width of the upper block's top, from the mesh: the pressure's resultant over it.
@@ -60,7 +50,8 @@ fn corner_tag() -> i64 {
 fn a_block_held_only_sideways_rests_on_its_contact() {
     // Held at one corner sideways: its vertical motion and rotation are free, and its flat
     // contact holds both.
-    let (dir, summary) = run(&floating_upper(vec![Dirichlet::on("upper_corner").ux(0.0)]));
+    let (dir, summary) =
+        run_to_summary(&floating_upper(vec![Dirichlet::on("upper_corner").ux(0.0)]));
     let contact = &summary["contact"];
     assert_eq!(contact["status"], "converged", "{contact}");
     let load = PRESSURE * top_width();
@@ -76,7 +67,7 @@ fn a_block_held_only_sideways_rests_on_its_contact() {
     // solve found there: the same field, and the support carries nothing.
     let floating = displacement_by_tag(&dir.path().join("out"));
     let corner = &floating[&corner_tag()];
-    let (held_dir, held) = run(&floating_upper(vec![
+    let (held_dir, held) = run_to_summary(&floating_upper(vec![
         Dirichlet::on("upper_corner").ux(0.0).uy(corner[1]),
     ]));
     assert_eq!(held["contact"]["status"], "converged");
@@ -99,7 +90,8 @@ fn a_block_held_only_sideways_rests_on_its_contact() {
 
 #[test]
 fn a_free_block_is_held_by_tied_contact() {
-    let (_dir, summary) = run(&floating_upper(Vec::new()).contact_setting("formulation", "tied"));
+    let (_dir, summary) =
+        run_to_summary(&floating_upper(Vec::new()).contact_setting("formulation", "tied"));
     let contact = &summary["contact"];
     assert_eq!(contact["status"], "converged", "{contact}");
     let load = PRESSURE * top_width();
@@ -140,7 +132,7 @@ fn a_block_held_only_sideways_rests_on_its_contact_3d() {
             }
             .load(Load::pressure("upper_top", PRESSURE))
         });
-    let (_dir, summary) = run(&case);
+    let (_dir, summary) = run_to_summary(&case);
     let contact = &summary["contact"];
     assert_eq!(contact["status"], "converged", "{contact}");
     let mesh = read_fixture("two_blocks_3d.msh");

@@ -9,7 +9,7 @@ mod common;
 
 use common::case_builder::{Body, CaseFile, Dirichlet, Force};
 use common::contact::{hemisphere_on_block, solve};
-use common::{half_disc_on_block, run_solve};
+use common::{half_disc_on_block, run_solve, run_to_summary};
 use internodes::contact::{ContactSolution, ContactStatus};
 
 /// The loop holds every active gap to `penetration_tolerance` (1e-3) of a spacing; the finest
@@ -152,16 +152,6 @@ fn block_pushed(top: impl FnOnce(Body) -> Body) -> CaseFile {
     ))
 }
 
-/// Runs `case` through the CLI: its output folder (kept alive by the guard) and summary.
-fn run(case: &CaseFile) -> (tempfile::TempDir, serde_json::Value) {
-    let (dir, path) = case.write();
-    let output = run_solve(&path);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{stderr}");
-    let text = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
-    (dir, serde_json::from_str(&text).unwrap())
-}
-
 /// The `block_top` reaction along y in a summary.
 fn top_reaction(summary: &serde_json::Value) -> f64 {
     summary["bodies"][0]["reactions"]["block_top"][1]
@@ -173,11 +163,11 @@ fn top_reaction(summary: &serde_json::Value) -> f64 {
 fn a_single_body_moves_by_the_displacement_whose_force_it_is_given() {
     // The top also shifted sideways: the prescribed dofs next to the force-controlled ones
     // pull on them (`applied` of `RigidColumn`).
-    let (displaced_dir, displaced) = run(&block_pushed(|body| {
+    let (displaced_dir, displaced) = run_to_summary(&block_pushed(|body| {
         body.dirichlet(Dirichlet::on("block_top").ux(0.003).uy(-0.01))
     }));
     let force = top_reaction(&displaced);
-    let (forced_dir, forced) = run(&block_pushed(|body| {
+    let (forced_dir, forced) = run_to_summary(&block_pushed(|body| {
         body.dirichlet(Dirichlet::on("block_top").ux(0.003))
             .force(Force::vertical("block_top", 2, force))
     }));

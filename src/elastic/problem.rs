@@ -193,6 +193,30 @@ impl<'m> ElasticProblem<'m> {
         Ok(problem)
     }
 
+    /// The components of one condition: at least one (else `none`), no z in 2D (else
+    /// `out_of_range`), all finite (else `NotFinite` naming `what`).
+    fn check_components(
+        &self,
+        components: &[Option<f64>; 3],
+        none: ProblemError,
+        out_of_range: ProblemError,
+        what: String,
+    ) -> Result<(), ProblemError> {
+        if components.iter().all(Option::is_none) {
+            return Err(none);
+        }
+        if self.body.dim == 2 && components[2].is_some() {
+            return Err(out_of_range);
+        }
+        if components.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(ProblemError::NotFinite {
+                body: self.body.name.clone(),
+                what,
+            });
+        }
+        Ok(())
+    }
+
     fn check(&self) -> Result<(), ProblemError> {
         let name = || self.body.name.clone();
         // Dirichlet conditions may sit on boundary or point groups, loads need facets.
@@ -215,44 +239,32 @@ impl<'m> ElasticProblem<'m> {
             if self.body.group_nodes(&f.group).is_none() {
                 return Err(unknown(&f.group));
             }
-            if f.components.iter().all(Option::is_none) {
-                return Err(ProblemError::NoForceComponent {
+            self.check_components(
+                &f.components,
+                ProblemError::NoForceComponent {
                     body: name(),
                     group: f.group.clone(),
-                });
-            }
-            if self.body.dim == 2 && f.components[2].is_some() {
-                return Err(ProblemError::ForceComponentOutOfRange {
+                },
+                ProblemError::ForceComponentOutOfRange {
                     body: name(),
                     group: f.group.clone(),
-                });
-            }
-            if f.components.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(ProblemError::NotFinite {
-                    body: name(),
-                    what: format!("the force on '{}'", f.group),
-                });
-            }
+                },
+                format!("the force on '{}'", f.group),
+            )?;
         }
         for d in &self.dirichlet {
-            if d.components.iter().all(Option::is_none) {
-                return Err(ProblemError::NoComponent {
+            self.check_components(
+                &d.components,
+                ProblemError::NoComponent {
                     body: name(),
                     group: d.group.clone(),
-                });
-            }
-            if self.body.dim == 2 && d.components[2].is_some() {
-                return Err(ProblemError::ComponentOutOfRange {
+                },
+                ProblemError::ComponentOutOfRange {
                     body: name(),
                     group: d.group.clone(),
-                });
-            }
-            if d.components.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(ProblemError::NotFinite {
-                    body: name(),
-                    what: format!("the Dirichlet value on '{}'", d.group),
-                });
-            }
+                },
+                format!("the Dirichlet value on '{}'", d.group),
+            )?;
         }
         if self.dirichlet.is_empty() && self.forces.is_empty() && self.pins.is_empty() {
             return Err(ProblemError::NoDirichlet { body: name() });

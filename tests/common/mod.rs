@@ -84,6 +84,17 @@ pub fn write_case(text: &str) -> (tempfile::TempDir, PathBuf) {
     (dir, path)
 }
 
+/// Runs `case` through the CLI, which must succeed: its folder (kept alive by the guard; the
+/// case writes into `out/` there) and its `summary.json`.
+pub fn run_to_summary(case: &case_builder::CaseFile) -> (tempfile::TempDir, serde_json::Value) {
+    let (dir, path) = case.write();
+    let output = run_solve(&path);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let text = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
+    (dir, serde_json::from_str(&text).unwrap())
+}
+
 /// Runs `internodes solve CASE --quiet`.
 pub fn run_solve(case: &Path) -> Output {
     run_solve_with(case, &[])
