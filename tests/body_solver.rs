@@ -429,10 +429,11 @@ mod with_petsc {
         let case = Case::load(&path).unwrap();
         let mesh = read_msh(&case.mesh).unwrap();
         let run = |body| {
-            let problem = case.contact_problem(&mesh).unwrap().unwrap();
-            solve_contact(problem, &settings(body), &case.load_steps())
+            let problem = case.contact_problems(&mesh).unwrap().remove(0);
+            solve_contact(vec![problem], &settings(body), &case.load_steps())
                 .unwrap()
-                .solution
+                .solutions
+                .remove(0)
         };
         let cholesky = run(BodySolverKind::Cholesky);
         let cg = run(BodySolverKind::CgAmg);

@@ -30,12 +30,14 @@ fn a_cancelled_token_stops_the_contact_solve() {
     let (case, mesh, settings) = half_disc_with_a_token();
     let steps = [0.25, 0.5, 0.75, 1.0];
     // Not cancelled: solved.
-    let problem = case.contact_problem(&mesh).unwrap().unwrap();
-    assert!(solve_contact(problem, &settings, &steps).is_ok());
+    let problem = case.contact_problems(&mesh).unwrap().remove(0);
+    assert!(solve_contact(vec![problem], &settings, &steps).is_ok());
     // Cancelled, here before the solve starts: the first safe point stops it.
     settings.cancel.cancel();
-    let problem = case.contact_problem(&mesh).unwrap().unwrap();
-    let error = solve_contact(problem, &settings, &steps).err().unwrap();
+    let problem = case.contact_problems(&mesh).unwrap().remove(0);
+    let error = solve_contact(vec![problem], &settings, &steps)
+        .err()
+        .unwrap();
     assert!(matches!(error, ContactError::Cancelled(_)), "{error}");
     assert_eq!(error.to_string(), "the solve was cancelled");
 }
@@ -46,9 +48,9 @@ fn a_token_cancelled_from_another_thread_stops_a_running_solve() {
     // Many load steps, so that the solve outlasts the wait below by far.
     let steps: Vec<f64> = (1..=2000).map(|k| f64::from(k) / 2000.0).collect();
     let token = settings.cancel.clone();
-    let problem = case.contact_problem(&mesh).unwrap().unwrap();
+    let problem = case.contact_problems(&mesh).unwrap().remove(0);
     let cancelled_at = std::thread::scope(|scope| {
-        let solve = scope.spawn(|| solve_contact(problem, &settings, &steps));
+        let solve = scope.spawn(|| solve_contact(vec![problem], &settings, &steps));
         std::thread::sleep(Duration::from_millis(300));
         let at = Instant::now();
         token.cancel();

@@ -18,14 +18,15 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
     let (dir, path) = case_file.write();
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
-    let problem = case.contact_problem(&mesh).unwrap().unwrap();
+    let problem = case.contact_problems(&mesh).unwrap().remove(0);
     let settings = SolverSettings {
         verbose: false,
         ..case.solver
     };
-    let mut solver = ContactSolver::new(&problem, &settings).unwrap();
-    let half = solver.solve(0.5, None).unwrap();
-    let full = solver.solve(1.0, Some(&half.active_set)).unwrap();
+    let mut solver = ContactSolver::new(std::slice::from_ref(&problem), &settings).unwrap();
+    let half = solver.solve(0.5, None).unwrap().remove(0);
+    let start = [half.active_set.clone()];
+    let full = solver.solve(1.0, Some(&start)).unwrap().remove(0);
     let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     // Both paths end when every active node lies within 0.01 tol_p h of the other surface
     // (the loop's stopping rule, tol_p = 1e-3): their displacements agree to that order.
@@ -37,7 +38,7 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
         .fold(f64::INFINITY, f64::min);
     let settled = 1e-2 * 1e-3 * h_min;
     for (factor, stepped) in [(0.5, &half), (1.0, &full)] {
-        let alone = solver.solve(factor, None).unwrap();
+        let alone = solver.solve(factor, None).unwrap().remove(0);
         assert_eq!(stepped.status, ContactStatus::Converged);
         assert_eq!(
             stepped.primary_fields.active, alone.primary_fields.active,

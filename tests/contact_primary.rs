@@ -148,10 +148,11 @@ fn every_load_step_of_an_explicit_stiff_primary_is_right_or_named() {
         .collect();
     let error = |force_on_sphere: f64, k: usize| force_on_sphere / references[k] - 1.0;
 
-    let problem = case.contact_problem(&mesh).unwrap().unwrap();
-    let run = solve_contact(problem, &settings, &factors).unwrap();
-    assert!(!run.steps.is_empty());
-    for (k, step) in run.steps.iter().enumerate() {
+    let problem = case.contact_problems(&mesh).unwrap().remove(0);
+    let run = solve_contact(vec![problem], &settings, &factors).unwrap();
+    let steps = &run.steps[0];
+    assert!(!steps.is_empty());
+    for (k, step) in steps.iter().enumerate() {
         let e = error(step.force_secondary[2], k);
         let trusted = step.status.is_solution() && step.accurate;
         assert!(

@@ -254,8 +254,8 @@ fn a_library_caller_without_load_factors_gets_an_error() {
     let case = Case::load(&path).unwrap();
     let mesh = read_msh(&case.mesh).unwrap();
     for factors in [vec![], vec![0.5, f64::NAN]] {
-        let problem = case.contact_problem(&mesh).unwrap().unwrap();
-        let error = solve_contact(problem, &case.solver, &factors)
+        let problem = case.contact_problems(&mesh).unwrap().remove(0);
+        let error = solve_contact(vec![problem], &case.solver, &factors)
             .err()
             .unwrap_or_else(|| panic!("{factors:?} accepted"));
         assert!(error.to_string().contains("load factors"), "{error}");

@@ -50,27 +50,55 @@ pub struct Case {
     pub solver: SolverSettings,
     #[serde(rename = "body")]
     pub bodies: Vec<BodySpec>,
-    /// Two of the bodies in contact (optional: without it every body is solved alone).
-    pub contact: Option<ContactSpec>,
+    /// The contact pairs: a `[contact]` table (one pair) or `[[contact]]` tables (several,
+    /// decided together; a body may be in several). None: every body is solved alone.
+    #[serde(default, rename = "contact", deserialize_with = "one_or_many")]
+    pub contacts: Vec<ContactSpec>,
+    /// The load factors of the contact solve, applied in turn to every load, force and
+    /// prescribed displacement; each step starts from the previous active sets and reuses every
+    /// factorization. Default: one step at factor 1. (A single `[contact]` table may hold them
+    /// instead.)
+    pub load_steps: Option<Vec<f64>>,
     /// The case file itself, set by [`Case::load`].
     #[serde(skip)]
     pub path: PathBuf,
 }
 
-/// The `[contact]` table: which bodies and surfaces meet, which carries the multiplier, the
-/// load steps, and the loop's settings ([`ContactSettings`], deserialized from the same table's
-/// remaining keys, so that the library's own type and defaults are the schema).
+/// The `contact` key: one `[contact]` table or a list of `[[contact]]` tables.
+fn one_or_many<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> Result<Vec<ContactSpec>, D::Error> {
+    use serde::de::Error;
+    match toml::Value::deserialize(deserializer)? {
+        toml::Value::Array(pairs) => pairs
+            .into_iter()
+            .map(|pair| ContactSpec::deserialize(pair).map_err(D::Error::custom))
+            .collect(),
+        table @ toml::Value::Table(_) => ContactSpec::deserialize(table)
+            .map(|pair| vec![pair])
+            .map_err(D::Error::custom),
+        other => Err(D::Error::custom(format!(
+            "contact: expected a [contact] table or [[contact]] tables, got a {}",
+            other.type_str()
+        ))),
+    }
+}
+
+/// A `[contact]` (or `[[contact]]`) table: which bodies and surfaces meet, which carries the
+/// multiplier, and the loop's settings ([`ContactSettings`], deserialized from the same
+/// table's remaining keys, so that the library's own type and defaults are the schema).
 #[derive(Debug, Clone)]
 pub struct ContactSpec {
+    /// What outputs call the pair (the `name` key; default `"BODY1-BODY2"`, the bodies in the
+    /// order given).
+    pub name: String,
     /// The two bodies in contact.
     pub bodies: [String; 2],
     /// Their candidate contact surfaces (boundary groups), in the same order.
     pub surfaces: [String; 2],
     /// "auto" (default) or one of the two bodies.
     pub primary: PrimaryChoice,
-    /// Load factors, applied in turn to every load and prescribed displacement of the two
-    /// bodies; each step starts from the previous active set and reuses every factorization.
-    /// Default: one step at factor 1.
+    /// The case's load factors ([`Case::load_steps`]), given in a single `[contact]` table.
     pub load_steps: Option<Vec<f64>>,
     pub settings: ContactSettings,
 }
@@ -99,13 +127,16 @@ impl<'de> Deserialize<'de> for ContactSpec {
             ))
         };
         let pair = "a list of two names";
-        let bodies = take(&mut table, "bodies", pair)?.ok_or_else(|| required("bodies"))?;
+        let name: Option<String> = take(&mut table, "name", "a name")?;
+        let bodies: [String; 2] =
+            take(&mut table, "bodies", pair)?.ok_or_else(|| required("bodies"))?;
         let surfaces = take(&mut table, "surfaces", pair)?.ok_or_else(|| required("surfaces"))?;
         let primary = take(&mut table, "primary", "\"auto\" or a body name")?.unwrap_or_default();
         let load_steps = take(&mut table, "load_steps", "a list of load factors")?;
         let settings = ContactSettings::deserialize(toml::Value::Table(table))
             .map_err(|e| D::Error::custom(format!("[contact]: {e}")))?;
         Ok(Self {
+            name: name.unwrap_or_else(|| format!("{}-{}", bodies[0], bodies[1])),
             bodies,
             surfaces,
             primary,
@@ -247,6 +278,7 @@ impl Case {
             case.material(spec)?;
         }
         case.check_unique_bodies()?;
+        case.check_pairs()?;
         case.check_geo_parameters()?;
         case.check_load_steps()?;
         Ok(case)
@@ -296,6 +328,85 @@ impl Case {
         Ok(())
     }
 
+    /// Each pair named once, of two different bodies that have `[[body]]` tables; the load
+    /// steps given once, for the whole case.
+    fn check_pairs(&self) -> Result<(), CaseError> {
+        for (p, pair) in self.contacts.iter().enumerate() {
+            let context = self.pair_context(p);
+            if pair.bodies[0] == pair.bodies[1] {
+                return Err(self.invalid(
+                    context,
+                    format!(
+                        "bodies must name two different bodies, got '{}' twice (a body in \
+                         contact with itself is not supported)",
+                        pair.bodies[0]
+                    ),
+                ));
+            }
+            if let Some(body) =
+                (pair.bodies.iter()).find(|b| !self.bodies.iter().any(|s| &s.name == *b))
+            {
+                let known: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+                return Err(self.invalid(
+                    context,
+                    format!(
+                        "body '{body}' has no [[body]] table (materials and supports are \
+                         needed; the case's bodies: {})",
+                        known.join(", ")
+                    ),
+                ));
+            }
+            if pair.name.is_empty() || pair.name.contains(['/', '\\']) {
+                return Err(self.invalid(
+                    format!("{context} name"),
+                    format!(
+                        "'{}': a pair's name goes into the file names \
+                         force_displacement_<name>.csv and .png, so it must be non-empty and \
+                         hold no '/' or '\\'",
+                        pair.name
+                    ),
+                ));
+            }
+            if let Some(q) = self.contacts[..p]
+                .iter()
+                .position(|other| other.name == pair.name)
+            {
+                return Err(self.invalid(
+                    context,
+                    format!(
+                        "pairs {} and {} are both named '{}'; give each pair its own name \
+                         (the `name` key), or do not list a pair twice",
+                        q + 1,
+                        p + 1,
+                        pair.name
+                    ),
+                ));
+            }
+            if pair.load_steps.is_some() && (self.contacts.len() > 1 || self.load_steps.is_some()) {
+                return Err(self.invalid(
+                    format!("{context} load_steps"),
+                    "the load steps are the whole case's: give them once, as `load_steps = \
+                     [...]` at the top of the case file (before the first table)",
+                ));
+            }
+        }
+        if self.contacts.is_empty() && self.load_steps.is_some() {
+            return Err(self.invalid(
+                "load_steps",
+                "load steps scale a contact solve, and the case has no [contact] table",
+            ));
+        }
+        Ok(())
+    }
+
+    /// How messages name pair `p`: `[contact]` for a case of one pair, `[[contact]] 'NAME'`.
+    pub fn pair_context(&self, p: usize) -> String {
+        match self.contacts.len() {
+            1 => "[contact]".to_string(),
+            _ => format!("[[contact]] '{}' (pair {})", self.contacts[p].name, p + 1),
+        }
+    }
+
     /// `geo_parameters` must be finite, belong to a `.geo` mesh and be names the script uses:
     /// gmsh ignores a `-setnumber` the script never reads and meshes its defaults.
     fn check_geo_parameters(&self) -> Result<(), CaseError> {
@@ -320,25 +431,28 @@ impl Case {
     /// longer than [`MAX_LOAD_STEPS`] is a mistake (it once took minutes and wrote a 490 MB
     /// summary), not a load history. Each factor is finite and within [`MAX_MAGNITUDE`].
     fn check_load_steps(&self) -> Result<(), CaseError> {
-        let count = self
-            .contact
-            .as_ref()
-            .and_then(|c| c.load_steps.as_ref())
-            .map_or(0, Vec::len);
+        let key = match self.load_steps {
+            Some(_) => "load_steps",
+            None => "[contact] load_steps",
+        };
+        let Some(steps) = (self.load_steps.as_ref())
+            .or_else(|| self.contacts.first().and_then(|c| c.load_steps.as_ref()))
+        else {
+            return Ok(());
+        };
+        let count = steps.len();
         if count > MAX_LOAD_STEPS {
             return Err(self.invalid(
-                "[contact] load_steps",
+                key,
                 format!(
                     "{count} load steps; at most {MAX_LOAD_STEPS} are allowed (each step is a \
                      whole contact solve)"
                 ),
             ));
         }
-        if let Some(steps) = self.contact.as_ref().and_then(|c| c.load_steps.as_ref())
-            && (steps.is_empty() || steps.iter().any(|&f| !in_range(f)))
-        {
+        if steps.is_empty() || steps.iter().any(|&f| !in_range(f)) {
             return Err(self.invalid(
-                "[contact] load_steps",
+                key,
                 format!(
                     "expected a non-empty list of finite factors {}, got {}",
                     magnitude_range(),
@@ -366,9 +480,10 @@ impl Case {
             }
             self.elastic_problem(body, spec)?;
         }
-        if let Some(contact) = &self.contact {
+        for (p, contact) in self.contacts.iter().enumerate() {
             for group in &contact.surfaces {
-                self.check_unambiguous(mesh, "[contact] surfaces", group)?;
+                let context = format!("{} surfaces", self.pair_context(p));
+                self.check_unambiguous(mesh, &context, group)?;
             }
         }
         Ok(())
@@ -503,14 +618,14 @@ impl Case {
     }
 
     /// The elastic problem of one body: material, Dirichlet conditions, forces, loads, body
-    /// force. A body of the `[contact]` may be left free to move by its supports
+    /// force. A body in contact may be left free to move by its supports
     /// (`ElasticProblem::floating`); any other must be held.
     pub fn elastic_problem<'m>(
         &self,
         body: &'m BodyMesh,
         spec: &BodySpec,
     ) -> Result<ElasticProblem<'m>, CaseError> {
-        let in_contact = (self.contact.as_ref()).is_some_and(|c| c.bodies.contains(&spec.name));
+        let in_contact = (self.contacts.iter()).any(|c| c.bodies.contains(&spec.name));
         let values = BodyValues {
             case: self,
             body: &spec.name,
@@ -583,47 +698,40 @@ impl Case {
 
     /// The load factors of the contact solve (default: one step at 1).
     pub fn load_steps(&self) -> Vec<f64> {
-        self.contact
-            .as_ref()
-            .and_then(|c| c.load_steps.clone())
+        (self.load_steps.clone())
+            .or_else(|| self.contacts.first().and_then(|c| c.load_steps.clone()))
             .unwrap_or_else(|| vec![1.0])
     }
 
-    /// The contact problem of the `[contact]` table, if any, with its primary body chosen.
-    pub fn contact_problem<'m>(
+    /// The contact problem of each pair, in the case's order, with its primary body chosen
+    /// (empty without contact).
+    pub fn contact_problems<'m>(
         &self,
         mesh: &'m Mesh,
-    ) -> Result<Option<ContactProblem<'m>>, CaseError> {
-        let Some(spec) = &self.contact else {
-            return Ok(None);
-        };
-        if spec.bodies[0] == spec.bodies[1] {
-            return Err(self.invalid("[contact]", "bodies must name two different bodies"));
+    ) -> Result<Vec<ContactProblem<'m>>, CaseError> {
+        let mut problems = Vec::with_capacity(self.contacts.len());
+        for (p, spec) in self.contacts.iter().enumerate() {
+            let context = self.pair_context(p);
+            spec.settings
+                .validate()
+                .map_err(|e| self.invalid(&context, e.to_string()))?;
+            let side = |body: &str, surface: &str| -> Result<ContactSide<'m>, CaseError> {
+                let body_spec = (self.bodies.iter().find(|b| b.name == body))
+                    .expect("check_pairs: every pair's bodies have [[body]] tables");
+                let body_mesh = self.body_mesh(mesh, body_spec)?;
+                let surface = ContactSurface::new(body_mesh, surface)
+                    .map_err(|e| self.invalid(&context, e.to_string()))?;
+                Ok((self.elastic_problem(body_mesh, body_spec)?, surface))
+            };
+            let sides = [
+                side(&spec.bodies[0], &spec.surfaces[0])?,
+                side(&spec.bodies[1], &spec.surfaces[1])?,
+            ];
+            let problem = ContactProblem::new(sides, &spec.primary, spec.settings)
+                .map_err(|message| self.invalid(&context, message))?;
+            problems.push(problem);
         }
-        spec.settings
-            .validate()
-            .map_err(|e| self.invalid("[contact]", e.to_string()))?;
-        let side = |body: &str, surface: &str| -> Result<ContactSide<'m>, CaseError> {
-            let body_spec = self.bodies.iter().find(|b| b.name == body).ok_or_else(|| {
-                self.invalid(
-                    "[contact]",
-                    format!(
-                        "body '{body}' has no [[body]] table (materials and supports are needed)"
-                    ),
-                )
-            })?;
-            let body_mesh = self.body_mesh(mesh, body_spec)?;
-            let surface = ContactSurface::new(body_mesh, surface)
-                .map_err(|e| self.invalid("[contact]", e.to_string()))?;
-            Ok((self.elastic_problem(body_mesh, body_spec)?, surface))
-        };
-        let sides = [
-            side(&spec.bodies[0], &spec.surfaces[0])?,
-            side(&spec.bodies[1], &spec.surfaces[1])?,
-        ];
-        ContactProblem::new(sides, &spec.primary, spec.settings)
-            .map(Some)
-            .map_err(|message| self.invalid("[contact]", message))
+        Ok(problems)
     }
 }
 

@@ -101,6 +101,37 @@ impl Update {
         }
     }
 
+    /// The update of the loop's whole active set from each pair's `(offset, update)`: the
+    /// pairs' nodes shifted by their offsets ([`super::ContactSolver`]); settled (within the
+    /// tolerance) when every pair is, with the largest gap error.
+    pub(super) fn merge(parts: Vec<(usize, Update)>) -> Self {
+        let shift = |v: &[(usize, f64)], offset: usize| -> Vec<(usize, f64)> {
+            v.iter().map(|&(i, x)| (offset + i, x)).collect()
+        };
+        let mut merged = Self {
+            next: BTreeSet::new(),
+            tension: Vec::new(),
+            penetrating: Vec::new(),
+            settled: true,
+            within_tolerance: true,
+            active: 0,
+            max_gap_error_over_h: 0.0,
+        };
+        for (offset, update) in parts {
+            merged.next.extend(update.next.iter().map(|&i| offset + i));
+            merged.tension.extend(shift(&update.tension, offset));
+            merged
+                .penetrating
+                .extend(shift(&update.penetrating, offset));
+            merged.settled &= update.settled;
+            merged.within_tolerance &= update.within_tolerance;
+            merged.active += update.active;
+            merged.max_gap_error_over_h =
+                merged.max_gap_error_over_h.max(update.max_gap_error_over_h);
+        }
+        merged
+    }
+
     /// The active set with only the worst violation switched, if any.
     pub(super) fn single_switch(&self, active: &BTreeSet<usize>) -> Option<BTreeSet<usize>> {
         let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));

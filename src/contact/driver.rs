@@ -26,8 +26,8 @@ use serde::Serialize;
 use super::certificate::CheckKind;
 use super::checks::agreement;
 use super::{
-    CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver, ContactStatus,
-    ForcedDisplacement, OtherPrimary, Transfer,
+    ActiveSet, CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver,
+    ContactStatus, ForcedDisplacement, OtherPrimary, Transfer,
 };
 use crate::elastic::SolverSettings;
 
@@ -86,23 +86,25 @@ impl StepRecord {
 
 /// A finished contact solve.
 pub struct ContactRun<'m> {
-    /// The problem of the answer: its primary is the body that carries the multiplier (the
-    /// other one after a retry), and its report says why.
-    pub problem: ContactProblem<'m>,
-    /// The last load step's answer; its status and certificate include the checks made after
-    /// the loop.
-    pub solution: ContactSolution,
-    /// One record per load step of the answer's primary.
-    pub steps: Vec<StepRecord>,
+    /// The pairs of the answer, in the order given: a single pair's primary is the body that
+    /// carries the multiplier (the other one after a retry), and its report says why.
+    pub problems: Vec<ContactProblem<'m>>,
+    /// Each pair's answer at the last load step; its status and certificate include the
+    /// checks made after the loop.
+    pub solutions: Vec<ContactSolution>,
+    /// Each pair's records, one per load step.
+    pub steps: Vec<Vec<StepRecord>>,
     /// Seconds of each set-up and load step, named in order (the checking solves prefixed).
     pub timings: Vec<(String, f64)>,
 }
 
-/// Solves `problem` at each of `load_factors` in turn (each step starting from the previous
-/// active set), with the retry and the agreement check of the module doc. Progress goes to the
-/// `log` crate (level info) when `solver.verbose`.
+/// Solves the contact `problems` (one or several pairs, decided together) at each of
+/// `load_factors` in turn (each step starting from the previous active set). A single pair
+/// gets the retry and the agreement checks of the module doc; several pairs are solved once,
+/// and a case that would need those checks is refused ([`refuse_unchecked`]). Progress goes
+/// to the `log` crate (level info) when `solver.verbose`.
 pub fn solve_contact<'m>(
-    problem: ContactProblem<'m>,
+    problems: Vec<ContactProblem<'m>>,
     solver: &SolverSettings,
     load_factors: &[f64],
 ) -> Result<ContactRun<'m>, ContactError> {
@@ -113,13 +115,77 @@ pub fn solve_contact<'m>(
         verbose: solver.verbose,
         timings: Vec::new(),
     };
+    let problems = match <[ContactProblem; 1]>::try_from(problems) {
+        Ok([problem]) => {
+            let (problem, solution, steps) = solve_pair(problem, solver, load_factors, &mut log)?;
+            return Ok(ContactRun {
+                problems: vec![problem],
+                solutions: vec![solution],
+                steps: vec![steps],
+                timings: log.timings,
+            });
+        }
+        Err(problems) => problems,
+    };
+    refuse_unchecked(&problems)?;
+    let (solutions, steps) = solve_load_steps(&problems, solver, load_factors, "", &mut log)?;
+    for solution in &solutions {
+        report_coverage(solution, &log);
+    }
+    Ok(ContactRun {
+        problems,
+        solutions,
+        steps,
+        timings: log.timings,
+    })
+}
+
+/// Several pairs are solved once: the retry with the other primary and the agreement checks
+/// (module doc) compare whole solves of one pair, and are not made for several. A pair whose
+/// answer one of them would have to confirm (a named primary that auto would not choose
+/// between bodies of different stiffness, `check_other_primary`, a named transfer auto would
+/// not choose) is refused rather than certified unchecked. (An untrusted answer between
+/// bodies of similar stiffness is reported as such, without the retry.)
+fn refuse_unchecked(problems: &[ContactProblem]) -> Result<(), ContactError> {
+    for (p, problem) in problems.iter().enumerate() {
+        let names = format!(
+            "'{}' and '{}'",
+            problem.primary.body.name, problem.secondary.body.name
+        );
+        let why = if problem.primary_report.other_primary == OtherPrimary::CheckAgreement {
+            "names a primary that \"auto\" would not choose (the stiffer body), whose answer \
+             must be checked against the other primary's"
+        } else if problem.settings.check_other_primary {
+            "asks for check_other_primary"
+        } else if problem.transfer_differs_from_auto() {
+            "names a transfer that \"auto\" would not choose, whose answer must be checked \
+             against auto's"
+        } else {
+            continue;
+        };
+        return Err(ContactError::PairSettings(format!(
+            "pair {} ({names}) {why}; that check is made for a case with one contact pair \
+             only: use primary = \"auto\" and transfer = \"auto\" with several pairs",
+            p + 1
+        )));
+    }
+    Ok(())
+}
+
+/// One pair, with the retry and the agreement checks of the module doc.
+fn solve_pair<'m>(
+    problem: ContactProblem<'m>,
+    solver: &SolverSettings,
+    load_factors: &[f64],
+    log: &mut Log,
+) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), ContactError> {
     // 1. The chosen primary.
-    let (solution, steps) = solve_load_steps(&problem, solver, load_factors, "", &mut log)?;
+    let (solution, steps) = solve_pair_steps(&problem, solver, load_factors, "", log)?;
     // 2. The other primary, when auto's choice between similar bodies did not settle.
     let other_primary = problem.primary_report.other_primary;
     let retry = other_primary == OtherPrimary::RetryIfUntrusted && !solution.is_trusted();
     let (problem, mut solution, mut steps) = if retry {
-        retry_with_other_primary(problem, solution, steps, solver, load_factors, &mut log)
+        retry_with_other_primary(problem, solution, steps, solver, load_factors, log)
     } else {
         (problem, solution, steps)
     };
@@ -150,12 +216,24 @@ pub fn solve_contact<'m>(
                     &mut steps,
                     solver,
                     load_factors,
-                    &mut log,
+                    log,
                 );
                 solver.cancel.check()?;
             }
         }
     }
+    report_coverage(&solution, log);
+    // The last step's record is the answer's, checks made after the loop included.
+    if let Some(last) = steps.last_mut() {
+        last.status = solution.status;
+        last.accurate = solution.certificate.accurate();
+        last.failed_checks = solution.certificate.failed();
+    }
+    Ok((problem, solution, steps))
+}
+
+/// Says which errors the accuracy report of `solution` could not estimate, and why.
+fn report_coverage(solution: &ContactSolution, log: &Log) {
     for error in solution.certificate.coverage() {
         if let Some(how) = error.not_estimated {
             log.say(format!(
@@ -164,18 +242,6 @@ pub fn solve_contact<'m>(
             ));
         }
     }
-    // The last step's record is the answer's, checks made after the loop included.
-    if let Some(last) = steps.last_mut() {
-        last.status = solution.status;
-        last.accurate = solution.certificate.accurate();
-        last.failed_checks = solution.certificate.failed();
-    }
-    Ok(ContactRun {
-        problem,
-        solution,
-        steps,
-        timings: log.timings,
-    })
 }
 
 /// Every load step again with the other body as primary. Its answer is kept if it is a
@@ -195,7 +261,7 @@ fn retry_with_other_primary<'m>(
         "primary = \"auto\": with '{first}' as primary the solve ended {first_ended}; solving \
          again with '{other_name}' as primary"
     ));
-    let retried = solve_load_steps(&other, solver, load_factors, "other primary: ", log);
+    let retried = solve_pair_steps(&other, solver, load_factors, "other primary: ", log);
     let tolerance = problem.settings.accuracy_tolerance;
     let retried =
         retried.map(|(second, steps)| (agrees_with_first(&solution, second, tolerance), steps));
@@ -300,7 +366,7 @@ fn check_against(
     let with = &other.with;
     log.say(format!("checking the answer: solving again with {with}"));
     let label = format!("check with {with}: ");
-    let solved = solve_load_steps(&other.problem, solver, load_factors, &label, log);
+    let solved = solve_pair_steps(&other.problem, solver, load_factors, &label, log);
     let (reference, other_steps) = match solved {
         Ok((check, other_steps))
             if check.status == ContactStatus::Converged && check.is_trusted() =>
@@ -400,29 +466,52 @@ impl<'m> OtherSolve<'m> {
     }
 }
 
-/// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
-/// load step, each starting from the previous active set; stops at the first step whose loop
-/// does not settle (`not-solved` steps go on). `label` prefixes the timing names.
-fn solve_load_steps(
+/// [`solve_load_steps`] of one pair.
+fn solve_pair_steps(
     problem: &ContactProblem,
     solver: &SolverSettings,
     load_factors: &[f64],
     label: &str,
     log: &mut Log,
 ) -> Result<(ContactSolution, Vec<StepRecord>), ContactError> {
-    let dim = problem.primary_surface.dim;
+    let (solutions, steps) = solve_load_steps(
+        std::slice::from_ref(problem),
+        solver,
+        load_factors,
+        label,
+        log,
+    )?;
+    let solution = solutions.into_iter().next().expect("one pair");
+    Ok((solution, steps.into_iter().next().expect("one pair")))
+}
+
+/// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
+/// load step, each starting from the previous active sets; stops at the first step whose loop
+/// does not settle (`not-solved` steps go on). `label` prefixes the timing names. Each pair's
+/// answer at the last step, and its records.
+#[allow(clippy::type_complexity)]
+fn solve_load_steps(
+    problems: &[ContactProblem],
+    solver: &SolverSettings,
+    load_factors: &[f64],
+    label: &str,
+    log: &mut Log,
+) -> Result<(Vec<ContactSolution>, Vec<Vec<StepRecord>>), ContactError> {
+    let dim = problems[0].primary_surface.dim;
     let phase = Instant::now();
-    let mut contact_solver = ContactSolver::new(problem, solver)?;
+    let mut contact_solver = ContactSolver::new(problems, solver)?;
     log.time(format!("{label}contact set-up"), phase);
-    let transfer = problem.transfer();
-    log.say(format!(
-        "{label}force on '{}': {} transfer ({})",
-        problem.secondary.body.name,
-        serde_json::to_value(transfer.transfer).expect("a unit enum serializes"),
-        transfer.reason
-    ));
-    let mut steps = Vec::new();
-    let mut last: Option<ContactSolution> = None;
+    for problem in problems {
+        let transfer = problem.transfer();
+        log.say(format!(
+            "{label}force on '{}': {} transfer ({})",
+            problem.secondary.body.name,
+            serde_json::to_value(transfer.transfer).expect("a unit enum serializes"),
+            transfer.reason
+        ));
+    }
+    let mut steps = vec![Vec::new(); problems.len()];
+    let mut last: Option<Vec<ContactSolution>> = None;
     for (k, &factor) in load_factors.iter().enumerate() {
         solver.cancel.check()?;
         if load_factors.len() > 1 {
@@ -433,34 +522,45 @@ fn solve_load_steps(
             ));
         }
         let phase = Instant::now();
-        let start = last.as_ref().map(|s| &s.active_set);
-        let solution = contact_solver.solve(factor, start)?;
+        let start: Option<Vec<ActiveSet>> = (last.as_ref())
+            .map(|solutions| solutions.iter().map(|s| s.active_set.clone()).collect());
+        let solutions = contact_solver.solve(factor, start.as_deref())?;
         let seconds = log.time(format!("{label}contact step {}", k + 1), phase);
-        log.say(format!(
-            "contact status: {}",
-            solution.describe(problem.settings.formulation)
-        ));
-        steps.push(StepRecord {
-            step: k + 1,
-            load_factor: factor,
-            status: solution.status,
-            iterations: solution.history.len(),
-            force_primary: solution.force_primary[..dim].to_vec(),
-            force_secondary: solution.force_secondary[..dim].to_vec(),
-            force_imbalance: solution.force_imbalance,
-            hertz_a: solution.hertz_primary.map(|h| h.a),
-            hertz_p0: solution.hertz_primary.map(|h| h.p0),
-            forced: solution.forced.clone(),
-            seconds,
-            accurate: solution.certificate.accurate(),
-            failed_checks: solution.certificate.failed(),
-        });
+        for ((problem, solution), steps) in problems.iter().zip(&solutions).zip(&mut steps) {
+            let pair = match problems.len() {
+                1 => String::new(),
+                _ => format!(
+                    "'{}' on '{}': ",
+                    problem.primary.body.name, problem.secondary.body.name
+                ),
+            };
+            log.say(format!(
+                "{pair}contact status: {}",
+                solution.describe(problem.settings.formulation)
+            ));
+            steps.push(StepRecord {
+                step: k + 1,
+                load_factor: factor,
+                status: solution.status,
+                iterations: solution.history.len(),
+                force_primary: solution.force_primary[..dim].to_vec(),
+                force_secondary: solution.force_secondary[..dim].to_vec(),
+                force_imbalance: solution.force_imbalance,
+                hertz_a: solution.hertz_primary.map(|h| h.a),
+                hertz_p0: solution.hertz_primary.map(|h| h.p0),
+                forced: solution.forced.clone(),
+                seconds,
+                accurate: solution.certificate.accurate(),
+                failed_checks: solution.certificate.failed(),
+            });
+        }
         // A step whose active set settled is a valid start for the next one, whatever its
         // checks say (each step is checked on its own: a narrow zone at a small load factor can
         // fail the sag check on a mesh that resolves the final zone); a loop that did not settle
         // is not.
-        let stop = !solution.status.is_solution() && solution.status != ContactStatus::NotSolved;
-        last = Some(solution);
+        let stop = (solutions.iter())
+            .any(|s| !s.status.is_solution() && s.status != ContactStatus::NotSolved);
+        last = Some(solutions);
         if stop {
             log.say("stopping the load steps: this step's active set did not settle");
             break;

@@ -128,11 +128,13 @@ pub enum ContactError {
         active: usize,
     },
     #[error(
-        "bodies '{first}' and '{second}' are both held only by their contact along a \
-         force-controlled component: together they are held by nothing. Hold one of them \
-         (a displacement) along it"
+        "bodies {bodies} are held only by their contacts (along a force-controlled component, \
+         or the rigid motions their supports leave free): together they are held by nothing. \
+         Hold one of them (a displacement)"
     )]
-    NothingHolds { first: String, second: String },
+    NothingHolds { bodies: String },
+    #[error("contact pairs: {0}")]
+    PairSettings(String),
     #[error("{0}")]
     Linalg(String),
     #[error(

@@ -18,6 +18,9 @@ pub(super) struct LastIterate<'a> {
     pub problem: &'a ContactProblem<'a>,
     /// The primary's and the secondary's assembly, with its statistics.
     pub bodies: [(&'a AssembledBody, &'a SolveStats); 2],
+    /// The forces every pair puts on each of the two bodies (the reactions balance them);
+    /// `solution` has this pair's alone.
+    pub body_contact_force: [&'a [f64]; 2],
     pub linear_solvers: LinearSolvers,
     pub load_factor: f64,
     pub status: ContactStatus,
@@ -36,6 +39,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
     let LastIterate {
         problem,
         bodies: [(body1, stats1), (body2, stats2)],
+        body_contact_force,
         linear_solvers,
         load_factor,
         status,
@@ -97,7 +101,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         &problem.primary,
         (body1, stats1),
         u1,
-        &solution.contact_force[0],
+        body_contact_force[0],
         load_factor,
         residual,
     );
@@ -105,7 +109,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         &problem.secondary,
         (body2, stats2),
         u2,
-        &solution.contact_force[1],
+        body_contact_force[1],
         load_factor,
         residual,
     );

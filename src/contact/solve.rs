@@ -64,7 +64,7 @@
 //! surface on two solves in a row, the second not contracting (or followed by an interface
 //! system that cannot be solved accurately), is [`ContactStatus::Unstable`].
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 use std::time::Instant;
 
 use super::active_set::{ActiveSet, Update};
@@ -81,8 +81,8 @@ use super::solution::{
     ContactSolution, ContactStatus, IterationRecord, LinearSolvers, PhaseSeconds,
 };
 use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
-use super::{ContactError, ContactProblem, ContactSurface, Formulation, Transfer};
-use crate::elastic::{AssembledBody, SolveStats, SolverSettings, assemble};
+use super::{ContactError, ContactProblem, ContactSettings, ContactSurface, Formulation, Transfer};
+use crate::elastic::{AssembledBody, ElasticProblem, SolveStats, SolverSettings, assemble};
 use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::BodySolverKind;
 
@@ -154,28 +154,40 @@ fn pairing_drift(
     if h.is_finite() { distance / h } else { 0.0 }
 }
 
-/// A contact problem set up once: both bodies assembled (and, on the Schur path, factored) and
-/// the interface operators built. Every load step reuses all of it: loads and prescribed
-/// displacements enter the system linearly, `f_c(s) = s f_c(1)`, while `K`, its factors and the
-/// interface geometry do not change.
+/// Contact pairs set up once: each body in contact assembled once (and, on the Schur path,
+/// factored), however many pairs it is in, and each pair's interface operators built. Every
+/// load step reuses all of it: loads and prescribed displacements enter the system linearly,
+/// `f_c(s) = s f_c(1)`, while `K`, its factors and the interface geometry do not change.
+///
+/// The loop decides all pairs together: one coupled system, one active set. That set numbers
+/// the primary candidates of the pairs one after another (pair `p`'s node `i` is `offsets[p]
+/// + i`), so that the safeguard against repeats sees the whole set; each pair keeps its own
+/// operators, linearized gaps and tolerances.
 pub struct ContactSolver<'a> {
-    pub(super) problem: &'a ContactProblem<'a>,
+    /// The contact pairs, in the case's order.
+    pub(super) pairs: &'a [ContactProblem<'a>],
     solver: SolverSettings,
-    pub(super) body1: AssembledBody,
-    pub(super) body2: AssembledBody,
-    pub(super) stats1: SolveStats,
-    pub(super) stats2: SolveStats,
+    /// Each body in contact, once, in the order the pairs first name it.
+    bodies: Vec<AssembledBody>,
+    stats: Vec<SolveStats>,
+    /// Where each body's elastic problem is: the first pair that names it, and its side (0 the
+    /// primary, 1 the secondary).
+    origin: Vec<(usize, usize)>,
+    /// Each pair's primary and secondary body (indices into `bodies`).
+    pair_bodies: Vec<[usize; 2]>,
+    /// The first index of each pair's candidates in the loop's active set, then their total.
+    offsets: Vec<usize>,
     factors: Option<BodyFactors>,
     /// The force-controlled components `(body, index into its rigid columns)` that nothing but
-    /// the contact holds (body 0 the primary): with no node in contact the system is singular.
+    /// the contacts hold: with no node in contact the system is singular.
     held_by_contact: Vec<(usize, usize)>,
-    /// The body (0 the primary) that only the contact holds along some rigid motions, with
-    /// those motions (combinations of `crate::fem::rigid_modes::RigidModes`, one per column):
-    /// the motions its Dirichlet supports leave free.
-    free_motions: Option<(usize, nalgebra::DMatrix<f64>)>,
-    /// Paired for the slide of the last solve; a solve without a start pairs them again
-    /// unslid, so that it does not depend on earlier solves.
-    operators: InterfaceOperators,
+    /// Each body that only its contacts hold along some rigid motions, with those motions
+    /// (combinations of `crate::fem::rigid_modes::RigidModes`, one per column): the motions
+    /// its Dirichlet supports leave free.
+    free_motions: Vec<(usize, nalgebra::DMatrix<f64>)>,
+    /// Each pair's operators, paired for the slide of the last solve; a solve without a start
+    /// pairs them again unslid, so that it does not depend on earlier solves.
+    operators: Vec<InterfaceOperators>,
 }
 
 /// The interface operators of `problem`, paired with the primary surface slid by `slid` over
@@ -191,10 +203,10 @@ fn pair(problem: &ContactProblem, slid: [f64; 3]) -> Result<InterfaceOperators, 
     )
 }
 
-/// The nodes of a body whose displacements the constraint rows read: its candidate surface's,
+/// The nodes of a body whose displacements the constraint rows read: its candidate surfaces',
 /// and the nodes a force-controlled group's row reads (its column `k`).
-fn read_nodes(surface: &ContactSurface, body: &AssembledBody) -> Vec<usize> {
-    let mut nodes = surface.nodes.clone();
+fn read_nodes(surfaces: &[&ContactSurface], body: &AssembledBody) -> Vec<usize> {
+    let mut nodes: Vec<usize> = surfaces.iter().flat_map(|s| s.nodes.clone()).collect();
     for rigid in &body.rigid {
         nodes.extend(rigid.column.iter().map(|&(dof, _)| dof / body.dim));
     }
@@ -203,77 +215,192 @@ fn read_nodes(surface: &ContactSurface, body: &AssembledBody) -> Vec<usize> {
     nodes
 }
 
+/// The settings the pairs share: the loop and its coupled solve are one for all of them.
+fn check_shared_settings(pairs: &[ContactProblem]) -> Result<(), ContactError> {
+    let Some(first) = pairs.first() else {
+        return Err(ContactError::PairSettings(
+            "no contact pair to solve".into(),
+        ));
+    };
+    for (p, pair) in pairs.iter().enumerate().skip(1) {
+        let (a, b) = (&first.settings, &pair.settings);
+        let differs = [
+            ("solver", a.solver != b.solver),
+            ("max_iterations", a.max_iterations != b.max_iterations),
+            (
+                "krylov_max_iterations",
+                a.krylov_max_iterations != b.krylov_max_iterations,
+            ),
+        ];
+        if let Some((key, _)) = differs.iter().find(|(_, differs)| *differs) {
+            return Err(ContactError::PairSettings(format!(
+                "contact pair {} sets {key} otherwise than pair 1: the active-set loop and its \
+                 coupled solve are shared by all pairs, give every pair the same {key}",
+                p + 1
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl<'a> ContactSolver<'a> {
     pub fn new(
-        problem: &'a ContactProblem<'a>,
+        pairs: &'a [ContactProblem<'a>],
         solver: &SolverSettings,
     ) -> Result<Self, ContactError> {
-        problem.settings.validate()?;
-        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        let (mut stats1, mut stats2) = (SolveStats::default(), SolveStats::default());
-        let body1 = assemble(&problem.primary, &mut stats1, false)?;
-        let body2 = assemble(&problem.secondary, &mut stats2, false)?;
-        let dofs = body1.f_c.len().max(body2.f_c.len());
-        let kind = solver.body.resolve(s1.dim, dofs);
-        let factors = match problem.settings.solver {
+        check_shared_settings(pairs)?;
+        for problem in pairs {
+            problem.settings.validate()?;
+        }
+        let settings = &pairs[0].settings;
+        let mut origin: Vec<(usize, usize)> = Vec::new();
+        let mut names: Vec<&str> = Vec::new();
+        let mut pair_bodies = Vec::with_capacity(pairs.len());
+        for (p, problem) in pairs.iter().enumerate() {
+            let mut sides = [0; 2];
+            for (side, elastic) in [&problem.primary, &problem.secondary].iter().enumerate() {
+                let name = elastic.body.name.as_str();
+                sides[side] = match names.iter().position(|&n| n == name) {
+                    Some(k) => k,
+                    None => {
+                        names.push(name);
+                        origin.push((p, side));
+                        names.len() - 1
+                    }
+                };
+            }
+            pair_bodies.push(sides);
+        }
+        let elastic = |(p, side): (usize, usize)| match side {
+            0 => &pairs[p].primary,
+            _ => &pairs[p].secondary,
+        };
+        let mut stats = vec![SolveStats::default(); origin.len()];
+        let bodies = (origin.iter().zip(&mut stats))
+            .map(|(&at, stats)| assemble(elastic(at), stats, false))
+            .collect::<Result<Vec<_>, _>>()?;
+        let dofs = bodies.iter().map(|b| b.f_c.len()).max().unwrap_or(0);
+        let dim = pairs[0].primary_surface.dim;
+        let kind = solver.body.resolve(dim, dofs);
+        let surfaces_of = |k: usize| -> Vec<&ContactSurface> {
+            (pairs.iter().zip(&pair_bodies))
+                .flat_map(|(problem, sides)| {
+                    let primary = (sides[0] == k).then_some(&problem.primary_surface);
+                    let secondary = (sides[1] == k).then_some(&problem.secondary_surface);
+                    primary.into_iter().chain(secondary)
+                })
+                .collect()
+        };
+        let body_refs: Vec<&AssembledBody> = bodies.iter().collect();
+        let factors = match settings.solver {
             CoupledSolver::MonolithicLu => None,
             _ => {
                 let start = Instant::now();
-                let materials = [&problem.primary.material, &problem.secondary.material];
-                let factors = BodyFactors::new(
-                    &[&body1, &body2],
-                    vec![read_nodes(s1, &body1), read_nodes(s2, &body2)],
-                    vec![compliance_factor(materials, s1.dim)],
-                    solver,
-                    kind,
-                    &problem.settings,
-                )?;
+                let candidates = (0..bodies.len())
+                    .map(|k| read_nodes(&surfaces_of(k), &bodies[k]))
+                    .collect();
+                let compliance = pairs
+                    .iter()
+                    .map(|p| compliance_factor([&p.primary.material, &p.secondary.material], dim))
+                    .collect();
+                let factors =
+                    BodyFactors::new(&body_refs, candidates, compliance, solver, kind, settings)?;
                 if solver.verbose {
                     let what = match kind {
                         BodySolverKind::CgAmg => "CG + AMG set-up",
                         _ => "Cholesky",
                     };
                     let seconds = start.elapsed().as_secs_f64();
-                    log::info!("  {what} of both bodies: {seconds:.3} s");
+                    log::info!("  {what} of the {} bodies: {seconds:.3} s", bodies.len());
                 }
                 Some(factors)
             }
         };
-        let operators = pair(problem, [0.0; 3])?;
-        let held_by_contact = coupled_solver::held_by_contacts_only(
-            &[&body1, &body2],
-            factors.as_ref(),
-            solver.ordering,
-        )?
-        .into_iter()
-        .enumerate()
-        .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
-        .collect::<Vec<_>>();
-        if held_by_contact.iter().any(|h| h.0 == 0) && held_by_contact.iter().any(|h| h.0 == 1) {
-            return Err(ContactError::NothingHolds {
-                first: problem.primary.body.name.clone(),
-                second: problem.secondary.body.name.clone(),
-            });
+        let operators = (pairs.iter())
+            .map(|problem| pair(problem, [0.0; 3]))
+            .collect::<Result<Vec<_>, _>>()?;
+        let held_by_contact =
+            coupled_solver::held_by_contacts_only(&body_refs, factors.as_ref(), solver.ordering)?
+                .into_iter()
+                .enumerate()
+                .flat_map(|(k, held)| held.into_iter().map(move |r| (k, r)))
+                .collect::<Vec<_>>();
+        let held = |k: usize| held_by_contact.iter().any(|h| h.0 == k);
+        // Each group of bodies linked by pairs needs a body its own supports hold.
+        for k in 0..bodies.len() {
+            let linked = linked_bodies(&pair_bodies, k);
+            if linked.iter().all(|&j| held(j)) && linked[0] == k {
+                let named: Vec<String> = linked
+                    .iter()
+                    .map(|&j| format!("'{}'", elastic(origin[j]).body.name))
+                    .collect();
+                return Err(ContactError::NothingHolds {
+                    bodies: named.join(", "),
+                });
+            }
         }
-        let free_motions = held_by_contact.first().map(|&(k, _)| {
-            let (elastic, body) = match k {
-                0 => (&problem.primary, &body1),
-                _ => (&problem.secondary, &body2),
-            };
-            (k, motions_left_free(&elastic.body.coords, body))
-        });
+        let mut free_motions = Vec::new();
+        for k in (0..bodies.len()).filter(|&k| held(k)) {
+            let motions = motions_left_free(&elastic(origin[k]).body.coords, &bodies[k]);
+            free_motions.push((k, motions));
+        }
+        let mut offsets = vec![0];
+        for problem in pairs {
+            offsets.push(offsets.last().unwrap() + problem.primary_surface.len());
+        }
         Ok(Self {
-            problem,
+            pairs,
             solver: solver.clone(),
-            body1,
-            body2,
-            stats1,
-            stats2,
+            bodies,
+            stats,
+            origin,
+            pair_bodies,
+            offsets,
             factors,
             held_by_contact,
             free_motions,
             operators,
         })
+    }
+
+    /// The elastic problem of body `k`.
+    fn elastic(&self, k: usize) -> &ElasticProblem<'a> {
+        let (p, side) = self.origin[k];
+        match side {
+            0 => &self.pairs[p].primary,
+            _ => &self.pairs[p].secondary,
+        }
+    }
+
+    /// The settings of the loop and its coupled solve, shared by the pairs.
+    fn loop_settings(&self) -> &ContactSettings {
+        &self.pairs[0].settings
+    }
+
+    /// Pair `p`'s active nodes (indices into its primary candidates) in the loop's `active`.
+    fn pair_nodes(&self, active: &BTreeSet<usize>, p: usize) -> Vec<usize> {
+        let offset = self.offsets[p];
+        active
+            .range(offset..self.offsets[p + 1])
+            .map(|&i| i - offset)
+            .collect()
+    }
+
+    /// The loop's active set with pair `p`'s nodes replaced by `nodes`.
+    fn with_pair_nodes(
+        &self,
+        active: &BTreeSet<usize>,
+        p: usize,
+        nodes: impl IntoIterator<Item = usize>,
+    ) -> BTreeSet<usize> {
+        let (offset, end) = (self.offsets[p], self.offsets[p + 1]);
+        let mut next: BTreeSet<usize> = active
+            .iter()
+            .copied()
+            .filter(|i| !(offset..end).contains(i))
+            .collect();
+        next.extend(nodes.into_iter().map(|i| offset + i));
+        next
     }
 
     /// The body and interface solvers that ran.
@@ -297,41 +424,57 @@ impl<'a> ContactSolver<'a> {
         }
     }
 
-    /// The primary candidates that touch or penetrate in the reference configuration, with
-    /// their constraints linearized there.
-    pub fn initial_active_set(&self) -> ActiveSet {
-        let (s1, s2) = (
-            &self.problem.primary_surface,
-            &self.problem.secondary_surface,
-        );
-        let tol = self.problem.settings.penetration_tolerance;
-        let gaps = geometric_gaps(s1, s2, None, None);
-        ActiveSet {
-            nodes: (0..s1.len())
-                .filter(|&i| gaps[i] < tol * s1.spacing[i])
-                .collect(),
-            rows: gap_rows(s1, s2, None, None),
-            corrections: vec![0.0; s1.len()],
-        }
+    /// Each pair's primary candidates that touch or penetrate in the reference configuration,
+    /// with their constraints linearized there.
+    pub fn initial_active_set(&self) -> Vec<ActiveSet> {
+        (self.pairs.iter())
+            .map(|problem| {
+                let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+                let tol = problem.settings.penetration_tolerance;
+                let gaps = geometric_gaps(s1, s2, None, None);
+                ActiveSet {
+                    nodes: (0..s1.len())
+                        .filter(|&i| gaps[i] < tol * s1.spacing[i])
+                        .collect(),
+                    rows: gap_rows(s1, s2, None, None),
+                    corrections: vec![0.0; s1.len()],
+                }
+            })
+            .collect()
     }
 
     /// Runs the active-set loop with the loads and prescribed displacements scaled by
-    /// `load_factor`, from `start` (default: [`Self::initial_active_set`]).
+    /// `load_factor`, from `start` (one active set per pair; default:
+    /// [`Self::initial_active_set`]). One answer per pair, in the pairs' order.
     pub fn solve(
         &mut self,
         load_factor: f64,
-        start: Option<&ActiveSet>,
-    ) -> Result<ContactSolution, ContactError> {
-        if start.is_none() && self.operators.slid != [0.0; 3] {
-            self.pair_again([0.0; 3])?;
+        start: Option<&[ActiveSet]>,
+    ) -> Result<Vec<ContactSolution>, ContactError> {
+        if start.is_none() {
+            for p in 0..self.pairs.len() {
+                if self.operators[p].slid != [0.0; 3] {
+                    self.pair_again(p, [0.0; 3])?;
+                }
+            }
         }
         let cold = start.is_none();
-        let start = start.cloned().unwrap_or_else(|| self.initial_active_set());
+        let start = match start {
+            Some(start) => start.to_vec(),
+            None => self.initial_active_set(),
+        };
+        let mut active = BTreeSet::new();
+        let (mut rows, mut corrections) = (Vec::new(), Vec::new());
+        for (p, set) in start.into_iter().enumerate() {
+            active.extend(set.nodes.iter().map(|&i| self.offsets[p] + i));
+            rows.push(set.rows);
+            corrections.push(set.corrections);
+        }
         let mut state = LoopState {
-            solved: start.nodes.clone(),
-            active: start.nodes,
-            rows: start.rows,
-            corrections: start.corrections,
+            solved: active.clone(),
+            active,
+            rows,
+            corrections,
             safeguard: Safeguard::default(),
             history: Vec::new(),
             last: None,
@@ -339,46 +482,49 @@ impl<'a> ContactSolver<'a> {
             first_contact: false,
         };
         let mut status = ContactStatus::IterationLimit;
-        for iteration in 1..=self.problem.settings.max_iterations {
+        for iteration in 1..=self.loop_settings().max_iterations {
             self.solver.cancel.check()?;
             if let Some(end) = self.iteration(&mut state, iteration, load_factor)? {
                 status = end;
                 break;
             }
         }
+        self.finish(load_factor, status, state)
+    }
+}
 
-        let (coupling, solution) = state.last.expect("max_iterations >= 1 is validated");
-        let next_start = ActiveSet {
-            nodes: state.active,
-            rows: state.rows,
-            corrections: state.corrections,
-        };
-        self.finish(
-            load_factor,
-            status,
-            state.history,
-            &coupling,
-            solution,
-            next_start,
-        )
+/// The bodies linked to body `k` through pairs (`k` among them), in increasing order.
+fn linked_bodies(pair_bodies: &[[usize; 2]], k: usize) -> Vec<usize> {
+    let mut linked = BTreeSet::from([k]);
+    loop {
+        let before = linked.len();
+        for sides in pair_bodies {
+            if sides.iter().any(|b| linked.contains(b)) {
+                linked.extend(sides.iter().copied());
+            }
+        }
+        if linked.len() == before {
+            return linked.into_iter().collect();
+        }
     }
 }
 
 /// The active-set loop between two iterations.
 struct LoopState {
-    /// The active set the next iteration solves on.
+    /// The active set the next iteration solves on (all pairs: [`ContactSolver::offsets`]).
     active: BTreeSet<usize>,
-    rows: Vec<GapRow>,
-    corrections: Vec<f64>,
+    /// Each pair's gap rows and tied corrections.
+    rows: Vec<Vec<GapRow>>,
+    corrections: Vec<Vec<f64>>,
     safeguard: Safeguard,
     history: Vec<IterationRecord>,
-    /// The last iterate: its coupling and solution.
-    last: Option<(Coupling, CoupledSolution)>,
+    /// The last iterate: each pair's coupling, and the solution.
+    last: Option<(Vec<Coupling>, CoupledSolution)>,
     /// The active set `last` was solved on (`active` moves on to the next one).
     solved: BTreeSet<usize>,
     /// Whether the solve started without an active set from an earlier one.
     cold: bool,
-    /// Whether the loop has chosen where a body that only its contacts hold touches first
+    /// Whether the loop has chosen where the bodies that only their contacts hold touch first
     /// ([`ContactSolver::first_contact`]).
     first_contact: bool,
 }
@@ -389,7 +535,7 @@ impl LoopState {
     fn advance(
         &mut self,
         record: IterationRecord,
-        last: (Coupling, CoupledSolution),
+        last: (Vec<Coupling>, CoupledSolution),
         step: Step,
     ) -> Option<ContactStatus> {
         self.history.push(record);
@@ -414,20 +560,19 @@ impl ContactSolver<'_> {
         iteration: usize,
         load_factor: f64,
     ) -> Result<Option<ContactStatus>, ContactError> {
-        let problem = self.problem;
         let mut seconds = PhaseSeconds::default();
-        if state.active.is_empty() || (iteration == 1 && state.cold) {
-            self.first_contact(state, load_factor)?;
-        }
+        self.first_contact(state, iteration, load_factor)?;
         // 1. The coupling of the active set: rows and columns of the fixed operators.
-        let nodes: Vec<usize> = state.active.iter().copied().collect();
-        let coupling = timed(&mut seconds.operators, || {
-            self.coupling(&nodes, &state.rows, &state.corrections)
+        let nodes: Vec<Vec<usize>> = (0..self.pairs.len())
+            .map(|p| self.pair_nodes(&state.active, p))
+            .collect();
+        let couplings = timed(&mut seconds.operators, || {
+            self.couplings(&nodes, &state.rows, &state.corrections)
         });
-        self.check_held(&coupling, &nodes)?;
+        self.check_held(&couplings, &nodes)?;
         // 2-4. The coupled solve, the gaps at the iterate, the active set update.
         let iterate = self.iterate(
-            &coupling,
+            &couplings,
             &state.active,
             load_factor,
             &state.safeguard,
@@ -454,37 +599,43 @@ impl ContactSolver<'_> {
             }
             iterate => iterate?,
         };
-        let drift = pairing_drift(
-            &self.operators.slid,
-            &slid,
-            &problem.primary_surface,
-            &nodes,
-        );
-        if problem.settings.formulation == Formulation::Tied {
-            state.corrections = gaps.iter().zip(&linear).map(|(g, l)| g - l).collect();
+        let drift: Vec<f64> = (0..self.pairs.len())
+            .map(|p| {
+                let s1 = &self.pairs[p].primary_surface;
+                pairing_drift(&self.operators[p].slid, &slid[p], s1, &nodes[p])
+            })
+            .collect();
+        for (p, problem) in self.pairs.iter().enumerate() {
+            if problem.settings.formulation == Formulation::Tied {
+                state.corrections[p] = (gaps[p].iter().zip(&linear[p]))
+                    .map(|(g, l)| g - l)
+                    .collect();
+            }
         }
         // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
         //    settled on a pairing the surfaces have slid away from is paired again where
         //    they touch, and solved again.
+        let drifted: Vec<usize> = (0..self.pairs.len())
+            .filter(|&p| drift[p] > REPAIR_DRIFT_OVER_H)
+            .collect();
         let step = match state.safeguard.next(&state.active, &update) {
-            Step::Stop(ContactStatus::Converged) if drift > REPAIR_DRIFT_OVER_H => {
-                timed(&mut seconds.operators, || self.pair_again(slid))?;
-                state.corrections = self.corrections(&solution, &gaps);
+            Step::Stop(ContactStatus::Converged) if !drifted.is_empty() => {
+                for &p in &drifted {
+                    timed(&mut seconds.operators, || self.pair_again(p, slid[p]))?;
+                    state.corrections[p] = self.corrections(p, &solution, &gaps[p]);
+                }
                 state.safeguard = Safeguard::default();
                 Step::Solve(state.active.clone())
             }
             // The first iteration of a solve goes on with the set the half-space model
             // predicts, rather than with every penetrating node.
-            Step::Solve(next)
-                if iteration == 1
-                    && !update.penetrating.is_empty()
-                    && problem.settings.formulation == Formulation::Frictionless =>
-            {
-                Step::Solve(self.predicted(&next, &update, &nodes, &solution, &coupling, &gaps))
+            Step::Solve(next) if iteration == 1 && !update.penetrating.is_empty() => {
+                Step::Solve(self.predicted(&next, &update, &nodes, &solution, &couplings, &gaps))
             }
             step => step,
         };
         let residual = solution.relative_residual;
+        let drift = drift.iter().copied().fold(0.0, f64::max);
         let record = record(
             &update,
             iteration,
@@ -496,113 +647,201 @@ impl ContactSolver<'_> {
         if self.solver.verbose {
             log::info!("{}", record.line());
         }
-        Ok(state.advance(record, (coupling, solution), step))
+        Ok(state.advance(record, (couplings, solution), step))
     }
 
-    /// Where a body that nothing but the contact holds along a force-controlled component
-    /// touches first, when the loop starts cold or has no node in contact: with no node in
-    /// contact its system is singular (the force would move it without bound), and from the
-    /// nodes that merely touch (a sphere's pole) the first iterate would carry the whole force
-    /// on them. The active set becomes the half-space model's zone for the force
-    /// (`super::half_space::force_controlled_set`), or the closest node if the model finds
-    /// none. If the loop lets go of every contact after that, the force pulls the body off: an
-    /// error that names it.
-    fn first_contact(&self, state: &mut LoopState, load_factor: f64) -> Result<(), ContactError> {
-        let Some(&(body, index)) = self.held_by_contact.first() else {
-            return Ok(());
-        };
-        let (name, assembled) = match body {
-            0 => (&self.problem.primary.body.name, &self.body1),
-            _ => (&self.problem.secondary.body.name, &self.body2),
-        };
-        let rigid = &assembled.rigid[index];
-        let component = ["x", "y", "z"][rigid.component];
-        if state.first_contact {
-            if state.active.is_empty() {
-                return Err(match rigid.pin {
-                    true => ContactError::FloatsAway { body: name.clone() },
-                    false => ContactError::PulledAway {
-                        body: name.clone(),
-                        group: rigid.group.clone(),
-                        component,
-                    },
-                });
-            }
+    /// Where the bodies that nothing but their contacts hold (along a force-controlled
+    /// component, or along the rigid motions their supports leave free) touch first, when the
+    /// loop starts cold or such a body has no node in contact: with no node in contact its
+    /// system is singular (the force would move it without bound), and from the nodes that
+    /// merely touch (a sphere's pole) the first iterate would carry the whole force on them.
+    /// Each pair of such a body starts on the half-space model's zone for the resultant of
+    /// its bodies' loads and forces (`super::half_space::force_controlled_set`), or on its
+    /// closest node if the model finds none. If the loop lets go of every contact of such a
+    /// body after that, its loads pull it off: an error that names it.
+    fn first_contact(
+        &self,
+        state: &mut LoopState,
+        iteration: usize,
+        load_factor: f64,
+    ) -> Result<(), ContactError> {
+        if self.held_by_contact.is_empty() {
             return Ok(());
         }
-        let problem = self.problem;
-        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        let gaps = match state.last.as_ref().map(|(_, solution)| &solution.u) {
-            Some(u) => geometric_gaps(s1, s2, Some(&u[0]), Some(&u[1])),
-            None => geometric_gaps(s1, s2, None, None),
-        };
-        // The force the contact carries, at most: the resultant of the body's loads and of the
-        // forces on its force-controlled groups (its supports may carry part of it; the zone
-        // then errs on the large side, which the loop corrects).
-        let dim = assembled.dim;
-        let force = (0..dim)
-            .map(|c| {
-                let on_groups: f64 = (assembled.rigid.iter())
-                    .filter(|rigid| !rigid.pin && rigid.component == c)
-                    .map(|rigid| rigid.force)
-                    .sum();
-                let loads: f64 = assembled.f.iter().skip(c).step_by(dim).sum();
-                (load_factor * (on_groups + loads)).powi(2)
+        let touches = |k: usize| {
+            (0..self.pairs.len()).any(|p| {
+                self.pair_bodies[p].contains(&k) && !self.pair_nodes(&state.active, p).is_empty()
             })
-            .sum::<f64>()
-            .sqrt();
-        let materials = [&problem.primary.material, &problem.secondary.material];
-        let c0 = compliance_factor(materials, s1.dim);
-        let mut zone: BTreeSet<usize> = force_controlled_set(s1, &gaps, force, c0)
-            .into_iter()
-            .collect();
-        if zone.is_empty() {
-            let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
-            zone.extend(closest);
+        };
+        let untouched = (self.held_by_contact.iter()).find(|&&(k, _)| !touches(k));
+        if !(untouched.is_some() || (iteration == 1 && state.cold)) {
+            return Ok(());
         }
-        if self.solver.verbose {
-            log::info!(
-                "  '{name}' is held along {component} only by the contact: it starts on the {} \
-                 nodes where two half-spaces would carry its force {force:.6e}",
-                zone.len()
-            );
+        if state.first_contact {
+            let Some(&(k, index)) = untouched else {
+                return Ok(());
+            };
+            let name = self.elastic(k).body.name.clone();
+            let rigid = &self.bodies[k].rigid[index];
+            return Err(match rigid.pin {
+                true => ContactError::FloatsAway { body: name },
+                false => ContactError::PulledAway {
+                    body: name,
+                    group: rigid.group.clone(),
+                    component: ["x", "y", "z"][rigid.component],
+                },
+            });
         }
-        state.active = zone;
+        let held = |k: usize| self.held_by_contact.iter().any(|h| h.0 == k);
+        for (p, problem) in self.pairs.iter().enumerate() {
+            let sides = self.pair_bodies[p];
+            if !sides.iter().any(|&k| held(k)) {
+                continue;
+            }
+            let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+            let gaps = match state.last.as_ref().map(|(_, solution)| &solution.u) {
+                Some(u) => geometric_gaps(s1, s2, Some(&u[sides[0]]), Some(&u[sides[1]])),
+                None => geometric_gaps(s1, s2, None, None),
+            };
+            // The force the contact carries, at most: the resultant of the loads and of the
+            // forces on the force-controlled groups of a body held by its contacts alone (its
+            // supports may carry part of it; the zone then errs on the large side, which the
+            // loop corrects).
+            let force = (sides.iter().filter(|&&k| held(k)))
+                .map(|&k| load_factor * self.resultant(k))
+                .fold(0.0, f64::max);
+            let materials = [&problem.primary.material, &problem.secondary.material];
+            let c0 = compliance_factor(materials, s1.dim);
+            let mut zone = force_controlled_set(s1, &gaps, force, c0);
+            if zone.is_empty() {
+                let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
+                zone.extend(closest);
+            }
+            if self.solver.verbose {
+                log::info!(
+                    "  '{}' and '{}': a body only the contacts hold starts on the {} nodes where \
+                     two half-spaces would carry the force {force:.6e}",
+                    problem.primary.body.name,
+                    problem.secondary.body.name,
+                    zone.len()
+                );
+            }
+            state.active = self.with_pair_nodes(&state.active, p, zone);
+        }
         state.first_contact = true;
         Ok(())
     }
 
-    /// An error unless the contact of the active `nodes` (with their `coupling`) holds the
-    /// body that only the contact holds along the motions its supports leave free: each
-    /// motion must move some active node along a direction its constraint holds (the normal;
-    /// every direction for tied contact). Without it the coupled system is singular along that
-    /// motion, and a Krylov solve may still return one of its infinitely many answers.
+    /// The magnitude of the resultant of body `k`'s loads and of the forces on its
+    /// force-controlled groups, at load factor 1.
+    fn resultant(&self, k: usize) -> f64 {
+        let body = &self.bodies[k];
+        let dim = body.dim;
+        (0..dim)
+            .map(|c| {
+                let on_groups: f64 = (body.rigid.iter())
+                    .filter(|rigid| !rigid.pin && rigid.component == c)
+                    .map(|rigid| rigid.force)
+                    .sum();
+                let loads: f64 = body.f.iter().skip(c).step_by(dim).sum();
+                (on_groups + loads).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    /// An error unless the contacts of the active nodes (with their `couplings`) hold each
+    /// body that only its contacts hold along the motions its supports leave free: each
+    /// motion must move some active node of its pairs along a direction its constraint holds
+    /// (the normal; every direction for tied contact). Without it the coupled system is
+    /// singular along that motion, and a Krylov solve may still return one of its infinitely
+    /// many answers.
     ///
     /// The test: with `h_i = [d . r_j(x_i)]_j` for each held direction `d` at each active node
     /// `x_i` and the free motions `V`, the Gram matrix `sum (h_i V)^T (h_i V)` must have no
     /// eigenvalue below [`HELD_PER_ROW`] times the number of rows (each `h_i` has a unit
     /// translation part, and the rotations are scaled by the body's size).
-    fn check_held(&self, coupling: &Coupling, nodes: &[usize]) -> Result<(), ContactError> {
-        let Some((body, motions)) = &self.free_motions else {
-            return Ok(());
-        };
-        let free = motions.ncols();
-        if free == 0 || nodes.is_empty() {
-            return Ok(());
+    fn check_held(&self, couplings: &[Coupling], nodes: &[Vec<usize>]) -> Result<(), ContactError> {
+        for (k, motions) in &self.free_motions {
+            let free = motions.ncols();
+            if free == 0 {
+                continue;
+            }
+            let elastic = self.elastic(*k);
+            let dim = elastic.body.dim;
+            let modes = RigidModes::new(&elastic.body.coords, dim);
+            // Two sets of (point, held directions): the constraints' and the body's own.
+            let mut sets: [Vec<([f64; 3], Vec<[f64; 3]>)>; 2] = [Vec::new(), Vec::new()];
+            for p in (0..self.pairs.len()).filter(|&p| self.pair_bodies[p].contains(k)) {
+                let side = usize::from(self.pair_bodies[p][0] != *k);
+                for (set, rows) in
+                    sets.iter_mut()
+                        .zip(self.held_rows(p, side, &couplings[p], &nodes[p]))
+                {
+                    set.extend(rows);
+                }
+            }
+            if sets[0].is_empty() {
+                continue;
+            }
+            let mut unheld = 0;
+            for set in sets {
+                let mut gram = nalgebra::DMatrix::<f64>::zeros(free, free);
+                let mut rows = 0.0;
+                for (at, directions) in set {
+                    let at = modes.at(&at);
+                    for d in directions {
+                        let h = nalgebra::DVector::from_iterator(
+                            at.len(),
+                            at.iter().map(|r| (0..3).map(|c| d[c] * r[c]).sum::<f64>()),
+                        );
+                        let hv = motions.transpose() * h;
+                        gram += &hv * hv.transpose();
+                        rows += 1.0;
+                    }
+                }
+                let eigenvalues = nalgebra::SymmetricEigen::new(gram).eigenvalues;
+                let held = |e: &&f64| **e > HELD_PER_ROW * rows;
+                unheld = unheld.max(eigenvalues.iter().filter(|e| !held(e)).count());
+            }
+            if unheld > 0 {
+                let active = nodes.iter().map(Vec::len).sum();
+                return Err(ContactError::NotHeld {
+                    body: elastic.body.name.clone(),
+                    free: unheld,
+                    active,
+                });
+            }
         }
-        let problem = self.problem;
-        let elastic = match body {
-            0 => &problem.primary,
-            _ => &problem.secondary,
-        };
-        let dim = elastic.body.dim;
-        let modes = RigidModes::new(&elastic.body.coords, dim);
+        Ok(())
+    }
+
+    /// The points and directions pair `p`'s active `nodes` hold on its body of `side` (0 the
+    /// primary): once the constraints' and once the body's own (module doc of
+    /// [`Self::check_held`]). Frictionless: the normal, taken as the secondary facet's (the
+    /// constraint's) and as the body's own surface's: a round body turning about its centre
+    /// moves its nodes along the other body's normal but maps its surface onto itself, so only
+    /// its own normals show that nothing holds it. Tied: every direction.
+    #[allow(clippy::type_complexity)]
+    fn held_rows(
+        &self,
+        p: usize,
+        side: usize,
+        coupling: &Coupling,
+        nodes: &[usize],
+    ) -> [Vec<([f64; 3], Vec<[f64; 3]>)>; 2] {
+        let problem = &self.pairs[p];
         let s1 = &problem.primary_surface;
-        // The directions each active node holds. Frictionless: its normal, taken once as the
-        // secondary facet's (the constraint's) and once as the primary surface's own: a round
-        // body turning about its centre moves its nodes along the other body's normal but
-        // maps its surface onto itself, so only its own normals show that nothing holds it.
-        let own: Vec<[f64; 3]> = match body {
+        let dim = s1.dim;
+        let points: Vec<[f64; 3]> = nodes.iter().map(|&i| s1.coords[i]).collect();
+        if problem.settings.formulation == Formulation::Tied {
+            let axes: Vec<[f64; 3]> = (0..dim)
+                .map(|c| std::array::from_fn(|j| f64::from(u8::from(j == c))))
+                .collect();
+            let rows: Vec<_> = points.iter().map(|&x| (x, axes.clone())).collect();
+            return [rows.clone(), rows];
+        }
+        let own: Vec<[f64; 3]> = match side {
             0 => nodes.iter().map(|&i| s1.normals[i]).collect(),
             // The secondary's own normal where each active node touches it: its nodes'
             // normals weighted as the constraint row weighs them.
@@ -624,146 +863,119 @@ impl ContactSolver<'_> {
                     .collect()
             }
         };
-        let direction_sets: Vec<Vec<Vec<[f64; 3]>>> = match problem.settings.formulation {
-            Formulation::Frictionless => vec![
-                (0..nodes.len())
-                    .map(|k| vec![coupling.normals[k]])
-                    .collect(),
-                own.into_iter().map(|n| vec![n]).collect(),
-            ],
-            Formulation::Tied => vec![
-                (0..nodes.len())
-                    .map(|_| {
-                        (0..dim)
-                            .map(|c| std::array::from_fn(|j| f64::from(u8::from(j == c))))
-                            .collect()
-                    })
-                    .collect(),
-            ],
-        };
-        let mut unheld = 0;
-        for directions in direction_sets {
-            let mut gram = nalgebra::DMatrix::<f64>::zeros(free, free);
-            let mut rows = 0.0;
-            for (&i, at_node) in nodes.iter().zip(directions) {
-                let at = modes.at(&s1.coords[i]);
-                for d in at_node {
-                    let h = nalgebra::DVector::from_iterator(
-                        at.len(),
-                        at.iter().map(|r| (0..3).map(|c| d[c] * r[c]).sum::<f64>()),
-                    );
-                    let hv = motions.transpose() * h;
-                    gram += &hv * hv.transpose();
-                    rows += 1.0;
-                }
-            }
-            let eigenvalues = nalgebra::SymmetricEigen::new(gram).eigenvalues;
-            let held = |e: &&f64| **e > HELD_PER_ROW * rows;
-            unheld = unheld.max(eigenvalues.iter().filter(|e| !held(e)).count());
-        }
-        if unheld > 0 {
-            return Err(ContactError::NotHeld {
-                body: elastic.body.name.clone(),
-                free: unheld,
-                active: nodes.len(),
-            });
-        }
-        Ok(())
+        let constraint = (points.iter().zip(&coupling.normals))
+            .map(|(&x, &n)| (x, vec![n]))
+            .collect();
+        let own = points.iter().zip(own).map(|(&x, n)| (x, vec![n])).collect();
+        [constraint, own]
     }
 
-    /// The active set the half-space model predicts (`super::half_space::predicted_set`) from
-    /// the iterate `solution` on the active `nodes` with its `coupling`, over the nodes the
-    /// update keeps or adds (`next`) and those it removes; `next` itself if the model predicts
-    /// no contact.
+    /// The active set the half-space model predicts (`super::half_space::predicted_set`) for
+    /// each frictionless pair from the iterate `solution` on the active `nodes` with their
+    /// `couplings`, over the nodes the update keeps or adds (`next`) and those it removes;
+    /// `next`'s nodes of a pair where the model predicts no contact.
     fn predicted(
         &self,
         next: &BTreeSet<usize>,
         update: &Update,
-        nodes: &[usize],
+        nodes: &[Vec<usize>],
         solution: &CoupledSolution,
-        coupling: &Coupling,
-        gaps: &[f64],
+        couplings: &[Coupling],
+        gaps: &[Vec<f64>],
     ) -> BTreeSet<usize> {
-        let problem = self.problem;
-        let s1 = &problem.primary_surface;
-        let mut pressure = vec![0.0; s1.len()];
-        for ((&i, t), n) in nodes
-            .iter()
-            .zip(&solution.traction[0])
-            .zip(&coupling.normals)
-        {
-            pressure[i] = -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]);
-        }
-        let mut candidates: BTreeSet<usize> = next.clone();
-        candidates.extend(update.tension.iter().map(|&(i, _)| i));
-        let candidates: Vec<usize> = candidates.into_iter().collect();
-        let materials = [&problem.primary.material, &problem.secondary.material];
-        let c0 = compliance_factor(materials, s1.dim);
-        let predicted: BTreeSet<usize> = predicted_set(s1, &candidates, gaps, &pressure, c0)
-            .into_iter()
-            .collect();
-        if self.solver.verbose {
-            log::info!(
-                "  half-space prediction: {} nodes active next (the update's {})",
-                predicted.len(),
-                next.len()
+        let mut predicted_all = next.clone();
+        for (p, problem) in self.pairs.iter().enumerate() {
+            if problem.settings.formulation != Formulation::Frictionless {
+                continue;
+            }
+            let s1 = &problem.primary_surface;
+            let mut pressure = vec![0.0; s1.len()];
+            for ((&i, t), n) in (nodes[p].iter())
+                .zip(&solution.traction[p])
+                .zip(&couplings[p].normals)
+            {
+                pressure[i] = -(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]);
+            }
+            let (offset, end) = (self.offsets[p], self.offsets[p + 1]);
+            let mut candidates: BTreeSet<usize> = self.pair_nodes(next, p).into_iter().collect();
+            candidates.extend(
+                (update.tension.iter())
+                    .filter(|&&(i, _)| (offset..end).contains(&i))
+                    .map(|&(i, _)| i - offset),
             );
+            let candidates: Vec<usize> = candidates.into_iter().collect();
+            let materials = [&problem.primary.material, &problem.secondary.material];
+            let c0 = compliance_factor(materials, s1.dim);
+            let predicted = predicted_set(s1, &candidates, &gaps[p], &pressure, c0);
+            if self.solver.verbose {
+                log::info!(
+                    "  half-space prediction: {} nodes active next (the update's {})",
+                    predicted.len(),
+                    self.pair_nodes(next, p).len()
+                );
+            }
+            if !predicted.is_empty() {
+                predicted_all = self.with_pair_nodes(&predicted_all, p, predicted);
+            }
         }
-        if predicted.is_empty() {
-            next.clone()
-        } else {
-            predicted
-        }
+        predicted_all
     }
 
-    /// The tied corrections of the current operators at `solution`, whose geometric gaps are
-    /// `gaps`: each gap less its linearization.
-    fn corrections(&self, solution: &CoupledSolution, gaps: &[f64]) -> Vec<f64> {
-        let (s1, s2) = (
-            &self.problem.primary_surface,
-            &self.problem.secondary_surface,
-        );
-        let jumps = (self.operators).jumps(s1, s2, &solution.u[0], &solution.u[1]);
-        let linear = self.operators.linearized_gaps(&jumps);
+    /// Pair `p`'s tied corrections of its current operators at `solution`, whose geometric
+    /// gaps are `gaps`: each gap less its linearization.
+    fn corrections(&self, p: usize, solution: &CoupledSolution, gaps: &[f64]) -> Vec<f64> {
+        let problem = &self.pairs[p];
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let [a, b] = self.pair_bodies[p];
+        let jumps = self.operators[p].jumps(s1, s2, &solution.u[a], &solution.u[b]);
+        let linear = self.operators[p].linearized_gaps(&jumps);
         gaps.iter().zip(&linear).map(|(g, l)| g - l).collect()
     }
 }
 
 impl ContactSolver<'_> {
-    /// The coupling of the active primary nodes `nodes` (surface indices): rows and columns of
-    /// the fixed operators, the constraint linearized by `rows` (frictionless) or corrected by
-    /// `corrections` (tied).
-    fn coupling(&mut self, nodes: &[usize], rows: &[GapRow], corrections: &[f64]) -> Coupling {
-        let problem = self.problem;
-        let formulation = problem.settings.formulation;
-        let constraint = match formulation {
-            Formulation::Frictionless => Constraint::Geometric { rows },
-            Formulation::Tied => Constraint::Interpolated { corrections },
-        };
-        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        (self.operators).coupling(s1, s2, formulation, nodes, constraint)
+    /// The coupling of each pair's active primary nodes `nodes` (surface indices): rows and
+    /// columns of its fixed operators, the constraint linearized by `rows` (frictionless) or
+    /// corrected by `corrections` (tied).
+    fn couplings(
+        &mut self,
+        nodes: &[Vec<usize>],
+        rows: &[Vec<GapRow>],
+        corrections: &[Vec<f64>],
+    ) -> Vec<Coupling> {
+        let mut couplings = Vec::with_capacity(self.pairs.len());
+        for (p, problem) in self.pairs.iter().enumerate() {
+            let formulation = problem.settings.formulation;
+            let constraint = match formulation {
+                Formulation::Frictionless => Constraint::Geometric { rows: &rows[p] },
+                Formulation::Tied => Constraint::Interpolated {
+                    corrections: &corrections[p],
+                },
+            };
+            let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+            let operators = &mut self.operators[p];
+            couplings.push(operators.coupling(s1, s2, formulation, &nodes[p], constraint));
+        }
+        couplings
     }
 
-    /// Steps 2-4 of the loop on the active set `active` with its `coupling`: the coupled
-    /// solve; the gaps of every primary candidate, geometric (the search) and linearized at
-    /// the iterate (into `rows`), and how far the active nodes' pairing has slid; the
-    /// primal-dual active set update. On the Krylov path the solve is first loose
+    /// Steps 2-4 of the loop on the active set `active` with the pairs' `couplings`: the
+    /// coupled solve; the gaps of every primary candidate of each pair, geometric (the search)
+    /// and linearized at the iterate (into `rows`), and how far each pair's active nodes have
+    /// slid; the primal-dual active set update. On the Krylov path the solve is first loose
     /// ([`Tightness::Loose`]) and solved again tightly when its update would keep the active
-    /// set or return to one seen before: no answer, status or check rests on a loose solve. The time of each phase is added to `seconds`.
+    /// set or return to one seen before: no answer, status or check rests on a loose solve.
+    /// The time of each phase is added to `seconds`.
     #[allow(clippy::too_many_arguments)]
     fn iterate(
         &mut self,
-        coupling: &Coupling,
+        couplings: &[Coupling],
         active: &BTreeSet<usize>,
         load_factor: f64,
         safeguard: &Safeguard,
-        rows: &mut Vec<GapRow>,
+        rows: &mut [Vec<GapRow>],
         seconds: &mut PhaseSeconds,
     ) -> Result<Iterate, ContactError> {
-        let problem = self.problem;
-        let settings = &problem.settings;
-        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        let nodes: Vec<usize> = active.iter().copied().collect();
         let mut loose = self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let mut krylov_iterations = None;
         loop {
@@ -773,29 +985,53 @@ impl ContactSolver<'_> {
                 } else {
                     Tightness::Tight
                 };
-                self.coupled_solve(coupling, load_factor, tightness)
+                self.coupled_solve(couplings, load_factor, tightness)
             })?;
             if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
                 *krylov_iterations.get_or_insert(0) += stats.iterations;
             }
-            let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
-            let (gaps, linear, slid) = timed(&mut seconds.search, || {
-                let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                *rows = gap_rows(s1, s2, Some(u1), Some(u2));
-                let jumps = self.operators.jumps(s1, s2, u1, u2);
-                let slid = self.operators.slide(s1, &jumps, &nodes);
-                (gaps, self.operators.linearized_gaps(&jumps), slid)
-            });
-            // The gap each active node's constraint holds: the gap of its linearization.
-            let held: Vec<f64> = match settings.formulation {
-                Formulation::Frictionless => rows.iter().map(|r| r.gap).collect(),
-                Formulation::Tied => gaps.clone(),
-            };
-            let update = timed(&mut seconds.checks, || {
-                let (traction, normals) = (&solution.traction[0], &coupling.normals);
-                let pinned = &safeguard.pinned;
-                Update::new(problem, &nodes, traction, normals, [&gaps, &held], pinned)
-            });
+            let (mut gaps, mut linear, mut slid) = (Vec::new(), Vec::new(), Vec::new());
+            let mut updates = Vec::new();
+            for (p, problem) in self.pairs.iter().enumerate() {
+                let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+                let [a, b] = self.pair_bodies[p];
+                let (u1, u2) = (&solution.u[a][..], &solution.u[b][..]);
+                let nodes = self.pair_nodes(active, p);
+                let operators = &self.operators[p];
+                let (pair_gaps, pair_linear, pair_slid) = timed(&mut seconds.search, || {
+                    let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
+                    rows[p] = gap_rows(s1, s2, Some(u1), Some(u2));
+                    let jumps = operators.jumps(s1, s2, u1, u2);
+                    let slid = operators.slide(s1, &jumps, &nodes);
+                    (gaps, operators.linearized_gaps(&jumps), slid)
+                });
+                // The gap each active node's constraint holds: the gap of its linearization.
+                let held: Vec<f64> = match problem.settings.formulation {
+                    Formulation::Frictionless => rows[p].iter().map(|r| r.gap).collect(),
+                    Formulation::Tied => pair_gaps.clone(),
+                };
+                let offset = self.offsets[p];
+                let update = timed(&mut seconds.checks, || {
+                    let (traction, normals) = (&solution.traction[p], &couplings[p].normals);
+                    let pinned: HashSet<usize> = (safeguard.pinned.iter())
+                        .filter(|&&i| (offset..self.offsets[p + 1]).contains(&i))
+                        .map(|&i| i - offset)
+                        .collect();
+                    Update::new(
+                        problem,
+                        &nodes,
+                        traction,
+                        normals,
+                        [&pair_gaps, &held],
+                        &pinned,
+                    )
+                });
+                updates.push((offset, update));
+                gaps.push(pair_gaps);
+                linear.push(pair_linear);
+                slid.push(pair_slid);
+            }
+            let update = Update::merge(updates);
             if loose && (update.next == *active || safeguard.seen.contains(&update.next)) {
                 loose = false;
                 continue;
@@ -811,61 +1047,83 @@ impl ContactSolver<'_> {
         }
     }
 
-    /// The answer of a loop that ended `loop_end` with `solution` on the active set of
-    /// `next_start`: certified without the loop's operators (`super::checks`), which decides
-    /// the status, with the fields and forces of `super::post`.
+    /// The answers of a loop that ended `loop_end` in `state`, one per pair: each certified
+    /// without the loop's operators (`super::checks`), which decides its status, with the
+    /// fields and forces of `super::post`.
     fn finish(
         &self,
         load_factor: f64,
         loop_end: ContactStatus,
-        history: Vec<IterationRecord>,
-        coupling: &Coupling,
-        solution: CoupledSolution,
-        next_start: ActiveSet,
-    ) -> Result<ContactSolution, ContactError> {
-        let nodes: Vec<usize> = next_start.nodes.iter().copied().collect();
-        let (certificate, gaps) = certify(self.problem, &solution, &nodes);
-        let status = contact_status(loop_end, &certificate, nodes.is_empty());
-        post::finish(LastIterate {
-            problem: self.problem,
-            bodies: [(&self.body1, &self.stats1), (&self.body2, &self.stats2)],
-            linear_solvers: self.linear_solvers(),
-            load_factor,
-            status,
-            history,
-            certificate,
-            gaps,
-            coupling,
-            solution,
-            active_set: next_start,
-        })
+        state: LoopState,
+    ) -> Result<Vec<ContactSolution>, ContactError> {
+        let (couplings, solution) = state.last.expect("max_iterations >= 1 is validated");
+        let dim = self.pairs[0].primary_surface.dim;
+        let mut answers = Vec::with_capacity(self.pairs.len());
+        for (p, problem) in self.pairs.iter().enumerate() {
+            let [a, b] = self.pair_bodies[p];
+            let nodes = self.pair_nodes(&state.active, p);
+            let pair = Pair {
+                primary: a,
+                secondary: b,
+                coupling: &couplings[p],
+            };
+            let view = solution.of_pair(p, &pair, dim);
+            let (certificate, gaps) = certify(problem, &view, &nodes);
+            let status = contact_status(loop_end, &certificate, nodes.is_empty());
+            let active_set = ActiveSet {
+                nodes: nodes.into_iter().collect(),
+                rows: state.rows[p].clone(),
+                corrections: state.corrections[p].clone(),
+            };
+            answers.push(post::finish(LastIterate {
+                problem,
+                bodies: [
+                    (&self.bodies[a], &self.stats[a]),
+                    (&self.bodies[b], &self.stats[b]),
+                ],
+                body_contact_force: [&solution.contact_force[a], &solution.contact_force[b]],
+                linear_solvers: self.linear_solvers(),
+                load_factor,
+                status,
+                history: state.history.clone(),
+                certificate,
+                gaps,
+                coupling: &couplings[p],
+                solution: view,
+                active_set,
+            })?);
+        }
+        Ok(answers)
     }
 
-    /// Builds the interface operators again, paired with the primary surface slid by `slid`;
-    /// the bodies' responses computed with the old ones are forgotten.
-    fn pair_again(&mut self, slid: [f64; 3]) -> Result<(), ContactError> {
-        self.operators = pair(self.problem, slid)?;
+    /// Builds pair `p`'s interface operators again, paired with its primary surface slid by
+    /// `slid`; the bodies' responses computed with the old ones are forgotten.
+    fn pair_again(&mut self, p: usize, slid: [f64; 3]) -> Result<(), ContactError> {
+        self.operators[p] = pair(&self.pairs[p], slid)?;
         if let Some(factors) = self.factors.as_mut() {
             factors.forget_responses();
         }
         Ok(())
     }
 
-    /// The coupled system of `coupling`, solved and checked by its relative residual; or, a
-    /// [`Tightness::Loose`] solve on the Krylov path, its residual only recorded.
+    /// The coupled system of the pairs' `couplings`, solved and checked by its relative
+    /// residual; or, a [`Tightness::Loose`] solve on the Krylov path, its residual only
+    /// recorded.
     fn coupled_solve(
         &mut self,
-        coupling: &Coupling,
+        couplings: &[Coupling],
         load_factor: f64,
         tightness: Tightness,
     ) -> Result<CoupledSolution, ContactError> {
-        let dim = self.problem.primary_surface.dim;
-        let bodies = [&self.body1, &self.body2];
-        let pairs = [Pair {
-            primary: 0,
-            secondary: 1,
-            coupling,
-        }];
+        let dim = self.pairs[0].primary_surface.dim;
+        let bodies: Vec<&AssembledBody> = self.bodies.iter().collect();
+        let pairs: Vec<Pair> = (couplings.iter().zip(&self.pair_bodies))
+            .map(|(coupling, &[primary, secondary])| Pair {
+                primary,
+                secondary,
+                coupling,
+            })
+            .collect();
         let system = CoupledSystem::assemble(&bodies, &pairs, dim, load_factor)?;
         let x = match self.factors.as_mut() {
             None => coupled_solver::solve_monolithic(&system, &bodies)?,
@@ -887,12 +1145,12 @@ impl ContactSolver<'_> {
 /// What steps 2-4 of one iteration found.
 struct Iterate {
     solution: CoupledSolution,
-    /// The geometric gap of every primary candidate at the iterate.
-    gaps: Vec<f64>,
+    /// The geometric gap of every primary candidate of each pair at the iterate.
+    gaps: Vec<Vec<f64>>,
     /// Their gaps through the interpolation operators (tied contact's corrections).
-    linear: Vec<f64>,
-    /// The slide of the active nodes' pairing ([`InterfaceOperators::slide`]).
-    slid: [f64; 3],
+    linear: Vec<Vec<f64>>,
+    /// The slide of each pair's active nodes' pairing ([`InterfaceOperators::slide`]).
+    slid: Vec<[f64; 3]>,
     update: Update,
     /// GMRES iterations of the solves (Krylov path).
     krylov_iterations: Option<usize>,

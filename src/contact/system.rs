@@ -106,7 +106,43 @@ pub struct CoupledSolution {
     pub relative_residual: f64,
 }
 
+/// Adds the forces pair `coupling`'s tractions `on_pair` put on its bodies to their nodal
+/// forces: `M_a lambda` on the primary, `-M_b R_ba lambda` on the secondary.
+fn add_pair_forces(
+    coupling: &Coupling,
+    on_pair: &[[f64; 3]],
+    dim: usize,
+    [primary, secondary]: [&mut [f64]; 2],
+) {
+    for (k, lambda) in on_pair.iter().enumerate() {
+        let node = coupling.primary_nodes[k];
+        for c in 0..dim {
+            primary[dim * node + c] += coupling.areas1[k] * lambda[c];
+            for &(node2, load) in &coupling.loads2[k] {
+                secondary[dim * node2 + c] -= load * lambda[c];
+            }
+        }
+    }
+}
+
 impl CoupledSolution {
+    /// Pair `p`'s part of the solution, as the solution of its two bodies alone: their
+    /// displacements and force-controlled displacements, its tractions, and the forces of
+    /// this pair alone on them (a body in several pairs receives the others' too).
+    pub fn of_pair(&self, p: usize, pair: &Pair, dim: usize) -> CoupledSolution {
+        let (a, b) = (pair.primary, pair.secondary);
+        let mut forces = [vec![0.0; self.u[a].len()], vec![0.0; self.u[b].len()]];
+        let [primary, secondary] = &mut forces;
+        add_pair_forces(pair.coupling, &self.traction[p], dim, [primary, secondary]);
+        CoupledSolution {
+            u: vec![self.u[a].clone(), self.u[b].clone()],
+            traction: vec![self.traction[p].clone()],
+            contact_force: forces.into(),
+            rigid: vec![self.rigid[a].clone(), self.rigid[b].clone()],
+            relative_residual: self.relative_residual,
+        }
+    }
+
     /// The total contact force on each body (components beyond `dim` are 0).
     pub fn total_forces(&self, dim: usize) -> Vec<[f64; 3]> {
         let total = |force: &[f64]| -> [f64; 3] {
@@ -433,15 +469,14 @@ impl CoupledSystem {
                     lambda
                 })
                 .collect();
-            for (k, lambda) in on_pair.iter().enumerate() {
-                let node = coupling.primary_nodes[k];
-                for c in 0..dim {
-                    contact_force[pair.primary][dim * node + c] += coupling.areas1[k] * lambda[c];
-                    for &(node2, load) in &coupling.loads2[k] {
-                        contact_force[pair.secondary][dim * node2 + c] -= load * lambda[c];
-                    }
-                }
-            }
+            let [primary, secondary] = if pair.primary < pair.secondary {
+                let (a, b) = contact_force.split_at_mut(pair.secondary);
+                [&mut a[pair.primary], &mut b[0]]
+            } else {
+                let (a, b) = contact_force.split_at_mut(pair.primary);
+                [&mut b[0], &mut a[pair.secondary]]
+            };
+            add_pair_forces(coupling, &on_pair, dim, [primary, secondary]);
             traction.push(on_pair);
         }
         CoupledSolution {

@@ -19,9 +19,12 @@ pub struct CaseSummary {
     pub mesh: String,
     pub dimension: usize,
     pub bodies: Vec<BodySummary>,
-    /// Present in contact runs.
+    /// Present in contact runs of one pair.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactSummary>,
+    /// Each pair's, in the case file's order, in contact runs of several pairs.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactSummary>,
     /// Seconds per phase of the whole run, in order.
     pub timings: Vec<(String, f64)>,
     /// The process's peak resident memory up to writing the summary, in MB (`VmHWM` of
@@ -57,6 +60,8 @@ pub struct BodySummary {
 /// How the contact solve ended, its forces and the iteration history.
 #[derive(Debug, Clone, Serialize)]
 pub struct ContactSummary {
+    /// The pair's name (`[contact] name`; default "BODY1-BODY2").
+    pub name: String,
     pub status: ContactStatus,
     pub primary: String,
     pub secondary: String,
@@ -131,29 +136,56 @@ impl Verdict {
 }
 
 impl CaseSummary {
-    /// Whether the case was solved, and accurately.
+    /// Whether the case was solved, and accurately: as its worst pair (a pair not solved
+    /// before one whose accuracy report failed), named when there are several.
     pub fn verdict(&self) -> Verdict {
-        match &self.contact {
-            Some(contact) if !contact.status.is_solution() => {
-                let failed = failures(&contact.solved.checks);
-                Verdict::NotSolved(format!(
-                    "the contact problem was not solved: status \"{}\"{}",
-                    contact.status.name(),
-                    if failed.is_empty() {
-                        String::new()
-                    } else {
-                        format!(", failed: {failed}")
-                    },
-                ))
+        let several = !self.contacts.is_empty();
+        let verdicts = self.contact.iter().chain(&self.contacts).map(|contact| {
+            let verdict = contact_verdict(contact);
+            match (several, verdict) {
+                (true, Verdict::NotSolved(why)) => {
+                    Verdict::NotSolved(format!("pair '{}': {why}", contact.name))
+                }
+                (true, Verdict::Inaccurate(why)) => {
+                    Verdict::Inaccurate(format!("pair '{}': {why}", contact.name))
+                }
+                (_, verdict) => verdict,
             }
-            Some(contact) if !contact.accuracy.passed => Verdict::Inaccurate(format!(
-                "the contact problem was solved, but its accuracy report failed: {}",
-                failures(&contact.accuracy.indicators)
-            )),
-            Some(contact) => earlier_steps_verdict(&contact.steps),
-            None => Verdict::Solved,
-        }
+        });
+        let verdicts: Vec<Verdict> = verdicts.collect();
+        (verdicts.iter())
+            .find(|v| matches!(v, Verdict::NotSolved(_)))
+            .or_else(|| {
+                verdicts
+                    .iter()
+                    .find(|v| matches!(v, Verdict::Inaccurate(_)))
+            })
+            .cloned()
+            .unwrap_or(Verdict::Solved)
     }
+}
+
+/// Whether one pair was solved, and accurately.
+fn contact_verdict(contact: &ContactSummary) -> Verdict {
+    if !contact.status.is_solution() {
+        let failed = failures(&contact.solved.checks);
+        return Verdict::NotSolved(format!(
+            "the contact problem was not solved: status \"{}\"{}",
+            contact.status.name(),
+            if failed.is_empty() {
+                String::new()
+            } else {
+                format!(", failed: {failed}")
+            },
+        ));
+    }
+    if !contact.accuracy.passed {
+        return Verdict::Inaccurate(format!(
+            "the contact problem was solved, but its accuracy report failed: {}",
+            failures(&contact.accuracy.indicators)
+        ));
+    }
+    earlier_steps_verdict(&contact.steps)
 }
 
 /// The verdict of the load steps before the last, whose answer was trusted: every step is an

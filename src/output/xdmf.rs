@@ -24,8 +24,9 @@ pub struct BodyFields<'a> {
     /// Interleaved, `dim` per node.
     pub displacement: &'a [f64],
     pub cell_fields: &'a CellFields,
-    /// Interface fields on the body's contact candidate surface, in contact runs.
-    pub surface: Option<&'a SurfaceFields>,
+    /// Interface fields on the body's contact candidate surfaces (one per pair it is in), in
+    /// contact runs.
+    pub surfaces: Vec<&'a SurfaceFields>,
 }
 
 /// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`.
@@ -81,7 +82,7 @@ impl Grid {
         let mut grid = Self {
             num_nodes,
             num_cells,
-            contact: bodies.iter().any(|b| b.surface.is_some()),
+            contact: bodies.iter().any(|b| !b.surfaces.is_empty()),
             geometry: Vec::with_capacity(3 * num_nodes),
             displacement: Vec::with_capacity(3 * num_nodes),
             node_tag: Vec::with_capacity(num_nodes),
@@ -100,7 +101,7 @@ impl Grid {
         };
         let mut offset = 0;
         for (id, body) in bodies.iter().enumerate() {
-            if let Some(surface) = body.surface {
+            for surface in &body.surfaces {
                 grid.add_surface(surface, offset);
             }
             let m = body.mesh;

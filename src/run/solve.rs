@@ -1,4 +1,4 @@
-//! A case solved in memory: the contact solve of the two bodies in contact, and each other body
+//! A case solved in memory: the contact solve of the bodies in contact, and each other body
 //! alone. Nothing is written here: the command line ([`super::solve_case`]) and the Python
 //! module write the result files from a [`CaseSolution`] with [`super::write_results`].
 
@@ -52,30 +52,31 @@ impl Timings {
 pub struct CaseSolution {
     /// In the case file's order of bodies.
     pub bodies: Vec<SolvedBody>,
-    /// The contact solve's outcome, when the case has a `[contact]` table.
-    pub contact: Option<SolvedContact>,
+    /// Each contact pair's outcome, in the case file's order (empty without contact).
+    pub contacts: Vec<SolvedContact>,
     pub timings: Timings,
 }
 
-/// One body's solution and, in contact runs, its contact surface's fields.
+/// One body's solution and, in contact runs, its contact surfaces' fields (one per pair it is
+/// in).
 pub struct SolvedBody {
     pub name: String,
     pub solution: ElasticSolution,
-    pub surface: Option<SurfaceFields>,
+    pub surfaces: Vec<SurfaceFields>,
 }
 
-/// What a contact solve leaves besides the two bodies' fields.
+/// What a contact pair's solve leaves besides its bodies' fields.
 pub struct SolvedContact {
     /// Status, certificate, accuracy report, forces and one record per load step: the
-    /// `contact` part of `summary.json`.
+    /// `contact` part of `summary.json` (an entry of `contacts` with several pairs).
     pub summary: ContactSummary,
-    /// The title of `force_displacement.png`.
+    /// The title of its force-displacement plot.
     pub plot_title: String,
     /// The approach the prescribed displacements impose at load factor 1 (the plot's x axis).
     pub imposed_approach: f64,
 }
 
-/// Solves every body of `case` on `mesh`: the two in contact together, the others alone. Every
+/// Solves every body of `case` on `mesh`: those in contact together, the others alone. Every
 /// body's problem is built first, so that bad input is an error before anything is solved.
 pub fn solve_case_on(
     case: &Case,
@@ -87,11 +88,12 @@ pub fn solve_case_on(
         case.check_export_names(mesh)?;
     }
     let mut bodies = Vec::new();
-    let mut contact = None;
-    if let Some(problem) = case.contact_problem(mesh)? {
-        let (solved, pair) = solve_contact_pair(case, problem, &mut timings)?;
-        contact = Some(solved);
-        bodies.extend(pair);
+    let mut contacts = Vec::new();
+    let problems = case.contact_problems(mesh)?;
+    if !problems.is_empty() {
+        let (solved, in_contact) = solve_contact_pairs(case, problems, &mut timings)?;
+        contacts = solved;
+        bodies.extend(in_contact);
     }
     for spec in &case.bodies {
         if !bodies.iter().any(|s| s.name == spec.name) {
@@ -101,70 +103,91 @@ pub fn solve_case_on(
     bodies.sort_by_key(|s| case.bodies.iter().position(|b| b.name == s.name));
     Ok(CaseSolution {
         bodies,
-        contact,
+        contacts,
         timings,
     })
 }
 
-/// The contact solve of the case's two bodies ([`solve_contact`]: its load steps, and the other
-/// primary's solve when the first choice may be wrong).
-fn solve_contact_pair(
+/// The contact solve of the case's pairs ([`solve_contact`]: its load steps, and for a single
+/// pair the other primary's solve when the first choice may be wrong), and the solution of
+/// each body in contact.
+fn solve_contact_pairs(
     case: &Case,
-    problem: ContactProblem,
+    problems: Vec<ContactProblem>,
     timings: &mut Timings,
-) -> Result<(SolvedContact, [SolvedBody; 2]), RunError> {
-    log::info!(
-        "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
-        problem.primary.body.name,
-        problem.primary_surface.group,
-        problem.primary_surface.len(),
-        problem.secondary.body.name,
-        problem.secondary_surface.group,
-        problem.secondary_surface.len(),
-        serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
-    );
-    log::info!(
-        "primary body '{}' ({}): {}",
-        problem.primary.body.name,
-        problem.primary_report.mode,
-        problem.primary_report.reason
-    );
-    let run = solve_contact(problem, &case.solver, &case.load_steps()).map_err(|source| {
+) -> Result<(Vec<SolvedContact>, Vec<SolvedBody>), RunError> {
+    for problem in &problems {
+        log::info!(
+            "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
+            problem.primary.body.name,
+            problem.primary_surface.group,
+            problem.primary_surface.len(),
+            problem.secondary.body.name,
+            problem.secondary_surface.group,
+            problem.secondary_surface.len(),
+            serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
+        );
+        log::info!(
+            "primary body '{}' ({}): {}",
+            problem.primary.body.name,
+            problem.primary_report.mode,
+            problem.primary_report.reason
+        );
+    }
+    let run = solve_contact(problems, &case.solver, &case.load_steps()).map_err(|source| {
         RunError::Contact {
             path: case.path.clone(),
             source,
         }
     })?;
     let ContactRun {
-        problem,
-        solution,
+        problems,
+        solutions,
         steps,
         timings: contact_timings,
     } = run;
     timings.phases.extend(contact_timings);
-    let solved = SolvedContact {
-        summary: summarize_contact(&problem, &solution, steps),
-        plot_title: format!(
-            "{}: contact of '{}' (primary) and '{}'",
-            case_name(case),
-            problem.primary.body.name,
-            problem.secondary.body.name
-        ),
-        imposed_approach: imposed_approach(&problem),
-    };
-    let bodies = [
-        SolvedBody {
-            name: problem.primary.body.name.clone(),
-            solution: solution.primary,
-            surface: Some(solution.primary_fields),
-        },
-        SolvedBody {
-            name: problem.secondary.body.name.clone(),
-            solution: solution.secondary,
-            surface: Some(solution.secondary_fields),
-        },
-    ];
-    Ok((solved, bodies))
+    let mut contacts = Vec::new();
+    let mut bodies: Vec<SolvedBody> = Vec::new();
+    let several = problems.len() > 1;
+    for (p, ((problem, solution), steps)) in problems.iter().zip(solutions).zip(steps).enumerate() {
+        let name = case.contacts[p].name.clone();
+        contacts.push(SolvedContact {
+            summary: summarize_contact(name.clone(), problem, &solution, steps),
+            plot_title: format!(
+                "{}: contact of '{}' (primary) and '{}'{}",
+                case_name(case),
+                problem.primary.body.name,
+                problem.secondary.body.name,
+                if several {
+                    format!(" (pair {name})")
+                } else {
+                    String::new()
+                }
+            ),
+            imposed_approach: imposed_approach(problem),
+        });
+        let sides = [
+            (&problem.primary, solution.primary, solution.primary_fields),
+            (
+                &problem.secondary,
+                solution.secondary,
+                solution.secondary_fields,
+            ),
+        ];
+        for (elastic, body_solution, fields) in sides {
+            match bodies.iter_mut().find(|b| b.name == elastic.body.name) {
+                // A body in several pairs has one solution: the first pair's.
+                Some(body) => body.surfaces.push(fields),
+                None => bodies.push(SolvedBody {
+                    name: elastic.body.name.clone(),
+                    solution: body_solution,
+                    surfaces: vec![fields],
+                }),
+            }
+        }
+    }
+    Ok((contacts, bodies))
 }
 
 /// One body that is in no contact, solved alone.
@@ -192,7 +215,7 @@ fn solve_alone(
     Ok(SolvedBody {
         name: spec.name.clone(),
         solution,
-        surface: None,
+        surfaces: Vec::new(),
     })
 }
 
@@ -236,7 +259,14 @@ impl CaseSolution {
             mesh: mesh.path.display().to_string(),
             dimension: mesh.dim,
             bodies,
-            contact: self.contact.as_ref().map(|c| c.summary.clone()),
+            contact: match &self.contacts[..] {
+                [single] => Some(single.summary.clone()),
+                _ => None,
+            },
+            contacts: match self.contacts.len() {
+                1 => Vec::new(),
+                _ => self.contacts.iter().map(|c| c.summary.clone()).collect(),
+            },
             timings: timings.with_total(),
             peak_memory_mb: peak_memory_mb(),
         }
@@ -244,6 +274,7 @@ impl CaseSolution {
 }
 
 fn summarize_contact(
+    name: String,
     problem: &ContactProblem,
     solution: &ContactSolution,
     steps: Vec<crate::contact::StepRecord>,
@@ -252,6 +283,7 @@ fn summarize_contact(
     let (solved, accuracy) = ContactSummary::checks(&solution.certificate);
     let active = |fields: &SurfaceFields| fields.active.iter().filter(|&&a| a).count();
     ContactSummary {
+        name,
         status: solution.status,
         primary: problem.primary.body.name.clone(),
         secondary: problem.secondary.body.name.clone(),

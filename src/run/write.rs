@@ -24,13 +24,19 @@ pub fn write_results(
     dir: &Path,
 ) -> Result<CaseSummary, RunError> {
     let phase = Instant::now();
-    if let Some(contact) = &solution.contact {
-        let csv = dir.join("force_displacement.csv");
+    // One curve per pair: force_displacement.csv and .png for a single pair,
+    // force_displacement_<pair>.csv and .png for each of several.
+    for contact in &solution.contacts {
+        let stem = match solution.contacts.len() {
+            1 => "force_displacement".to_string(),
+            _ => format!("force_displacement_{}", contact.summary.name),
+        };
+        let csv = dir.join(format!("{stem}.csv"));
         std::fs::write(&csv, force_displacement_csv(&contact.summary.steps))
             .map_err(|source| OutputError::Io { path: csv, source })?;
         // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
         // A warning, since a file the user expects is missing.
-        let png = dir.join("force_displacement.png");
+        let png = dir.join(format!("{stem}.png"));
         let steps = &contact.summary.steps;
         if let Err(e) =
             write_force_displacement_png(&png, &contact.plot_title, steps, contact.imposed_approach)
@@ -46,7 +52,7 @@ pub fn write_results(
             mesh: body,
             displacement: &s.solution.displacement,
             cell_fields: &s.solution.cell_fields,
-            surface: s.surface.as_ref(),
+            surfaces: s.surfaces.iter().collect(),
         })
         .collect();
     write_xdmf(dir, "solution", &fields)?;

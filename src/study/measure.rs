@@ -54,7 +54,7 @@ pub fn contact_zone_spacing(
         return none;
     };
     let mut active = vec![false; body.num_nodes()];
-    if let Some(fields) = &solved.surface {
+    for fields in &solved.surfaces {
         for (&node, &on) in fields.nodes.iter().zip(&fields.active) {
             active[node] |= on;
         }

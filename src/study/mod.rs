@@ -182,11 +182,16 @@ pub fn run_study(
     };
     spec.check()
         .map_err(|m| invalid(format!("study parameter: {m}")))?;
-    if case.contact.is_none() {
-        return Err(invalid(
-            "a refinement study measures contact quantities, and the case has no [contact] table"
+    if case.contacts.len() != 1 {
+        return Err(invalid(match case.contacts.len() {
+            0 => "a refinement study measures contact quantities, and the case has no [contact] \
+                  table"
                 .to_string(),
-        ));
+            n => format!(
+                "a refinement study measures the quantities of one contact pair, and the case \
+                 has {n}: study a case with one [contact] table"
+            ),
+        }));
     }
     let cases = (spec.values.iter())
         .map(|&v| case.with_geo_parameter(&spec.parameter, v))
@@ -234,7 +239,7 @@ fn solve_level(
         case.path.display(),
         spec.parameter
     );
-    let contact = case.contact.clone();
+    let contact = case.contacts.first().cloned();
     let run =
         solve_loaded_case(case, &run_options, "internodes study", &command).map_err(|source| {
             StudyError::Level {

@@ -15,20 +15,22 @@ pub fn solve_with(case: &CaseFile, loop_only: bool) -> Result<ContactSolution, S
     let (_dir, path) = case.write();
     let case = Case::load(&path).map_err(|e| e.to_string())?;
     let mesh = read_msh(&case.mesh).map_err(|e| e.to_string())?;
-    let problem = case
-        .contact_problem(&mesh)
-        .map_err(|e| e.to_string())?
-        .expect("the case has a [contact] table");
+    let mut problems = case.contact_problems(&mesh).map_err(|e| e.to_string())?;
+    assert_eq!(problems.len(), 1, "the case has one [contact] table");
+    let problem = problems.remove(0);
     let settings = SolverSettings {
         verbose: false,
         ..case.solver.clone()
     };
     if loop_only {
-        let mut solver = ContactSolver::new(&problem, &settings).map_err(|e| e.to_string())?;
-        return solver.solve(1.0, None).map_err(|e| e.to_string());
+        let mut solver = ContactSolver::new(std::slice::from_ref(&problem), &settings)
+            .map_err(|e| e.to_string())?;
+        let mut solutions = solver.solve(1.0, None).map_err(|e| e.to_string())?;
+        return Ok(solutions.remove(0));
     }
-    let run = solve_contact(problem, &settings, &case.load_steps()).map_err(|e| e.to_string())?;
-    Ok(run.solution)
+    let mut run =
+        solve_contact(vec![problem], &settings, &case.load_steps()).map_err(|e| e.to_string())?;
+    Ok(run.solutions.remove(0))
 }
 
 pub fn solve(case: &CaseFile) -> Result<ContactSolution, String> {
