@@ -87,7 +87,7 @@ fn main() {
             (body, problem, system, factor)
         })
         .collect();
-    let contact = case.contact_problem(&mesh).unwrap_or_else(exit);
+    let contact = case.contact_problems(&mesh).unwrap_or_else(exit);
 
     for _ in 0..repeats {
         for (pool, &threads) in pools.iter().zip(&THREADS) {
@@ -136,12 +136,14 @@ fn main() {
                     );
                     keep(&name(&format!("{NUM_RHS} solutions")), threads, &x);
                 }
-                match &contact {
+                match contact.first() {
                     Some(problem) => {
-                        let (seconds, mut solver) =
-                            timed(|| ContactSolver::new(problem, &case.solver).unwrap());
+                        let (seconds, mut solver) = timed(|| {
+                            ContactSolver::new(std::slice::from_ref(problem), &case.solver).unwrap()
+                        });
                         record("contact set-up".into(), threads, seconds);
-                        let (seconds, solution) = timed(|| solver.solve(1.0, None).unwrap());
+                        let (seconds, solution) =
+                            timed(|| solver.solve(1.0, None).unwrap().remove(0));
                         record(
                             format!(
                                 "contact solve ({} iterations, {} active)",

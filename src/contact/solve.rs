@@ -133,6 +133,10 @@ fn motions_left_free(coords: &[[f64; 3]], body: &AssembledBody) -> nalgebra::DMa
     nalgebra::DMatrix::from_fn(count, free.len(), |r, c| eigen.eigenvectors[(r, free[c])])
 }
 
+/// A point of an active node and the directions its contact holds there
+/// ([`ContactSolver::check_held`]).
+type HeldRow = ([f64; 3], Vec<[f64; 3]>);
+
 /// When the surfaces have slid ([`InterfaceOperators::slide`]) this many spacings of the
 /// active nodes away from the pairing of the operators, they are paired again once the active
 /// set settles.
@@ -160,9 +164,9 @@ fn pairing_drift(
 /// `f_c(s) = s f_c(1)`, while `K`, its factors and the interface geometry do not change.
 ///
 /// The loop decides all pairs together: one coupled system, one active set. That set numbers
-/// the primary candidates of the pairs one after another (pair `p`'s node `i` is `offsets[p]
-/// + i`), so that the safeguard against repeats sees the whole set; each pair keeps its own
-/// operators, linearized gaps and tolerances.
+/// the primary candidates of the pairs one after another (pair `p`'s node `i` is
+/// `offsets[p] + i`), so that the safeguard against repeats sees the whole set; each pair
+/// keeps its own operators, linearized gaps and tolerances.
 pub struct ContactSolver<'a> {
     /// The contact pairs, in the case's order.
     pub(super) pairs: &'a [ContactProblem<'a>],
@@ -771,7 +775,7 @@ impl ContactSolver<'_> {
             let dim = elastic.body.dim;
             let modes = RigidModes::new(&elastic.body.coords, dim);
             // Two sets of (point, held directions): the constraints' and the body's own.
-            let mut sets: [Vec<([f64; 3], Vec<[f64; 3]>)>; 2] = [Vec::new(), Vec::new()];
+            let mut sets: [Vec<HeldRow>; 2] = [Vec::new(), Vec::new()];
             for p in (0..self.pairs.len()).filter(|&p| self.pair_bodies[p].contains(k)) {
                 let side = usize::from(self.pair_bodies[p][0] != *k);
                 for (set, rows) in
@@ -822,14 +826,13 @@ impl ContactSolver<'_> {
     /// constraint's) and as the body's own surface's: a round body turning about its centre
     /// moves its nodes along the other body's normal but maps its surface onto itself, so only
     /// its own normals show that nothing holds it. Tied: every direction.
-    #[allow(clippy::type_complexity)]
     fn held_rows(
         &self,
         p: usize,
         side: usize,
         coupling: &Coupling,
         nodes: &[usize],
-    ) -> [Vec<([f64; 3], Vec<[f64; 3]>)>; 2] {
+    ) -> [Vec<HeldRow>; 2] {
         let problem = &self.pairs[p];
         let s1 = &problem.primary_surface;
         let dim = s1.dim;

@@ -9,7 +9,7 @@
 mod solve;
 mod write;
 
-pub use solve::{CaseSolution, SolvedBody, SolvedContact, Timings, solve_case_on};
+pub use solve::{CaseSolution, PairSurface, SolvedBody, SolvedContact, Timings, solve_case_on};
 pub use write::write_results;
 
 use std::path::{Path, PathBuf};

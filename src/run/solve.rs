@@ -58,11 +58,18 @@ pub struct CaseSolution {
 }
 
 /// One body's solution and, in contact runs, its contact surfaces' fields (one per pair it is
-/// in).
+/// in, in the case's order of pairs).
 pub struct SolvedBody {
     pub name: String,
     pub solution: ElasticSolution,
-    pub surfaces: Vec<SurfaceFields>,
+    pub surfaces: Vec<PairSurface>,
+}
+
+/// A body's contact surface in one pair.
+pub struct PairSurface {
+    /// The pair's name.
+    pub pair: String,
+    pub fields: SurfaceFields,
 }
 
 /// What a contact pair's solve leaves besides its bodies' fields.
@@ -176,6 +183,10 @@ fn solve_contact_pairs(
             ),
         ];
         for (elastic, body_solution, fields) in sides {
+            let fields = PairSurface {
+                pair: name.clone(),
+                fields,
+            };
             match bodies.iter_mut().find(|b| b.name == elastic.body.name) {
                 // A body in several pairs has one solution: the first pair's.
                 Some(body) => body.surfaces.push(fields),

@@ -52,7 +52,7 @@ pub fn write_results(
             mesh: body,
             displacement: &s.solution.displacement,
             cell_fields: &s.solution.cell_fields,
-            surfaces: s.surfaces.iter().collect(),
+            surfaces: s.surfaces.iter().map(|s| &s.fields).collect(),
         })
         .collect();
     write_xdmf(dir, "solution", &fields)?;

@@ -54,7 +54,8 @@ pub fn contact_zone_spacing(
         return none;
     };
     let mut active = vec![false; body.num_nodes()];
-    for fields in &solved.surfaces {
+    for surface in &solved.surfaces {
+        let fields = &surface.fields;
         for (&node, &on) in fields.nodes.iter().zip(&fields.active) {
             active[node] |= on;
         }
