@@ -1,5 +1,6 @@
 //! `force_displacement.png`: the contact force and the contact radius of each load step
-//! against the imposed approach, the picture of `force_displacement.csv`.
+//! against the imposed approach, one curve per contact pair, the picture of
+//! `force_displacement.csv`.
 //!
 //! plotters draws text with a font it is given at run time (its pure-Rust `ab_glyph` backend,
 //! so no fontconfig or freetype): DejaVu Sans from Debian's `fonts-dejavu-core`, or the file
@@ -41,17 +42,19 @@ pub enum PlotError {
 /// Width and height of the picture in pixels: two panels side by side.
 pub const PLOT_SIZE: (u32, u32) = (1200, 540);
 
-/// Draws `steps` into the PNG file `path`, two panels against the imposed approach, axes from
-/// 0, a dot per step and a line between successive steps (none from the origin): the magnitude of the contact force on the primary body, and the contact radius
-/// (half-width in 2D) of each step's Hertz fit. `approach` is the imposed approach at load
-/// factor 1 (the largest difference between the two bodies' prescribed displacements); where
-/// no displacement is imposed (0: the bodies are loaded by forces) the x axis is the load
-/// factor. In a force-controlled run (`[[body.force]]`) the x axis is the displacement the
-/// first force-controlled group moved by, an output of each step.
+/// Draws the load steps of each pair of `curves` (its name and its steps) into the PNG file
+/// `path`, two panels against the imposed approach, axes from 0, a dot per step and a line
+/// between successive steps (none from the origin): the magnitude of the contact force on the
+/// primary body, and the contact radius (half-width in 2D) of each step's Hertz fit; one curve
+/// per pair, with a legend of the pairs' names when there are several. `approach` is the
+/// imposed approach at load factor 1 (the largest difference between two bodies' prescribed
+/// displacements); where no displacement is imposed (0: the bodies are loaded by forces) the x
+/// axis is the load factor. In a force-controlled run (`[[body.force]]`) the x axis is the
+/// displacement the first force-controlled group moved by, an output of each step.
 pub fn write_force_displacement_png(
     path: &Path,
     title: &str,
-    steps: &[StepRecord],
+    curves: &[(&str, &[StepRecord])],
     approach: f64,
 ) -> Result<(), PlotError> {
     register_font()?;
@@ -64,7 +67,8 @@ pub fn write_force_displacement_png(
     } else {
         (1.0, "load factor (no displacement imposed)".to_string())
     };
-    let forced = steps.first().and_then(|s| s.forced.first());
+    // The first force-controlled group of any pair, and its displacement at each step.
+    let forced = (curves.iter()).find_map(|(_, steps)| steps.first()?.forced.first());
     let x_desc = match forced {
         Some(f) => format!(
             "displacement |u{}| of '{}' on '{}' (force-controlled)",
@@ -72,18 +76,32 @@ pub fn write_force_displacement_png(
         ),
         None => x_desc,
     };
-    let x = |s: &StepRecord| match s.forced.first() {
-        Some(f) if forced.is_some() => f.displacement.abs(),
-        _ => scale * s.load_factor,
+    let x = |k: usize, s: &StepRecord| {
+        let moved = forced.and_then(|f| {
+            (curves.iter())
+                .filter_map(|(_, steps)| steps.get(k))
+                .flat_map(|step| &step.forced)
+                .find(|g| g.body == f.body && g.group == f.group && g.component == f.component)
+        });
+        match moved {
+            Some(g) => g.displacement.abs(),
+            None => scale * s.load_factor,
+        }
     };
     let norm = |f: &[f64]| f.iter().map(|c| c * c).sum::<f64>().sqrt();
     // Only solved points: a line from the origin to a single step would read as a linear law.
-    let force: Vec<(f64, f64)> = (steps.iter())
-        .map(|s| (x(s), norm(&s.force_primary)))
-        .collect();
-    let radius: Vec<(f64, f64)> = (steps.iter())
-        .filter_map(|s| s.hertz_a.map(|a| (x(s), a)))
-        .collect();
+    let series = |value: &dyn Fn(&StepRecord) -> Option<f64>| -> Vec<Series> {
+        (curves.iter())
+            .map(|(name, steps)| {
+                let points = (steps.iter().enumerate())
+                    .filter_map(|(k, s)| value(s).map(|v| (x(k, s), v)))
+                    .collect();
+                (name.to_string(), points)
+            })
+            .collect()
+    };
+    let force = series(&|s| Some(norm(&s.force_primary)));
+    let radius = series(&|s| s.hertz_a);
 
     let root = BitMapBackend::new(path, PLOT_SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| draw_error(&e))?;
@@ -100,25 +118,29 @@ pub fn write_force_displacement_png(
             1,
         ),
     ];
-    for (area, points, y_desc, colour) in panels {
-        draw_panel(path, area, points, (&x_desc, y_desc), colour)?;
+    for (area, series, y_desc, colour) in panels {
+        draw_panel(path, area, series, (&x_desc, y_desc), colour)?;
     }
     root.present().map_err(|e| draw_error(&e))
 }
 
-/// One panel: `points` as a line with a dot at each (one point: the dot alone), on axes from 0
-/// described by `desc` (x, y), in
-/// colour number `colour` of plotters' palette.
+/// A curve of a panel: its name (the pair's) and points.
+type Series = (String, Vec<(f64, f64)>);
+
+/// One panel: each of `series` as a line with a dot at each point (one point: the dot
+/// alone), on axes from 0 described by `desc` (x, y), in colours of plotters' palette from
+/// number `colour` on; several series get a legend of their names.
 fn draw_panel(
     path: &Path,
     area: &DrawingArea<BitMapBackend, Shift>,
-    points: &[(f64, f64)],
+    series: &[Series],
     (x_desc, y_desc): (&str, &str),
     colour: usize,
 ) -> Result<(), PlotError> {
     let draw_error = |e: &dyn std::fmt::Display| draw_error(path, e);
-    let x_range = padded_range(points.iter().map(|p| p.0));
-    let y_range = padded_range(points.iter().map(|p| p.1));
+    let points = || series.iter().flat_map(|(_, points)| points.iter());
+    let x_range = padded_range(points().map(|p| p.0));
+    let y_range = padded_range(points().map(|p| p.1));
     let mut chart = ChartBuilder::on(area)
         .margin(20)
         .x_label_area_size(50)
@@ -137,16 +159,31 @@ fn draw_panel(
         .y_label_formatter(&|v| tick_label(*v))
         .draw()
         .map_err(|e| draw_error(&e))?;
-    let color = Palette99::pick(colour).to_rgba();
-    chart
-        .draw_series(LineSeries::new(
-            points.iter().copied(),
-            color.stroke_width(2),
-        ))
-        .map_err(|e| draw_error(&e))?;
-    chart
-        .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
-        .map_err(|e| draw_error(&e))?;
+    for (k, (name, points)) in series.iter().enumerate() {
+        let color = Palette99::pick(colour + 2 * k).to_rgba();
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                color.stroke_width(2),
+            ))
+            .map_err(|e| draw_error(&e))?
+            .label(name.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(|e| draw_error(&e))?;
+    }
+    if series.len() > 1 {
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 14))
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| draw_error(&e))?;
+    }
     Ok(())
 }
 

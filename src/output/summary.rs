@@ -257,8 +257,38 @@ impl ContactSummary {
     }
 }
 
-/// The load steps as `force_displacement.csv`: one header line, one row per step.
-pub fn force_displacement_csv(steps: &[StepRecord]) -> String {
+/// The load steps of each pair of `curves` (its name and its steps) as
+/// `force_displacement.csv`: one header line, one row per step. One pair: the columns of
+/// [`pair_csv`]. Several: the step and load factor, then each pair's other columns, their
+/// names prefixed by the pair's (`upper-middle.contact_force_y`); the pairs share the loop, so
+/// they have the same steps.
+pub fn force_displacement_csv(curves: &[(&str, &[StepRecord])]) -> String {
+    let tables: Vec<String> = curves.iter().map(|(_, steps)| pair_csv(steps)).collect();
+    if let [table] = &tables[..] {
+        return table.clone();
+    }
+    let split = |line: &str| -> Vec<String> { line.split(',').map(str::to_string).collect() };
+    let lines: Vec<Vec<Vec<String>>> = (tables.iter())
+        .map(|table| table.lines().map(split).collect())
+        .collect();
+    let rows = lines.iter().map(Vec::len).min().unwrap_or(0);
+    let mut text = String::new();
+    for row in 0..rows {
+        let mut fields: Vec<String> = lines[0][row][..2].to_vec();
+        for ((name, _), table) in curves.iter().zip(&lines) {
+            fields.extend(table[row][2..].iter().map(|field| match row {
+                0 => format!("{name}.{field}"),
+                _ => field.clone(),
+            }));
+        }
+        text += &fields.join(",");
+        text += "\n";
+    }
+    text
+}
+
+/// One pair's load steps as CSV: one header line, one row per step.
+fn pair_csv(steps: &[StepRecord]) -> String {
     let dim = steps.first().map_or(0, |s| s.force_primary.len());
     let axes = ["x", "y", "z"];
     let mut text = String::from("step,load_factor,status,iterations");

@@ -156,21 +156,15 @@ fn solve_contact_pairs(
     timings.phases.extend(contact_timings);
     let mut contacts = Vec::new();
     let mut bodies: Vec<SolvedBody> = Vec::new();
-    let several = problems.len() > 1;
     for (p, ((problem, solution), steps)) in problems.iter().zip(solutions).zip(steps).enumerate() {
         let name = case.contacts[p].name.clone();
         contacts.push(SolvedContact {
             summary: summarize_contact(name.clone(), problem, &solution, steps),
             plot_title: format!(
-                "{}: contact of '{}' (primary) and '{}'{}",
+                "{}: contact of '{}' (primary) and '{}'",
                 case_name(case),
                 problem.primary.body.name,
                 problem.secondary.body.name,
-                if several {
-                    format!(" (pair {name})")
-                } else {
-                    String::new()
-                }
             ),
             imposed_approach: imposed_approach(problem),
         });
@@ -334,7 +328,7 @@ fn imposed_approach(problem: &ContactProblem) -> f64 {
 }
 
 /// The case file's name without its extension (the plot title).
-fn case_name(case: &Case) -> String {
+pub(super) fn case_name(case: &Case) -> String {
     case.path.file_stem().map_or_else(
         || case.path.display().to_string(),
         |s| s.to_string_lossy().into_owned(),

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::case::Case;
+use crate::contact::StepRecord;
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
 use crate::mesh::{BodyMesh, Mesh};
 use crate::output::{
@@ -13,6 +14,7 @@ use crate::output::{
     write_matrix_market, write_xdmf,
 };
 
+use super::solve::case_name;
 use super::{CaseSolution, RunError};
 
 /// Writes the result files of `solution` into `dir` and returns the summary it wrote (its
@@ -24,23 +26,24 @@ pub fn write_results(
     dir: &Path,
 ) -> Result<CaseSummary, RunError> {
     let phase = Instant::now();
-    // One curve per pair: force_displacement.csv and .png for a single pair,
-    // force_displacement_<pair>.csv and .png for each of several.
-    for contact in &solution.contacts {
-        let stem = match solution.contacts.len() {
-            1 => "force_displacement".to_string(),
-            _ => format!("force_displacement_{}", contact.summary.name),
-        };
-        let csv = dir.join(format!("{stem}.csv"));
-        std::fs::write(&csv, force_displacement_csv(&contact.summary.steps))
+    if !solution.contacts.is_empty() {
+        let curves: Vec<(&str, &[StepRecord])> = (solution.contacts.iter())
+            .map(|c| (c.summary.name.as_str(), &c.summary.steps[..]))
+            .collect();
+        let csv = dir.join("force_displacement.csv");
+        std::fs::write(&csv, force_displacement_csv(&curves))
             .map_err(|source| OutputError::Io { path: csv, source })?;
         // The plot only pictures the CSV: without it (e.g. no font) the run is still complete.
         // A warning, since a file the user expects is missing.
-        let png = dir.join(format!("{stem}.png"));
-        let steps = &contact.summary.steps;
-        if let Err(e) =
-            write_force_displacement_png(&png, &contact.plot_title, steps, contact.imposed_approach)
-        {
+        let png = dir.join("force_displacement.png");
+        let approach = (solution.contacts.iter())
+            .map(|c| c.imposed_approach)
+            .fold(0.0, f64::max);
+        let title = match &solution.contacts[..] {
+            [single] => single.plot_title.clone(),
+            _ => format!("{}: {} contact pairs", case_name(case), curves.len()),
+        };
+        if let Err(e) = write_force_displacement_png(&png, &title, &curves, approach) {
             log::warn!("{} not written: {e}", png.display());
         }
     }
