@@ -1,7 +1,7 @@
-//! Two elastic bodies in contact, coupled by INTERNODES.
+//! Elastic bodies in contact, coupled by INTERNODES: one or several pairs, decided together.
 //!
-//! Body 1 (primary) carries the multiplier `lambda`, the contact traction on it; body 2
-//! (secondary) receives `-R21 lambda`. The files in the order of one solve; each imports only
+//! In each pair, body 1 (primary) carries the multiplier `lambda`, the contact traction on it;
+//! body 2 (secondary) receives `-R21 lambda`. The files in the order of one solve; each imports only
 //! files listed before it (`tests/architecture.rs` checks that the imports have no cycle):
 //! - the geometry: `projection.rs` (closest points on a P1 surface), `boundary.rs`, `rbf.rs`
 //!   (rescaled Wendland C2 interpolation), `surface.rs` (a candidate surface: nodes, facets,
@@ -9,8 +9,7 @@
 //!   an iterate);
 //! - `settings.rs` (every setting, its default and range) and `problem.rs` (the two bodies,
 //!   their surfaces, which one is primary, which transfer);
-//! - the linear algebra of an iteration, written for any number of bodies and pairs (the loop
-//!   still drives one pair): `compliance.rs` (the bodies' responses to unit tractions),
+//! - the linear algebra of an iteration, for any number of bodies and pairs: `compliance.rs` (the bodies' responses to unit tractions),
 //!   `system.rs` (the coupled system of an active set), `interface.rs` (the
 //!   interface operators, built once over all candidates: the interpolation evaluated at each
 //!   node's closest point on the other surface, the contact normal), `half_space.rs` (the
@@ -22,10 +21,11 @@
 //!   certificate independently of the loop's operators (the residuals that decide the status,
 //!   the accuracy report), `hertz.rs` fits a Hertz profile, `post.rs` makes the fields and
 //!   forces of the last iterate;
-//! - the loop: `safeguard.rs` (when it stops) and `solve.rs` (the active-set loop);
-//! - `driver.rs`: [`solve_contact`], the solve a caller asks for: the load steps, and a second
-//!   solve with the other body as primary, or auto's transfer, when a choice made may be the
-//!   wrong one.
+//! - the loop: `safeguard.rs` (when it stops) and `solve.rs` (the active-set loop over every
+//!   pair);
+//! - `driver.rs`: [`solve_contact`], the solve a caller asks for: the load steps, and for a
+//!   single pair a second solve with the other body as primary, or auto's transfer, when a
+//!   choice made may be the wrong one.
 //!
 //! Method, signs and the reasons behind each rule: `docs/method.md`.
 

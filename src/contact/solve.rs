@@ -660,8 +660,9 @@ impl ContactSolver<'_> {
     /// system is singular (the force would move it without bound), and from the nodes that
     /// merely touch (a sphere's pole) the first iterate would carry the whole force on them.
     /// Each pair of such a body starts on the half-space model's zone for the resultant of
-    /// its bodies' loads and forces (`super::half_space::force_controlled_set`), or on its
-    /// closest node if the model finds none. If the loop lets go of every contact of such a
+    /// its bodies' loads and forces (`super::half_space::force_controlled_set`); where the
+    /// model finds none (no force: a floating block between two others), on the nodes that
+    /// touch already, or the closest node. If the loop lets go of every contact of such a
     /// body after that, its loads pull it off: an error that names it.
     fn first_contact(
         &self,
@@ -718,13 +719,17 @@ impl ContactSolver<'_> {
             let c0 = compliance_factor(materials, s1.dim);
             let mut zone = force_controlled_set(s1, &gaps, force, c0);
             if zone.is_empty() {
+                // No force to place: the nodes that touch already, or the closest one.
+                zone = self.pair_nodes(&state.active, p);
+            }
+            if zone.is_empty() {
                 let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
                 zone.extend(closest);
             }
             if self.solver.verbose {
                 log::info!(
-                    "  '{}' and '{}': a body only the contacts hold starts on the {} nodes where \
-                     two half-spaces would carry the force {force:.6e}",
+                    "  '{}' and '{}': a body only the contacts hold starts on {} nodes (the zone \
+                     where two half-spaces carry the force {force:.6e}, or those that touch)",
                     problem.primary.body.name,
                     problem.secondary.body.name,
                     zone.len()
