@@ -45,21 +45,28 @@ fn pairs(keys: &str) -> String {
     )
 }
 
-/// The case of the stack: `contact` (the pairs), every block on rollers along its sides, the
-/// lower base held vertically, the upper top loaded by `top` (a `[[body.dirichlet]]` or
+/// The case of the `dim`-D stack: `contact` (the pairs), every block on rollers along its sides,
+/// the lower base held vertically, the upper top loaded by `top` (a `[[body.dirichlet]]` or
 /// `[[body.force]]` table's lines after its group); the middle block has no other support.
-fn stack(contact: &str, top: &str) -> String {
+fn stack(dim: usize, contact: &str, top: &str) -> String {
     let mut text = format!(
         "mesh = {:?}\noutput = \"out\"\n\n{contact}\n",
-        fixture("three_blocks_2d.msh")
+        fixture(&format!("three_blocks_{dim}d.msh"))
     );
+    let rollers = match dim {
+        2 => "ux = 0.0",
+        _ => "ux = 0.0\nuy = 0.0",
+    };
+    let vertical = ["ux", "uy", "uz"][dim - 1];
     for (name, e) in BLOCKS {
         text += &format!(
             "[[body]]\nname = \"{name}\"\nyoungs_modulus = {e}\npoisson_ratio = {NU}\n\n\
-             [[body.dirichlet]]\ngroup = \"{name}_sides\"\nux = 0.0\n\n"
+             [[body.dirichlet]]\ngroup = \"{name}_sides\"\n{rollers}\n\n"
         );
         match name {
-            "lower" => text += "[[body.dirichlet]]\ngroup = \"lower_base\"\nuy = 0.0\n\n",
+            "lower" => {
+                text += &format!("[[body.dirichlet]]\ngroup = \"lower_base\"\n{vertical} = 0.0\n\n")
+            }
             "upper" => text += &format!("{top}\n\n"),
             _ => {}
         }
@@ -67,12 +74,22 @@ fn stack(contact: &str, top: &str) -> String {
     text
 }
 
-/// The stack pushed down by [`PUSH`] at its top.
-fn pushed(contact: &str) -> String {
+/// The `dim`-D stack pushed down by [`PUSH`] at its top.
+fn pushed_in(dim: usize, contact: &str) -> String {
+    let vertical = ["ux", "uy", "uz"][dim - 1];
     stack(
+        dim,
         contact,
-        &format!("[[body.dirichlet]]\ngroup = \"upper_top\"\nuy = {}", -PUSH),
+        &format!(
+            "[[body.dirichlet]]\ngroup = \"upper_top\"\n{vertical} = {}",
+            -PUSH
+        ),
     )
+}
+
+/// The 2D stack pushed down by [`PUSH`] at its top.
+fn pushed(contact: &str) -> String {
+    pushed_in(2, contact)
 }
 
 /// The loop's own stopping rule holds each active node within `0.01 penetration_tolerance h`
@@ -91,43 +108,56 @@ fn solve(text: &str) -> Result<CaseSolution, String> {
 /// The vertical contact force of each pair on its primary, and each pair's status.
 fn forces(solution: &CaseSolution) -> Vec<(f64, ContactStatus)> {
     (solution.contacts.iter())
-        .map(|c| (c.summary.force_primary[1].abs(), c.summary.status))
+        .map(|c| {
+            let force = &c.summary.force_primary;
+            (force[force.len() - 1].abs(), c.summary.status)
+        })
         .collect()
 }
 
 #[test]
-fn a_stack_of_three_blocks_carries_the_exact_uniaxial_stress_on_every_solver() {
+fn a_stack_of_three_blocks_carries_the_exact_uniaxial_strain_in_2d_and_3d_on_every_solver() {
     let sigma = exact_stress(PUSH);
-    for solver in ["auto", "schur", "monolithic-lu"] {
-        let keys = format!("{TIGHT}\nsolver = \"{solver}\"");
-        let solution = solve(&pushed(&pairs(&keys))).unwrap();
-        for (p, (force, status)) in forces(&solution).into_iter().enumerate() {
-            assert_eq!(status, ContactStatus::Converged, "{solver}, pair {p}");
-            let error = (force - sigma).abs() / sigma;
-            assert!(
-                error < 1e-9,
-                "{solver}, pair {p}: force {force}, exact {sigma}"
-            );
-        }
-        // The field: each block's vertical displacement is linear, its strain -sigma / M. GMRES
-        // stops at the relative residual 1e-12 of the interface equation (the two-block patch
-        // test's pressures: 1e-10), which left 1.3e-9 of the push sideways.
-        let mut bottom = 0.0;
-        for (name, e) in BLOCKS {
-            let body = solution.bodies.iter().find(|b| b.name == name).unwrap();
-            let mesh = read_msh(&fixture("three_blocks_2d.msh")).unwrap();
-            let coords = &mesh.body(name).unwrap().coords;
-            let y0 = coords.iter().map(|x| x[1]).fold(f64::INFINITY, f64::min);
-            let strain = -sigma / constrained_modulus(e);
-            for (node, x) in coords.iter().enumerate() {
-                let exact = bottom + strain * (x[1] - y0);
-                let u = &body.solution.displacement[2 * node..2 * node + 2];
+    for dim in [2, 3] {
+        let mesh = read_msh(&fixture(&format!("three_blocks_{dim}d.msh"))).unwrap();
+        for solver in ["auto", "schur", "monolithic-lu"] {
+            let keys = format!("{TIGHT}\nsolver = \"{solver}\"");
+            let label = format!("{dim}D, {solver}");
+            let solution = solve(&pushed_in(dim, &pairs(&keys))).unwrap();
+            for (p, (force, status)) in forces(&solution).into_iter().enumerate() {
+                assert_eq!(status, ContactStatus::Converged, "{label}, pair {p}");
+                let error = (force - sigma).abs() / sigma;
                 assert!(
-                    (u[1] - exact).abs() < 1e-8 * PUSH && u[0].abs() < 1e-8 * PUSH,
-                    "{solver}, {name}: u = {u:?} at {x:?}, exact uy {exact}"
+                    error < 1e-9,
+                    "{label}, pair {p}: force {force}, exact {sigma}"
                 );
             }
-            bottom += strain;
+            // The field: each block's vertical displacement is linear, its strain -sigma / M,
+            // the others zero. GMRES stops at the relative residual 1e-12 of the interface
+            // equation (the two-block patch test's pressures: 1e-10), which left 1.3e-9 of the
+            // push sideways in 2D.
+            let mut bottom = 0.0;
+            for (name, e) in BLOCKS {
+                let body = solution.bodies.iter().find(|b| b.name == name).unwrap();
+                let coords = &mesh.body(name).unwrap().coords;
+                let y0 = coords
+                    .iter()
+                    .map(|x| x[dim - 1])
+                    .fold(f64::INFINITY, f64::min);
+                let strain = -sigma / constrained_modulus(e);
+                for (node, x) in coords.iter().enumerate() {
+                    let exact = bottom + strain * (x[dim - 1] - y0);
+                    let u = &body.solution.displacement[dim * node..dim * (node + 1)];
+                    let error = (0..dim)
+                        .map(|c| (u[c] - if c == dim - 1 { exact } else { 0.0 }).abs())
+                        .fold(0.0, f64::max);
+                    assert!(
+                        error < 1e-8 * PUSH,
+                        "{label}, {name}: u = {u:?} at {x:?}, exact vertical {exact}"
+                    );
+                }
+                bottom += strain;
+            }
         }
     }
 }
@@ -159,27 +189,33 @@ fn a_force_on_the_top_gives_the_exact_approach_through_a_floating_block() {
     // held vertically by nothing but their contacts. The approach is the force times the
     // stack's compliance, and both contacts carry the force.
     let force = 4.0;
-    let top = format!("[[body.force]]\ngroup = \"upper_top\"\nfy = {}", -force);
-    let solution = solve(&stack(&pairs(TIGHT), &top)).unwrap();
-    for (p, (carried, status)) in forces(&solution).into_iter().enumerate() {
-        assert_eq!(status, ContactStatus::Converged, "pair {p}");
+    for dim in [2, 3] {
+        let component = ["fx", "fy", "fz"][dim - 1];
+        let top = format!(
+            "[[body.force]]\ngroup = \"upper_top\"\n{component} = {}",
+            -force
+        );
+        let solution = solve(&stack(dim, &pairs(TIGHT), &top)).unwrap();
+        for (p, (carried, status)) in forces(&solution).into_iter().enumerate() {
+            assert_eq!(status, ContactStatus::Converged, "{dim}D, pair {p}");
+            assert!(
+                (carried - force).abs() < 1e-9 * force,
+                "{dim}D, pair {p}: {carried}"
+            );
+        }
+        let steps = &solution.contacts[0].summary.steps;
+        let forced = &steps.last().unwrap().forced[0];
+        assert_eq!(
+            (forced.body.as_str(), forced.group.as_str()),
+            ("upper", "upper_top")
+        );
+        let approach = force / exact_stress(1.0);
         assert!(
-            (carried - force).abs() < 1e-9 * force,
-            "pair {p}: {carried}"
+            (forced.displacement + approach).abs() < 1e-9 * approach,
+            "{dim}D: approach {} against {approach}",
+            -forced.displacement
         );
     }
-    let steps = &solution.contacts[0].summary.steps;
-    let forced = &steps.last().unwrap().forced[0];
-    assert_eq!(
-        (forced.body.as_str(), forced.group.as_str()),
-        ("upper", "upper_top")
-    );
-    let approach = force / exact_stress(1.0);
-    assert!(
-        (forced.displacement + approach).abs() < 1e-9 * approach,
-        "approach {} against {approach}",
-        -forced.displacement
-    );
 }
 
 #[test]
@@ -187,6 +223,7 @@ fn a_pair_that_does_not_touch_is_no_contact_while_the_other_converges() {
     // The upper block is lifted off; the middle block, held at its sides, presses on the
     // lower one.
     let lifted = stack(
+        2,
         &pairs(""),
         "[[body.dirichlet]]\ngroup = \"upper_top\"\nuy = 0.01",
     )
