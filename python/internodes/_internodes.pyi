@@ -7,7 +7,7 @@ from typing import Any, Mapping, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-from .summary import ForcedDisplacement, Summary
+from .summary import Contact, ForcedDisplacement, Summary
 
 __all__ = [
     "__version__",
@@ -15,6 +15,7 @@ __all__ = [
     "Cancel",
     "Cancelled",
     "Case",
+    "ContactResult",
     "InputError",
     "Mesh",
     "NotSolvedError",
@@ -76,8 +77,9 @@ class Case:
     def from_dict(
         table: Mapping[str, Any], name: str = "case", folder: Optional[_StrPath] = None
     ) -> Case:
-        """A case from a dict with the case file's keys; `mesh` may be left out when a Mesh is
-        passed to solve(). Relative paths are relative to `folder` (default: the current one)."""
+        """A case from a dict with the case file's keys ("contact": a dict, or a list of dicts
+        for several pairs); `mesh` may be left out when a Mesh is passed to solve(). Relative
+        paths are relative to `folder` (default: the current one)."""
     @property
     def path(self) -> Path:
         """The case file, or the name given to from_dict."""
@@ -90,6 +92,10 @@ class Case:
     @property
     def load_steps(self) -> list[float]:
         """The contact solve's load factors ([1.0] unless the case lists steps)."""
+    @property
+    def pairs(self) -> list[str]:
+        """The contact pairs' names, in the case's order ([contact] name, default
+        "BODY1-BODY2"; empty without contact)."""
 
 @final
 class Mesh:
@@ -162,14 +168,20 @@ class BodyResult:
     """(m, 3, 3) Cauchy stress per cell."""
     von_mises: npt.NDArray[np.float64]
     """(m,) von Mises stress per cell."""
-    surface: Optional[SurfaceResult]
-    """The contact surface's fields in contact runs, else None."""
+    surfaces: dict[str, SurfaceResult]
+    """Its contact surface in each contact pair it is in, by pair name (in the case's order;
+    empty for a body in no pair)."""
+    @property
+    def surface(self) -> Optional[SurfaceResult]:
+        """The contact surface of a body in one contact pair, None for a body in none; a body
+        in several pairs raises ValueError (use surfaces[pair])."""
 
 @final
 class Step:
     """How one load step ended (the library's record of it). Status, accuracy verdict, failed
     checks, forces and Hertz fit are this step's own; the accuracy report's details and the
-    iteration history are kept for the last step only (Result.summary["contact"])."""
+    iteration history are kept for the last step only (Result.summary["contact"], or the
+    pair's ContactResult.summary)."""
 
     step: int
     """1, 2, ... in the order solved."""
@@ -194,6 +206,38 @@ class Step:
     seconds: float
 
 @final
+class ContactResult:
+    """One contact pair's result (Result.contacts[name])."""
+
+    @property
+    def name(self) -> str:
+        """The pair's name ([contact] name, default "BODY1-BODY2")."""
+    @property
+    def status(self) -> str:
+        """This pair's contact status ("converged", "no-contact", "iteration-limit", ...)."""
+    @property
+    def primary(self) -> str:
+        """The body that carries the multiplier."""
+    @property
+    def secondary(self) -> str:
+        """The other body."""
+    @property
+    def solved(self) -> bool:
+        """This pair's contact problem solved at every load step."""
+    @property
+    def accurate(self) -> bool:
+        """Solved, and its accuracy report passed at every load step."""
+    @property
+    def exit_code(self) -> int:
+        """The command line's exit status were this the only pair: 0, 2 or 3."""
+    @property
+    def steps(self) -> list[Step]:
+        """One Step per load step solved, in order: this pair's status, forces, accuracy."""
+    @property
+    def summary(self) -> Contact:
+        """This pair's record of summary.json (its "contact", or its entry of "contacts")."""
+
+@final
 class Result:
     """A solved case."""
 
@@ -204,7 +248,11 @@ class Result:
     @property
     def status(self) -> Optional[str]:
         """The contact status ("converged", "no-contact", "iteration-limit", ...), or None when
-        the case has no contact."""
+        the case has no contact. With several pairs, the worst pair's: the first pair whose
+        status is not a solution, else "converged" if any pair converged, else "no-contact"."""
+    @property
+    def contacts(self) -> dict[str, ContactResult]:
+        """Each contact pair's result by name, in the case's order (empty without contact)."""
     @property
     def solved(self) -> bool:
         """Every body solved and the contact problem, if any, solved."""
@@ -220,7 +268,8 @@ class Result:
         report (exit_code 0), with the command line's message, which names the failed steps."""
     @property
     def steps(self) -> list[Step]:
-        """One Step per load step solved, in order (empty without contact)."""
+        """One Step per load step solved, in order (empty without contact). With several
+        contact pairs it raises ValueError: use contacts[name].steps."""
     @property
     def bodies(self) -> dict[str, BodyResult]:
         """Each body's fields by name."""

@@ -16,7 +16,7 @@ CELL_TYPES = {2: "triangle", 3: "tetra"}
 def to_meshio(result: "_Result") -> "dict[str, _meshio.Mesh]":
     """Each body's mesh and fields as a ``meshio.Mesh``, by body name: the fields
     ``solution.xdmf`` holds. Point data: ``displacement``, and in contact runs the contact
-    fields on the candidate surface (zero at other nodes, as in the XDMF file):
+    fields on the candidate surfaces (zero at other nodes, as in the XDMF file):
     ``contact_pressure``, ``contact_mean_pressure``, ``contact_traction``, ``normal_gap``,
     ``contact_active``. Cell data: ``strain`` and ``stress`` (3 x 3 per cell) and
     ``von_mises``. Needs the ``meshio`` package (Debian: python3-meshio)."""
@@ -27,17 +27,17 @@ def to_meshio(result: "_Result") -> "dict[str, _meshio.Mesh]":
         dim = body.coordinates.shape[1]
         points = body.coordinates
         point_data = {"displacement": body.displacement}
-        surface = body.surface
-        if surface is not None:
+        # A body in several pairs has a surface in each, written in the case's order of pairs
+        # (as solution.xdmf: a node on two surfaces holds the later pair's values).
+        for surface in body.surfaces.values():
             nodes = surface.nodes.astype(np.intp)
             for key, values in [("contact_pressure", surface.pressure),
                                 ("contact_mean_pressure", surface.mean_pressure),
                                 ("contact_traction", surface.traction),
                                 ("normal_gap", surface.gap),
                                 ("contact_active", surface.active.astype(np.float64))]:
-                full = np.zeros((len(points),) + values.shape[1:])
+                full = point_data.setdefault(key, np.zeros((len(points),) + values.shape[1:]))
                 full[nodes] = values
-                point_data[key] = full
         cells = [(CELL_TYPES[dim], body.cells.astype(np.int64))]
         cell_data = {"strain": [body.strain], "stress": [body.stress], "von_mises": [body.von_mises]}
         meshes[name] = meshio.Mesh(points, cells, point_data=point_data, cell_data=cell_data)

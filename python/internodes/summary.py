@@ -130,8 +130,12 @@ class StepRecord(TypedDict):
 
 
 class Contact(TypedDict):
-    """The contact record: status, choices, checks, forces and history of the last load step."""
+    """The contact record of one pair: status, choices, checks, forces and history of the last
+    load step."""
 
+    name: str
+    """The pair's name ([contact] name; default "BODY1-BODY2", the bodies in the order
+    given)."""
     status: str
     """"converged", "no-contact", "not-solved", "stalled", "unstable", "cycling" or
     "iteration-limit"."""
@@ -177,7 +181,10 @@ class Body(TypedDict):
 
 class _SummaryOptional(TypedDict, total=False):
     contact: Contact
-    """Present when the case has a [contact] table."""
+    """Present when the case has one contact pair (a [contact] table, or one [[contact]])."""
+    contacts: list[Contact]
+    """Present when the case has several contact pairs ([[contact]] tables): each pair's
+    record, in the case's order (then `contact` is absent)."""
     peak_memory_mb: float
     """The process's peak resident memory, where Linux reports it."""
 

@@ -19,13 +19,13 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
 
 use internodes::case::{Case as CaseFile, CaseError, check_geo_parameters};
-use internodes::contact::StepRecord;
+use internodes::contact::{ContactStatus, StepRecord};
 use internodes::mesh::{
     GmshModel, Mesh as BodyMeshes, MeshError, ModelElements, ModelGroup, mesh_from_model, mesh_geo,
     read_msh, read_msh_bytes,
 };
 use internodes::output::{
-    CaseSummary, GENERATED_MESH, OutputError, ResultFolder, Verdict, unsaid_causes,
+    CaseSummary, ContactSummary, GENERATED_MESH, OutputError, ResultFolder, Verdict, unsaid_causes,
 };
 use internodes::run::{CaseSolution, RunError, Timings, solve_case_on, write_results};
 use internodes::study::{Study as StudyRun, StudyError, StudyOptions, StudySpec, run_study};
@@ -130,7 +130,7 @@ impl Case {
     }
 
     /// A case from a dict with the case file's keys (`{"mesh": ..., "body": [...], "contact":
-    /// {...}}`). `mesh` may be left out when a `Mesh` is passed to `solve`. `name` stands for
+    /// {...}}`; `"contact"` a list of such dicts for several pairs). `mesh` may be left out when a `Mesh` is passed to `solve`. `name` stands for
     /// the case file in messages and the plot title; relative paths are relative to `folder`
     /// (default: the current directory).
     #[staticmethod]
@@ -209,6 +209,13 @@ impl Case {
         self.file.load_steps()
     }
 
+    /// The contact pairs' names, in the case's order (`[contact] name`, default
+    /// `"BODY1-BODY2"`; empty without contact).
+    #[getter]
+    fn pairs(&self) -> Vec<String> {
+        self.file.contacts.iter().map(|c| c.name.clone()).collect()
+    }
+
     /// Pickling: the case's keys (as TOML), name and folder, read again with the same checks.
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let restore = py
@@ -221,10 +228,10 @@ impl Case {
 
     fn __repr__(&self) -> String {
         format!(
-            "Case('{}', bodies={:?}, contact={})",
+            "Case('{}', bodies={:?}, pairs={})",
             self.file.path.display(),
             self.bodies(),
-            self.file.contact.is_some()
+            self.file.contacts.len()
         )
     }
 }
@@ -612,6 +619,7 @@ fn solve(
         solution,
         summary,
         bodies: PyOnceLock::new(),
+        contacts: PyOnceLock::new(),
     })
 }
 
@@ -798,6 +806,7 @@ struct Result {
     solution: CaseSolution,
     summary: CaseSummary,
     bodies: PyOnceLock<Py<PyDict>>,
+    contacts: PyOnceLock<Py<PyDict>>,
 }
 
 #[pymethods]
@@ -812,13 +821,47 @@ impl Result {
     }
 
     /// The contact status (`"converged"`, `"no-contact"`, `"iteration-limit"`, ...), or `None`
-    /// when the case has no contact.
+    /// when the case has no contact. With several pairs, the worst pair's: the first pair (in
+    /// the case's order) whose status is not a solution, else `"converged"` if any pair
+    /// converged, else `"no-contact"` (each pair's: `contacts[name].status`).
     #[getter]
     fn status(&self) -> Option<&'static str> {
-        self.summary.contact.as_ref().map(|c| c.status.name())
+        let statuses: Vec<ContactStatus> = self.pair_summaries().map(|c| c.status).collect();
+        if statuses.is_empty() {
+            return None;
+        }
+        let status = (statuses.iter())
+            .find(|s| !s.is_solution())
+            .or_else(|| (statuses.iter()).find(|s| matches!(s, ContactStatus::Converged)))
+            .unwrap_or(&ContactStatus::NoContact);
+        Some(status.name())
     }
 
-    /// Whether every body was solved and the contact problem, if any, was solved.
+    /// Each contact pair's result by name (a `dict` of `ContactResult`, in the case's order;
+    /// empty without contact), built on first access.
+    #[getter]
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let contacts = self
+            .contacts
+            .get_or_try_init(py, || -> PyResult<Py<PyDict>> {
+                let dict = PyDict::new(py);
+                for pair in self.pair_summaries() {
+                    let mut alone = self.summary.clone();
+                    alone.contact = Some(pair.clone());
+                    alone.contacts = Vec::new();
+                    let result = ContactResult {
+                        summary: pair.clone(),
+                        verdict: alone.verdict(),
+                    };
+                    dict.set_item(&pair.name, Py::new(py, result)?)?;
+                }
+                Ok(dict.unbind())
+            })?;
+        Ok(contacts.bind(py).clone())
+    }
+
+    /// Whether every body was solved and the contact problem, if any, was solved (every pair's,
+    /// with several pairs).
     #[getter]
     fn solved(&self) -> bool {
         !matches!(self.summary.verdict(), Verdict::NotSolved(_))
@@ -838,7 +881,8 @@ impl Result {
     }
 
     /// Raises `NotSolvedError` unless every load step was solved and passed its accuracy
-    /// report (`exit_code` 0), with the command line's message, which names the failed steps.
+    /// report (`exit_code` 0), with the command line's message, which names the failed steps
+    /// (and, with several pairs, the worst pair).
     fn raise_for_status(&self) -> PyResult<()> {
         match self.summary.verdict() {
             Verdict::Solved => Ok(()),
@@ -848,12 +892,20 @@ impl Result {
 
     /// One `Step` per load step solved, in order (empty without contact). The solve stops at
     /// the first step whose active set did not settle, so there may be fewer than the case's
-    /// `load_steps`.
+    /// `load_steps`. A case of several contact pairs raises `ValueError`: each pair has its
+    /// own steps (`contacts[name].steps`).
     #[getter]
     fn steps(&self, py: Python<'_>) -> PyResult<Vec<Step>> {
-        (self.step_records().iter())
-            .map(|record| Step::new(py, record))
-            .collect()
+        match &self.summary.contact {
+            Some(contact) => steps(py, &contact.steps),
+            None if self.summary.contacts.is_empty() => Ok(Vec::new()),
+            None => Err(PyValueError::new_err(format!(
+                "the case has {} contact pairs ({}), each with its own load steps: use \
+                 result.contacts[name].steps",
+                self.summary.contacts.len(),
+                quoted(self.summary.contacts.iter().map(|c| c.name.as_str()))
+            ))),
+        }
     }
 
     /// Each body's fields by name (a `dict` of `BodyResult`), built on first access.
@@ -894,8 +946,10 @@ impl Result {
 }
 
 impl Result {
-    fn step_records(&self) -> &[StepRecord] {
-        self.summary.contact.as_ref().map_or(&[], |c| &c.steps)
+    /// Each pair's summary, in the case's order (the summary's `contact` for one pair,
+    /// `contacts` for several).
+    fn pair_summaries(&self) -> impl Iterator<Item = &ContactSummary> {
+        self.summary.contact.iter().chain(&self.summary.contacts)
     }
 
     fn write_into(&self, folder: &Path) -> PyResult<()> {
@@ -1094,7 +1148,7 @@ impl Study {
 /// How one load step ended: the library's record of it (`StepRecord`). Each step's status,
 /// accuracy verdict, failed checks, forces and Hertz fit are its own; the accuracy report's
 /// details (each check's value and tolerance) and the iteration history are kept for the last
-/// step only (`Result.summary["contact"]`).
+/// step only (`Result.summary["contact"]`, or the pair's `ContactResult.summary`).
 #[pyclass(module = "internodes", frozen, get_all)]
 struct Step {
     /// 1, 2, ... in the order solved.
@@ -1167,6 +1221,98 @@ impl Step {
     }
 }
 
+/// The `Step` of each record.
+fn steps(py: Python<'_>, records: &[StepRecord]) -> PyResult<Vec<Step>> {
+    records.iter().map(|record| Step::new(py, record)).collect()
+}
+
+/// Names as `'a', 'b'`, for messages.
+fn quoted<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    names
+        .map(|n| format!("'{n}'"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One contact pair's result: its status, bodies, load steps and summary (an entry of the
+/// summary's `contacts` with several pairs, its `contact` with one).
+#[pyclass(module = "internodes", frozen)]
+struct ContactResult {
+    summary: ContactSummary,
+    /// This pair's verdict alone.
+    verdict: Verdict,
+}
+
+#[pymethods]
+impl ContactResult {
+    /// The pair's name (`[contact] name`, default `"BODY1-BODY2"`).
+    #[getter]
+    fn name(&self) -> String {
+        self.summary.name.clone()
+    }
+
+    /// This pair's contact status (`"converged"`, `"no-contact"`, `"iteration-limit"`, ...).
+    #[getter]
+    fn status(&self) -> &'static str {
+        self.summary.status.name()
+    }
+
+    /// The body that carries the multiplier.
+    #[getter]
+    fn primary(&self) -> String {
+        self.summary.primary.clone()
+    }
+
+    /// The other body.
+    #[getter]
+    fn secondary(&self) -> String {
+        self.summary.secondary.clone()
+    }
+
+    /// Whether this pair's contact problem was solved at every load step.
+    #[getter]
+    fn solved(&self) -> bool {
+        !matches!(self.verdict, Verdict::NotSolved(_))
+    }
+
+    /// Whether it was solved and passed its accuracy report at every load step.
+    #[getter]
+    fn accurate(&self) -> bool {
+        self.verdict == Verdict::Solved
+    }
+
+    /// The command line's exit status were this the only pair: 0 solved, 2 not solved, 3
+    /// solved but inaccurate.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.verdict.exit_status()
+    }
+
+    /// One `Step` per load step solved, in order: this pair's forces, status and accuracy.
+    #[getter]
+    fn steps(&self, py: Python<'_>) -> PyResult<Vec<Step>> {
+        steps(py, &self.summary.steps)
+    }
+
+    /// This pair's part of `summary.json` (its `contact`, or its entry of `contacts`).
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = serde_json::to_string(&self.summary)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "ContactResult('{}', status={}, primary='{}', secondary='{}')",
+            self.summary.name,
+            self.summary.status.name(),
+            self.summary.primary,
+            self.summary.secondary
+        )
+    }
+}
+
 /// One body's fields: node-wise arrays in the body's local numbering, cell-wise arrays in its
 /// cell order.
 #[pyclass(module = "internodes", frozen, get_all)]
@@ -1187,8 +1333,9 @@ struct BodyResult {
     stress: Py<PyAny>,
     /// `(m,)` von Mises stress per cell.
     von_mises: Py<PyAny>,
-    /// The contact surface's fields in contact runs, else `None`.
-    surface: Option<Py<SurfaceResult>>,
+    /// Its contact surface's fields in each contact pair it is in, by pair name (in the case's
+    /// order; empty for a body in no pair).
+    surfaces: Py<PyDict>,
 }
 
 /// Interface fields on a body's contact candidate surface.
@@ -1239,24 +1386,21 @@ impl BodyResult {
         let fields = &solved.solution.cell_fields;
         let coordinates = body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect();
         let tensors = |t: &[[f64; 9]]| t.iter().flatten().copied().collect::<Vec<f64>>();
-        let surface = match &solved.surface {
-            None => None,
-            Some(s) => {
-                let k = s.nodes.len();
-                let traction = s.traction.iter().flat_map(|t| t[..dim].to_vec()).collect();
-                Some(Py::new(
-                    py,
-                    SurfaceResult {
-                        nodes: array(py, s.nodes.clone(), &[k])?,
-                        pressure: array(py, s.pressure.clone(), &[k])?,
-                        mean_pressure: array(py, s.mean_pressure.clone(), &[k])?,
-                        traction: array(py, traction, &[k, dim])?,
-                        gap: array(py, s.normal_gap.clone(), &[k])?,
-                        active: array(py, s.active.clone(), &[k])?,
-                    },
-                )?)
-            }
-        };
+        let surfaces = PyDict::new(py);
+        for surface in &solved.surfaces {
+            let s = &surface.fields;
+            let k = s.nodes.len();
+            let traction = s.traction.iter().flat_map(|t| t[..dim].to_vec()).collect();
+            let fields = SurfaceResult {
+                nodes: array(py, s.nodes.clone(), &[k])?,
+                pressure: array(py, s.pressure.clone(), &[k])?,
+                mean_pressure: array(py, s.mean_pressure.clone(), &[k])?,
+                traction: array(py, traction, &[k, dim])?,
+                gap: array(py, s.normal_gap.clone(), &[k])?,
+                active: array(py, s.active.clone(), &[k])?,
+            };
+            surfaces.set_item(&surface.pair, Py::new(py, fields)?)?;
+        }
         Ok(BodyResult {
             name: solved.name.clone(),
             coordinates: array(py, coordinates, &[n, dim])?,
@@ -1267,13 +1411,33 @@ impl BodyResult {
             strain: array(py, tensors(&fields.strain), &[m, 3, 3])?,
             stress: array(py, tensors(&fields.stress), &[m, 3, 3])?,
             von_mises: array(py, fields.von_mises.clone(), &[m])?,
-            surface,
+            surfaces: surfaces.unbind(),
         })
     }
 }
 
 #[pymethods]
 impl BodyResult {
+    /// The contact surface's fields for a body in one contact pair, `None` for a body in none;
+    /// a body in several pairs raises `ValueError` (use `surfaces[pair]`).
+    #[getter]
+    fn surface<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let surfaces = self.surfaces.bind(py);
+        match surfaces.len() {
+            0 => Ok(None),
+            1 => Ok(Some(surfaces.values().get_item(0)?)),
+            n => {
+                let names: Vec<String> = surfaces.keys().extract()?;
+                Err(PyValueError::new_err(format!(
+                    "body '{}' is in {n} contact pairs ({}), with a contact surface in each: \
+                     use surfaces[pair name]",
+                    self.name,
+                    quoted(names.iter().map(String::as_str))
+                )))
+            }
+        }
+    }
+
     fn __repr__(&self) -> String {
         format!("BodyResult('{}')", self.name)
     }
@@ -1298,6 +1462,7 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Study>()?;
     m.add_class::<Cancel>()?;
     m.add_class::<Step>()?;
+    m.add_class::<ContactResult>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(study, m)?)?;
     // What pickles of cases and meshes are read back with.

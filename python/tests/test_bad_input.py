@@ -46,7 +46,9 @@ def test_a_missing_case_file_names_it():
      r"body\[0\].youngs_modulus is None"),
     ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}], "solver": {"rtol": 2.0}},
      r"rtol must be in \(0, 1\)"),
-    ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}],
+    # Both bodies named: a pair's body without a [[body]] table is refused first.
+    ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3},
+               {"name": "block", "youngs_modulus": 1.0, "poisson_ratio": 0.3}],
       "contact": {"bodies": ["disc", "block"], "surfaces": ["a", "b"], "load_steps": []}},
      "load_steps"),
     ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}], "mesh": object()},
