@@ -27,7 +27,7 @@ Family 2, **two half-discs pressed into one block** (``geo/two_discs_on_block_2d
 lower half-discs of radius R = 1 (E = 1000, nu = 0.3), 3R apart centre to centre, on a block
 8R x 2R whose base is clamped, each disc's flat top pushed down by d = 0.015 and held
 laterally; two pairs that share the block. The mesh is mirror-symmetric about x = 0 (the geo
-copies the right half's mesh onto the left; gmsh's copy places 7 of the arcs' nodes up to 7e-8 R
+copies the right half's mesh onto the left; gmsh's copy places a few of the arcs' nodes up to 1e-7 R
 off the mirror image, which ``symmetrize`` moves onto it, so that the mirror image is exact to
 round-off: ``premise: mirror mesh``). The block is 1e3 times stiffer than the discs (E = 1e6): the
 two indentations then interact only through the block, whose whole compliance is about 1e-3 of
