@@ -20,7 +20,9 @@ study (``hertz_suite.py``), the independent dolfinx rigid-flat reference
 parameter ranges (``sweep.py``; ``--quick``: its quick subset), the gated sweep of flat faces
 in contact, flat blocks and stiff flat punches (``flat_sweep.py``; ``--quick``: its quick subset), the
 gated sweep of contact at edges and corners off the other body's mesh lines (``edge_sweep.py``;
-``--quick``: its quick subset) and the refinement study with its grid convergence index against
+``--quick``: its quick subset), the gated suite of several contact pairs in one case (a three-block
+stack against its exact solution, two discs on one block, a disc between two plates under a force;
+``multi_body.py``; ``--quick``: its quick subset) and the refinement study with its grid convergence index against
 Hertz (``refinement_study.py``; not run by ``--quick``). Everything goes into ``validation/report/`` (``report.py``):
 README.md with every table and figure, and results.json.
 
@@ -61,7 +63,7 @@ REPORT = VALIDATION / "report"
 QUICK_REPORT = BUILD / "report-quick"
 # Contact suites: module name, whether its checks gate the run.
 SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False, "sweep": True, "flat_sweep": True,
-          "edge_sweep": True, "refinement_study": False}
+          "edge_sweep": True, "multi_body": True, "refinement_study": False}
 # Regression bands on the target suites' figures, one section per mode.
 BANDS = VALIDATION / "bands.json"
 # A figure may grow to BAND_RELATIVE times its committed value plus BAND_ABSOLUTE before the band
