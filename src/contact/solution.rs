@@ -148,7 +148,7 @@ pub struct HertzFit {
     /// Contact radius (3D) or half-width (2D).
     pub a: f64,
     pub p0: f64,
-    /// Centre of the contact zone (mean-pressure-weighted centroid of the active nodes).
+    /// Centre of the contact zone: the vertex of the fitted profile (`super::hertz`).
     pub center: [f64; 3],
 }
 
