@@ -80,7 +80,6 @@ Meshes, case files, outputs, logs and cached dolfinx references go to validation
 
 from __future__ import annotations
 
-import argparse
 import functools
 import json
 import math
@@ -98,7 +97,7 @@ import edge_reference  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ReferenceFailure  # noqa: E402
 from flat_sweep import RunFailed  # noqa: E402
-from suite import (MeshFailed, SuiteResult, body_table, case_toml, contact_table, group_edges, json_safe, mesh_geo,  # noqa: E402
+from suite import (checks_table, standalone, MeshFailed, SuiteResult, body_table, case_toml, contact_table, group_edges, json_safe, mesh_geo,  # noqa: E402
                    run_solve, solver_reports, vouched)
 from sweep import loaded, read_output, solved_primary, vertical_force  # noqa: E402
 
@@ -579,32 +578,13 @@ def report_text(cases: list[EdgeCase], checks: list[Check], records: dict, quick
                          f"{' (' + ', '.join(r['failed']) + ')' if r.get('failed') else ''} | {fe} | {zone} "
                          f"| {'**' + r['class'] + '**' if r['class'] in ('WRONG', 'ERROR') else r['class']} "
                          f"| {r['seconds']:.1f} |")
-    lines += ["", "**Checks**", "", "| check | case | figure | tolerance | result | note |",
-              "|---|---|---|---|---|---|"]
-    lines += [f"| {c.check} | {c.case} | {'n/a' if math.isnan(c.figure) else f'{c.figure:.3g}'} | {c.tolerance:.3g} "
-              f"| {'PASS' if c.passed else '**FAIL**'} | {c.note} |" for c in checks]
+    lines += checks_table(checks)
     lines += ["", DECISIONS]
     return "\n".join(lines)
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="the quick subset only (make test)")
-    parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes")
-    parser.add_argument("--cases", nargs="+", help="case or family names (default: all)")
-    parser.add_argument("--out", type=Path, default=BUILD / "report")
-    args = parser.parse_args()
-    known = {c.name for c in CASES} | set(FAMILIES)
-    unknown = set(args.cases or []) - known
-    if unknown:
-        parser.error(f"unknown cases {sorted(unknown)}; known: {sorted(known)}")
-    result = run_suite(args.binary, args.quick, args.out, args.cases)
-    print(result.text)
-    (args.out / "edge_sweep.json").write_text(json.dumps(
-        {"binary": str(args.binary), "checks": [asdict(c) | {"figure": c.figure if math.isfinite(c.figure) else None,
-                                                             "passed": c.passed} for c in result.checks],
-         "data": result.data}, indent=1))
-    return 0 if all(c.passed for c in result.checks) else 1
+    return standalone(__doc__, {c.name for c in CASES} | set(FAMILIES), run_suite, "edge_sweep.json", BUILD, binary=True)
 
 
 if __name__ == "__main__":

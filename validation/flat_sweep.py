@@ -75,7 +75,6 @@ Meshes, case files, outputs, logs and cached dolfinx references go to validation
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -91,7 +90,7 @@ REPO = VALIDATION.parent
 import flat_reference  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ReferenceFailure  # noqa: E402
-from suite import (Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
+from suite import (checks_table, standalone, Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
                    report_rows, run_solve,  # noqa: E402
                    solver_reports, surface_spacing, vouched)
 from sweep import plot_summary, read_output, solved_primary, vertical_force  # noqa: E402
@@ -671,29 +670,13 @@ def report_text(cases: list[FlatCase], checks: list[Check], records: dict, quick
         lines.append(f"| {case.name} | {case.parameters_text()} | {case.why} | {'yes' if case.quick else ''} "
                      f"| {reference} | {r.get('status', r.get('error', ''))} | {r.get('iterations', '')} "
                      f"| {r.get('seconds', math.nan):.1f} |")
-    lines += ["", "**Checks**", "", "| check | case | figure | tolerance | result | note |", "|---|---|---|---|---|---|"]
-    lines += [f"| {c.check} | {c.case} | {'n/a' if math.isnan(c.figure) else f'{c.figure:.3g}'} | {c.tolerance:.3g} "
-              f"| {'PASS' if c.passed else '**FAIL**'} | {c.note} |" for c in checks]
+    lines += checks_table(checks)
     lines += ["", DECISIONS]
     return "\n".join(lines)
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="the quick subset only (make test)")
-    parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes")
-    parser.add_argument("--cases", nargs="+", help="case names (default: all)")
-    parser.add_argument("--out", type=Path, default=BUILD / "report")
-    args = parser.parse_args()
-    unknown = set(args.cases or []) - {c.name for c in CASES}
-    if unknown:
-        parser.error(f"unknown cases {sorted(unknown)}; known: {[c.name for c in CASES]}")
-    result = run_suite(args.binary, args.quick, args.out, args.cases)
-    print(result.text)
-    (args.out / "flat_sweep.json").write_text(json.dumps(
-        {"checks": [asdict(c) | {"figure": c.figure if math.isfinite(c.figure) else None, "passed": c.passed}
-                    for c in result.checks], "data": result.data}, indent=1))
-    return 0 if all(c.passed for c in result.checks) else 1
+    return standalone(__doc__, {c.name for c in CASES}, run_suite, "flat_sweep.json", BUILD)
 
 
 if __name__ == "__main__":

@@ -13,11 +13,13 @@ reference) go in ``text`` and ``data``, never in ``checks``.
 
 from __future__ import annotations
 
+import argparse
 import hashlib
 import json
+import math
 import subprocess
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from compare import Check
@@ -310,3 +312,34 @@ def _report_row(kind: str, case: str, report: dict | None, key: str, required: t
     if flags != (worst <= 1.0):
         return Check(kind, case, math.nan, 1.0, f"{kind}.passed = {report.get('passed')} contradicts its figures; {note}")
     return Check(kind, case, worst, 1.0, note)
+
+
+def checks_table(checks: list[Check]) -> list[str]:
+    """The report's table of ``checks``: one row each, the figure, tolerance, PASS/FAIL and note."""
+    return ["", "**Checks**", "", "| check | case | figure | tolerance | result | note |", "|---|---|---|---|---|---|",
+            *(f"| {c.check} | {c.case} | {'n/a' if math.isnan(c.figure) else f'{c.figure:.3g}'} | {c.tolerance:.3g} "
+              f"| {'PASS' if c.passed else '**FAIL**'} | {c.note} |" for c in checks)]
+
+
+def standalone(doc: str, names: set[str], run, json_name: str, build: Path, **extra) -> int:
+    """A suite run alone (its ``main``): the flags ``--quick``, ``--binary``, ``--cases`` (of
+    ``names``) and ``--out``; ``run(binary, quick, out, cases)`` gives its SuiteResult, whose
+    text is printed and whose checks and data go to ``out/json_name`` (with ``extra``, and the
+    binary when ``extra`` asks for it by ``binary=True``). 0 if every check passed."""
+    repo = Path(__file__).resolve().parent.parent
+    parser = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="the quick subset only (make test)")
+    parser.add_argument("--binary", type=Path, default=repo / "target/release/internodes")
+    parser.add_argument("--cases", nargs="+", help="case names (default: all)")
+    parser.add_argument("--out", type=Path, default=build / "report")
+    args = parser.parse_args()
+    unknown = set(args.cases or []) - names
+    if unknown:
+        parser.error(f"unknown cases {sorted(unknown)}; known: {sorted(names)}")
+    result = run(args.binary.resolve(), args.quick, args.out, args.cases)
+    print(result.text)
+    head = {"binary": str(args.binary)} if extra.pop("binary", False) else {}
+    checks = [asdict(c) | {"figure": c.figure if math.isfinite(c.figure) else None, "passed": c.passed}
+              for c in result.checks]
+    (args.out / json_name).write_text(json.dumps(head | {"checks": checks, "data": result.data} | extra, indent=1))
+    return 0 if all(c.passed for c in result.checks) else 1
