@@ -353,3 +353,16 @@ fn load_steps_at_the_top_apply_to_every_pair() {
         }
     }
 }
+
+#[test]
+fn a_floating_block_its_flat_contacts_cannot_hold_sideways_is_refused_by_name() {
+    // Without its rollers the middle block may slide between the two flat faces: frictionless
+    // contact does not hold it there, and nothing else does.
+    let text = pushed(&pairs("")).replace(
+        "[[body.dirichlet]]\ngroup = \"middle_sides\"\nux = 0.0\n\n",
+        "",
+    );
+    assert!(!text.contains("middle_sides"), "the rollers are removed");
+    let message = solve(&text).err().expect("nothing holds the middle block sideways");
+    assert_names(&message, &["'middle'", "held by its contact alone", "support the body"]);
+}
