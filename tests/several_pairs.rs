@@ -363,6 +363,11 @@ fn a_floating_block_its_flat_contacts_cannot_hold_sideways_is_refused_by_name() 
         "",
     );
     assert!(!text.contains("middle_sides"), "the rollers are removed");
-    let message = solve(&text).err().expect("nothing holds the middle block sideways");
-    assert_names(&message, &["'middle'", "held by its contact alone", "support the body"]);
+    let message = solve(&text)
+        .err()
+        .expect("nothing holds the middle block sideways");
+    assert_names(
+        &message,
+        &["'middle'", "held by its contact alone", "support the body"],
+    );
 }
