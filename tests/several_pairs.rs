@@ -12,7 +12,7 @@ mod common;
 
 use common::{fixture, run_solve, write_case};
 use internodes::case::Case;
-use internodes::contact::ContactStatus;
+use internodes::contact::{CheckKind, ContactStatus};
 use internodes::mesh::read_msh;
 use internodes::run::{CaseSolution, Timings, solve_case_on};
 
@@ -317,10 +317,6 @@ fn cases_the_pairs_cannot_solve_are_refused_with_what_to_do() {
     );
     let solvers = pairs("").replacen("[[contact]]", "[[contact]]\nsolver = \"schur\"", 1);
     assert_names(&refusal(&solvers, ""), &["pair 2", "solver", "shared"]);
-    // A stiff primary named by hand is checked against the other primary in a one-pair case;
-    // with several pairs that check is not made, so the case is refused.
-    let stiff = pairs("").replacen("[[contact]]", "[[contact]]\nprimary = \"middle\"", 1);
-    assert_names(&refusal(&stiff, ""), &["pair 1", "primary = \"auto\""]);
     let not_a_table = "contact = 3";
     assert_names(&refusal(not_a_table, ""), &["[[contact]] tables"]);
 }
@@ -370,4 +366,30 @@ fn a_floating_block_its_flat_contacts_cannot_hold_sideways_is_refused_by_name() 
         &message,
         &["'middle'", "held by its contact alone", "support the body"],
     );
+}
+
+#[test]
+fn a_named_stiff_primary_and_check_other_primary_are_checked_in_their_own_pairs() {
+    // Pair 1 names the stiffer middle block primary (auto would not): its force is checked
+    // against the answer with the upper block as primary. Pair 2 asks for the same check.
+    let named = pairs("")
+        .replacen("[[contact]]", "[[contact]]\nprimary = \"middle\"", 1)
+        .replace(
+            "surfaces = [\"middle_bottom\", \"lower_contact\"]",
+            "surfaces = [\"middle_bottom\", \"lower_contact\"]\ncheck_other_primary = true",
+        );
+    let solution = solve(&pushed(&named)).unwrap();
+    let sigma = exact_stress(PUSH);
+    for (p, contact) in solution.contacts.iter().enumerate() {
+        let summary = &contact.summary;
+        let agreement = (summary.accuracy.indicators.iter())
+            .find(|c| c.name == CheckKind::PrimaryAgreement)
+            .unwrap_or_else(|| panic!("pair {p}: no primary agreement"));
+        assert!(agreement.passed, "pair {p}: {}", agreement.describe());
+        assert!(agreement.value < 1e-3, "pair {p}: {}", agreement.describe());
+        let force = summary.force_primary[1].abs();
+        assert!((force - sigma).abs() < 1e-3 * sigma, "pair {p}: {force}");
+        assert!(summary.status.is_solution(), "pair {p}");
+    }
+    assert_eq!(solution.contacts[0].summary.primary, "middle");
 }

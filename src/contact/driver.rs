@@ -1,23 +1,28 @@
-//! The contact solve a caller asks for: from a problem and its load factors to a certified
-//! answer, whichever primary carries it.
+//! The contact solve a caller asks for: from the contact pairs and their load factors to a
+//! certified answer for each pair, whichever primary carries it.
 //!
 //! ```text
-//! 1. every load step with the chosen primary (one set-up, one active-set loop per step)
-//! 2. if "auto" chose between bodies of similar stiffness and the answer is not trusted
-//!    (not solved, or its accuracy report failed):
-//!      every load step with the other primary; keep its answer if that one is, and agrees
-//!      with the first one where that one settled with a passing accuracy report
-//! 3. if the primary was named and is much stiffer than the other body, or the case asks
-//!    (check_other_primary):
-//!      every load step with the other primary; check that the two contact forces agree
-//! 4. if a transfer was named that auto would not choose:
-//!      every load step with auto's transfer; check that the two contact forces agree
+//! 1. every load step with the chosen primaries (one set-up, one active-set loop per step,
+//!    all pairs together)
+//! 2. for each pair where "auto" chose between bodies of similar stiffness and the answer is
+//!    not trusted (not solved, or its accuracy report failed):
+//!      every load step with the other primary in those pairs; keep that answer if each of
+//!      them is trusted there (and agrees with the first one where that one settled with a
+//!      passing accuracy report) and no other pair lost its trust
+//! 3. for each pair whose primary was named and is much stiffer than the other body, or
+//!    that asks (check_other_primary):
+//!      every load step with the other primary in those pairs; check that each one's two
+//!      contact forces agree
+//! 4. for each pair that names a transfer auto would not choose:
+//!      every load step with auto's transfer in those pairs; check that the forces agree
 //! ```
 //!
 //! Step 2 answers the sag of a curved secondary between the nodes of a coarse flat primary
 //! ([`OtherPrimary::RetryIfUntrusted`]); step 3 the stiff primary that passes every check of
-//! the loop's certificate with a wrong force ([`OtherPrimary::CheckAgreement`]). Both live here,
-//! not in the command line, so that every caller of [`solve_contact`] gets the same answer.
+//! the loop's certificate with a wrong force ([`OtherPrimary::CheckAgreement`]). The pairs are
+//! decided together, so each of steps 2 to 4 solves the whole case again with the
+//! alternative in the pairs concerned, the others as they are. They live here, not in the
+//! command line, so that every caller of [`solve_contact`] gets the same answer.
 
 use std::time::Instant;
 
@@ -99,10 +104,9 @@ pub struct ContactRun<'m> {
 }
 
 /// Solves the contact `problems` (one or several pairs, decided together) at each of
-/// `load_factors` in turn (each step starting from the previous active set). A single pair
-/// gets the retry and the agreement checks of the module doc; several pairs are solved once,
-/// and a case that would need those checks is refused ([`refuse_unchecked`]). Progress goes
-/// to the `log` crate (level info) when `solver.verbose`.
+/// `load_factors` in turn (each step starting from the previous active sets), with the retry
+/// and the agreement checks of the module doc for each pair that needs them. Progress goes to
+/// the `log` crate (level info) when `solver.verbose`.
 pub fn solve_contact<'m>(
     problems: Vec<ContactProblem<'m>>,
     solver: &SolverSettings,
@@ -115,121 +119,71 @@ pub fn solve_contact<'m>(
         verbose: solver.verbose,
         timings: Vec::new(),
     };
-    let problems = match <[ContactProblem; 1]>::try_from(problems) {
-        Ok([problem]) => {
-            let (problem, solution, steps) = solve_pair(problem, solver, load_factors, &mut log)?;
-            return Ok(ContactRun {
-                problems: vec![problem],
-                solutions: vec![solution],
-                steps: vec![steps],
-                timings: log.timings,
-            });
-        }
-        Err(problems) => problems,
-    };
-    refuse_unchecked(&problems)?;
+    // 1. The chosen primaries.
     let (solutions, steps) = solve_load_steps(&problems, solver, load_factors, "", &mut log)?;
-    for solution in &solutions {
-        report_coverage(solution, &log);
-    }
-    Ok(ContactRun {
+    let mut run = Answer {
         problems,
         solutions,
         steps,
+    };
+    // 2. The other primary of each pair where auto's choice between similar bodies did not
+    //    settle.
+    let retried: Vec<usize> = (0..run.problems.len())
+        .filter(|&p| {
+            run.problems[p].primary_report.other_primary == OtherPrimary::RetryIfUntrusted
+                && !run.solutions[p].is_trusted()
+        })
+        .collect();
+    if !retried.is_empty() {
+        run = retry_with_other_primary(run, &retried, solver, load_factors, &mut log);
+    }
+    // The retry and the checks go on after an error of their own: a cancelled one ends here.
+    solver.cancel.check()?;
+    // 3. The other primary's forces, where a stiff primary was named or the case asks for
+    //    them (a retry has compared the two already); 4. auto's transfer's, where another
+    //    transfer was named. Only pairs with a solved step have an answer to check.
+    for alternative in [Alternative::OtherPrimary, Alternative::AutoTransfer] {
+        let due: Vec<usize> = (0..run.problems.len())
+            .filter(|&p| {
+                let problem = &run.problems[p];
+                let solved = run.steps[p].iter().any(|s| s.status.is_solution());
+                solved
+                    && match alternative {
+                        Alternative::OtherPrimary => {
+                            problem.primary_report.other_primary == OtherPrimary::CheckAgreement
+                                || (problem.settings.check_other_primary && !retried.contains(&p))
+                        }
+                        Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
+                    }
+            })
+            .collect();
+        if !due.is_empty() {
+            check_against(&mut run, alternative, &due, solver, load_factors, &mut log);
+            solver.cancel.check()?;
+        }
+    }
+    for (solution, steps) in run.solutions.iter().zip(&mut run.steps) {
+        report_coverage(solution, &log);
+        // The last step's record is the answer's, checks made after the loop included.
+        if let Some(last) = steps.last_mut() {
+            last.status = solution.status;
+            last.accurate = solution.certificate.accurate();
+            last.failed_checks = solution.certificate.failed();
+        }
+    }
+    Ok(ContactRun {
+        problems: run.problems,
+        solutions: run.solutions,
+        steps: run.steps,
         timings: log.timings,
     })
 }
 
-/// Several pairs are solved once: the retry with the other primary and the agreement checks
-/// (module doc) compare whole solves of one pair, and are not made for several. A pair whose
-/// answer one of them would have to confirm (a named primary that auto would not choose
-/// between bodies of different stiffness, `check_other_primary`, a named transfer auto would
-/// not choose) is refused rather than certified unchecked. (An untrusted answer between
-/// bodies of similar stiffness is reported as such, without the retry.)
-fn refuse_unchecked(problems: &[ContactProblem]) -> Result<(), ContactError> {
-    for (p, problem) in problems.iter().enumerate() {
-        let names = format!(
-            "'{}' and '{}'",
-            problem.primary.body.name, problem.secondary.body.name
-        );
-        let why = if problem.primary_report.other_primary == OtherPrimary::CheckAgreement {
-            "names a primary that \"auto\" would not choose (the stiffer body), whose answer \
-             must be checked against the other primary's"
-        } else if problem.settings.check_other_primary {
-            "asks for check_other_primary"
-        } else if problem.transfer_differs_from_auto() {
-            "names a transfer that \"auto\" would not choose, whose answer must be checked \
-             against auto's"
-        } else {
-            continue;
-        };
-        return Err(ContactError::PairSettings(format!(
-            "pair {} ({names}) {why}; that check is made for a case with one contact pair \
-             only: use primary = \"auto\" and transfer = \"auto\" with several pairs",
-            p + 1
-        )));
-    }
-    Ok(())
-}
-
-/// One pair, with the retry and the agreement checks of the module doc.
-fn solve_pair<'m>(
-    problem: ContactProblem<'m>,
-    solver: &SolverSettings,
-    load_factors: &[f64],
-    log: &mut Log,
-) -> Result<(ContactProblem<'m>, ContactSolution, Vec<StepRecord>), ContactError> {
-    // 1. The chosen primary.
-    let (solution, steps) = solve_pair_steps(&problem, solver, load_factors, "", log)?;
-    // 2. The other primary, when auto's choice between similar bodies did not settle.
-    let other_primary = problem.primary_report.other_primary;
-    let retry = other_primary == OtherPrimary::RetryIfUntrusted && !solution.is_trusted();
-    let (problem, mut solution, mut steps) = if retry {
-        retry_with_other_primary(problem, solution, steps, solver, load_factors, log)
-    } else {
-        (problem, solution, steps)
-    };
-    // The retry and the checks go on after an error of their own: a cancelled one ends here.
-    solver.cancel.check()?;
-    // 3. The other primary's forces, when a stiff primary was named or the case asks for
-    //    them (a retry has compared the two already); 4. auto's transfer's, when another
-    //    transfer was named.
-    if steps.iter().any(|s| s.status.is_solution()) {
-        for alternative in [Alternative::OtherPrimary, Alternative::AutoTransfer] {
-            let due = match alternative {
-                Alternative::OtherPrimary => {
-                    other_primary == OtherPrimary::CheckAgreement
-                        || (problem.settings.check_other_primary && !retry)
-                }
-                Alternative::AutoTransfer => problem.transfer_differs_from_auto(),
-            };
-            if due {
-                // The other discretization is the better one when it is auto's choice.
-                let reference_is_better = match alternative {
-                    Alternative::OtherPrimary => other_primary == OtherPrimary::CheckAgreement,
-                    Alternative::AutoTransfer => true,
-                };
-                solution = check_against(
-                    &problem,
-                    (alternative, reference_is_better),
-                    solution,
-                    &mut steps,
-                    solver,
-                    load_factors,
-                    log,
-                );
-                solver.cancel.check()?;
-            }
-        }
-    }
-    report_coverage(&solution, log);
-    // The last step's record is the answer's, checks made after the loop included.
-    if let Some(last) = steps.last_mut() {
-        last.status = solution.status;
-        last.accurate = solution.certificate.accurate();
-        last.failed_checks = solution.certificate.failed();
-    }
-    Ok((problem, solution, steps))
+/// The pairs, their answers at the last load step and their step records, of one solve.
+struct Answer<'m> {
+    problems: Vec<ContactProblem<'m>>,
+    solutions: Vec<ContactSolution>,
+    steps: Vec<Vec<StepRecord>>,
 }
 
 /// Says which errors the accuracy report of `solution` could not estimate, and why.
@@ -244,46 +198,84 @@ fn report_coverage(solution: &ContactSolution, log: &Log) {
     }
 }
 
-/// Every load step again with the other body as primary. Its answer is kept if it is a
-/// solution; otherwise the first one is, and the reason says what both ended with.
+/// Every load step again with the other body as primary in each of the `retried` pairs (the
+/// pairs are decided together, so the whole case is solved again). The second answer is kept
+/// if every retried pair is trusted there (and agrees with the first where that one settled:
+/// [`agrees_with_first`]) and no pair trusted in the first answer lost it; otherwise the first
+/// answer is, and each retried pair's reason says what both ended with.
 fn retry_with_other_primary<'m>(
-    problem: ContactProblem<'m>,
-    solution: ContactSolution,
-    steps: Vec<StepRecord>,
+    first: Answer<'m>,
+    retried: &[usize],
     solver: &SolverSettings,
     load_factors: &[f64],
     log: &mut Log,
-) -> (ContactProblem<'m>, ContactSolution, Vec<StepRecord>) {
-    let (first, first_ended) = (problem.primary.body.name.clone(), solution.ending());
-    let other = problem.clone().with_other_primary();
-    let other_name = other.primary.body.name.clone();
-    log.say(format!(
-        "primary = \"auto\": with '{first}' as primary the solve ended {first_ended}; solving \
-         again with '{other_name}' as primary"
-    ));
-    let retried = solve_pair_steps(&other, solver, load_factors, "other primary: ", log);
-    let tolerance = problem.settings.accuracy_tolerance;
-    let retried =
-        retried.map(|(second, steps)| (agrees_with_first(&solution, second, tolerance), steps));
-    match retried {
-        Ok((second, second_steps)) if second.is_trusted() => (
-            other.with_reason_appended(&format!(
-                "'{other_name}' carries the multiplier because '{first}' as primary ended \
-                 {first_ended}"
-            )),
-            second,
-            second_steps,
-        ),
+) -> Answer<'m> {
+    let mut others = first.problems.clone();
+    for &p in retried {
+        let other = others[p].clone().with_other_primary();
+        log.say(format!(
+            "primary = \"auto\": with '{}' as primary the solve ended {}; solving again with '{}' \
+             as primary",
+            first.problems[p].primary.body.name,
+            first.solutions[p].ending(),
+            other.primary.body.name
+        ));
+        others[p] = other;
+    }
+    let retry = solve_load_steps(&others, solver, load_factors, "other primary: ", log);
+    let retry = retry.map(|(solutions, steps)| {
+        let solutions: Vec<ContactSolution> = (solutions.into_iter().enumerate())
+            .map(|(p, second)| match retried.contains(&p) {
+                true => {
+                    let tolerance = first.problems[p].settings.accuracy_tolerance;
+                    agrees_with_first(&first.solutions[p], second, tolerance)
+                }
+                false => second,
+            })
+            .collect();
+        (solutions, steps)
+    });
+    let keep_second = retry.as_ref().is_ok_and(|(second, _)| {
+        (0..second.len()).all(|p| match retried.contains(&p) {
+            true => second[p].is_trusted(),
+            false => !first.solutions[p].is_trusted() || second[p].is_trusted(),
+        })
+    });
+    match retry {
+        Ok((solutions, steps)) if keep_second => {
+            for &p in retried {
+                let (first_name, other_name) = (
+                    &first.problems[p].primary.body.name,
+                    &others[p].primary.body.name,
+                );
+                let reason = format!(
+                    "'{other_name}' carries the multiplier because '{first_name}' as primary \
+                     ended {}",
+                    first.solutions[p].ending()
+                );
+                others[p] = others[p].clone().with_reason_appended(&reason);
+            }
+            Answer {
+                problems: others,
+                solutions,
+                steps,
+            }
+        }
         retry => {
-            let second_ended = match retry {
-                Ok((second, _)) => second.ending(),
-                Err(e) => format!("with an error ({e})"),
-            };
-            let problem = problem.with_reason_appended(&format!(
-                "kept although it ended {first_ended}: '{other_name}' as primary ended \
-                 {second_ended}"
-            ));
-            (problem, solution, steps)
+            let mut problems = first.problems.clone();
+            for &p in retried {
+                let second_ended = match &retry {
+                    Ok((second, _)) => second[p].ending(),
+                    Err(e) => format!("with an error ({e})"),
+                };
+                let reason = format!(
+                    "kept although it ended {}: '{}' as primary ended {second_ended}",
+                    first.solutions[p].ending(),
+                    others[p].primary.body.name
+                );
+                problems[p] = problems[p].clone().with_reason_appended(&reason);
+            }
+            Answer { problems, ..first }
         }
     }
 }
@@ -337,94 +329,124 @@ enum Alternative {
 /// a 1% tolerance while 1.01% off the reference.
 const ERROR_PER_DISTANCE_TO_BETTER: f64 = 1.25;
 
-/// Every load step again with the `alternative` discretization, and an agreement check of each
-/// step's force against it (`primary agreement` or `transfer agreement`): in the last step's
-/// accuracy report, and in every step's record (the force-displacement curve is an answer
-/// too). The answer kept is the named choice's. When the alternative is the better
-/// discretization (`reference_is_better`: auto's primary or transfer, the named one not), the
-/// distance to it may be at most the accuracy tolerance over
-/// [`ERROR_PER_DISTANCE_TO_BETTER`]; otherwise the tolerance itself (the answer checked is
-/// the better one, its error at most the distance).
+/// Every load step again with the `alternative` discretization of the `due` pairs (the other
+/// pairs as they are: the pairs are decided together), and an agreement check of each due
+/// pair's force at each step against it (`primary agreement` or `transfer agreement`): in the
+/// last step's accuracy report, and in every step's record (the force-displacement curve is an
+/// answer too). The answers kept are the named choices'. When the alternative is the better
+/// discretization (auto's primary or transfer, the named one not), the distance to it may be
+/// at most the accuracy tolerance over [`ERROR_PER_DISTANCE_TO_BETTER`]; otherwise the
+/// tolerance itself (the answer checked is the better one, its error at most the distance).
 fn check_against(
-    problem: &ContactProblem,
-    (alternative, reference_is_better): (Alternative, bool),
-    mut solution: ContactSolution,
-    steps: &mut [StepRecord],
+    run: &mut Answer,
+    alternative: Alternative,
+    due: &[usize],
     solver: &SolverSettings,
     load_factors: &[f64],
     log: &mut Log,
-) -> ContactSolution {
-    let per_distance = match reference_is_better {
-        true => ERROR_PER_DISTANCE_TO_BETTER,
-        false => 1.0,
+) {
+    let other = OtherSolve::new(&run.problems, alternative, due);
+    for (&p, with) in due.iter().zip(&other.with) {
+        let pair = pair_label(&run.problems, p);
+        log.say(format!(
+            "{pair}checking the answer: solving again with {with}"
+        ));
+    }
+    let label = match &other.with[..] {
+        [with] => format!("check with {with}: "),
+        _ => "check with the other discretizations: ".to_string(),
     };
-    let (tolerance, formulation) = (
-        problem.settings.accuracy_tolerance / per_distance,
-        problem.settings.formulation,
-    );
-    let other = OtherSolve::new(problem, alternative);
-    let with = &other.with;
-    log.say(format!("checking the answer: solving again with {with}"));
-    let label = format!("check with {with}: ");
-    let solved = solve_pair_steps(&other.problem, solver, load_factors, &label, log);
-    let (reference, other_steps) = match solved {
-        Ok((check, other_steps))
-            if check.status == ContactStatus::Converged && check.is_trusted() =>
-        {
-            (
-                Ok(other.on_these_bodies(check.force_primary, check.force_secondary)),
-                other_steps,
-            )
-        }
-        Ok((check, other_steps)) => (Err(check.ending()), other_steps),
-        Err(e) => (Err(format!("with an error ({e})")), Vec::new()),
-    };
-    other.certify_earlier_steps(steps, &other_steps, tolerance);
-    let forces = [solution.force_primary, solution.force_secondary];
-    let check = agreement(other.kind, forces, reference, with, tolerance);
-    log.say(format!("check with {with}: {}", check.describe()));
-    solution.certify_further(check);
-    log.say(format!(
-        "contact status: {}",
-        solution.describe(formulation)
-    ));
-    solution
+    let solved = solve_load_steps(&other.problems, solver, load_factors, &label, log);
+    for (k, &p) in due.iter().enumerate() {
+        let problem = &run.problems[p];
+        let reference_is_better = match alternative {
+            Alternative::OtherPrimary => {
+                problem.primary_report.other_primary == OtherPrimary::CheckAgreement
+            }
+            Alternative::AutoTransfer => true,
+        };
+        let per_distance = match reference_is_better {
+            true => ERROR_PER_DISTANCE_TO_BETTER,
+            false => 1.0,
+        };
+        let tolerance = problem.settings.accuracy_tolerance / per_distance;
+        let (reference, other_steps) = match &solved {
+            Ok((checks, other_steps))
+                if checks[p].status == ContactStatus::Converged && checks[p].is_trusted() =>
+            {
+                let check = &checks[p];
+                (
+                    Ok(other.on_these_bodies(check.force_primary, check.force_secondary)),
+                    &other_steps[p][..],
+                )
+            }
+            Ok((checks, other_steps)) => (Err(checks[p].ending()), &other_steps[p][..]),
+            Err(e) => (Err(format!("with an error ({e})")), &[][..]),
+        };
+        let with = &other.with[k];
+        other.certify_earlier_steps(&mut run.steps[p], other_steps, with, tolerance);
+        let solution = &mut run.solutions[p];
+        let forces = [solution.force_primary, solution.force_secondary];
+        let check = agreement(other.kind, forces, reference, with, tolerance);
+        let pair = pair_label(&run.problems, p);
+        log.say(format!("{pair}check with {with}: {}", check.describe()));
+        solution.certify_further(check);
+        log.say(format!(
+            "{pair}contact status: {}",
+            solution.describe(problem.settings.formulation)
+        ));
+    }
 }
 
-/// The solve of an [`Alternative`] that an answer is checked against.
+/// How messages name pair `p` of `problems`: nothing for a single pair.
+fn pair_label(problems: &[ContactProblem], p: usize) -> String {
+    match problems.len() {
+        1 => String::new(),
+        _ => format!(
+            "'{}' on '{}': ",
+            problems[p].primary.body.name, problems[p].secondary.body.name
+        ),
+    }
+}
+
+/// The solve of an [`Alternative`] that the answers of some pairs are checked against.
 struct OtherSolve<'m> {
-    problem: ContactProblem<'m>,
+    /// Every pair: the checked ones with the alternative discretization.
+    problems: Vec<ContactProblem<'m>>,
     kind: CheckKind,
-    /// Whether its primary is this solve's secondary.
+    /// Whether a checked pair's primary is this solve's secondary.
     swapped: bool,
-    /// What the messages call it: "'block' as primary", "the interpolation transfer".
-    with: String,
+    /// What the messages call the alternative of each checked pair: "'block' as primary",
+    /// "the interpolation transfer".
+    with: Vec<String>,
 }
 
 impl<'m> OtherSolve<'m> {
-    fn new(problem: &ContactProblem<'m>, alternative: Alternative) -> Self {
-        let (other, kind, swapped) = match alternative {
-            Alternative::OtherPrimary => (
-                problem.clone().with_other_primary(),
-                CheckKind::PrimaryAgreement,
-                true,
-            ),
-            Alternative::AutoTransfer => (
-                problem.clone().with_transfer(Transfer::Auto),
-                CheckKind::TransferAgreement,
-                false,
-            ),
+    fn new(problems: &[ContactProblem<'m>], alternative: Alternative, checked: &[usize]) -> Self {
+        let (kind, swapped) = match alternative {
+            Alternative::OtherPrimary => (CheckKind::PrimaryAgreement, true),
+            Alternative::AutoTransfer => (CheckKind::TransferAgreement, false),
         };
-        let with = match alternative {
-            Alternative::OtherPrimary => format!("'{}' as primary", other.primary.body.name),
-            Alternative::AutoTransfer => format!(
-                "the {} transfer",
-                serde_json::to_value(other.transfer().transfer).expect("a unit enum serializes")
-            )
-            .replace('"', ""),
-        };
+        let mut others = problems.to_vec();
+        let mut with = Vec::with_capacity(checked.len());
+        for &p in checked {
+            let other = match alternative {
+                Alternative::OtherPrimary => problems[p].clone().with_other_primary(),
+                Alternative::AutoTransfer => problems[p].clone().with_transfer(Transfer::Auto),
+            };
+            with.push(match alternative {
+                Alternative::OtherPrimary => format!("'{}' as primary", other.primary.body.name),
+                Alternative::AutoTransfer => format!(
+                    "the {} transfer",
+                    serde_json::to_value(other.transfer().transfer)
+                        .expect("a unit enum serializes")
+                )
+                .replace('"', ""),
+            });
+            others[p] = other;
+        }
         OtherSolve {
-            problem: other,
+            problems: others,
             kind,
             swapped,
             with,
@@ -441,12 +463,13 @@ impl<'m> OtherSolve<'m> {
         }
     }
 
-    /// The agreement check of the steps before the last, each against `other_steps`' step at
-    /// the same load factor.
+    /// The agreement check of a pair's steps before the last, each against `other_steps`'
+    /// step at the same load factor (the alternative called `with`).
     fn certify_earlier_steps(
         &self,
         steps: &mut [StepRecord],
         other_steps: &[StepRecord],
+        with: &str,
         tolerance: f64,
     ) {
         let trusted = |o: &StepRecord| o.status == ContactStatus::Converged && o.is_trusted();
@@ -460,29 +483,10 @@ impl<'m> OtherSolve<'m> {
                 None => Err("before this load step (its load steps stopped)".to_string()),
             };
             let forces = [vector(&step.force_primary), vector(&step.force_secondary)];
-            let check = agreement(self.kind, forces, other_step, &self.with, tolerance);
+            let check = agreement(self.kind, forces, other_step, with, tolerance);
             step.certify_further(&check);
         }
     }
-}
-
-/// [`solve_load_steps`] of one pair.
-fn solve_pair_steps(
-    problem: &ContactProblem,
-    solver: &SolverSettings,
-    load_factors: &[f64],
-    label: &str,
-    log: &mut Log,
-) -> Result<(ContactSolution, Vec<StepRecord>), ContactError> {
-    let (solutions, steps) = solve_load_steps(
-        std::slice::from_ref(problem),
-        solver,
-        load_factors,
-        label,
-        log,
-    )?;
-    let solution = solutions.into_iter().next().expect("one pair");
-    Ok((solution, steps.into_iter().next().expect("one pair")))
 }
 
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
