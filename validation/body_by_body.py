@@ -26,12 +26,24 @@ cell by cell:
 * ``reactions``: max |R - R_ref| / max |R_ref| over the Dirichlet groups;
 * ``contact force``: |F - F_ref| / |F_ref|, F the total contact force of the
   body in ``summary.json`` and F_ref the sum of dolfinx's contact load vector
-  (no linear solve: round-off only, tolerance 1e-12);
+  (no linear solve: round-off only, tolerance 1e-12; with several pairs over
+  the sum of the pairs' |F|);
 * ``status``: 0 if the contact solve converged, 1 otherwise (tolerance 0).
 
 Agreement to 1e-8 (observed: round-off) shows that each body's field is the
 exact discrete elastic solution for the tractions internodes reports: the
 contact iteration adds nothing to the bodies but these surface loads.
+
+Several contact pairs (``[[contact]]``): a body in several pairs is loaded on
+each of its contact surfaces, and its contact forces are compared relative to
+the sum of their magnitudes (a block between two others carries a net contact
+force of nothing). A force-controlled group (``[[body.force]]``) is held by
+dolfinx at the displacement internodes found for it, so its reaction must be
+the force (``reactions``). A body whose supports leave it free to move (held
+by its contacts alone) has the free dofs of dim far-apart nodes pinned at
+internodes' displacement: internodes' answer puts no force on them, so their
+reaction in dolfinx (``pinned reaction``) is how far its contact forces
+balance its loads, over the sum of their magnitudes.
 
 Run alone:  /usr/bin/python3 validation/body_by_body.py [--quick] [--binary PATH]
 """
@@ -56,7 +68,7 @@ VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
 
 from compare import ERRORS, Check, InternodesOutput, cell_order, failure, pad3, reaction_check, relative_max  # noqa: E402
-from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case  # noqa: E402
+from dolfinx_reference import Body, ReferenceFailure, ReferenceModel, read_case, rigid_body_modes  # noqa: E402
 from suite import MeshFailed, SuiteResult, contact_sides, mesh_geo, run_solve, toml_text  # noqa: E402
 
 BUILD = VALIDATION / "build" / "body_by_body"
@@ -77,6 +89,7 @@ class ContactCase:
     parameters: dict
     template: str  # geo/<template>.toml: bodies, supports, contact surfaces
     quick: bool = False  # also in the quick run (make test)
+    formulations: tuple[str, ...] = FORMULATIONS  # each solved in turn
 
     def description(self) -> str:
         return f"{self.geo}.geo, " + ", ".join(f"{k} = {v}" for k, v in self.parameters.items())
@@ -89,6 +102,14 @@ CASES = (
                 quick=True),
     ContactCase("hemisphere_hc0.015", "hemisphere_on_block", 3,
                 {"h_c": 0.015, "r_c": 0.16, "h_far": 0.5, "d_far": 1.0}, "hemisphere_on_block"),
+    # Several pairs (the templates' own formulation): a block held only by its two contacts; a
+    # disc and a ball held only by theirs, between plates of which the upper is pressed by a force.
+    ContactCase("three_blocks_2d", "three_blocks_2d", 2, {}, "three_blocks_2d", quick=True,
+                formulations=("frictionless",)),
+    ContactCase("disc_between_plates_2d", "disc_between_plates_2d", 2, {}, "disc_between_plates_2d", quick=True,
+                formulations=("frictionless",)),
+    ContactCase("ball_between_plates_3d", "ball_between_plates_3d", 3, {"h_c": 0.015, "r_c": 0.16},
+                "ball_between_plates_3d", formulations=("frictionless",)),
 )
 
 
@@ -101,26 +122,49 @@ class StepFailed(RuntimeError):
 # ---------------------------------------------------------------------------
 
 
-def write_cases(case: ContactCase, formulation: str, mesh: Path, folder: Path) -> tuple[Path, Path, dict]:
-    """The internodes case file (template with this mesh and formulation) and its bodies-only twin.
+def write_case(case: ContactCase, formulation: str, mesh: Path, folder: Path) -> tuple[Path, dict, list[dict]]:
+    """The internodes case file: the template with this mesh and formulation (in every pair).
 
-    ``dolfinx_reference.read_case`` reads only ``mesh`` and ``[[body]]``: the
-    twin holds exactly the same bodies, so both codes see the same supports
-    and materials. Returns (case file, bodies file, the [contact] table).
+    Returns (case file, the template's data, its contact tables: one for a `[contact]` table,
+    one per pair for `[[contact]]` tables).
     """
     with open(REPO / "geo" / f"{case.template}.toml", "rb") as f:
         data = tomllib.load(f)
     data.pop("geo_parameters", None)
     data["mesh"] = str(mesh)
     data["output"] = str(folder / "internodes")
-    data["contact"] = data["contact"] | {"formulation": formulation}
+    tables = data["contact"] if isinstance(data["contact"], list) else [data["contact"]]
+    tables = [t | {"formulation": formulation} for t in tables]
+    data["contact"] = tables if isinstance(data["contact"], list) else tables[0]
     folder.mkdir(parents=True, exist_ok=True)
-    case_file, bodies_file = folder / "case.toml", folder / "bodies.toml"
+    case_file = folder / "case.toml"
     case_file.write_text(f"# {case.description()}, {formulation} (written by body_by_body.py)\n"
                          + toml_text(data))
-    bodies_file.write_text("# the bodies of case.toml, for dolfinx_reference.read_case\n"
-                           + toml_text({"mesh": data["mesh"], "body": data["body"]}))
-    return case_file, bodies_file, data["contact"]
+    return case_file, data, tables
+
+
+def write_bodies(data: dict, forced: list[dict], folder: Path) -> Path:
+    """The bodies of the case file, for ``dolfinx_reference.read_case`` (which reads only ``mesh``
+    and ``[[body]]``: both codes see the same supports and materials), each force-controlled group
+    turned into a Dirichlet condition at the displacement internodes found for it (``forced``: the
+    last step's records), so that dolfinx solves the same body with the group where the force put
+    it; its reaction must then be the force."""
+    bodies = []
+    for body in data["body"]:
+        body = {k: v for k, v in body.items() if k != "force"}
+        dirichlet = [dict(d) for d in body.get("dirichlet", [])]
+        for record in (r for r in forced if r["body"] == body["name"]):
+            key = f"u{record['component']}"
+            entry = next((d for d in dirichlet if d["group"] == record["group"]), None)
+            if entry is None:
+                entry = {"group": record["group"]}
+                dirichlet.append(entry)
+            entry[key] = record["displacement"]
+        bodies.append(body | {"dirichlet": dirichlet})
+    path = folder / "bodies.toml"
+    path.write_text("# the bodies of case.toml, force-controlled groups at their displacement, for "
+                    "dolfinx_reference.read_case\n" + toml_text({"mesh": data["mesh"], "body": bodies}))
+    return path
 
 
 def generate_mesh(case: ContactCase) -> Path:
@@ -141,32 +185,34 @@ class TractionModel(ReferenceModel):
 
     def __init__(self, msh_path: Path, node_coordinates: dict[str, np.ndarray]):
         super().__init__(msh_path, node_coordinates)
-        self.tractions: dict[str, tuple[str, np.ndarray]] = {}
+        self.tractions: dict[str, tuple[list[str], np.ndarray]] = {}
 
-    def set_traction(self, body: str, group: str, nodal: np.ndarray) -> None:
-        """Load ``body`` with the P1 traction of nodal values ``nodal`` (n, 3), internodes local numbering, on ``group``.
+    def set_traction(self, body: str, groups: list[str], nodal: np.ndarray) -> None:
+        """Load ``body`` with the P1 traction of nodal values ``nodal`` (n, 3), internodes local numbering, on
+        its contact surfaces ``groups`` (one per pair the body is in).
 
-        Nodes with a nonzero traction must lie on ``group``: elsewhere the
-        ds(group) integral would not see them.
+        Nodes with a nonzero traction must lie on one of ``groups``: elsewhere
+        the ds(group) integrals would not see them.
         """
         on_group = np.zeros(len(nodal), bool)
         local = np.full(self.V.dofmap.index_map.size_local, -1)
         local[self.vertex_map(body)] = np.arange(len(nodal))
-        vertex_dofs = fem.locate_dofs_topological(self.Q, self.dim - 1, self.facets(group))
-        on_group[local[vertex_dofs]] = True
+        for group in groups:
+            vertex_dofs = fem.locate_dofs_topological(self.Q, self.dim - 1, self.facets(group))
+            on_group[local[vertex_dofs]] = True
         off = np.flatnonzero((nodal != 0).any(axis=1) & ~on_group)
         if off.size:
-            raise ReferenceFailure(f"body '{body}': {off.size} nodes off '{group}' carry a contact traction "
+            raise ReferenceFailure(f"body '{body}': {off.size} nodes off {groups} carry a contact traction "
                                    f"(first: local node {off[0]})")
         if (nodal[:, self.dim:] != 0).any():
             raise ReferenceFailure(f"body '{body}': nonzero out-of-plane traction in a 2D run")
-        self.tractions[body] = (group, nodal[:, : self.dim])
+        self.tractions[body] = (groups, nodal[:, : self.dim])
 
     def traction_load(self, body: str) -> np.ndarray:
         """The lumped contact load A_a t_a (n * dim,), internodes numbering; A_a = sum_b M[a, b], M the
-        group's P1 surface mass assembled by dolfinx."""
-        group, nodal = self.tractions[body]
-        areas = np.asarray(self.surface_mass(body, group).sum(axis=1)).ravel()
+        P1 surface mass of the body's contact surfaces assembled by dolfinx."""
+        groups, nodal = self.tractions[body]
+        areas = sum(np.asarray(self.surface_mass(body, group).sum(axis=1)).ravel() for group in groups)
         return (areas[:, None] * nodal).ravel()
 
     def load_vector(self, body: Body) -> np.ndarray:
@@ -192,13 +238,43 @@ def contact_tractions(folder: Path, out: InternodesOutput) -> dict[str, np.ndarr
             for name, b in out.bodies.items()}
 
 
+def pins(model: TractionModel, body: Body, x: np.ndarray, u: np.ndarray) -> dict[int, float]:
+    """For a body whose Dirichlet groups leave rigid motions free (held by its contacts alone), the
+    free dofs of dim far-apart nodes (the farthest from the centroid, the farthest from it, in 3D
+    the farthest from the line of the two) at internodes' displacement ``u`` (n, dim): dolfinx then
+    solves the same body with no free motion, and the reactions of these dofs measure how far
+    internodes' contact forces balance the body's loads. Empty for a body its supports hold."""
+    dim = model.dim
+    constrained = np.concatenate([dofs for group in model.dirichlet_dofs(body).values()
+                                  for dofs in group.values()] or [np.zeros(0, int)]).astype(int)
+    modes = rigid_body_modes(x[:, :dim])
+    if np.linalg.matrix_rank(modes[constrained]) == modes.shape[1]:
+        return {}
+    first = int(np.linalg.norm(x - x.mean(axis=0), axis=1).argmax())
+    second = int(np.linalg.norm(x - x[first], axis=1).argmax())
+    nodes = [first, second]
+    if dim == 3:
+        axis = (x[second] - x[first]) / np.linalg.norm(x[second] - x[first])
+        offset = x - x[first]
+        nodes.append(int(np.linalg.norm(offset - np.outer(offset @ axis, axis), axis=1).argmax()))
+    held = set(constrained.tolist())
+    return {dim * a + i: float(u[a, i]) for a in nodes for i in range(dim) if dim * a + i not in held}
+
+
 def body_checks(model: TractionModel, out: InternodesOutput, body: Body, summary_force: list[float],
-                label: str) -> tuple[list[Check], dict]:
-    """Solve ``body`` alone in dolfinx with its contact traction; compare fields, reactions and force."""
+                scale: float, label: str) -> tuple[list[Check], dict]:
+    """Solve ``body`` alone in dolfinx with its contact traction; compare fields, reactions and force (and,
+    for a body held by its contacts alone, the reactions of the dofs pinned at internodes' values).
+
+    ``scale`` is the sum of the magnitudes of the body's contact forces, pair by pair: forces are
+    compared relative to it, since a body between two others carries a net contact force of
+    nothing (its two contacts balance) and the reactions of its rollers are round-off."""
     ours = out.body(body.name)
     where = f"{label} {body.name}"
     start = time.perf_counter()
-    ref = model.solve(body)
+    pinned = pins(model, body, ours.geometry[:, : model.dim], ours.displacement[:, : model.dim])
+    ref = model.solve(body, pinned)
+    pinned_reaction = ref.reactions.pop("pinned", None)
     force_ref = model.contact_force(body.name)
     seconds = time.perf_counter() - start
     u_ref = pad3(ref.displacement)
@@ -207,9 +283,9 @@ def body_checks(model: TractionModel, out: InternodesOutput, body: Body, summary
     figures = {
         "displacement": relative_max(ours.displacement, u_ref),
         "stress": relative_max(ours.stress, stress_ref),
-        "contact force": float(np.linalg.norm(force - force_ref) / np.linalg.norm(force_ref)),
+        "contact force": float(np.linalg.norm(force - force_ref) / scale),
     }
-    reactions = reaction_check(ours.summary.get("reactions", {}), ref.reactions, where)
+    reactions = reaction_check(ours.summary.get("reactions", {}), ref.reactions, where, scale)
     figures["reactions"] = reactions.figure
     checks = [
         Check("displacement", where, figures["displacement"], FIELD_TOLERANCE,
@@ -218,8 +294,15 @@ def body_checks(model: TractionModel, out: InternodesOutput, body: Body, summary
               f"max|sigma| = {abs(stress_ref).max():.3e}, {len(stress_ref)} cells"),
         reactions,
         Check("contact force", where, figures["contact force"], FORCE_TOLERANCE,
-              "|F| = {:.6e}".format(np.linalg.norm(force_ref))),
+              f"|F| = {np.linalg.norm(force_ref):.6e}, over the sum of its pairs' |F| {scale:.6e}"),
     ]
+    if pinned_reaction is not None:
+        # Held by its contacts alone: the pinned dofs carry no force in internodes' answer, so
+        # their reaction in dolfinx is the balance of the body's loads, to the fields' precision.
+        figures["pinned reaction"] = float(np.linalg.norm(pinned_reaction) / scale)
+        checks.append(Check("pinned reaction", where, figures["pinned reaction"], FIELD_TOLERANCE,
+                            f"{len(pinned)} dofs of a body held by its contacts alone pinned at internodes' "
+                            f"displacement; |R| over the sum of its pairs' |F|"))
     info = {"nodes": len(u_ref), "cells": len(stress_ref), "contact_force": force_ref.tolist(),
             "figures": figures, "dolfinx_seconds": seconds}
     return checks, info
@@ -234,7 +317,7 @@ def check_case(binary: Path, case: ContactCase, mesh: Path, formulation: str) ->
     """Solve with internodes, then every body alone with dolfinx; checks and a record for the report."""
     label = f"{case.name} {formulation}"
     folder = BUILD / f"{case.name}_{formulation}"
-    case_file, bodies_file, contact = write_cases(case, formulation, mesh, folder)
+    case_file, data, tables = write_case(case, formulation, mesh, folder)
     output = folder / "internodes"
     shutil.rmtree(output, ignore_errors=True)  # never compare stale output
     start = time.perf_counter()
@@ -244,33 +327,42 @@ def check_case(binary: Path, case: ContactCase, mesh: Path, formulation: str) ->
     record = {"case": case.name, "mesh": case.description(), "formulation": formulation,
               "internodes_seconds": time.perf_counter() - start}
 
-    summary = json.loads((output / "summary.json").read_text())["contact"]
-    status = summary["status"]
-    record |= {"status": status, "iterations": len(summary["iterations"]),
-               "active": [summary["active_primary"], summary["active_secondary"]],
-               "force_imbalance": summary["force_imbalance"]}
-    checks = [Check("status", label, 0 if status == "converged" else 1, 0,
-                    f"{status}, {len(summary['iterations'])} iterations, active "
-                    f"{summary['active_primary']} + {summary['active_secondary']}")]
+    summary = json.loads((output / "summary.json").read_text())
+    pairs = summary["contacts"] if "contacts" in summary else [summary["contact"]]
+    statuses = [p["status"] for p in pairs]
+    record |= {"status": ", ".join(statuses), "iterations": len(pairs[0]["iterations"]),
+               "active": [[p["active_primary"], p["active_secondary"]] for p in pairs],
+               "force_imbalance": [p["force_imbalance"] for p in pairs]}
+    checks = [Check("status", f"{label} {p['name']}" if len(pairs) > 1 else label,
+                    0 if p["status"] == "converged" else 1, 0,
+                    f"{p['status']}, {len(p['iterations'])} iterations, active "
+                    f"{p['active_primary']} + {p['active_secondary']}") for p in pairs]
+    forced = [r for p in pairs for r in (p["steps"][-1].get("forced") or [])]
 
     start = time.perf_counter()
     out = InternodesOutput(output)
-    bodies = read_case(bodies_file).bodies
+    bodies = read_case(write_bodies(data, forced, folder)).bodies
     model = TractionModel(mesh, {b.name: out.body(b.name).geometry for b in bodies})
     tractions = contact_tractions(output, out)
-    surfaces = contact_sides(contact)
-    primary = summary.get("primary", contact.get("primary"))  # as solved (the case may say "auto")
-    secondary = next(b for b in surfaces if b != primary)
-    sides = {primary: (surfaces[primary], summary["force_primary"]),
-             secondary: (surfaces[secondary], summary["force_secondary"])}
+    # Each body's contact surfaces and the total contact force on it, over the pairs it is in
+    # (as solved: the primary may be "auto"'s, or the other body after a retry).
+    sides: dict[str, tuple[list[str], np.ndarray, float]] = {}
+    for table, pair in zip(tables, pairs):
+        surfaces = contact_sides(table)
+        for name, key in ((pair["primary"], "force_primary"), (pair["secondary"], "force_secondary")):
+            groups, force, scale = sides.get(name, ([], np.zeros(len(pair[key])), 0.0))
+            on_body = np.asarray(pair[key], dtype=float)
+            sides[name] = (groups + [surfaces[name]], force + on_body, scale + float(np.linalg.norm(on_body)))
     record["bodies"] = {}
     for body in bodies:
-        group, force = sides[body.name]
+        if body.name not in sides:
+            continue
+        groups, force, scale = sides[body.name]
         try:
-            model.set_traction(body.name, group, tractions[body.name])
-            body_result, info = body_checks(model, out, body, force, label)
+            model.set_traction(body.name, groups, tractions[body.name])
+            body_result, info = body_checks(model, out, body, list(force), scale, label)
             checks += body_result
-            record["bodies"][body.name] = info | {"surface": group}
+            record["bodies"][body.name] = info | {"surfaces": groups}
         except ERRORS as error:
             checks.append(failure("body", f"{label} {body.name}", f"{type(error).__name__}: {error}"))
     record["dolfinx_seconds"] = time.perf_counter() - start
@@ -327,7 +419,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path) -> SuiteResult:
         except (StepFailed, OSError) as error:
             result.checks.append(failure("mesh", case.name, str(error)))
             continue
-        for formulation in FORMULATIONS:
+        for formulation in case.formulations:
             label = f"{case.name} {formulation}"
             try:
                 checks, record = check_case(binary, case, mesh, formulation)

@@ -414,21 +414,29 @@ class ReferenceModel:
                 raise ReferenceFailure(f"{self.path}: Dirichlet group '{d.group}' is not on body '{body.name}'")
         return result
 
-    def solve(self, body: Body) -> BodySolution:
+    def solve(self, body: Body, pinned: dict[int, float] | None = None) -> BodySolution:
         """Solve the body's problem; displacements, cell strains / stresses, reactions.
 
         With C the constrained dofs (values g) and F the free ones:
         u_C = g, K_FF u_F = f_F - K_FC g (Cholesky, MUMPS); then the reactions
         R_G[i] = sum over the dofs of component i constrained by G of
-        (K u - f), K and f unconstrained (a free component gives 0).
+        (K u - f), K and f unconstrained (a free component gives 0). ``pinned``
+        (internodes dof -> value) constrains more dofs, for a body its
+        Dirichlet groups leave free to move; their reactions are under the
+        group name ``"pinned"``.
         """
         K, f = self.stiffness(body), self.load_vector(body)
         constrained = self.dirichlet_dofs(body)
-        u = solve_constrained(K, f, prescribed_values(body, constrained, len(f)),
-                              f"{self.path}: body '{body.name}'")
+        g = prescribed_values(body, constrained, len(f))
+        if pinned:
+            g[list(pinned)] = list(pinned.values())
+        u = solve_constrained(K, f, g, f"{self.path}: body '{body.name}'")
         residual = K @ u - f
         reactions = {group: np.array([residual[dofs[i]].sum() if i in dofs else 0.0 for i in range(self.dim)])
                      for group, dofs in constrained.items()}
+        if pinned:
+            dofs = np.array(sorted(pinned))
+            reactions["pinned"] = np.array([residual[dofs[dofs % self.dim == i]].sum() for i in range(self.dim)])
         strain, stress = self._cell_tensors(u, body)
         return BodySolution(u.reshape(-1, self.dim), self.local_cells(body.name), strain, stress, reactions)
 
