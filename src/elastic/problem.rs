@@ -126,7 +126,21 @@ impl<'m> ElasticProblem<'m> {
         loads: Vec<LoadCondition>,
         body_force: Option<[f64; 3]>,
     ) -> Result<Self, ProblemError> {
-        let problem = Self {
+        let problem = Self::unpinned(body, material, dirichlet, forces, loads, body_force);
+        problem.check()?;
+        Ok(problem)
+    }
+
+    /// The problem as given, without pins and unchecked.
+    fn unpinned(
+        body: &'m BodyMesh,
+        material: Material,
+        dirichlet: Vec<DirichletCondition>,
+        forces: Vec<ForceCondition>,
+        loads: Vec<LoadCondition>,
+        body_force: Option<[f64; 3]>,
+    ) -> Self {
+        Self {
             body,
             material,
             dirichlet,
@@ -134,9 +148,7 @@ impl<'m> ElasticProblem<'m> {
             pins: Vec::new(),
             loads,
             body_force,
-        };
-        problem.check()?;
-        Ok(problem)
+        }
     }
 
     /// [`Self::with_forces`] for a body in contact, which its supports may leave free to move
@@ -152,15 +164,7 @@ impl<'m> ElasticProblem<'m> {
         loads: Vec<LoadCondition>,
         body_force: Option<[f64; 3]>,
     ) -> Result<Self, ProblemError> {
-        let mut problem = Self {
-            body,
-            material,
-            dirichlet,
-            forces,
-            pins: Vec::new(),
-            loads,
-            body_force,
-        };
+        let mut problem = Self::unpinned(body, material, dirichlet, forces, loads, body_force);
         match problem.check() {
             Ok(()) => return Ok(problem),
             Err(ProblemError::NoDirichlet { .. } | ProblemError::FreeRigidModes { .. }) => {}
