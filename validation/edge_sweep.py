@@ -97,7 +97,7 @@ import edge_reference  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ReferenceFailure  # noqa: E402
 from flat_sweep import RunFailed  # noqa: E402
-from suite import (checks_table, standalone, MeshFailed, SuiteResult, body_table, case_toml, contact_table, group_edges, json_safe, mesh_geo,  # noqa: E402
+from suite import (checks_table, run_cases, standalone, MeshFailed, SuiteResult, body_table, case_toml, contact_table, group_edges, json_safe, mesh_geo,  # noqa: E402
                    run_solve, solver_reports, vouched)
 from sweep import loaded, read_output, solved_primary, vertical_force  # noqa: E402
 
@@ -514,18 +514,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
     start = time.perf_counter()
     out_dir.mkdir(parents=True, exist_ok=True)
     cases = [c for c in CASES if (c.quick or not quick) and (not names or c.name in names or c.family in names)]
-    checks: list[Check] = []
-    records: dict = {}
-    for case in cases:
-        print(f"  {case.name}: {case.text()} ...", flush=True)
-        case_start = time.perf_counter()
-        case_checks_, record = run_case(binary, case)
-        record["wall_seconds"] = time.perf_counter() - case_start
-        checks += case_checks_
-        records[case.name] = record
-        failed = [f"{c.check} {c.case}" for c in case_checks_ if not c.passed]
-        verdict = "all checks pass" if not failed else "FAILED: " + "; ".join(failed)
-        print(f"    {record['wall_seconds']:.1f} s; {verdict}", flush=True)
+    checks, records = run_cases(cases, lambda case: run_case(binary, case), lambda case: case.text())
     seconds = time.perf_counter() - start
     tally = counts(records)
     text = report_text(cases, checks, records, quick, seconds, tally)

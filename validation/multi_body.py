@@ -124,7 +124,7 @@ REPO = VALIDATION.parent
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
 from contact_reference import ellipse_fit  # noqa: E402
-from suite import (checks_table, standalone, Figure, MeshFailed, SuiteResult, json_safe, mesh_geo, report_rows, run_solve,  # noqa: E402
+from suite import (checks_table, run_cases, standalone, Figure, MeshFailed, SuiteResult, json_safe, mesh_geo, report_rows, run_solve,  # noqa: E402
                    toml_text)
 
 BUILD = VALIDATION / "build" / "multi_body"
@@ -711,18 +711,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
     start = time.perf_counter()
     out_dir.mkdir(parents=True, exist_ok=True)
     cases = [c for c in CASES if (c.quick or not quick) and (not names or c.name in names)]
-    checks: list[Check] = []
-    records: dict = {}
-    for case in cases:
-        print(f"  {case.name}: {case.why} ...", flush=True)
-        case_start = time.perf_counter()
-        case_checks, record = run_case(binary, case)
-        record["wall_seconds"] = time.perf_counter() - case_start
-        checks += case_checks
-        records[case.name] = record
-        failed = [f"{c.check} ({c.case})" for c in case_checks if not c.passed]
-        print(f"    {len(case_checks)} checks, {record['wall_seconds']:.1f} s; "
-              f"{'all pass' if not failed else 'FAILED: ' + ', '.join(failed)}", flush=True)
+    checks, records = run_cases(cases, lambda case: run_case(binary, case), lambda case: case.why)
     figures = []
     png = out_dir / "multi_body_pressure.png"
     try:

@@ -343,3 +343,24 @@ def standalone(doc: str, names: set[str], run, json_name: str, build: Path, **ex
               for c in result.checks]
     (args.out / json_name).write_text(json.dumps(head | {"checks": checks, "data": result.data} | extra, indent=1))
     return 0 if all(c.passed for c in result.checks) else 1
+
+
+def run_cases(cases: list, run, describe) -> tuple[list[Check], dict]:
+    """Each of ``cases`` in turn: ``run(case)`` gives its checks and its record (which gets its wall
+    time, ``wall_seconds``); the progress is printed as ``name: describe(case) ...``, then the
+    status (if the record has one), the wall time and the checks that failed. Returns every
+    check and the records by case name."""
+    checks: list[Check] = []
+    records: dict = {}
+    for case in cases:
+        print(f"  {case.name}: {describe(case)} ...", flush=True)
+        start = time.perf_counter()
+        case_checks, record = run(case)
+        record["wall_seconds"] = time.perf_counter() - start
+        checks += case_checks
+        records[case.name] = record
+        failed = [f"{c.check} ({c.case})" for c in case_checks if not c.passed]
+        status = record.get("status", record.get("error"))
+        print(f"    {f'{status}, ' if status else ''}{len(case_checks)} checks, {record['wall_seconds']:.1f} s; "
+              f"{'all pass' if not failed else 'FAILED: ' + ', '.join(failed)}", flush=True)
+    return checks, records

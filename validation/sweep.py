@@ -139,7 +139,7 @@ import contact_reference  # noqa: E402
 import rigid_flat_comparison  # noqa: E402
 import hertz_theory  # noqa: E402
 from compare import Check  # noqa: E402
-from suite import (checks_table, standalone, Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
+from suite import (checks_table, run_cases, standalone, Figure, MeshFailed, SuiteResult, body_table, case_toml, contact_table, json_safe, mesh_geo,
                    report_rows, run_solve,  # noqa: E402
                    solver_reports, surface_spacing, vouched)
 
@@ -802,18 +802,7 @@ def run_suite(binary: Path, quick: bool, out_dir: Path, names: list[str] | None 
     start = time.perf_counter()
     out_dir.mkdir(parents=True, exist_ok=True)
     cases = [c for c in CASES if (c.quick or not quick) and (not names or c.name in names)]
-    checks: list[Check] = []
-    records: dict = {}
-    for case in cases:
-        print(f"  {case.name}: {case.parameters_text()} ...", flush=True)
-        case_start = time.perf_counter()
-        case_checks, record = run_case(binary, case, out_dir)
-        record["wall_seconds"] = time.perf_counter() - case_start
-        checks += case_checks
-        records[case.name] = record
-        failed = [c.check for c in case_checks if not c.passed]
-        print(f"    {record.get('status', record.get('error'))}, {record['wall_seconds']:.1f} s; "
-              f"{'all checks pass' if not failed else 'FAILED: ' + ', '.join(failed)}", flush=True)
+    checks, records = run_cases(cases, lambda case: run_case(binary, case, out_dir), lambda case: case.parameters_text())
     figures = []
     summary_png = out_dir / "sweep_summary.png"
     if plot_summary(cases, checks, records, summary_png):
