@@ -28,6 +28,7 @@
 //! - [`case`]: the TOML case file;
 //! - [`output`]: XDMF/HDF5, JSON summary, Matrix Market;
 //! - [`cancel`]: the token that stops a solve from outside it;
+//! - [`parallel`]: the MPI ranks of a distributed run (`mpirun -n N internodes solve`);
 //! - [`run`]: `internodes solve CASE`, from the case file to the result files;
 //! - [`study`]: `internodes study CASE`, a mesh refinement study with the grid convergence index.
 
@@ -39,5 +40,6 @@ pub mod fem;
 pub mod linalg;
 pub mod mesh;
 pub mod output;
+pub mod parallel;
 pub mod run;
 pub mod study;

@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 use internodes::case::Case;
 use internodes::mesh::{MeshSummary, read_msh};
 use internodes::output::{Verdict, unsaid_causes};
+use internodes::parallel;
 use internodes::run::{RunOptions, solve_case};
 use internodes::study::{StudyOptions, StudySpec, files::markdown, run_study};
 
@@ -77,10 +78,20 @@ fn main() -> ExitCode {
     // reference solver) take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
     let cli = Cli::parse();
-    let quiet = matches!(
-        cli.command,
-        Command::Solve { quiet: true, .. } | Command::Study { quiet: true, .. }
-    );
+    // Under an MPI launcher (`mpirun -n N internodes solve CASE`): join the run. Every rank
+    // solves; rank 0 alone prints and writes.
+    let ranks = match parallel::start() {
+        Ok(ranks) => ranks,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let quiet = ranks.rank != 0
+        || matches!(
+            cli.command,
+            Command::Solve { quiet: true, .. } | Command::Study { quiet: true, .. }
+        );
     StderrLogger::install(if quiet {
         log::LevelFilter::Warn
     } else {
@@ -97,7 +108,7 @@ fn main() -> ExitCode {
             &RunOptions {
                 output,
                 export_matrices,
-                quiet,
+                quiet: quiet || ranks.rank != 0,
             },
         )
         .map_err(Into::into)
@@ -105,6 +116,7 @@ fn main() -> ExitCode {
             let folder = report.output_dir.display();
             let verdict = report.summary.verdict();
             match &verdict {
+                _ if ranks.rank != 0 => {}
                 Verdict::NotSolved(why) => eprintln!(
                     "error: {why} (see {folder}/summary.json); the last iterate was written for inspection"
                 ),
@@ -113,6 +125,12 @@ fn main() -> ExitCode {
             }
             verdict.exit_status()
         }),
+        Command::Study { .. } if ranks.size > 1 => Err(format!(
+            "internodes study runs on one process (launched on {} MPI ranks): run the study \
+             without mpirun, or each level with `mpirun -n N internodes solve`",
+            ranks.size
+        )
+        .into()),
         Command::Study {
             case,
             parameter,
@@ -121,16 +139,38 @@ fn main() -> ExitCode {
         } => study(&case, &parameter, &StudyOptions { output, quiet }),
         Command::Info { mesh } => read_msh(&mesh)
             .map_err(Into::into)
-            .and_then(|m| print_stdout(&MeshSummary(&m).to_string()))
+            .and_then(|m| match ranks.rank {
+                0 => print_stdout(&MeshSummary(&m).to_string()),
+                _ => Ok(()),
+            })
             .map(|()| 0),
     };
     match result {
-        Ok(code) => ExitCode::from(code),
-        Err(e) => {
-            eprintln!("error: {e}");
-            for cause in unsaid_causes(&*e) {
-                eprintln!("  caused by: {cause}");
+        Ok(code) => match parallel::finish() {
+            Ok(()) => ExitCode::from(code),
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
             }
+        },
+        Err(e) => {
+            // Every rank that fails says so (one may fail alone), then ends the whole run: the
+            // others may be waiting for it.
+            let rank = match ranks.size {
+                1 => String::new(),
+                size => format!(" (rank {} of {size})", ranks.rank),
+            };
+            // One write: the lines of two ranks' errors do not interleave.
+            let mut message = format!("error{rank}: {e}\n");
+            for cause in unsaid_causes(&*e) {
+                message.push_str(&format!("  caused by: {cause}\n"));
+            }
+            eprint!("{message}");
+            if ranks.size > 1 {
+                parallel::abort(1)
+            }
+            // A launcher's single rank finalizes MPI all the same.
+            let _ = parallel::finish();
             ExitCode::FAILURE
         }
     }

@@ -79,7 +79,11 @@ fn run_error(error: RunError) -> PyErr {
     let text = message(&error);
     match error {
         RunError::Case(_) => InputError::new_err(text),
-        RunError::Solve { .. } | RunError::Contact { .. } => SolveError::new_err(text),
+        // A Python process is one rank: it never meets an MPI error, but would be told as a
+        // failed solve.
+        RunError::Solve { .. } | RunError::Contact { .. } | RunError::Parallel(_) => {
+            SolveError::new_err(text)
+        }
         RunError::Output(_) => WriteError::new_err(text),
     }
 }
@@ -1037,7 +1041,9 @@ fn study_error(error: StudyError) -> PyErr {
             let text = format!("study level {parameter} = {value}: {}", message(&*source));
             match *source {
                 RunError::Case(_) => InputError::new_err(text),
-                RunError::Solve { .. } | RunError::Contact { .. } => SolveError::new_err(text),
+                RunError::Solve { .. } | RunError::Contact { .. } | RunError::Parallel(_) => {
+                    SolveError::new_err(text)
+                }
                 RunError::Output(_) => WriteError::new_err(text),
             }
         }

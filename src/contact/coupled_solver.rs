@@ -126,7 +126,9 @@ impl BodyFactors {
         } else {
             Interface::dense(&candidates, bodies)
         };
-        let fallback = (method == CoupledSolver::Auto).then_some(candidates);
+        // A distributed run has no factors to fall back on (`crate::parallel`).
+        let fallback = (method == CoupledSolver::Auto && !crate::parallel::distributed())
+            .then_some(candidates);
         Ok(Self {
             solvers,
             compliance,
@@ -152,6 +154,11 @@ impl BodyFactors {
     /// round-off on request: [`Self::solve`]).
     pub fn is_krylov(&self) -> bool {
         matches!(self.interface, Interface::Krylov { .. })
+    }
+
+    /// Each body's share of its unknowns among the MPI ranks (`BodySolver::rank_dofs`).
+    pub fn rank_dofs(&self) -> Vec<Vec<usize>> {
+        self.solvers.iter().map(BodySolver::rank_dofs).collect()
     }
 
     /// The bodies' solver (Cholesky after a fallback from CG + AMG).

@@ -317,6 +317,9 @@ impl<'a> ContactSolver<'a> {
                     let seconds = start.elapsed().as_secs_f64();
                     log::info!("  {what} of the {} bodies: {seconds:.3} s", bodies.len());
                 }
+                for (stats, shares) in stats.iter_mut().zip(factors.rank_dofs()) {
+                    stats.rank_dofs = shares;
+                }
                 Some(factors)
             }
         };

@@ -32,6 +32,10 @@ pub struct SolveStats {
     /// CG iterations of the solve (CG + AMG only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cg_iterations: Option<usize>,
+    /// Each MPI rank's number of the body's dofs, in rank order (`[num_dofs]` on one process;
+    /// absent where the body was not solved).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rank_dofs: Vec<usize>,
     /// `||K_c u - f_c|| / ||f_c||` of the constrained system.
     pub relative_residual: f64,
     /// Seconds per phase, in order.

@@ -566,6 +566,7 @@ pub fn solve(
         }
     };
     stats.body_solver = Some(solver.kind());
+    stats.rank_dofs = solver.rank_dofs();
 
     // 5. Solve and check the residual of the constrained system. Force-controlled components
     //    (`RigidColumn`) border it: with `W = K_c^-1 [k_1 .. k_r]` and `u0 = K_c^-1 f_c`, their

@@ -72,8 +72,11 @@ pub const CG_AMG_AVAILABLE: bool = cfg!(feature = "petsc");
 impl BodySolverKind {
     /// The solver `auto` stands for on a single body of `num_dofs` dofs in dimension `dim`
     /// (other kinds stand for themselves).
+    /// In a distributed run ([`crate::parallel`]) `auto` stands for CG + AMG whatever the size:
+    /// a factor is not distributed.
     pub fn resolve(self, dim: usize, num_dofs: usize) -> Self {
         match self {
+            Self::Auto if crate::parallel::distributed() => Self::CgAmg,
             Self::Auto if CG_AMG_AVAILABLE && dim == 3 && num_dofs >= AUTO_CG_AMG_MIN_DOFS_3D => {
                 Self::CgAmg
             }
@@ -114,11 +117,21 @@ impl BodySolver {
     ) -> Result<Self, LinalgError> {
         #[cfg(feature = "petsc")]
         {
-            CgAmg::new(Communicator::solo()?, matrix, dim, coords, rtol).map(Self::CgAmg)
+            CgAmg::new(Communicator::of_run()?, matrix, dim, coords, rtol).map(Self::CgAmg)
         }
         #[cfg(not(feature = "petsc"))]
         {
             Err(LinalgError::PetscUnavailable)
+        }
+    }
+
+    /// Each rank's number of the body's unknowns, in rank order (`[n]` on one process; a
+    /// factor is never distributed).
+    pub fn rank_dofs(&self) -> Vec<usize> {
+        match self {
+            Self::Cholesky(factor) => vec![factor.size()],
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.rank_dofs(),
         }
     }
 

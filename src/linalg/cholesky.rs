@@ -161,6 +161,11 @@ impl Cholesky {
         &self.symbolic
     }
 
+    /// The matrix's size.
+    pub fn size(&self) -> usize {
+        self.symbolic.inner.nrows()
+    }
+
     /// Overwrites the columns of `rhs` (n x k, column-major) with the solutions of `K x = rhs`.
     ///
     /// The columns are cut into the fewest blocks of at most `RHS_BLOCK` columns, of equal

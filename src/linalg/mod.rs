@@ -22,6 +22,8 @@ pub enum LinalgError {
     NotPositiveDefinite { pivot: usize },
     #[error("fill-reducing ordering failed: {0}")]
     Ordering(String),
+    #[error("partitioning a body among the MPI ranks failed: {0}")]
+    Partition(String),
     #[error("sparse factorization failed: {0}")]
     Faer(String),
     #[error(

@@ -30,6 +30,12 @@ pub struct CaseSummary {
     /// The process's peak resident memory up to writing the summary, in MB (`VmHWM` of
     /// `/proc/self/status`; absent where the system does not report it).
     pub peak_memory_mb: Option<f64>,
+    /// The number of MPI ranks that solved the case (1: one process).
+    pub ranks: usize,
+    /// Every rank's peak memory, in rank order, in a distributed run (rank 0's is
+    /// `peak_memory_mb`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rank_peak_memory_mb: Vec<f64>,
 }
 
 /// The process's peak resident set size in MB, where Linux reports it.

@@ -19,9 +19,14 @@ use thiserror::Error;
 
 use crate::case::{Case, CaseError};
 use crate::contact::ContactError;
+use crate::contact::CoupledSolver;
 use crate::elastic::SolveError;
+use crate::linalg::BodySolverKind;
 use crate::mesh::{Mesh, MeshError, mesh_geo, read_msh, read_msh_bytes};
-use crate::output::{CaseSummary, GENERATED_MESH, OutputError, ResultFolder, mark_failed_folder};
+use crate::output::{
+    CaseSummary, GENERATED_MESH, OutputError, ResultFolder, mark_failed_folder, peak_memory_mb,
+};
+use crate::parallel::{self, ParallelError};
 
 /// Command-line overrides of the case file.
 #[derive(Debug, Clone, Default)]
@@ -41,6 +46,8 @@ pub enum RunError {
     Contact { path: PathBuf, source: ContactError },
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    Parallel(ParallelError),
 }
 
 impl RunError {
@@ -119,6 +126,13 @@ pub fn solve_loaded_case(
         }
         .into());
     };
+    if parallel::distributed() {
+        check_distributable(&case)?;
+        if !parallel::is_root() {
+            let output = output.clone();
+            return solve_beside_root(case, &output);
+        }
+    }
     let results = ResultFolder::create(
         output,
         origin,
@@ -145,6 +159,83 @@ pub fn solve_loaded_case(
     }
 }
 
+/// What a distributed run cannot do: factor a body (`body = "cholesky"`; `auto` is CG + AMG
+/// there) or solve the coupled system by one sparse LU (`solver = "monolithic-lu"`).
+fn check_distributable(case: &Case) -> Result<(), CaseError> {
+    let ranks = parallel::ranks().size;
+    let refuse = |context: &str, what: &str| CaseError::Invalid {
+        path: case.path.clone(),
+        context: context.to_string(),
+        message: format!(
+            "{what} runs on one process, and this run has {ranks} MPI ranks: a distributed run \
+             solves each body by CG + AMG (body = \"cg-amg\" or \"auto\") and the coupled \
+             system by GMRES (solver = \"auto\", \"krylov\" or \"schur\")"
+        ),
+    };
+    if case.solver.body == BodySolverKind::Cholesky {
+        return Err(refuse(
+            "[solver] body",
+            "the Cholesky factor (body = \"cholesky\")",
+        ));
+    }
+    if case
+        .contacts
+        .iter()
+        .any(|c| c.settings.solver == CoupledSolver::MonolithicLu)
+    {
+        return Err(refuse(
+            "[contact] solver",
+            "the sparse LU of solver = \"monolithic-lu\"",
+        ));
+    }
+    Ok(())
+}
+
+/// A rank other than 0 of a distributed run: the same solve, in step with rank 0 (which
+/// meshes a `.geo` and hands the mesh over), writing nothing.
+fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunError> {
+    let timings = Timings::start();
+    case.solver.verbose = false;
+    let mesh = match case.generates_mesh() {
+        true => {
+            let bytes = parallel::share_from_root(Vec::new()).map_err(RunError::Parallel)?;
+            read_msh_bytes(&output.join(GENERATED_MESH), &bytes).map_err(|source| {
+                CaseError::Mesh {
+                    path: case.path.clone(),
+                    source,
+                }
+            })?
+        }
+        false => read_case_mesh(&case)?,
+    };
+    let mut solution = solve_case_on(&case, &mesh, timings)?;
+    solution.rank_peak_memory_mb = gather_peak_memory()?;
+    let summary = solution.summary_with(&case, &mesh, &solution.timings);
+    Ok(SolvedRun {
+        report: RunReport {
+            output_dir: output.to_owned(),
+            summary,
+        },
+        mesh,
+        solution,
+    })
+}
+
+/// Every rank's peak memory in MB, in rank order, in a distributed run (empty otherwise).
+fn gather_peak_memory() -> Result<Vec<f64>, RunError> {
+    if !parallel::distributed() {
+        return Ok(Vec::new());
+    }
+    parallel::gather(peak_memory_mb().unwrap_or(f64::NAN)).map_err(RunError::Parallel)
+}
+
+fn read_case_mesh(case: &Case) -> Result<Mesh, CaseError> {
+    read_msh(&case.mesh).map_err(|source| CaseError::Mesh {
+        path: case.path.clone(),
+        source,
+    })
+}
+
 /// The run itself: every result file is written into the staging folder of `results`; returns
 /// the summary, the mesh and the solution.
 fn solve_into(
@@ -165,10 +256,7 @@ fn solve_into(
         timings.record("gmsh", phase);
         mesh
     } else {
-        read_msh(&case.mesh).map_err(|source| CaseError::Mesh {
-            path: case.path.clone(),
-            source,
-        })?
+        read_case_mesh(&case)?
     };
     let seconds = timings.record("read mesh", phase);
     log::info!(
@@ -179,7 +267,8 @@ fn solve_into(
     );
 
     // 2. Every body solved: the two in contact together, the others alone.
-    let solution = solve_case_on(&case, &mesh, timings)?;
+    let mut solution = solve_case_on(&case, &mesh, timings)?;
+    solution.rank_peak_memory_mb = gather_peak_memory()?;
 
     // 3. The result files, into the staging folder.
     let summary = write_results(&solution, &case, &mesh, results.staging())?;
@@ -216,6 +305,8 @@ fn generate_mesh(case: &Case, results: &ResultFolder) -> Result<Mesh, RunError> 
             source,
         })
     })?;
+    // The other ranks of a distributed run read the same mesh.
+    let bytes = parallel::share_from_root(bytes).map_err(RunError::Parallel)?;
     let msh = results.publish(GENERATED_MESH)?;
     Ok(read_msh_bytes(&msh, &bytes).map_err(mesh_error)?)
 }

@@ -55,6 +55,8 @@ pub struct CaseSolution {
     /// Each contact pair's outcome, in the case file's order (empty without contact).
     pub contacts: Vec<SolvedContact>,
     pub timings: Timings,
+    /// Every rank's peak memory (MB) in a distributed run, in rank order (empty otherwise).
+    pub rank_peak_memory_mb: Vec<f64>,
 }
 
 /// One body's solution and, in contact runs, its contact surfaces' fields (one per pair it is
@@ -112,6 +114,7 @@ pub fn solve_case_on(
         bodies,
         contacts,
         timings,
+        rank_peak_memory_mb: Vec::new(),
     })
 }
 
@@ -274,6 +277,8 @@ impl CaseSolution {
             },
             timings: timings.with_total(),
             peak_memory_mb: peak_memory_mb(),
+            ranks: crate::parallel::ranks().size,
+            rank_peak_memory_mb: self.rank_peak_memory_mb.clone(),
         }
     }
 }

@@ -54,8 +54,13 @@
 //!   `PetscFPTrapPush` stack and `PetscCitationsRegister` are reached only in set-up
 //!   (Chebyshev's eigenvalue estimate in `KSPSetUp`); no MPI call is on the path on
 //!   `PETSC_COMM_SELF`.
-//! - Objects are created on a communicator given by the caller ([`Communicator::solo`] today),
-//!   so that a distributed version changes the set-up, not this solver.
+//! - Objects are created on a communicator given by the caller: [`Communicator::solo`], or
+//!   in a distributed run ([`crate::parallel`]) [`Communicator::world`], every rank. Then a
+//!   [`Distribution`] shares the body's rows among the ranks, each rank hands PETSc only its
+//!   own rows, and a solve or a V-cycle takes and returns whole vectors in our numbering (each
+//!   rank passes its rows in, and receives every rank's rows of the result). Every call on
+//!   such an object is collective: a distributed run has one thread per rank, so every rank
+//!   makes them in the same order, and V-cycles never overlap.
 
 use std::ffi::{CStr, c_char, c_int};
 use std::ptr::NonNull;
@@ -64,6 +69,10 @@ use std::sync::{Mutex, OnceLock, PoisonError, RwLock, RwLockWriteGuard};
 use faer::sparse::SparseColMat;
 
 use super::LinalgError;
+use crate::parallel::Ranks;
+
+mod distribution;
+use distribution::Distribution;
 
 /// MPI's Fortran communicator handle (`MPI_Fint`, an `int` in Open MPI and MPICH alike).
 type MpiFint = c_int;
@@ -77,6 +86,24 @@ unsafe extern "C" {
     fn internodes_petsc_initialize(step: *mut *const c_char) -> c_int;
     fn internodes_petsc_options_are_ours(ours: *mut c_int, step: *mut *const c_char) -> c_int;
     fn internodes_petsc_comm_self() -> MpiFint;
+    fn internodes_petsc_comm_world() -> MpiFint;
+    fn internodes_mpi_rank_size(
+        rank: *mut c_int,
+        size: *mut c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_allgather(
+        local: *const f64,
+        count: c_int,
+        global: *mut f64,
+        counts: *const c_int,
+        displs: *const c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_broadcast_length(len: *mut i64, step: *mut *const c_char) -> c_int;
+    fn internodes_mpi_broadcast(data: *mut u8, len: i64, step: *mut *const c_char) -> c_int;
+    fn internodes_mpi_abort(code: c_int);
+    fn internodes_petsc_finalize(step: *mut *const c_char) -> c_int;
     fn internodes_petsc_error_text(code: c_int) -> *const c_char;
     fn internodes_ksp_reason_name(reason: c_int) -> *const c_char;
     fn internodes_cgamg_create(
@@ -173,16 +200,138 @@ fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
     }
 }
 
-/// The communicator PETSc objects are created on.
+/// The communicator PETSc objects are created on, with this process's place in it.
 #[derive(Debug, Clone, Copy)]
-pub struct Communicator(MpiFint);
+pub struct Communicator {
+    handle: MpiFint,
+    ranks: Ranks,
+}
 
 impl Communicator {
     /// `PETSC_COMM_SELF`: this process alone (initializes PETSc if needed).
     pub fn solo() -> Result<Self, LinalgError> {
         let _lock = petsc()?;
-        // SAFETY: PETSc is initialized.
-        Ok(Self(unsafe { internodes_petsc_comm_self() }))
+        Ok(Self {
+            // SAFETY: PETSc is initialized.
+            handle: unsafe { internodes_petsc_comm_self() },
+            ranks: Ranks::ONE,
+        })
+    }
+
+    /// `PETSC_COMM_WORLD`: every rank of the run (initializes PETSc, and MPI, if needed).
+    pub fn world() -> Result<Self, LinalgError> {
+        let ranks = world_ranks()?;
+        let _lock = petsc()?;
+        Ok(Self {
+            // SAFETY: PETSc is initialized.
+            handle: unsafe { internodes_petsc_comm_world() },
+            ranks,
+        })
+    }
+
+    /// The run's: [`Self::world`] in a distributed run, [`Self::solo`] otherwise.
+    pub fn of_run() -> Result<Self, LinalgError> {
+        match crate::parallel::distributed() {
+            true => Self::world(),
+            false => Self::solo(),
+        }
+    }
+}
+
+/// This process's rank and the number of ranks of `PETSC_COMM_WORLD` (initializes PETSc, and
+/// MPI, if needed: collective the first time).
+pub fn world_ranks() -> Result<Ranks, LinalgError> {
+    let _lock = petsc()?;
+    let (mut rank, mut size) = (0, 0);
+    let mut step = std::ptr::null();
+    // SAFETY: PETSc is initialized, the lock is held.
+    let code = unsafe { internodes_mpi_rank_size(&mut rank, &mut size, &mut step) };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    Ok(Ranks {
+        rank: rank as usize,
+        size: size as usize,
+    })
+}
+
+/// An MPI count: the counts of our vectors fit in an `int` as long as PETSc's 32-bit indices do.
+fn mpi_count(n: usize) -> Result<c_int, LinalgError> {
+    c_int::try_from(n).map_err(|_| LinalgError::Sizes(format!("{n} values in one MPI message")))
+}
+
+/// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
+/// order, on every rank (collective over `PETSC_COMM_WORLD`).
+pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
+    let total = counts.iter().sum();
+    let mut displs = Vec::with_capacity(counts.len());
+    let mut at = 0;
+    for &count in counts {
+        displs.push(mpi_count(at)?);
+        at += count;
+    }
+    let counts = counts
+        .iter()
+        .map(|&c| mpi_count(c))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut global = vec![0.0; total];
+    let mut step = std::ptr::null();
+    let _lock = petsc()?;
+    // SAFETY: `global` holds the sum of `counts`, `counts` and `displs` one value per rank,
+    // `local` this rank's count; the lock is held.
+    let code = unsafe {
+        internodes_mpi_allgather(
+            local.as_ptr(),
+            mpi_count(local.len())?,
+            global.as_mut_ptr(),
+            counts.as_ptr(),
+            displs.as_ptr(),
+            &mut step,
+        )
+    };
+    match code {
+        0 => Ok(global),
+        _ => Err(petsc_error(step, code)),
+    }
+}
+
+/// Rank 0's `bytes` on every rank (collective over `PETSC_COMM_WORLD`; the other ranks'
+/// `bytes` are not read).
+pub fn broadcast_bytes(bytes: Vec<u8>) -> Result<Vec<u8>, LinalgError> {
+    let mut len = bytes.len() as i64;
+    let mut step = std::ptr::null();
+    let _lock = petsc()?;
+    // SAFETY: the lock is held; `len` is one value.
+    let code = unsafe { internodes_mpi_broadcast_length(&mut len, &mut step) };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    let mut data = bytes;
+    data.resize(len.max(0) as usize, 0);
+    // SAFETY: `data` holds `len` bytes on every rank; the lock is held.
+    let code = unsafe { internodes_mpi_broadcast(data.as_mut_ptr(), len, &mut step) };
+    match code {
+        0 => Ok(data),
+        _ => Err(petsc_error(step, code)),
+    }
+}
+
+/// Ends every rank of the run with `code` (`MPI_Abort`).
+pub fn abort_world(code: i32) -> ! {
+    // No lock: the thread that holds it may be the one waiting for the other ranks.
+    // SAFETY: PETSc (MPI) is initialized in a distributed run; MPI_Abort does not return.
+    unsafe { internodes_mpi_abort(code) };
+    std::process::exit(code)
+}
+
+/// `PetscFinalize` (and MPI's): the last PETSc call of the process.
+pub fn finalize() -> Result<(), LinalgError> {
+    let _lock = petsc()?;
+    let mut step = std::ptr::null();
+    // SAFETY: the lock is held; the caller has dropped every PETSc object.
+    match unsafe { internodes_petsc_finalize(&mut step) } {
+        0 => Ok(()),
+        code => Err(petsc_error(step, code)),
     }
 }
 
@@ -197,7 +346,11 @@ pub struct CgStats {
 /// CG + GAMG set up for one matrix.
 pub struct CgAmg {
     raw: NonNull<RawCgAmg>,
+    /// The matrix's size.
     n: usize,
+    /// How its rows are shared among the ranks (`None` on one process: PETSc has them all, in
+    /// our numbering).
+    distribution: Option<Distribution>,
     /// The relative residual [`Self::solve`] stops at.
     rtol: f64,
     /// Held by [`Self::precondition`] under the shared [`PETSC`] lock: the object's vectors
@@ -253,17 +406,37 @@ impl CgAmg {
         // here (checked below), and its values, counts of allocated entries, are below
         // i64::MAX. A converted copy would cost 8 bytes per stored entry at the peak.
         const _: () = assert!(size_of::<usize>() == size_of::<i64>());
-        let row_ptr = symbolic.col_ptr().as_ptr().cast::<i64>();
-        let col_idx = symbolic.row_idx().as_ptr().cast::<i64>();
+        let distribution = match comm.ranks.size {
+            1 => None,
+            _ => Some(Distribution::new(matrix, dim, comm.ranks)?),
+        };
+        // This rank's rows: all of them as they are on one process, else in PETSc's numbering.
+        let local_rows = distribution.as_ref().map(|d| d.local_rows(matrix, coords));
+        let (local, row_ptr, col_idx, values, coords) = match &local_rows {
+            None => (
+                n,
+                symbolic.col_ptr().as_ptr().cast::<i64>(),
+                symbolic.row_idx().as_ptr().cast::<i64>(),
+                values,
+                coords,
+            ),
+            Some((row_ptr, col_idx, values, coords)) => (
+                row_ptr.len() - 1,
+                row_ptr.as_ptr(),
+                col_idx.as_ptr(),
+                &values[..],
+                &coords[..],
+            ),
+        };
         let _lock = petsc()?;
         let mut raw = std::ptr::null_mut();
         let mut step = std::ptr::null();
-        // SAFETY: the arrays have the lengths the shim reads (n + 1, nnz, nnz, n), it copies
-        // them, and the lock is held.
+        // SAFETY: the arrays have the lengths the shim reads (local + 1, nnz, nnz, local), it
+        // copies them, and the lock is held.
         let code = unsafe {
             internodes_cgamg_create(
-                comm.0,
-                n as i64,
+                comm.handle,
+                local as i64,
                 dim as i64,
                 row_ptr,
                 col_idx,
@@ -282,9 +455,45 @@ impl CgAmg {
         Ok(Self {
             raw,
             n,
+            distribution,
             rtol,
             applying: Mutex::new(()),
         })
+    }
+
+    /// Each rank's number of unknowns of this matrix, in rank order (one value on one process).
+    pub fn rank_dofs(&self) -> Vec<usize> {
+        match &self.distribution {
+            None => vec![self.n],
+            Some(d) => d.counts().to_vec(),
+        }
+    }
+
+    /// This rank's part of `whole` (our numbering), as PETSc's vectors hold it.
+    fn local_part<'a>(&self, whole: &'a [f64]) -> std::borrow::Cow<'a, [f64]> {
+        match &self.distribution {
+            None => whole.into(),
+            Some(d) => d.local_part(whole).into(),
+        }
+    }
+
+    /// A buffer for this rank's part of a result.
+    fn local_buffer(&self) -> Vec<f64> {
+        vec![
+            0.0;
+            self.distribution
+                .as_ref()
+                .map_or(self.n, Distribution::local)
+        ]
+    }
+
+    /// Every rank's part of a result (`local`) into `whole`, on every rank.
+    fn assemble_whole(&self, local: Vec<f64>, whole: &mut [f64]) -> Result<(), LinalgError> {
+        match &self.distribution {
+            None => whole.copy_from_slice(&local),
+            Some(d) => d.gather(&local, whole)?,
+        }
+        Ok(())
     }
 
     /// Solves `K x = rhs` from `x = 0`. Fails with [`LinalgError::NotConverged`] unless CG
@@ -302,17 +511,19 @@ impl CgAmg {
                 self.n
             )));
         }
-        let mut x = vec![0.0; self.n];
+        let local_rhs = self.local_part(rhs);
+        let mut local_x = self.local_buffer();
         let (mut iterations, mut residual, mut reason) = (0i64, 0.0, 0);
         let mut step = std::ptr::null();
         let code = {
             let _lock = petsc()?;
-            // SAFETY: `rhs` and `x` hold `n` values, `raw` is alive, the lock is held.
+            // SAFETY: `local_rhs` and `local_x` hold this rank's rows, `raw` is alive, the lock
+            // is held.
             unsafe {
                 internodes_cgamg_solve(
                     self.raw.as_ptr(),
-                    rhs.as_ptr(),
-                    x.as_mut_ptr(),
+                    local_rhs.as_ptr(),
+                    local_x.as_mut_ptr(),
                     rtol,
                     &mut iterations,
                     &mut residual,
@@ -324,6 +535,8 @@ impl CgAmg {
         if code != 0 {
             return Err(petsc_error(step, code));
         }
+        let mut x = vec![0.0; self.n];
+        self.assemble_whole(local_x, &mut x)?;
         let iterations = iterations.max(0) as usize;
         let norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
         let relative_residual = if norm > 0.0 {
@@ -368,28 +581,32 @@ impl CgAmg {
                 self.n
             )));
         }
+        let local_rhs = self.local_part(rhs);
+        let mut local_x = self.local_buffer();
         let mut step = std::ptr::null();
         let code = {
             // PETSc is initialized (`self` exists). `applying` is taken under the shared lock,
             // never the other way round, and released first (reverse order of declaration).
-            let concurrent = concurrent_v_cycles();
+            // A distributed V-cycle is collective: never beside another call.
+            let concurrent = concurrent_v_cycles() && self.distribution.is_none();
             let _exclusive = if concurrent { None } else { Some(petsc()?) };
             let _shared = concurrent.then(|| PETSC.read().unwrap_or_else(PoisonError::into_inner));
             let _own =
                 concurrent.then(|| self.applying.lock().unwrap_or_else(PoisonError::into_inner));
-            // SAFETY: `rhs` and `x` hold `n` values, `raw` is alive, and either PETSc is held
-            // exclusively or it is held shared with this object's mutex (see `impl Sync`).
+            // SAFETY: `local_rhs` and `local_x` hold this rank's rows, `raw` is alive, and
+            // either PETSc is held exclusively or it is held shared with this object's mutex
+            // (see `impl Sync`).
             unsafe {
                 internodes_cgamg_precondition(
                     self.raw.as_ptr(),
-                    rhs.as_ptr(),
-                    x.as_mut_ptr(),
+                    local_rhs.as_ptr(),
+                    local_x.as_mut_ptr(),
                     &mut step,
                 )
             }
         };
         match code {
-            0 => Ok(()),
+            0 => self.assemble_whole(local_x, x),
             _ => Err(petsc_error(step, code)),
         }
     }

@@ -70,6 +70,63 @@ MPI_Fint internodes_petsc_comm_self(void)
     return MPI_Comm_c2f(PETSC_COMM_SELF);
 }
 
+/* PETSC_COMM_WORLD (MPI_COMM_WORLD: every rank of the run) as a Fortran handle. */
+MPI_Fint internodes_petsc_comm_world(void)
+{
+    return MPI_Comm_c2f(PETSC_COMM_WORLD);
+}
+
+/* This process's rank and the number of ranks in PETSC_COMM_WORLD. */
+int internodes_mpi_rank_size(int *rank, int *size, const char **step)
+{
+    TRY(MPI_Comm_rank(PETSC_COMM_WORLD, rank));
+    TRY(MPI_Comm_size(PETSC_COMM_WORLD, size));
+    return 0;
+}
+
+/* Every rank's `local` (counts[r] values from rank r) into `global`, in rank order, on every
+ * rank (MPI_Allgatherv over PETSC_COMM_WORLD; displs[r] is where rank r's values start). */
+int internodes_mpi_allgather(const double *local, int count, double *global, const int *counts,
+                             const int *displs, const char **step)
+{
+    TRY(MPI_Allgatherv(local, count, MPI_DOUBLE, global, counts, displs, MPI_DOUBLE, PETSC_COMM_WORLD));
+    return 0;
+}
+
+/* Rank 0's `len` bytes at `data` into `data` on every rank (every rank knows `len`: see
+ * internodes_mpi_broadcast_length). In chunks, since MPI counts are ints. */
+int internodes_mpi_broadcast(void *data, int64_t len, const char **step)
+{
+    const int64_t chunk = 1 << 30;
+    for (int64_t at = 0; at < len; at += chunk) {
+        int n = (int)(len - at < chunk ? len - at : chunk);
+        TRY(MPI_Bcast((char *)data + at, n, MPI_BYTE, 0, PETSC_COMM_WORLD));
+    }
+    return 0;
+}
+
+/* The length rank 0 broadcasts next, on every rank (the first half of a broadcast). */
+int internodes_mpi_broadcast_length(int64_t *len, const char **step)
+{
+    TRY(MPI_Bcast(len, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD));
+    return 0;
+}
+
+/* Ends every rank of the run with `code` (a rank that failed alone: the others may be waiting
+ * for it in a collective call, and would wait for ever). */
+void internodes_mpi_abort(int code)
+{
+    MPI_Abort(PETSC_COMM_WORLD, code);
+}
+
+/* PetscFinalize, which finalizes MPI (a rank that exits without it is reported by mpirun as
+ * ended improperly). Every PETSc object must have been destroyed. */
+int internodes_petsc_finalize(const char **step)
+{
+    TRY(PetscFinalize());
+    return 0;
+}
+
 /* The generic text of a PETSc error code. */
 const char *internodes_petsc_error_text(int code)
 {

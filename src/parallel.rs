@@ -1,0 +1,151 @@
+//! The MPI ranks of a run: `mpirun -n N internodes solve CASE` runs the same program on `N`
+//! processes (`docs/parallel.md`).
+//!
+//! Every rank reads the case and the mesh, assembles each body and runs the contact loop and
+//! its coupled GMRES on whole vectors; what is distributed is each body's linear algebra in
+//! PETSc: its matrix rows (a METIS partition of its nodes), its GAMG hierarchy and the
+//! V-cycles and CG solves on it, whose results every rank then receives whole
+//! (`crate::linalg::petsc`). So every rank takes the same decisions on the same numbers, and
+//! only rank 0 writes: the output folder is the serial run's, with the ranks recorded.
+//!
+//! A rank runs one thread (one rank per core): the calls into PETSc are collective, and with
+//! one thread every rank makes them in the same order.
+//!
+//! Without the cargo feature `petsc` a run is always one rank; launched by `mpirun` on more,
+//! [`start`] refuses.
+
+use std::sync::OnceLock;
+
+use serde::Serialize;
+use thiserror::Error;
+
+/// This process's place in the run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Ranks {
+    /// 0 to `size - 1`.
+    pub rank: usize,
+    /// The number of processes of the run.
+    pub size: usize,
+}
+
+impl Ranks {
+    /// A run of one process.
+    pub const ONE: Self = Self { rank: 0, size: 1 };
+}
+
+#[derive(Debug, Error)]
+pub enum ParallelError {
+    #[error(
+        "launched on {0} MPI ranks, but this binary was built without PETSc, which carries the \
+         distribution (rebuild with `cargo build --release --features petsc`, as `make` does)"
+    )]
+    NoPetsc(usize),
+    #[error("MPI: {0}")]
+    Mpi(String),
+    #[error("the rayon thread pool of a rank: {0}")]
+    Threads(String),
+}
+
+static RUN: OnceLock<Ranks> = OnceLock::new();
+
+/// The number of ranks the environment of an MPI launcher announces (Open MPI's `mpirun`,
+/// and the PMI of MPICH, Intel MPI and Slurm's `srun`), if it names one.
+fn announced_size() -> Option<usize> {
+    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
+        .iter()
+        .find_map(|name| std::env::var(name).ok()?.trim().parse().ok())
+}
+
+/// Joins the run when an MPI launcher started this process: initializes MPI (through
+/// PETSc), learns this rank and the number of ranks, and on more than one keeps this process
+/// to one thread. Without a launcher, or on one rank, the run is serial and nothing changes.
+/// Called once, first thing, by the command line (never by the library: a Python process is
+/// always a serial run).
+pub fn start() -> Result<Ranks, ParallelError> {
+    let Some(announced) = announced_size() else {
+        return Ok(*RUN.get_or_init(|| Ranks::ONE));
+    };
+    let ranks = join_world(announced)?;
+    if ranks.size > 1 {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build_global()
+            .map_err(|e| ParallelError::Threads(e.to_string()))?;
+    }
+    Ok(*RUN.get_or_init(|| ranks))
+}
+
+#[cfg(feature = "petsc")]
+fn join_world(_announced: usize) -> Result<Ranks, ParallelError> {
+    crate::linalg::petsc::world_ranks().map_err(|e| ParallelError::Mpi(e.to_string()))
+}
+
+#[cfg(not(feature = "petsc"))]
+fn join_world(announced: usize) -> Result<Ranks, ParallelError> {
+    match announced {
+        0 | 1 => Ok(Ranks::ONE),
+        size => Err(ParallelError::NoPetsc(size)),
+    }
+}
+
+/// This process's place in the run (one rank unless [`start`] joined more).
+pub fn ranks() -> Ranks {
+    RUN.get().copied().unwrap_or(Ranks::ONE)
+}
+
+/// Whether the run has more than one rank.
+pub fn distributed() -> bool {
+    ranks().size > 1
+}
+
+/// Whether this rank writes the results and prints (rank 0).
+pub fn is_root() -> bool {
+    ranks().rank == 0
+}
+
+/// Rank 0's `bytes` on every rank (`bytes` is read on rank 0 only). Serial: `bytes` itself.
+pub fn share_from_root(bytes: Vec<u8>) -> Result<Vec<u8>, ParallelError> {
+    if !distributed() {
+        return Ok(bytes);
+    }
+    #[cfg(feature = "petsc")]
+    {
+        crate::linalg::petsc::broadcast_bytes(bytes).map_err(|e| ParallelError::Mpi(e.to_string()))
+    }
+    #[cfg(not(feature = "petsc"))]
+    unreachable!("a run without PETSc is never distributed (`start`)")
+}
+
+/// Every rank's `value`, in rank order, on every rank. Serial: `[value]`.
+pub fn gather(value: f64) -> Result<Vec<f64>, ParallelError> {
+    if !distributed() {
+        return Ok(vec![value]);
+    }
+    #[cfg(feature = "petsc")]
+    {
+        crate::linalg::petsc::gather_values(&[value], &vec![1; ranks().size])
+            .map_err(|e| ParallelError::Mpi(e.to_string()))
+    }
+    #[cfg(not(feature = "petsc"))]
+    unreachable!("a run without PETSc is never distributed (`start`)")
+}
+
+/// Ends the run: on several ranks, every rank with `code` (`MPI_Abort`), since the others may
+/// be waiting for this one in a collective call; on one, this process.
+pub fn abort(code: u8) -> ! {
+    #[cfg(feature = "petsc")]
+    if distributed() {
+        crate::linalg::petsc::abort_world(i32::from(code));
+    }
+    std::process::exit(i32::from(code))
+}
+
+/// Finalizes MPI on a run that joined it (mpirun reports a rank that exits without it as
+/// ended improperly). Every PETSc object must be gone.
+pub fn finish() -> Result<(), ParallelError> {
+    #[cfg(feature = "petsc")]
+    if announced_size().is_some() {
+        return crate::linalg::petsc::finalize().map_err(|e| ParallelError::Mpi(e.to_string()));
+    }
+    Ok(())
+}

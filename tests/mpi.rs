@@ -1,0 +1,362 @@
+//! Distributed runs: `mpirun -n 2 internodes solve CASE` gives the answer of one process and
+//! writes the same output folder; a rank that fails alone ends every rank; what cannot be
+//! distributed is refused.
+//!
+//! The reference is the serial run with the same body solver (CG + AMG): two ranks build GAMG
+//! on a partitioned matrix, a different preconditioner of the same systems, so the answers
+//! agree to the solves' tolerance, not bit for bit. The bound is the one that
+//! `tests/contact_solvers.rs` sets between CG + AMG and Cholesky bodies (1e-6 of the largest
+//! value; its reason is there: gaps settle within 1e-5 h); measured here 2e-8 to 7e-8.
+
+#![cfg(feature = "petsc")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BINARY: &str = env!("CARGO_BIN_EXE_internodes");
+
+/// Agreement of a 2-rank run with the serial one (see the module doc).
+const AGREEMENT: f64 = 1e-6;
+
+/// Longer than any run here takes (a few seconds each); a run still going then is hung.
+const HANG: Duration = Duration::from_secs(300);
+
+/// `mpirun` with the flags a container's root needs, `ranks` processes of `args` (or, with
+/// `ranks = 0`, `args` as the whole command line after the flags: several programs).
+fn mpirun(ranks: usize, args: &[&str]) -> Output {
+    let mut command = Command::new("mpirun");
+    command.args(["--allow-run-as-root", "--oversubscribe"]);
+    if ranks > 0 {
+        command.args(["-n", &ranks.to_string(), BINARY]);
+    }
+    command.args(args);
+    run_within(command, HANG)
+}
+
+/// Runs `command`, failing the test if it has not ended after `limit`.
+fn run_within(mut command: Command, limit: Duration) -> Output {
+    let mut child = command
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("mpirun (Debian: openmpi-bin) on PATH");
+    let start = Instant::now();
+    while child.try_wait().expect("waiting for mpirun").is_none() {
+        if start.elapsed() > limit {
+            child.kill().ok();
+            let output = child.wait_with_output().unwrap();
+            panic!(
+                "still running after {limit:?}: a hang\n{}",
+                String::from_utf8_lossy(&output.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.wait_with_output().unwrap()
+}
+
+fn serial(args: &[&str]) -> Output {
+    Command::new(BINARY).args(args).output().unwrap()
+}
+
+fn text(output: &Output) -> String {
+    format!(
+        "status {:?}\nstdout:\n{}\nstderr:\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}
+
+/// The example case `geo/<name>.toml`, its mesh path made absolute, with `extra` appended,
+/// written into `dir`.
+fn example_case(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    let geo = Path::new(env!("CARGO_MANIFEST_DIR")).join("geo");
+    let original = std::fs::read_to_string(geo.join(format!("{name}.toml"))).unwrap();
+    let mut case: toml::Table = toml::from_str(&original).unwrap();
+    let mesh = case["mesh"].as_str().unwrap().to_string();
+    case.insert("mesh".into(), geo.join(mesh).display().to_string().into());
+    let mut text = toml::to_string(&case).unwrap();
+    text.push_str(extra);
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn read(dir: &Path, name: &str) -> Vec<f64> {
+    let file = hdf5::File::open(dir.join("solution.h5")).unwrap();
+    file.dataset(name).unwrap().read_raw::<f64>().unwrap()
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Each pair's summary: `contact` (one pair) or `contacts` (several).
+fn pairs(summary: &serde_json::Value) -> Vec<serde_json::Value> {
+    match summary.get("contact") {
+        Some(pair) => vec![pair.clone()],
+        None => summary["contacts"].as_array().cloned().unwrap_or_default(),
+    }
+}
+
+/// `max |a - b| / max |a|`.
+fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    if scale > 0.0 { diff / scale } else { diff }
+}
+
+fn files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Solves the example `name` with CG + AMG bodies on one process and on two ranks, and
+/// compares everything a user reads: statuses, active sets, forces per load step, fields, the
+/// accuracy report, the folder's files; and the rank record of the summary.
+///
+/// `contact_settings` go into every contact table. `laterals_from_step`: the load step from
+/// which every force component is compared; before it, only the component along the load
+/// (see the floating ball's test).
+fn two_ranks_give_the_serial_answer(name: &str, contact_settings: &str, laterals_from_step: usize) {
+    let dir = tempfile::tempdir().unwrap();
+    let case = example_case(dir.path(), name, "\n[solver]\nbody = \"cg-amg\"\n");
+    if !contact_settings.is_empty() {
+        let text = std::fs::read_to_string(&case).unwrap();
+        let text = text
+            .replace(
+                "[[contact]]\n",
+                &format!("[[contact]]\n{contact_settings}\n"),
+            )
+            .replace("[contact]\n", &format!("[contact]\n{contact_settings}\n"));
+        std::fs::write(&case, text).unwrap();
+    }
+    let case = case.to_str().unwrap();
+    let (one, two) = (dir.path().join("one"), dir.path().join("two"));
+    let serial_run = serial(&["solve", case, "-q", "-o", one.to_str().unwrap()]);
+    let parallel_run = mpirun(2, &["solve", case, "-q", "-o", two.to_str().unwrap()]);
+    assert!(
+        serial_run.status.success(),
+        "{name} serial: {}",
+        text(&serial_run)
+    );
+    assert!(
+        parallel_run.status.success(),
+        "{name} on 2 ranks: {}",
+        text(&parallel_run)
+    );
+    assert!(
+        parallel_run.stdout.is_empty() && parallel_run.stderr.is_empty(),
+        "{}",
+        text(&parallel_run)
+    );
+
+    assert_eq!(
+        files(&one),
+        files(&two),
+        "{name}: the output folders' files"
+    );
+    for field in [
+        "fields/displacement",
+        "fields/contact_pressure",
+        "fields/stress",
+    ] {
+        let d = relative_difference(&read(&one, field), &read(&two, field));
+        assert!(d <= AGREEMENT, "{name}: {field} differs by {d:.2e}");
+    }
+    assert_eq!(
+        read(&one, "fields/contact_active"),
+        read(&two, "fields/contact_active"),
+        "{name}: active sets"
+    );
+
+    let (a, b) = (summary(&one), summary(&two));
+    assert_eq!(a["ranks"], 1);
+    assert_eq!(b["ranks"], 2);
+    assert_eq!(b["rank_peak_memory_mb"].as_array().map(Vec::len), Some(2));
+    for body in b["bodies"].as_array().unwrap() {
+        let shares: Vec<u64> = (body["solve"]["rank_dofs"].as_array().unwrap().iter())
+            .map(|v| v.as_u64().unwrap())
+            .collect();
+        assert_eq!(shares.len(), 2, "{name}: {body}");
+        assert_eq!(
+            shares.iter().sum::<u64>(),
+            body["num_dofs"].as_u64().unwrap()
+        );
+        // METIS's parts: within its 3% imbalance of an even split.
+        let even = body["num_dofs"].as_f64().unwrap() / 2.0;
+        assert!(
+            shares
+                .iter()
+                .all(|&s| (s as f64 - even).abs() <= 0.03 * even + 3.0),
+            "{shares:?}"
+        );
+    }
+    let (pairs_a, pairs_b) = (pairs(&a), pairs(&b));
+    assert!(!pairs_a.is_empty());
+    for (p, q) in pairs_a.iter().zip(&pairs_b) {
+        assert_eq!(p["status"], q["status"], "{name}");
+        // The same checks pass and fail (their values agree to the solves' tolerance; where a
+        // value is round-off, as a penetration of 1e-14 h, its node may differ).
+        for report in ["solved", "accuracy"] {
+            let verdicts = |pair: &serde_json::Value| -> Vec<String> {
+                (pair[report]["checks"].as_array().into_iter().flatten())
+                    .map(|c| format!("{} {}", c["name"], c["passed"]))
+                    .collect()
+            };
+            assert_eq!(verdicts(p), verdicts(q), "{name}: {report}");
+            assert_eq!(p[report]["passed"], q[report]["passed"], "{name}: {report}");
+        }
+        let (steps_p, steps_q) = (
+            p["steps"].as_array().unwrap(),
+            q["steps"].as_array().unwrap(),
+        );
+        assert_eq!(steps_p.len(), steps_q.len());
+        for (k, (s, t)) in steps_p.iter().zip(steps_q).enumerate() {
+            assert_eq!(s["status"], t["status"], "{name}");
+            assert_eq!(
+                s["iterations"], t["iterations"],
+                "{name}: active-set iterations"
+            );
+            assert_eq!(s["accurate"], t["accurate"], "{name}: the accuracy report");
+            assert_eq!(s["failed_checks"], t["failed_checks"], "{name}");
+            let force = |step: &serde_json::Value| -> Vec<f64> {
+                (step["force_primary"].as_array().unwrap().iter())
+                    .map(|v| v.as_f64().unwrap())
+                    .collect()
+            };
+            let (f, g) = (force(s), force(t));
+            let d = match k + 1 >= laterals_from_step {
+                true => relative_difference(&f, &g),
+                false => (f[f.len() - 1] - g[g.len() - 1]).abs() / f[f.len() - 1].abs(),
+            };
+            assert!(
+                d <= AGREEMENT,
+                "{name}: step {}: force differs by {d:.2e}",
+                k + 1
+            );
+        }
+    }
+}
+
+#[test]
+fn the_demo_on_two_ranks_gives_the_serial_answer() {
+    // 3D Hertz, five load steps; the mesh made by gmsh on rank 0 and sent to rank 1.
+    two_ranks_give_the_serial_answer("hemisphere_on_block", "", 1);
+}
+
+#[test]
+fn a_floating_ball_between_plates_under_a_force_on_two_ranks_gives_the_serial_answer() {
+    // Two pairs, a body held by its contacts alone, force control. Solved to a penetration
+    // tolerance of 1e-9 h: at the default (1e-3 h) the loop stops once the gaps settle within
+    // 1e-5 h, and the floating ball's position may differ by that much between any two
+    // preconditioners (measured: 1.1e-5 of the largest displacement, CG + AMG against
+    // Cholesky, one process).
+    //
+    // The lateral force components of the first step (load factor 0.5) are left out: the two
+    // runs' loose first solves differ at 1e-7, their active-set paths then differ (the same
+    // final set), and a pair is paired again only once its surfaces slid 0.05 spacings from
+    // where it was last paired, so each run keeps a pairing made at another state: the lateral
+    // components of the upper pair then differ by 3.6e-5 of its force (the z components by
+    // 1e-12). The last step's pairing is the same and every component agrees (8e-12).
+    two_ranks_give_the_serial_answer("ball_between_plates_3d", "penetration_tolerance = 1e-9", 2);
+}
+
+#[test]
+fn a_single_body_on_two_ranks_gives_the_serial_answer() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = example_case(dir.path(), "block_3d", "\n[solver]\nbody = \"cg-amg\"\n");
+    let case = case.to_str().unwrap();
+    let (one, two) = (dir.path().join("one"), dir.path().join("two"));
+    let serial_run = serial(&["solve", case, "-q", "-o", one.to_str().unwrap()]);
+    let parallel_run = mpirun(2, &["solve", case, "-q", "-o", two.to_str().unwrap()]);
+    assert!(serial_run.status.success(), "{}", text(&serial_run));
+    assert!(parallel_run.status.success(), "{}", text(&parallel_run));
+    assert_eq!(files(&one), files(&two));
+    let d = relative_difference(
+        &read(&one, "fields/displacement"),
+        &read(&two, "fields/displacement"),
+    );
+    // One CG solve to the case's rtol (1e-10 by default) with either preconditioner.
+    assert!(d <= 1e-8, "displacement differs by {d:.2e}");
+}
+
+#[test]
+fn a_rank_that_fails_alone_ends_every_rank_with_its_error() {
+    // Rank 0 alone writes, so it alone finds that the output folder is a file; rank 1 goes on
+    // into the body solver's collective set-up and would wait for rank 0 for ever.
+    let dir = tempfile::tempdir().unwrap();
+    let case = example_case(dir.path(), "block_3d", "\n[solver]\nbody = \"cg-amg\"\n");
+    let out = dir.path().join("a_file");
+    std::fs::write(&out, "not a folder").unwrap();
+    let run = mpirun(
+        2,
+        &[
+            "solve",
+            case.to_str().unwrap(),
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(!run.status.success(), "{}", text(&run));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("error (rank 0 of 2)"), "{}", text(&run));
+    assert!(stderr.contains("a_file"), "{}", text(&run));
+    assert!(!stderr.contains("error (rank 1 of 2)"), "{}", text(&run));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "not a folder");
+}
+
+#[test]
+fn what_runs_on_one_process_only_is_refused_on_two_ranks() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "[solver] body",
+            "\n[solver]\nbody = \"cholesky\"\n",
+            "block_3d",
+        ),
+        ("[contact] solver", "", "hemisphere_on_block"),
+    ];
+    for (context, extra, name) in cases {
+        let case = example_case(dir.path(), name, extra);
+        if name == "hemisphere_on_block" {
+            let text = std::fs::read_to_string(&case).unwrap();
+            let text = text.replace("[contact]\n", "[contact]\nsolver = \"monolithic-lu\"\n");
+            std::fs::write(&case, text).unwrap();
+        }
+        let out = dir.path().join("out");
+        let run = mpirun(
+            2,
+            &["solve", case.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        );
+        assert!(!run.status.success(), "{}", text(&run));
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            stderr.contains(context) && stderr.contains("2 MPI ranks"),
+            "{context}: {}",
+            text(&run)
+        );
+    }
+    let run = mpirun(
+        2,
+        &[
+            "study",
+            "geo/hemisphere_on_block.toml",
+            "--parameter",
+            "level=0,1",
+        ],
+    );
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("runs on one process"));
+}
