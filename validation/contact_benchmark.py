@@ -138,12 +138,16 @@ PATHS = {
     "default": {"body": "auto", "solver": "auto",
                 "label": "what `auto` picks: the coupled GMRES, Cholesky bodies below 30,000 DOFs in the larger "
                          "body and AMG above (older binaries: below 250,000 DOFs)"},
+    "mpi2": {"body": "auto", "solver": "auto", "ranks": 2,
+             "label": "the default case file under `mpirun -n 2`: each body's rows split between the two ranks "
+                      "(METIS), AMG for every body whatever its size, the coupled GMRES on every rank; peak "
+                      "memory is the sum of the ranks' peaks (summary.json's rank_peak_memory_mb)"},
 }
 
 # A run is killed (and reported as skipped) beyond these limits. An iterative run at 1M DOFs
 # may take 30 to 60 minutes.
 MAX_RSS_GB = 18.0
-MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0, "default": 5400.0}
+MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0, "default": 5400.0, "mpi2": 5400.0}
 MAX_SECONDS_DOLFINX = 600.0
 # ... but at the on-request sizes (3M DOFs), where reading and distributing the mesh alone takes minutes.
 MAX_SECONDS_DOLFINX_LARGE = 1800.0
@@ -200,6 +204,8 @@ RUNS = {
     "iterative_steps": ("iterative, load steps (0.5, 1.0)", "iterative", LOAD_STEPS),
     "default_one": ("default, one step (1.0)", "default", ONE_STEP),
     "default_steps": ("default, load steps (0.5, 1.0)", "default", LOAD_STEPS),
+    "mpi2_one": ("mpi2, one step (1.0)", "mpi2", ONE_STEP),
+    "mpi2_steps": ("mpi2, load steps (0.5, 1.0)", "mpi2", LOAD_STEPS),
     "dolfinx_cg": ("dolfinx, CG + GAMG", None, None),
     "dolfinx_mumps": ("dolfinx, MUMPS Cholesky", None, None),
     "dolfinx_cg_mpi": (f"dolfinx, CG + GAMG, {MPI_RANKS} MPI ranks", None, None),
@@ -403,13 +409,21 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
     """One internodes contact solve (verbose: the log has every step's iterations)."""
     shutil.rmtree(output, ignore_errors=True)  # never read a stale summary
     log = output.with_suffix(".log")
-    usage = measure([binary, "solve", case, "--output", output], log, max_seconds=MAX_SECONDS_OURS[path],
+    ranks = PATHS[path].get("ranks", 1)
+    launcher = [MPIRUN, "-n", str(ranks)] if ranks > 1 else []
+    usage = measure([*launcher, binary, "solve", case, "--output", output], log,
+                    env=MPI_ENV if ranks > 1 else None, max_seconds=MAX_SECONDS_OURS[path],
                     max_rss_gb=MAX_RSS_GB, check=False)
     summary_file = output / "summary.json"
     if not summary_file.is_file():  # an error before the result files: no timings
         tail = " | ".join(log.read_text().strip().splitlines()[-3:])
         raise RunFailed(f"exit status {usage['exit_status']}: {tail}")
     summary = json.loads(summary_file.read_text())
+    if ranks > 1:  # mpirun's own rusage is one process's: the ranks' own peaks, summed, replace it
+        if summary.get("ranks") != ranks or len(summary.get("rank_peak_memory_mb") or []) != ranks:
+            raise RunFailed(f"{summary_file}: not a run on {ranks} ranks")
+        usage |= {"peak_mb_mpirun": usage["peak_mb"], "peak_mb": sum(summary["rank_peak_memory_mb"]),
+                  "rank_peak_mb": summary["rank_peak_memory_mb"]}
     contact = summary["contact"]
     # The coupled solver asked for (contact.settings.solver); the ones that ran are
     # contact.linear_solvers (interface, body, and a GMRES failure that moved auto to schur).
