@@ -328,9 +328,9 @@ def not_run_reason(path: str, count: int) -> str | None:
 LOAD_STEP_LINE = re.compile(r"^load step (\d+)/(\d+): factor (\S+)$")
 ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-(\d+)\s.*; ([-+0-9.eE]+) s"
                             r"(?: \((.*)\))?\s*$")
-# "  Cholesky of both bodies: 0.290 s": the body solvers' set-up (the factors, or PETSc + the AMG
+# "  Cholesky of the 2 bodies: 0.290 s" ("of both bodies" before several pairs): the body solvers' set-up (the factors, or PETSc + the AMG
 # hierarchies on the iterative path, whatever the label says).
-BODY_SETUP_LINE = re.compile(r"^\s+(\S.*?) of both bodies: ([-+0-9.eE]+) s$")
+BODY_SETUP_LINE = re.compile(r"^\s+(\S.*?) of (?:both|the \d+) bodies: ([-+0-9.eE]+) s$")
 # An active-set iteration may print two: a loose solve, then the exact one (summed).
 # "interface GMRES" (nested: each product full elastic solves of both bodies) or, since the coupled solve,
 # "coupled GMRES" (one right-preconditioned GMRES on the whole coupled system per active-set iteration).
@@ -372,7 +372,7 @@ def parse_log(log: Path) -> tuple[str, float, list[list[dict]]]:
                               "phases": _phases(match[6]), "krylov": krylov})
             krylov = None
     if set_up is None:
-        raise RunFailed(f"{log}: no '... of both bodies: X s' line (log format changed?)")
+        raise RunFailed(f"{log}: no '... of the 2 bodies: X s' line (log format changed?)")
     return label, set_up, steps
 
 
