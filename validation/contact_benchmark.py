@@ -480,6 +480,38 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
     }
 
 
+def rank_agreement(serial: Path, parallel: Path) -> dict:
+    """The 2-rank run against the serial one, from their result files: the largest displacement and
+    pressure differences over the largest values, the force difference per step over the force, and
+    whether the active sets are the same node for node."""
+    import h5py
+    with h5py.File(serial / "solution.h5") as a, h5py.File(parallel / "solution.h5") as b:
+        def relative(name: str) -> float:
+            x, y = np.asarray(a[name]), np.asarray(b[name])
+            return float(np.abs(x - y).max() / max(np.abs(x).max(), 1e-300))
+        same_active = bool(np.array_equal(np.asarray(a["fields/contact_active"]), np.asarray(b["fields/contact_active"])))
+        fields = {"displacement": relative("fields/displacement"), "pressure": relative("fields/contact_pressure")}
+    steps_a, steps_b = (json.loads((d / "summary.json").read_text())["contact"]["steps"] for d in (serial, parallel))
+    force = max(abs(s["force_primary"][-1] - t["force_primary"][-1]) / abs(s["force_primary"][-1])
+                for s, t in zip(steps_a, steps_b))
+    return fields | {"force": force, "same_active_set": same_active,
+                     "same_statuses": [s["status"] for s in steps_a] == [t["status"] for t in steps_b]}
+
+
+def agreement_lines(sizes: list[dict]) -> list[str]:
+    """The report's bullets: each size's 2-rank run against the serial one."""
+    lines = []
+    for size in sizes:
+        for one in ("one", "steps"):
+            q = size["runs"].get(f"mpi2_{one}", {}).get("vs_serial")
+            if q:
+                lines.append(f"* {size['name']}, {_kind(f'mpi2_{one}')}: displacement {q['displacement']:.1e}, "
+                             f"contact pressure {q['pressure']:.1e}, force {q['force']:.1e} (largest over the "
+                             f"steps); active set {'the same' if q['same_active_set'] else 'DIFFERENT'}, statuses "
+                             f"{'the same' if q['same_statuses'] else 'DIFFERENT'}")
+    return lines or ["* no size has both runs"]
+
+
 def dolfinx_seconds(count: int) -> float:
     """The time limit of a dolfinx run at a mesh of ``count`` DOFs."""
     return MAX_SECONDS_DOLFINX_LARGE if count > 1_500_000 else MAX_SECONDS_DOLFINX
@@ -575,6 +607,10 @@ def benchmark_size(size: Size, binary: Path, paths: list[str], earlier: list[dic
     if timed(runs["dolfinx_cg"]) and timed(runs["dolfinx_mumps"]):
         u_cg, u_mumps = (np.load(size.folder / f"{r}.u.npy") for r in ("dolfinx_cg", "dolfinx_mumps"))
         runs["dolfinx_cg"]["l2_vs_mumps"] = float(np.linalg.norm(u_cg - u_mumps) / np.linalg.norm(u_mumps))
+    for one in ("one", "steps"):  # our 2-rank run against the serial one: the same answer?
+        serial_run, parallel_run = runs.get(f"default_{one}", {}), runs.get(f"mpi2_{one}", {})
+        if timed(serial_run) and timed(parallel_run):
+            parallel_run["vs_serial"] = rank_agreement(size.folder / f"default_{one}", size.folder / f"mpi2_{one}")
     if timed(runs["dolfinx_cg"]) and timed(runs["dolfinx_cg_mpi"]):  # the same solution, other DOF order
         norm = float(np.linalg.norm(np.load(size.folder / "dolfinx_cg.u.npy")))
         runs["dolfinx_cg_mpi"]["norm_vs_serial"] = abs(runs["dolfinx_cg_mpi"]["solution_norm"] - norm) / norm
@@ -1229,6 +1265,14 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "(validation/dolfinx_parallel_elastic.py: the mesh read by rank 0 and distributed by dolfinx; each phase "
         "ends with a barrier and is timed on rank 0); its memory is the sum of the ranks' peaks.",
         "",
+        "### Two ranks against one",
+        "",
+        "Path `mpi2` against `default` on the same mesh, from their output files (largest difference over the "
+        "largest value; the serial run's bodies are Cholesky below 30,000 DOFs, CG + AMG above, the 2-rank "
+        "run's always CG + AMG):",
+        "",
+        *agreement_lines(sizes),
+        "",
         "### Aims",
         "",
         markdown(aims_table(sizes)),
@@ -1357,6 +1401,12 @@ def upgrade(size: dict) -> dict:
     for run in OURS:
         runs.setdefault(run, {"not_run": "not in results.json (written before the iterative path was benchmarked)"})
     runs.setdefault("dolfinx_cg_mpi", {"not_run": "not in results.json (written before the MPI run was added)"})
+    for one in ("one", "steps"):  # written before the 2-rank agreement: computed from the kept output folders
+        serial_run, parallel_run = runs.get(f"default_{one}", {}), runs.get(f"mpi2_{one}", {})
+        folders = [BENCH / size["name"] / f"{path}_{one}" for path in ("default", "mpi2")]
+        if (timed(serial_run) and timed(parallel_run) and "vs_serial" not in parallel_run
+                and all((f / "solution.h5").is_file() for f in folders)):
+            parallel_run["vs_serial"] = rank_agreement(*folders)
     return size
 
 
