@@ -106,13 +106,19 @@ class RunFailed(RuntimeError):
 
 
 def _rss_gb(pid: int) -> float:
-    """Current resident memory of a process (GB; 0 if it is gone)."""
+    """Current resident memory of a process and its descendants (GB; 0 if it is gone): under
+    mpirun the ranks are mpirun's children, and the limit is on their sum."""
     try:
         status = Path(f"/proc/{pid}/status").read_text()
     except OSError:
         return 0.0
     match = re.search(r"^VmRSS:\s+(\d+) kB", status, re.MULTILINE)
-    return int(match[1]) / 2**20 if match else 0.0
+    own = int(match[1]) / 2**20 if match else 0.0
+    try:
+        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+    except OSError:
+        children = []
+    return own + sum(_rss_gb(int(child)) for child in children)
 
 
 def measure(command: list, log: Path, env: dict | None = None, *, max_seconds: float = MAX_SECONDS,
@@ -127,8 +133,9 @@ def measure(command: list, log: Path, env: dict | None = None, *, max_seconds: f
     load = os.getloadavg()[0]  # other processes on the machine (shared): reported with the run
     with open(log, "w") as out:
         start = time.perf_counter()
+        # Its own process group: a kill takes mpirun's ranks too.
         child = subprocess.Popen([str(c) for c in command], stdout=out, stderr=subprocess.STDOUT,
-                                 env=os.environ | (env or {}))
+                                 env=os.environ | (env or {}), start_new_session=True)
         stopped = None
         while True:
             pid, status, usage = os.wait4(child.pid, os.WNOHANG)
@@ -138,7 +145,7 @@ def measure(command: list, log: Path, env: dict | None = None, *, max_seconds: f
             if stopped is None and (elapsed > max_seconds or rss > max_rss_gb):
                 stopped = (f"stopped after {elapsed:.0f} s at {rss:.1f} GB "
                            f"(limits {max_seconds:.0f} s, {max_rss_gb:.0f} GB)")
-                os.kill(child.pid, signal.SIGKILL)
+                os.killpg(child.pid, signal.SIGKILL)
             time.sleep(0.05)
         wall = time.perf_counter() - start
     child.returncode = os.waitstatus_to_exitcode(status)
