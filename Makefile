@@ -36,9 +36,9 @@ python: build
 demo: build
 	$(BINARY) solve geo/hemisphere_on_block.toml --output out/demo
 
-# Unit and integration tests, the Python module's tests and examples, then the quick
-# validation: the coarsest level of every suite, same thresholds (report in
-# validation/build/report-quick/).
+# Unit and integration tests (tests/mpi.rs runs the solver on 2 and 3 MPI ranks with mpirun),
+# the Python module's tests and examples, then the quick validation: the coarsest level of every
+# suite, same thresholds (report in validation/build/report-quick/).
 test: build python
 	cargo test --release --features "$(FEATURES)"
 	$(VENV)/bin/python -m pytest python/tests
