@@ -155,7 +155,12 @@ fn main() -> ExitCode {
         },
         Err(e) => {
             // Every rank that fails says so (one may fail alone), then ends the whole run: the
-            // others may be waiting for it.
+            // others may be waiting for it. Most errors are every rank's (a bad case file): the
+            // other ranks give rank 0 a moment to say it once and end them all, before saying it
+            // themselves.
+            if ranks.rank != 0 {
+                std::thread::sleep(std::time::Duration::from_secs(2));
+            }
             let rank = match ranks.size {
                 1 => String::new(),
                 size => format!(" (rank {} of {size})", ranks.rank),

@@ -376,6 +376,9 @@ fn what_runs_on_one_process_only_is_refused_on_two_ranks() {
             "{context}: {}",
             text(&run)
         );
+        // Every rank meets this error; it is said once, by rank 0.
+        assert_eq!(stderr.matches("error (rank").count(), 1, "{}", text(&run));
+        assert!(stderr.contains("error (rank 0 of 2)"), "{}", text(&run));
     }
     let run = mpirun(
         2,

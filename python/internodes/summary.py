@@ -187,6 +187,9 @@ class _SummaryOptional(TypedDict, total=False):
     record, in the case's order (then `contact` is absent)."""
     peak_memory_mb: float
     """The process's peak resident memory, where Linux reports it."""
+    rank_peak_memory_mb: list[float]
+    """Each MPI rank's peak memory, in rank order, in a distributed run (`mpirun`); absent
+    otherwise (a Python process is one rank)."""
 
 
 class Summary(_SummaryOptional):
@@ -197,3 +200,5 @@ class Summary(_SummaryOptional):
     dimension: int
     bodies: list[Body]
     timings: list[object]
+    ranks: int
+    """The number of MPI processes that solved the case: 1 from Python."""
