@@ -80,10 +80,13 @@ fn main() {
             let body = case.body_mesh(&mesh, spec).unwrap_or_else(exit);
             let problem = case.elastic_problem(body, spec).unwrap_or_else(exit);
             let system = assemble(&problem, &mut SolveStats::default(), false).unwrap();
-            let symbolic =
-                CholeskySymbolic::new(&system.graph, system.k_c.symbolic(), case.solver.ordering)
-                    .unwrap();
-            let factor = Cholesky::factorize(symbolic, &system.k_c).unwrap();
+            let symbolic = CholeskySymbolic::new(
+                &system.graph,
+                system.k_c.as_ref().unwrap().symbolic(),
+                case.solver.ordering,
+            )
+            .unwrap();
+            let factor = Cholesky::factorize(symbolic, system.k_c.as_ref().unwrap()).unwrap();
             (body, problem, system, factor)
         })
         .collect();
@@ -105,11 +108,11 @@ fn main() {
                     let (seconds, _) = timed(|| {
                         let symbolic = CholeskySymbolic::new(
                             &system.graph,
-                            system.k_c.symbolic(),
+                            system.k_c.as_ref().unwrap().symbolic(),
                             case.solver.ordering,
                         )
                         .unwrap();
-                        Cholesky::factorize(symbolic, &system.k_c).unwrap()
+                        Cholesky::factorize(symbolic, system.k_c.as_ref().unwrap()).unwrap()
                     });
                     record(name("Cholesky (ordering + numeric)"), threads, seconds);
 

@@ -147,11 +147,11 @@ fn cholesky_solves_are_identical_for_any_thread_count() {
         with_threads(threads, || {
             let symbolic = CholeskySymbolic::new(
                 &system.graph,
-                system.k_c.symbolic(),
+                system.k_c.as_ref().unwrap().symbolic(),
                 Ordering::NestedDissection,
             )
             .unwrap();
-            let factor = Cholesky::factorize(symbolic, &system.k_c).unwrap();
+            let factor = Cholesky::factorize(symbolic, system.k_c.as_ref().unwrap()).unwrap();
             let mut one = system.f_c.clone();
             factor.solve_in_place(&mut one, 1);
             let mut many = rhs.clone();
@@ -270,7 +270,13 @@ mod v_cycles {
         let problem = clamped_cube(&body);
         let mut stats = SolveStats::default();
         let system = assemble(&problem, &mut stats, false).expect("assembly");
-        BodySolver::cg_amg(&system.k_c, system.dim, &system.coordinates, 1e-10).expect("set-up")
+        BodySolver::cg_amg(
+            system.k_c.as_ref().unwrap(),
+            system.dim,
+            &system.coordinates,
+            1e-10,
+        )
+        .expect("set-up")
     }
 
     /// The `k`-th right-hand side of `n` values: reproducible, different for every `k`.

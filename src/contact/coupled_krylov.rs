@@ -45,7 +45,7 @@ use thiserror::Error;
 use super::ContactError;
 use super::compliance::MultiplierKey;
 use super::half_space::HalfSpace;
-use super::system::{CoupledSystem, Pair};
+use super::system::{CoupledSystem, Pair, stiffness_product};
 use crate::cancel::Cancel;
 use crate::elastic::AssembledBody;
 use crate::linalg::BodySolver;
@@ -317,7 +317,7 @@ fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
 /// The operator `A` and the block preconditioner `P^-1` of the module doc.
 struct Blocks<'a> {
     system: &'a CoupledSystem,
-    /// Each body's constrained stiffness (symmetric), `k_c`.
+    /// Each body's constrained stiffness (symmetric), `k_c` (or its distributed solver's copy).
     bodies: &'a [&'a AssembledBody],
     solvers: &'a [BodySolver],
     /// `S~` of each pair, on its multipliers: the pairs' blocks of the preconditioner.
@@ -346,10 +346,11 @@ impl Operators for Blocks<'_> {
             .body_parts(out_u)
             .into_par_iter()
             .zip(self.bodies)
+            .zip(self.solvers)
             .zip(system.offsets.par_windows(2))
-            .for_each(|((out, body), range)| {
-                symmetric_product(&body.k_c, &x[range[0]..range[1]], out)
-            });
+            .try_for_each(|(((out, body), solver), range)| {
+                stiffness_product(body, Some(solver), &x[range[0]..range[1]], out)
+            })?;
         for ((o, d), l) in out_l.iter_mut().zip(&system.d).zip(&x[n..]) {
             *o = d * l;
         }
@@ -457,17 +458,4 @@ impl RigidBlock {
         let y = lu.solve(&rhs).unwrap_or(rhs);
         out[self.first..].copy_from_slice(y.as_slice());
     }
-}
-
-/// `out = K x` for a symmetric `K` stored by compressed columns: entry `j` is column `j` dotted
-/// with `x`, so the rows are independent and computed in parallel, each in a fixed order (the
-/// same result for any number of threads).
-fn symmetric_product(k: &faer::sparse::SparseColMat<usize, f64>, x: &[f64], out: &mut [f64]) {
-    let (symbolic, values) = k.parts();
-    let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-    out.par_iter_mut().enumerate().for_each(|(j, o)| {
-        *o = (col_ptr[j]..col_ptr[j + 1])
-            .map(|p| values[p] * x[row_idx[p]])
-            .sum();
-    });
 }

@@ -41,10 +41,12 @@ use super::ContactError;
 use super::compliance::SurfaceResponse;
 use super::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
 use super::settings::{ContactSettings, CoupledSolver};
-use super::system::{CoupledSystem, Pair};
+use super::system::{CoupledSystem, Pair, assembled};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
-use crate::linalg::{BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Ordering};
+use crate::linalg::{
+    BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
+};
 
 /// The solvers (Cholesky factors, or CG + AMG) of every body's constrained stiffness matrix,
 /// and what the interface solve keeps between iterations: the bodies' responses to the
@@ -92,6 +94,9 @@ impl BodyFactors {
     /// all its pairs), which the response caches of the dense path cover; `compliance` each
     /// pair's half-space compliance factor (`super::half_space::compliance_factor`), for the
     /// Krylov path's preconditioner.
+    ///
+    /// `ready`: solvers already set up for the bodies (those of
+    /// [`distributed_solvers`]); otherwise they are set up here.
     pub fn new(
         bodies: &[&AssembledBody],
         candidates: Vec<Vec<usize>>,
@@ -99,21 +104,25 @@ impl BodyFactors {
         settings: &SolverSettings,
         kind: BodySolverKind,
         contact: &ContactSettings,
+        ready: Option<Vec<BodySolver>>,
     ) -> Result<Self, ContactError> {
         let method = contact.solver;
         let dim = bodies.first().map_or(3, |body| body.dim);
         let factor = |body: &&AssembledBody| match kind {
             BodySolverKind::CgAmg => {
-                BodySolver::cg_amg(&body.k_c, body.dim, &body.coordinates, settings.rtol)
-                    .map_err(|e| ContactError::Linalg(format!("CG + AMG of a body: {e}")))
+                BodySolver::cg_amg(assembled(body)?, body.dim, &body.coordinates, settings.rtol)
+                    .map_err(cg_amg_error)
             }
             _ => cholesky(body, settings.ordering),
         };
         // The set-ups are independent: side by side.
-        let solvers = bodies
-            .par_iter()
-            .map(factor)
-            .collect::<Result<Vec<_>, _>>()?;
+        let solvers = match ready {
+            Some(solvers) => solvers,
+            None => bodies
+                .par_iter()
+                .map(factor)
+                .collect::<Result<Vec<_>, _>>()?,
+        };
         let cg = kind == BodySolverKind::CgAmg;
         let krylov = cg || matches!(method, CoupledSolver::Krylov | CoupledSolver::Auto);
         let interface = if krylov {
@@ -154,6 +163,11 @@ impl BodyFactors {
     /// round-off on request: [`Self::solve`]).
     pub fn is_krylov(&self) -> bool {
         matches!(self.interface, Interface::Krylov { .. })
+    }
+
+    /// Each body's solver.
+    pub fn solvers(&self) -> &[BodySolver] {
+        &self.solvers
     }
 
     /// Each body's share of its unknowns among the MPI ranks (`BodySolver::rank_dofs`).
@@ -296,10 +310,38 @@ pub fn held_by_contacts_only(
 
 /// The Cholesky factor of a body's constrained stiffness.
 fn cholesky(body: &AssembledBody, ordering: Ordering) -> Result<BodySolver, ContactError> {
-    CholeskySymbolic::new(&body.graph, body.k_c.symbolic(), ordering)
-        .and_then(|symbolic| Cholesky::factorize(symbolic, &body.k_c))
+    let k_c = assembled(body)?;
+    CholeskySymbolic::new(&body.graph, k_c.symbolic(), ordering)
+        .and_then(|symbolic| Cholesky::factorize(symbolic, k_c))
         .map(BodySolver::Cholesky)
         .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))
+}
+
+fn cg_amg_error(e: LinalgError) -> ContactError {
+    ContactError::Linalg(format!("CG + AMG of a body: {e}"))
+}
+
+/// The bodies' CG + AMG solvers of a distributed run, which takes each body's `K_c`: every
+/// matrix is handed to PETSc (each rank its rows), then ours is released (`AssembledBody::k_c`
+/// becomes `None`: products go through the solver), then the multigrid hierarchies are built.
+/// So a rank never holds our whole `K_c` beside a hierarchy being set up: at 3M DOFs our copy
+/// is 2.2 GB on every rank, PETSc's is split among them.
+pub fn distributed_solvers(
+    bodies: &mut [AssembledBody],
+    settings: &SolverSettings,
+) -> Result<Vec<BodySolver>, ContactError> {
+    let mut pending = Vec::with_capacity(bodies.len());
+    for body in bodies.iter() {
+        let matrix =
+            BodySolver::cg_amg_matrix(assembled(body)?, body.dim, &body.coordinates, settings.rtol);
+        pending.push(matrix.map_err(cg_amg_error)?);
+    }
+    for body in bodies.iter_mut() {
+        body.k_c = None;
+    }
+    (pending.into_iter())
+        .map(|matrix| matrix.set_up().map_err(cg_amg_error))
+        .collect()
 }
 
 /// The coupled system solved by one sparse LU of its whole matrix.
@@ -339,7 +381,7 @@ fn solve_schur(
     extend_responses(system, solvers, responses)?;
     let schur = schur_complement(system, responses).lu();
     let mut x = eliminate(system, solvers, &schur, &system.f, &system.g)?;
-    let residual = system.residual(bodies, &x);
+    let residual = system.residual(bodies, Some(solvers), &x)?;
     let (r_u, r_l) = residual.split_at(system.num_displacements());
     let correction = eliminate(system, solvers, &schur, r_u, r_l)?;
     x.iter_mut().zip(&correction).for_each(|(x, dx)| *x += dx);
@@ -705,6 +747,7 @@ mod tests {
                 &settings,
                 BodySolverKind::Cholesky,
                 &contact,
+                None,
             )
             .unwrap();
             let x = factors

@@ -280,7 +280,7 @@ impl<'a> ContactSolver<'a> {
             _ => &pairs[p].secondary,
         };
         let mut stats = vec![SolveStats::default(); origin.len()];
-        let bodies = (origin.iter().zip(&mut stats))
+        let mut bodies = (origin.iter().zip(&mut stats))
             .map(|(&at, stats)| assemble(elastic(at), stats, false))
             .collect::<Result<Vec<_>, _>>()?;
         let dofs = bodies.iter().map(|b| b.f_c.len()).max().unwrap_or(0);
@@ -295,11 +295,20 @@ impl<'a> ContactSolver<'a> {
                 })
                 .collect()
         };
+        // A distributed run hands each body's matrix to PETSc and releases ours before the
+        // multigrid hierarchies are built (`coupled_solver::distributed_solvers`).
+        let start = Instant::now();
+        let ready = match settings.solver {
+            CoupledSolver::MonolithicLu => None,
+            _ if kind == BodySolverKind::CgAmg && crate::parallel::distributed() => {
+                Some(coupled_solver::distributed_solvers(&mut bodies, solver)?)
+            }
+            _ => None,
+        };
         let body_refs: Vec<&AssembledBody> = bodies.iter().collect();
         let factors = match settings.solver {
             CoupledSolver::MonolithicLu => None,
             _ => {
-                let start = Instant::now();
                 let candidates = (0..bodies.len())
                     .map(|k| read_nodes(&surfaces_of(k), &bodies[k]))
                     .collect();
@@ -307,8 +316,9 @@ impl<'a> ContactSolver<'a> {
                     .iter()
                     .map(|p| compliance_factor([&p.primary.material, &p.secondary.material], dim))
                     .collect();
-                let factors =
-                    BodyFactors::new(&body_refs, candidates, compliance, solver, kind, settings)?;
+                let factors = BodyFactors::new(
+                    &body_refs, candidates, compliance, solver, kind, settings, ready,
+                )?;
                 if solver.verbose {
                     let what = match kind {
                         BodySolverKind::CgAmg => "CG + AMG set-up",
@@ -1142,7 +1152,8 @@ impl ContactSolver<'_> {
         };
         let loose = tightness == Tightness::Loose
             && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
-        let residual = system.relative_residual(&bodies, &x);
+        let solvers = self.factors.as_ref().map(BodyFactors::solvers);
+        let residual = system.relative_residual(&bodies, solvers, &x)?;
         if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
             return Err(ContactError::Inaccurate {
                 residual,

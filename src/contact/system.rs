@@ -54,8 +54,10 @@ use faer::sparse::{SparseColMat, Triplet};
 
 use super::compliance::MultiplierKey;
 use super::{ContactError, Formulation};
+use rayon::prelude::*;
+
 use crate::elastic::AssembledBody;
-use crate::linalg::mat_vec;
+use crate::linalg::{BodySolver, mat_vec};
 
 /// The interface operators of one pair in one iteration, on its active primary nodes I (built
 /// by `super::interface::InterfaceOperators::coupling`).
@@ -266,10 +268,7 @@ impl CoupledSystem {
             rigid_offsets.push(rigid_offsets.last().unwrap() + body.rigid.len());
         }
         let m = *rigid_offsets.last().unwrap();
-        let k_scale = bodies
-            .iter()
-            .map(|b| diagonal_max(&b.k_c))
-            .fold(0.0, f64::max);
+        let k_scale = bodies.iter().map(|b| b.k_scale).fold(0.0, f64::max);
         let m_scale = (pairs.iter())
             .flat_map(|pair| pair.coupling.areas1.iter().copied())
             .fold(0.0, f64::max);
@@ -367,7 +366,7 @@ impl CoupledSystem {
         let n = self.num_displacements();
         let mut triplets = Vec::new();
         for (body, &offset) in bodies.iter().zip(&self.offsets) {
-            let (symbolic, values) = body.k_c.parts();
+            let (symbolic, values) = assembled(body)?.parts();
             let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
             for j in 0..symbolic.ncols() {
                 for p in col_ptr[j]..col_ptr[j + 1] {
@@ -392,12 +391,25 @@ impl CoupledSystem {
     }
 
     /// `[f; g] - A x` for the whole matrix `A` of [`Self::matrix`], applied block by block
-    /// without assembling it.
-    pub fn residual(&self, bodies: &[&AssembledBody], x: &[f64]) -> Vec<f64> {
+    /// without assembling it (`solvers`: the bodies' solvers, for the products of a body whose
+    /// `K_c` a distributed solver holds).
+    pub fn residual(
+        &self,
+        bodies: &[&AssembledBody],
+        solvers: Option<&[BodySolver]>,
+        x: &[f64],
+    ) -> Result<Vec<f64>, ContactError> {
         let n = self.num_displacements();
-        let mut ax = Vec::with_capacity(n + self.m);
+        let mut ax = vec![0.0; n];
         for (k, body) in bodies.iter().enumerate() {
-            ax.extend(mat_vec(&body.k_c, &x[self.body_dofs(k)]));
+            let range = self.body_dofs(k);
+            match (&body.k_c, solvers) {
+                (Some(k_c), _) => ax[range.clone()].copy_from_slice(&mat_vec(k_c, &x[range])),
+                (None, Some(solvers)) => {
+                    stiffness_product(body, Some(&solvers[k]), &x[range.clone()], &mut ax[range])?
+                }
+                (None, None) => return Err(released()),
+            }
         }
         ax.extend(self.d.iter().zip(&x[n..]).map(|(d, l)| d * l));
         for &(k, l, value) in &self.d_coupled {
@@ -410,15 +422,20 @@ impl CoupledSystem {
             ax[n + k] += value * x[col];
         }
         let rhs = self.rhs();
-        rhs.iter().zip(&ax).map(|(b, a)| b - a).collect()
+        Ok(rhs.iter().zip(&ax).map(|(b, a)| b - a).collect())
     }
 
     /// `||A x - [f; g]|| / ||[f; g]||` ([`Self::residual`]).
-    pub fn relative_residual(&self, bodies: &[&AssembledBody], x: &[f64]) -> f64 {
+    pub fn relative_residual(
+        &self,
+        bodies: &[&AssembledBody],
+        solvers: Option<&[BodySolver]>,
+        x: &[f64],
+    ) -> Result<f64, ContactError> {
         let norm = |v: &[f64]| v.iter().map(|e| e * e).sum::<f64>().sqrt();
-        let r = norm(&self.residual(bodies, x));
+        let r = norm(&self.residual(bodies, solvers, x)?);
         let nb = norm(&self.rhs());
-        if nb > 0.0 { r / nb } else { r }
+        Ok(if nb > 0.0 { r / nb } else { r })
     }
 
     /// `[f; g]`.
@@ -709,11 +726,48 @@ impl PairBlocks {
     }
 }
 
-fn diagonal_max(k: &SparseColMat<usize, f64>) -> f64 {
+/// `out = K_c x` for one body: by its assembled `K_c`, or where a distributed solver holds it
+/// instead (`AssembledBody::k_c`), by that solver.
+pub fn stiffness_product(
+    body: &AssembledBody,
+    solver: Option<&BodySolver>,
+    x: &[f64],
+    out: &mut [f64],
+) -> Result<(), ContactError> {
+    match (&body.k_c, solver) {
+        (Some(k_c), _) => {
+            symmetric_product(k_c, x, out);
+            Ok(())
+        }
+        (None, Some(solver)) => solver
+            .multiply(x, out)
+            .map_err(|e| ContactError::Linalg(format!("a body's stiffness product: {e}"))),
+        (None, None) => Err(released()),
+    }
+}
+
+/// A body's assembled `K_c`, for what only it can do (a factor, an assembled matrix).
+pub fn assembled(body: &AssembledBody) -> Result<&SparseColMat<usize, f64>, ContactError> {
+    body.k_c.as_ref().ok_or_else(released)
+}
+
+fn released() -> ContactError {
+    ContactError::Linalg(
+        "a body's stiffness was released to its distributed solver, and this step needs it \
+         assembled"
+            .to_string(),
+    )
+}
+
+/// `out = K x` for a symmetric `K` stored by compressed columns: entry `j` is column `j` dotted
+/// with `x`, so the rows are independent and computed in parallel, each in a fixed order (the
+/// same result for any number of threads).
+pub fn symmetric_product(k: &SparseColMat<usize, f64>, x: &[f64], out: &mut [f64]) {
     let (symbolic, values) = k.parts();
     let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-    (0..symbolic.ncols())
-        .flat_map(|j| (col_ptr[j]..col_ptr[j + 1]).filter(move |&p| row_idx[p] == j))
-        .map(|p| values[p].abs())
-        .fold(0.0, f64::max)
+    out.par_iter_mut().enumerate().for_each(|(j, o)| {
+        *o = (col_ptr[j]..col_ptr[j + 1])
+            .map(|p| values[p] * x[row_idx[p]])
+            .sum();
+    });
 }

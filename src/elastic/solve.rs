@@ -240,7 +240,11 @@ pub struct AssembledBody {
     pub prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
     pub f: Vec<f64>,
     pub constraints: Constraints,
-    pub k_c: SparseColMat<usize, f64>,
+    /// The constrained stiffness `K_c`; `None` once released to a distributed solver (a contact
+    /// solve on several MPI ranks: PETSc holds each rank's rows, and products go through it).
+    pub k_c: Option<SparseColMat<usize, f64>>,
+    /// The largest diagonal entry of `K_c` (the contact system's scale).
+    pub k_scale: f64,
     pub f_c: Vec<f64>,
     /// The force-controlled components of the body, in the order of
     /// [`forced_components`]: their dofs are held at 0 in `k_c` and move by unknowns of the
@@ -399,10 +403,21 @@ pub fn assemble(
         prescribed_rows,
         f,
         constraints,
-        k_c,
+        k_scale: largest_diagonal(&k_c),
+        k_c: Some(k_c),
         f_c,
         rigid,
     })
+}
+
+/// The largest absolute diagonal entry of `k`.
+fn largest_diagonal(k: &SparseColMat<usize, f64>) -> f64 {
+    let (symbolic, values) = k.parts();
+    let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+    (0..symbolic.ncols())
+        .flat_map(|j| (col_ptr[j]..col_ptr[j + 1]).filter(move |&p| row_idx[p] == j))
+        .map(|p| values[p].abs())
+        .fold(0.0, f64::max)
 }
 
 /// Reaction of each Dirichlet and force-controlled group: `sum (K u - s f - f_other)` over its
@@ -537,7 +552,13 @@ pub fn solve(
     };
     let mut stats = SolveStats::default();
     let system = assemble(problem, &mut stats, verbose)?;
-    let (graph, k_c, f_c) = (&system.graph, &system.k_c, &system.f_c);
+    let (graph, f_c) = (&system.graph, &system.f_c);
+    // A body solved alone keeps its `K_c` (only a distributed contact solve releases it).
+    let k_c = system.k_c.as_ref().ok_or_else(|| {
+        linalg(LinalgError::Sizes(
+            "the stiffness was released to a distributed solver".into(),
+        ))
+    })?;
 
     // 4. The body solver: Cholesky (symbolic, then numeric) or CG + AMG (matrix and multigrid
     //    hierarchy). Both take K_c as it is: Dirichlet rows and columns zeroed with K_dd kept on

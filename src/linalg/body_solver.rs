@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use super::{Cholesky, LinalgError};
 
 #[cfg(feature = "petsc")]
-use super::petsc::{CgAmg, Communicator};
+use super::petsc::{CgAmg, CgAmgMatrix, Communicator};
 
 /// The body solver a case asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -135,6 +135,39 @@ impl BodySolver {
         }
     }
 
+    /// [`Self::cg_amg`] in two steps: PETSc's copy of `matrix` now, its multigrid hierarchy
+    /// by [`PendingCgAmg::set_up`], so that the caller can free `matrix` in between.
+    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
+    pub fn cg_amg_matrix(
+        matrix: &SparseColMat<usize, f64>,
+        dim: usize,
+        coords: &[f64],
+        rtol: f64,
+    ) -> Result<PendingCgAmg, LinalgError> {
+        #[cfg(feature = "petsc")]
+        {
+            CgAmgMatrix::new(Communicator::of_run()?, matrix, dim, coords, rtol)
+                .map(|matrix| PendingCgAmg { matrix })
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            Err(LinalgError::PetscUnavailable)
+        }
+    }
+
+    /// `y = K x` by the solver's own copy of the matrix: CG + AMG's (on several ranks, each
+    /// computes its rows). A factor keeps no matrix: [`LinalgError::Sizes`].
+    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
+    pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
+        match self {
+            Self::Cholesky(_) => Err(LinalgError::Sizes(
+                "a product by a Cholesky factor, which keeps no matrix".to_string(),
+            )),
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.multiply(x, y),
+        }
+    }
+
     pub fn kind(&self) -> BodySolverKind {
         match self {
             Self::Cholesky(_) => BodySolverKind::Cholesky,
@@ -199,6 +232,27 @@ impl BodySolver {
             }
             #[cfg(feature = "petsc")]
             Self::CgAmg(cg) => cg.precondition(r, x),
+        }
+    }
+}
+
+/// A CG + AMG solver whose matrix PETSc holds, its multigrid hierarchy not yet built
+/// ([`BodySolver::cg_amg_matrix`]).
+pub struct PendingCgAmg {
+    #[cfg(feature = "petsc")]
+    matrix: CgAmgMatrix,
+}
+
+impl PendingCgAmg {
+    /// Builds the hierarchy: the body's solver.
+    pub fn set_up(self) -> Result<BodySolver, LinalgError> {
+        #[cfg(feature = "petsc")]
+        {
+            self.matrix.set_up().map(BodySolver::CgAmg)
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            Err(LinalgError::PetscUnavailable)
         }
     }
 }

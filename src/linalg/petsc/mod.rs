@@ -135,6 +135,13 @@ unsafe extern "C" {
         x: *mut f64,
         step: *mut *const c_char,
     ) -> c_int;
+    fn internodes_cgamg_set_up(solver: *mut RawCgAmg, step: *mut *const c_char) -> c_int;
+    fn internodes_cgamg_multiply(
+        solver: *mut RawCgAmg,
+        x: *const f64,
+        y: *mut f64,
+        step: *mut *const c_char,
+    ) -> c_int;
     fn internodes_cgamg_destroy(solver: *mut RawCgAmg);
 }
 
@@ -374,12 +381,56 @@ unsafe impl Sync for CgAmg {}
 /// not converging.
 const MAX_ITERATIONS: i64 = 2000;
 
+/// PETSc's copy of a body's matrix with its CG + GAMG solver, before the GAMG hierarchy is
+/// built ([`CgAmgMatrix::set_up`]): the caller may free its own copy of the matrix in between,
+/// so that the two and the hierarchy's set-up never peak together.
+pub struct CgAmgMatrix(CgAmg);
+
+impl CgAmgMatrix {
+    /// PETSc's copy of `matrix` (symmetric positive definite; its compressed columns are read
+    /// as compressed rows; on several ranks, this rank's rows) with `dim` dofs per node,
+    /// interleaved, the nodes at `coords` (`dim` per node), on `comm`. Solves will stop at the
+    /// relative residual `rtol`.
+    pub fn new(
+        comm: Communicator,
+        matrix: &SparseColMat<usize, f64>,
+        dim: usize,
+        coords: &[f64],
+        rtol: f64,
+    ) -> Result<Self, LinalgError> {
+        CgAmg::build(comm, matrix, dim, coords, rtol).map(Self)
+    }
+
+    /// Builds the GAMG hierarchy: the solver is ready.
+    pub fn set_up(self) -> Result<CgAmg, LinalgError> {
+        let _lock = petsc()?;
+        let mut step = std::ptr::null();
+        // SAFETY: `raw` is alive and built; the lock is held.
+        let code = unsafe { internodes_cgamg_set_up(self.0.raw.as_ptr(), &mut step) };
+        match code {
+            0 => Ok(self.0),
+            _ => Err(petsc_error(step, code)),
+        }
+    }
+}
+
 impl CgAmg {
     /// Builds the operator `matrix` (symmetric positive definite; its compressed columns are
     /// read as compressed rows) with `dim` dofs per node, interleaved, the nodes at `coords`
     /// (`dim` per node), and its GAMG hierarchy, on `comm`. Solves stop at the relative
     /// residual `rtol`.
     pub fn new(
+        comm: Communicator,
+        matrix: &SparseColMat<usize, f64>,
+        dim: usize,
+        coords: &[f64],
+        rtol: f64,
+    ) -> Result<Self, LinalgError> {
+        CgAmgMatrix::new(comm, matrix, dim, coords, rtol)?.set_up()
+    }
+
+    /// [`CgAmgMatrix::new`]'s PETSc objects, without the hierarchy.
+    fn build(
         comm: Communicator,
         matrix: &SparseColMat<usize, f64>,
         dim: usize,
@@ -565,6 +616,39 @@ impl CgAmg {
 }
 
 impl CgAmg {
+    /// `y = K x` by PETSc's copy of the matrix (on several ranks each computes its rows, and
+    /// every rank receives all of `y`).
+    pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
+        if x.len() != self.n || y.len() != self.n {
+            return Err(LinalgError::Sizes(format!(
+                "a product of {} values into {} for {} unknowns",
+                x.len(),
+                y.len(),
+                self.n
+            )));
+        }
+        let local_x = self.local_part(x);
+        let mut local_y = self.local_buffer();
+        let mut step = std::ptr::null();
+        let code = {
+            let _lock = petsc()?;
+            // SAFETY: `local_x` and `local_y` hold this rank's rows, `raw` is alive, the lock
+            // is held.
+            unsafe {
+                internodes_cgamg_multiply(
+                    self.raw.as_ptr(),
+                    local_x.as_ptr(),
+                    local_y.as_mut_ptr(),
+                    &mut step,
+                )
+            }
+        };
+        match code {
+            0 => self.assemble_whole(local_y, y),
+            _ => Err(petsc_error(step, code)),
+        }
+    }
+
     /// `x = P^-1 rhs` for GAMG's preconditioner `P` alone: one V-cycle (the smoothers are
     /// Chebyshev polynomials with eigenvalue bounds estimated once at set-up, so the map is the
     /// same linear one at every call).

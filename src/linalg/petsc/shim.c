@@ -225,8 +225,17 @@ static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, co
     /* GAMG's defaults are only complete after SetFromOptions (without it its setup was 5x
      * slower in validation/benchmark.py); it also lets PETSC_OPTIONS add e.g. -ksp_view. */
     TRY(KSPSetFromOptions(s->ksp));
-    TRY(KSPSetUp(s->ksp));
     TRY(MatCreateVecs(s->a, &s->x, &s->b));
+    return 0;
+}
+
+/* The GAMG hierarchy of a built object (internodes_cgamg_create): a separate step, so that the
+ * caller can free its own copy of the matrix first. */
+int internodes_cgamg_set_up(InternodesCgAmg *s, const char **step)
+{
+    PC pc;
+    TRY(KSPSetUp(s->ksp));
+    TRY(KSPGetPC(s->ksp, &pc));
     /* One V-cycle now, while the caller holds PETSc exclusively: PETSc finishes the set-up on
      * the first application (the coarse level's block Jacobi factors its LU in
      * PCSetUpOnBlocks, through PCSetUp, MatGetFactor and MatGetOrdering, which touch
@@ -234,6 +243,21 @@ static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, co
      * object's memory, which internodes_cgamg_precondition relies on (see mod.rs). */
     TRY(VecSet(s->b, 1.0));
     TRY(PCApply(pc, s->b, s->x));
+    return 0;
+}
+
+/* y = A x, this rank's rows of x in and of y out. */
+int internodes_cgamg_multiply(InternodesCgAmg *s, const double *x, double *y, const char **step)
+{
+    PetscScalar *data;
+
+    TRY(VecGetArray(s->b, &data));
+    memcpy(data, x, (size_t)s->n * sizeof(double));
+    TRY(VecRestoreArray(s->b, &data));
+    TRY(MatMult(s->a, s->b, s->x));
+    TRY(VecGetArray(s->x, &data));
+    memcpy(y, data, (size_t)s->n * sizeof(double));
+    TRY(VecRestoreArray(s->x, &data));
     return 0;
 }
 
@@ -248,8 +272,9 @@ void internodes_cgamg_destroy(InternodesCgAmg *s)
 }
 
 /* Builds the operator (n x n CSR, symmetric positive definite, `block` dofs per node,
- * interleaved) and its GAMG hierarchy on the communicator `fcomm`; `coords` holds the node
- * coordinates, `block` per node (n values). */
+ * interleaved: this rank's n rows) and its CG + GAMG solver on the communicator `fcomm`;
+ * `coords` holds the node coordinates, `block` per node (n values). The GAMG hierarchy is built
+ * by internodes_cgamg_set_up, which must follow before any solve or application. */
 int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int64_t *row_ptr,
                             const int64_t *col_idx, const double *values, const double *coords,
                             double rtol, int64_t max_it, InternodesCgAmg **out, const char **step)
