@@ -108,21 +108,13 @@ impl BodySolver {
     /// CG + AMG on `matrix` (symmetric positive definite, `dim` dofs per node, interleaved,
     /// nodes at `coords`, `dim` values each), solving to the relative residual `rtol`. Without
     /// the feature `petsc`: [`LinalgError::PetscUnavailable`].
-    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
     pub fn cg_amg(
         matrix: &SparseColMat<usize, f64>,
         dim: usize,
         coords: &[f64],
         rtol: f64,
     ) -> Result<Self, LinalgError> {
-        #[cfg(feature = "petsc")]
-        {
-            CgAmg::new(Communicator::of_run()?, matrix, dim, coords, rtol).map(Self::CgAmg)
-        }
-        #[cfg(not(feature = "petsc"))]
-        {
-            Err(LinalgError::PetscUnavailable)
-        }
+        Self::cg_amg_matrix(matrix, dim, coords, rtol)?.set_up()
     }
 
     /// Each rank's number of the body's unknowns, in rank order (`[n]` on one process; a

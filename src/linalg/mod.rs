@@ -10,7 +10,9 @@ mod ordering;
 #[cfg(feature = "petsc")]
 pub mod petsc;
 
-pub use body_solver::{AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE};
+pub use body_solver::{
+    AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE, PendingCgAmg,
+};
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
 
 use faer::sparse::SparseColMat;

@@ -7,9 +7,9 @@
 //! The C side (`shim.c`, built by `build.rs` with the cargo feature `petsc`) builds the AIJ
 //! matrix from our compressed arrays with block size `dim`, the rigid-body modes of the nodes
 //! as GAMG's near-null space (`MatNullSpaceCreateRigidBody` on the nodal coordinates: the
-//! modes of `crate::fem::rigid_modes`), and the KSP; [`CgAmg::new`] does this once (the
-//! GAMG hierarchy included), and [`CgAmg::solve`] can then be called for any number of
-//! right-hand sides.
+//! modes of `crate::fem::rigid_modes`), and the KSP; [`CgAmgMatrix::new`] does this once, then
+//! [`CgAmgMatrix::set_up`] builds the GAMG hierarchy, and [`CgAmg::solve`] can be called for
+//! any number of right-hand sides.
 //!
 //! # PETSc in a Rust process
 //!
@@ -17,12 +17,13 @@
 //!   with `PetscReturnErrorHandler`: a PETSc error is a return code, turned into
 //!   [`LinalgError::Petsc`], never a message and an abort. (MPI's initialization, inside
 //!   PETSc's, lets Open MPI put a backtrace printer on SIGSEGV, SIGBUS and SIGFPE where no
-//!   handler was set; it re-raises the signal.) PETSc is never finalized (the process ends
-//!   instead; PETSc's objects are destroyed with their Rust owners).
+//!   handler was set; it re-raises the signal.) PETSc is finalized only at the end of a
+//!   process an MPI launcher started ([`finalize`], from `crate::parallel::finish`); otherwise
+//!   the process ends instead. PETSc's objects are destroyed with their Rust owners.
 //! - PETSc is not thread-safe (Debian's 3.18 is built without `PETSC_HAVE_THREADSAFETY`), and
 //!   `cargo test` and rayon call from several threads. One global `RwLock` orders the calls:
-//!   initialization, [`CgAmg::new`] (set-up), [`CgAmg::solve_within`] (CG) and destruction
-//!   hold it exclusively; [`CgAmg::precondition`] (one V-cycle, `PCApply`) holds it shared,
+//!   initialization, [`CgAmgMatrix::new`] and [`CgAmgMatrix::set_up`] (set-up),
+//!   [`CgAmg::solve_within`] (CG), [`CgAmg::multiply`] and destruction hold it exclusively; [`CgAmg::precondition`] (one V-cycle, `PCApply`) holds it shared,
 //!   plus a mutex of its object, so that the V-cycles of two bodies in a coupled Krylov
 //!   solve (`rayon::join`) run at the same time, while one object is never applied from two
 //!   threads at once and nothing else runs beside an application.
@@ -56,7 +57,7 @@
 //!   `PETSC_COMM_SELF`.
 //! - Objects are created on a communicator given by the caller: [`Communicator::solo`], or
 //!   in a distributed run ([`crate::parallel`]) [`Communicator::world`], every rank. Then a
-//!   [`Distribution`] shares the body's rows among the ranks, each rank hands PETSc only its
+//!   `Distribution` shares the body's rows among the ranks, each rank hands PETSc only its
 //!   own rows, and a solve or a V-cycle takes and returns whole vectors in our numbering (each
 //!   rank passes its rows in, and receives every rank's rows of the result). Every call on
 //!   such an object is collective: a distributed run has one thread per rank, so every rank
@@ -415,20 +416,6 @@ impl CgAmgMatrix {
 }
 
 impl CgAmg {
-    /// Builds the operator `matrix` (symmetric positive definite; its compressed columns are
-    /// read as compressed rows) with `dim` dofs per node, interleaved, the nodes at `coords`
-    /// (`dim` per node), and its GAMG hierarchy, on `comm`. Solves stop at the relative
-    /// residual `rtol`.
-    pub fn new(
-        comm: Communicator,
-        matrix: &SparseColMat<usize, f64>,
-        dim: usize,
-        coords: &[f64],
-        rtol: f64,
-    ) -> Result<Self, LinalgError> {
-        CgAmgMatrix::new(comm, matrix, dim, coords, rtol)?.set_up()
-    }
-
     /// [`CgAmgMatrix::new`]'s PETSc objects, without the hierarchy.
     fn build(
         comm: Communicator,
@@ -619,34 +606,11 @@ impl CgAmg {
     /// `y = K x` by PETSc's copy of the matrix (on several ranks each computes its rows, and
     /// every rank receives all of `y`).
     pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
-        if x.len() != self.n || y.len() != self.n {
-            return Err(LinalgError::Sizes(format!(
-                "a product of {} values into {} for {} unknowns",
-                x.len(),
-                y.len(),
-                self.n
-            )));
-        }
-        let local_x = self.local_part(x);
-        let mut local_y = self.local_buffer();
-        let mut step = std::ptr::null();
-        let code = {
+        self.on_rows("a product", x, y, |x, y, step| {
             let _lock = petsc()?;
-            // SAFETY: `local_x` and `local_y` hold this rank's rows, `raw` is alive, the lock
-            // is held.
-            unsafe {
-                internodes_cgamg_multiply(
-                    self.raw.as_ptr(),
-                    local_x.as_ptr(),
-                    local_y.as_mut_ptr(),
-                    &mut step,
-                )
-            }
-        };
-        match code {
-            0 => self.assemble_whole(local_y, y),
-            _ => Err(petsc_error(step, code)),
-        }
+            // SAFETY: `x` and `y` hold this rank's rows, `raw` is alive, the lock is held.
+            Ok(unsafe { internodes_cgamg_multiply(self.raw.as_ptr(), x, y, step) })
+        })
     }
 
     /// `x = P^-1 rhs` for GAMG's preconditioner `P` alone: one V-cycle (the smoothers are
@@ -657,18 +621,7 @@ impl CgAmg {
     /// (unless PETSc's options database holds options of its own: see the module's doc); those
     /// of one object take turns.
     pub fn precondition(&self, rhs: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
-        if rhs.len() != self.n || x.len() != self.n {
-            return Err(LinalgError::Sizes(format!(
-                "a V-cycle on {} values into {} for {} unknowns",
-                rhs.len(),
-                x.len(),
-                self.n
-            )));
-        }
-        let local_rhs = self.local_part(rhs);
-        let mut local_x = self.local_buffer();
-        let mut step = std::ptr::null();
-        let code = {
+        self.on_rows("a V-cycle", rhs, x, |rhs, x, step| {
             // PETSc is initialized (`self` exists). `applying` is taken under the shared lock,
             // never the other way round, and released first (reverse order of declaration).
             // A distributed V-cycle is collective: never beside another call.
@@ -677,21 +630,36 @@ impl CgAmg {
             let _shared = concurrent.then(|| PETSC.read().unwrap_or_else(PoisonError::into_inner));
             let _own =
                 concurrent.then(|| self.applying.lock().unwrap_or_else(PoisonError::into_inner));
-            // SAFETY: `local_rhs` and `local_x` hold this rank's rows, `raw` is alive, and
-            // either PETSc is held exclusively or it is held shared with this object's mutex
-            // (see `impl Sync`).
-            unsafe {
-                internodes_cgamg_precondition(
-                    self.raw.as_ptr(),
-                    local_rhs.as_ptr(),
-                    local_x.as_mut_ptr(),
-                    &mut step,
-                )
-            }
-        };
-        match code {
-            0 => self.assemble_whole(local_x, x),
-            _ => Err(petsc_error(step, code)),
+            // SAFETY: `rhs` and `x` hold this rank's rows, `raw` is alive, and either PETSc is
+            // held exclusively or it is held shared with this object's mutex (see `impl Sync`).
+            Ok(unsafe { internodes_cgamg_precondition(self.raw.as_ptr(), rhs, x, step) })
+        })
+    }
+
+    /// A linear map of the shim (`call`: this rank's rows of `input` in, of the result out; it
+    /// returns the shim's code and sets `step` on error) applied to whole vectors in our
+    /// numbering: every rank receives every rank's rows of `output`.
+    fn on_rows(
+        &self,
+        what: &str,
+        input: &[f64],
+        output: &mut [f64],
+        call: impl FnOnce(*const f64, *mut f64, &mut *const c_char) -> Result<c_int, LinalgError>,
+    ) -> Result<(), LinalgError> {
+        if input.len() != self.n || output.len() != self.n {
+            return Err(LinalgError::Sizes(format!(
+                "{what} on {} values into {} for {} unknowns",
+                input.len(),
+                output.len(),
+                self.n
+            )));
+        }
+        let local_input = self.local_part(input);
+        let mut local_output = self.local_buffer();
+        let mut step = std::ptr::null();
+        match call(local_input.as_ptr(), local_output.as_mut_ptr(), &mut step)? {
+            0 => self.assemble_whole(local_output, output),
+            code => Err(petsc_error(step, code)),
         }
     }
 }
