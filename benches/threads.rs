@@ -82,11 +82,11 @@ fn main() {
             let system = assemble(&problem, &mut SolveStats::default(), false).unwrap();
             let symbolic = CholeskySymbolic::new(
                 &system.graph,
-                system.k_c.as_ref().unwrap().symbolic(),
+                system.stiffness.whole().unwrap().symbolic(),
                 case.solver.ordering,
             )
             .unwrap();
-            let factor = Cholesky::factorize(symbolic, system.k_c.as_ref().unwrap()).unwrap();
+            let factor = Cholesky::factorize(symbolic, system.stiffness.whole().unwrap()).unwrap();
             (body, problem, system, factor)
         })
         .collect();
@@ -108,11 +108,11 @@ fn main() {
                     let (seconds, _) = timed(|| {
                         let symbolic = CholeskySymbolic::new(
                             &system.graph,
-                            system.k_c.as_ref().unwrap().symbolic(),
+                            system.stiffness.whole().unwrap().symbolic(),
                             case.solver.ordering,
                         )
                         .unwrap();
-                        Cholesky::factorize(symbolic, system.k_c.as_ref().unwrap()).unwrap()
+                        Cholesky::factorize(symbolic, system.stiffness.whole().unwrap()).unwrap()
                     });
                     record(name("Cholesky (ordering + numeric)"), threads, seconds);
 

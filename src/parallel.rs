@@ -118,16 +118,22 @@ pub fn share_from_root(bytes: Vec<u8>) -> Result<Vec<u8>, ParallelError> {
 
 /// Every rank's `value`, in rank order, on every rank. Serial: `[value]`.
 pub fn gather(value: f64) -> Result<Vec<f64>, ParallelError> {
-    if !distributed() {
-        return Ok(vec![value]);
+    all_gather(&[value], &vec![1; ranks().size])
+}
+
+/// Every rank's `local` values (`counts[r]` of them from rank r, in rank order) on every
+/// rank (`MPI_Allgatherv`). With one count: `local` itself.
+pub fn all_gather(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelError> {
+    if counts.len() <= 1 {
+        return Ok(local.to_vec());
     }
     #[cfg(feature = "petsc")]
     {
-        crate::linalg::petsc::gather_values(&[value], &vec![1; ranks().size])
+        crate::linalg::petsc::gather_values(local, counts)
             .map_err(|e| ParallelError::Mpi(e.to_string()))
     }
     #[cfg(not(feature = "petsc"))]
-    unreachable!("a run without PETSc is never distributed (`start`)")
+    Err(ParallelError::NoPetsc(counts.len()))
 }
 
 /// Ends the run: on several ranks, every rank with `code` (`MPI_Abort`), since the others may

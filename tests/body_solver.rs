@@ -282,7 +282,7 @@ mod with_petsc {
         let mut stats = Default::default();
         let system = assemble(&problem, &mut stats, false).unwrap();
         let solver = BodySolver::cg_amg(
-            system.k_c.as_ref().unwrap(),
+            system.stiffness.whole().unwrap(),
             system.dim,
             &system.coordinates,
             1e-10,
@@ -304,14 +304,18 @@ mod with_petsc {
         let doubled: Vec<f64> = reference.displacement.iter().map(|v| 2.0 * v).collect();
         assert!(relative_difference(x(1), &doubled) < 1e-8);
         assert!(
-            relative_residual(system.k_c.as_ref().unwrap(), x(2), &columns[2 * n..3 * n]) <= 1e-10
+            relative_residual(
+                system.stiffness.whole().unwrap(),
+                x(2),
+                &columns[2 * n..3 * n]
+            ) <= 1e-10
         );
         assert!(x(3).iter().all(|&v| v == 0.0));
         // And again, the same answer from the same setup.
         let mut again = system.f_c.clone();
         solver.solve_in_place(&mut again, 1).unwrap();
         assert!(relative_difference(&again, x(0)) < 1e-12);
-        let residual = mat_vec(system.k_c.as_ref().unwrap(), &again);
+        let residual = mat_vec(system.stiffness.whole().unwrap(), &again);
         assert!(relative_difference(&residual, &system.f_c) < 1e-8);
     }
 
@@ -322,7 +326,7 @@ mod with_petsc {
         let mut stats = Default::default();
         let system = assemble(&problem, &mut stats, false).unwrap();
         // K_c - sigma I, sigma the mean diagonal entry: inside K_c's spectrum.
-        let (symbolic, values) = system.k_c.as_ref().unwrap().parts();
+        let (symbolic, values) = system.stiffness.whole().unwrap().parts();
         let n = symbolic.ncols();
         let mut shifted = values.to_vec();
         let diagonal: Vec<usize> = (0..n)
@@ -395,7 +399,7 @@ mod with_petsc {
         let system = assemble(&problem, &mut stats, false).unwrap();
         let short = &system.coordinates[1..];
         assert!(matches!(
-            BodySolver::cg_amg(system.k_c.as_ref().unwrap(), system.dim, short, 1e-10),
+            BodySolver::cg_amg(system.stiffness.whole().unwrap(), system.dim, short, 1e-10),
             Err(LinalgError::Sizes(_))
         ));
     }

@@ -147,11 +147,11 @@ fn cholesky_solves_are_identical_for_any_thread_count() {
         with_threads(threads, || {
             let symbolic = CholeskySymbolic::new(
                 &system.graph,
-                system.k_c.as_ref().unwrap().symbolic(),
+                system.stiffness.whole().unwrap().symbolic(),
                 Ordering::NestedDissection,
             )
             .unwrap();
-            let factor = Cholesky::factorize(symbolic, system.k_c.as_ref().unwrap()).unwrap();
+            let factor = Cholesky::factorize(symbolic, system.stiffness.whole().unwrap()).unwrap();
             let mut one = system.f_c.clone();
             factor.solve_in_place(&mut one, 1);
             let mut many = rhs.clone();
@@ -271,7 +271,7 @@ mod v_cycles {
         let mut stats = SolveStats::default();
         let system = assemble(&problem, &mut stats, false).expect("assembly");
         BodySolver::cg_amg(
-            system.k_c.as_ref().unwrap(),
+            system.stiffness.whole().unwrap(),
             system.dim,
             &system.coordinates,
             1e-10,

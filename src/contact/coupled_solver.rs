@@ -321,23 +321,20 @@ fn cg_amg_error(e: LinalgError) -> ContactError {
     ContactError::Linalg(format!("CG + AMG of a body: {e}"))
 }
 
-/// The bodies' CG + AMG solvers of a distributed run, which takes each body's `K_c`: every
-/// matrix is handed to PETSc (each rank its rows), then ours is released (`AssembledBody::k_c`
-/// becomes `None`: products go through the solver), then the multigrid hierarchies are built.
-/// So a rank never holds our whole `K_c` beside a hierarchy being set up: at 3M DOFs our copy
-/// is 2.2 GB on every rank, PETSc's is split among them.
+/// The bodies' CG + AMG solvers of a distributed run, from each rank's rows of each body's
+/// `K_c` (`AssembledBody::stiffness` is left `Released`: products go through the solver): every
+/// body's rows go to PETSc and are freed, then the multigrid hierarchies are built, so that a
+/// rank never holds its rows beside a hierarchy being set up.
 pub fn distributed_solvers(
     bodies: &mut [AssembledBody],
     settings: &SolverSettings,
 ) -> Result<Vec<BodySolver>, ContactError> {
     let mut pending = Vec::with_capacity(bodies.len());
-    for body in bodies.iter() {
-        let matrix =
-            BodySolver::cg_amg_matrix(assembled(body)?, body.dim, &body.coordinates, settings.rtol);
-        pending.push(matrix.map_err(cg_amg_error)?);
-    }
     for body in bodies.iter_mut() {
-        body.k_c = None;
+        let rows = body.stiffness.take_rows().ok_or_else(|| {
+            ContactError::Linalg("a distributed solver for a body assembled whole".to_string())
+        })?;
+        pending.push(BodySolver::cg_amg_rows(rows, settings.rtol).map_err(cg_amg_error)?);
     }
     (pending.into_iter())
         .map(|matrix| matrix.set_up().map_err(cg_amg_error))

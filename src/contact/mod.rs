@@ -69,7 +69,7 @@ pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;
 
-use crate::elastic::ProblemError;
+use crate::elastic::{ProblemError, SolveError};
 
 /// Why a contact solve could not be carried out (how the active-set loop ended is a
 /// [`ContactStatus`], not an error).
@@ -147,4 +147,15 @@ pub enum ContactError {
     /// The solve's [`crate::cancel::Cancel`] token was cancelled.
     #[error(transparent)]
     Cancelled(#[from] crate::cancel::Cancelled),
+}
+
+/// A body's assembly failing inside a contact solve: a problem error as it is, anything else
+/// (a partition or an MPI call of a distributed run) as a linear-algebra failure.
+impl From<SolveError> for ContactError {
+    fn from(e: SolveError) -> Self {
+        match e {
+            SolveError::Problem(problem) => Self::Problem(problem),
+            other => Self::Linalg(other.to_string()),
+        }
+    }
 }

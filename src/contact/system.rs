@@ -403,7 +403,7 @@ impl CoupledSystem {
         let mut ax = vec![0.0; n];
         for (k, body) in bodies.iter().enumerate() {
             let range = self.body_dofs(k);
-            match (&body.k_c, solvers) {
+            match (body.stiffness.whole(), solvers) {
                 (Some(k_c), _) => ax[range.clone()].copy_from_slice(&mat_vec(k_c, &x[range])),
                 (None, Some(solvers)) => {
                     stiffness_product(body, Some(&solvers[k]), &x[range.clone()], &mut ax[range])?
@@ -727,14 +727,14 @@ impl PairBlocks {
 }
 
 /// `out = K_c x` for one body: by its assembled `K_c`, or where a distributed solver holds it
-/// instead (`AssembledBody::k_c`), by that solver.
+/// instead (`AssembledBody::stiffness`), by that solver.
 pub fn stiffness_product(
     body: &AssembledBody,
     solver: Option<&BodySolver>,
     x: &[f64],
     out: &mut [f64],
 ) -> Result<(), ContactError> {
-    match (&body.k_c, solver) {
+    match (body.stiffness.whole(), solver) {
         (Some(k_c), _) => {
             symmetric_product(k_c, x, out);
             Ok(())
@@ -748,13 +748,13 @@ pub fn stiffness_product(
 
 /// A body's assembled `K_c`, for what only it can do (a factor, an assembled matrix).
 pub fn assembled(body: &AssembledBody) -> Result<&SparseColMat<usize, f64>, ContactError> {
-    body.k_c.as_ref().ok_or_else(released)
+    body.stiffness.whole().ok_or_else(released)
 }
 
 fn released() -> ContactError {
     ContactError::Linalg(
-        "a body's stiffness was released to its distributed solver, and this step needs it \
-         assembled"
+        "a body's stiffness is distributed among the ranks (PETSc holds it), and this step needs \
+         it whole"
             .to_string(),
     )
 }

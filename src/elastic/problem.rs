@@ -170,7 +170,7 @@ impl<'m> ElasticProblem<'m> {
             Err(ProblemError::NoDirichlet { .. } | ProblemError::FreeRigidModes { .. }) => {}
             Err(other) => return Err(other),
         }
-        let mut constraints = super::solve::constraints(&problem)?;
+        let mut constraints = super::assemble::constraints(&problem)?;
         let (coords, dim) = (&body.coords, body.dim);
         let mut free = crate::fem::rigid_modes::free_rigid_modes(coords, dim, &constraints);
         for node in far_apart_nodes(coords, dim) {
@@ -273,7 +273,7 @@ impl<'m> ElasticProblem<'m> {
         if self.dirichlet.is_empty() && self.forces.is_empty() && self.pins.is_empty() {
             return Err(ProblemError::NoDirichlet { body: name() });
         }
-        let constraints = super::solve::constraints(self)?;
+        let constraints = super::assemble::constraints(self)?;
         let free = crate::fem::rigid_modes::free_rigid_modes(
             &self.body.coords,
             self.body.dim,

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use super::kernels::{
     facet_mass, facet_measure_and_normal, tetrahedron_stiffness, triangle_stiffness,
 };
-use super::{Material, SparsityPattern};
+use super::{Material, NodeGraph, SparsityPattern};
 use crate::mesh::{BodyMesh, FacetGroup};
 
 /// Coordinates of the `N` nodes of a cell or facet.
@@ -17,6 +17,34 @@ pub fn node_coords<const N: usize>(coords: &[[f64; 3]], nodes: &[usize]) -> [[f6
 /// The stiffness pattern of a body: `dim` unknowns per node, coupled through the cells.
 pub fn stiffness_pattern(body: &BodyMesh) -> SparsityPattern {
     SparsityPattern::new(
+        body.num_nodes(),
+        &body.cells,
+        body.nodes_per_cell(),
+        body.dim,
+    )
+}
+
+/// The stiffness matrix of one cell (its node indices `cell`) into `element`: column-major,
+/// `dim * nodes` square, unknowns interleaved per node.
+pub fn element_stiffness(
+    body: &BodyMesh,
+    material: &Material,
+    cell: &[usize],
+    element: &mut [f64],
+) {
+    if body.dim == 2 {
+        let ke = triangle_stiffness(&node_coords(&body.coords, cell), material);
+        element.copy_from_slice(ke.as_slice());
+    } else {
+        let ke = tetrahedron_stiffness(&node_coords(&body.coords, cell), material);
+        element.copy_from_slice(ke.as_slice());
+    }
+}
+
+/// The node graph of a body's stiffness (`dim` unknowns per node): all a distributed run
+/// builds of the pattern of the whole matrix (`super::NodeColumns` holds its rank's part).
+pub fn stiffness_graph(body: &BodyMesh) -> NodeGraph {
+    NodeGraph::new(
         body.num_nodes(),
         &body.cells,
         body.nodes_per_cell(),
@@ -52,15 +80,7 @@ pub fn assemble_stiffness(
         out[..cells.len() / nodes_per_cell * size]
             .par_chunks_exact_mut(size)
             .zip(cells.par_chunks_exact(nodes_per_cell))
-            .for_each(|(element, cell)| {
-                if body.dim == 2 {
-                    let ke = triangle_stiffness(&node_coords(&body.coords, cell), material);
-                    element.copy_from_slice(ke.as_slice());
-                } else {
-                    let ke = tetrahedron_stiffness(&node_coords(&body.coords, cell), material);
-                    element.copy_from_slice(ke.as_slice());
-                }
-            });
+            .for_each(|(element, cell)| element_stiffness(body, material, cell, element));
     };
     let mut values = vec![0.0; pattern.nnz()];
     let batch_len = CELL_BATCH.min(body.num_cells()) * size;

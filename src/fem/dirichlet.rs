@@ -8,6 +8,8 @@
 
 use faer::sparse::SparseColMat;
 
+use super::NodeColumns;
+
 /// Which dofs are prescribed, and to what.
 #[derive(Debug, Clone)]
 pub struct Constraints {
@@ -73,5 +75,41 @@ impl Constraints {
             }
         }
         (SparseColMat::new(symbolic, values), rhs)
+    }
+
+    /// [`Self::apply`] on some columns of `K` (a rank's rows in a distributed run): the columns
+    /// are constrained in place as `apply` leaves them in `K_c`, and the entries of `f_c` at
+    /// their unknowns are returned, in column order. A free unknown's pull by the prescribed
+    /// ones, `-sum_d K_jd g_d`, is read from its own column (`K` is symmetric), in the order
+    /// `apply` sums it.
+    pub fn apply_to_columns(&self, columns: &mut NodeColumns, f: &[f64]) -> Vec<f64> {
+        (0..columns.num_columns())
+            .map(|q| {
+                let j = columns.dof(q);
+                let (rows, values) = columns.column_mut(q);
+                match self.prescribed[j] {
+                    Some(g) => {
+                        let mut rhs = 0.0;
+                        for (&i, value) in rows.iter().zip(values.iter_mut()) {
+                            match i == j {
+                                true => rhs = *value * g,
+                                false => *value = 0.0,
+                            }
+                        }
+                        rhs
+                    }
+                    None => {
+                        let mut rhs = f[j];
+                        for (&i, value) in rows.iter().zip(values.iter_mut()) {
+                            if let Some(g) = self.prescribed[i] {
+                                rhs -= *value * g;
+                                *value = 0.0;
+                            }
+                        }
+                        rhs
+                    }
+                }
+            })
+            .collect()
     }
 }

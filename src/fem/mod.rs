@@ -9,6 +9,7 @@
 //! fills a pattern computed once ([`SparsityPattern`]).
 
 pub mod assembly;
+mod columns;
 mod dirichlet;
 pub mod kernels;
 pub mod loads;
@@ -17,6 +18,7 @@ pub mod rigid_modes;
 mod sparsity;
 pub mod stress;
 
+pub use columns::NodeColumns;
 pub use dirichlet::Constraints;
 pub use material::{Material, MaterialError};
 pub use sparsity::{NodeGraph, SparsityPattern};

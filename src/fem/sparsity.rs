@@ -20,29 +20,7 @@ pub struct NodeGraph {
 }
 
 impl NodeGraph {
-    pub fn num_nodes(&self) -> usize {
-        self.neighbour_ptr.len() - 1
-    }
-
-    pub fn block(&self) -> usize {
-        self.block
-    }
-
-    /// Neighbours of node `a`, including `a`, sorted.
-    pub fn neighbours(&self, a: usize) -> &[usize] {
-        &self.neighbours[self.neighbour_ptr[a]..self.neighbour_ptr[a + 1]]
-    }
-}
-
-/// Compressed-column pattern of a finite element matrix, with the node graph it came from.
-#[derive(Debug, Clone)]
-pub struct SparsityPattern {
-    graph: NodeGraph,
-    symbolic: SymbolicSparseColMat<usize>,
-}
-
-impl SparsityPattern {
-    /// The pattern of `num_nodes` nodes coupled through `elements` (`nodes_per_element` node
+    /// The graph of `num_nodes` nodes coupled through `elements` (`nodes_per_element` node
     /// indices each, flat), with `block` unknowns per node.
     pub fn new(
         num_nodes: usize,
@@ -82,13 +60,50 @@ impl SparsityPattern {
             neighbours.extend_from_slice(&scratch);
             neighbour_ptr.push(neighbours.len());
         }
+        Self {
+            block,
+            neighbour_ptr,
+            neighbours,
+        }
+    }
 
+    pub fn num_nodes(&self) -> usize {
+        self.neighbour_ptr.len() - 1
+    }
+
+    pub fn block(&self) -> usize {
+        self.block
+    }
+
+    /// Neighbours of node `a`, including `a`, sorted.
+    pub fn neighbours(&self, a: usize) -> &[usize] {
+        &self.neighbours[self.neighbour_ptr[a]..self.neighbour_ptr[a + 1]]
+    }
+}
+
+/// Compressed-column pattern of a finite element matrix, with the node graph it came from.
+#[derive(Debug, Clone)]
+pub struct SparsityPattern {
+    graph: NodeGraph,
+    symbolic: SymbolicSparseColMat<usize>,
+}
+
+impl SparsityPattern {
+    /// The pattern of `num_nodes` nodes coupled through `elements` (`nodes_per_element` node
+    /// indices each, flat), with `block` unknowns per node.
+    pub fn new(
+        num_nodes: usize,
+        elements: &[usize],
+        nodes_per_element: usize,
+        block: usize,
+    ) -> Self {
+        let graph = NodeGraph::new(num_nodes, elements, nodes_per_element, block);
         let n = block * num_nodes;
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0usize);
-        let mut row_idx = Vec::with_capacity(block * block * neighbours.len());
+        let mut row_idx = Vec::with_capacity(block * block * graph.neighbours.len());
         for a in 0..num_nodes {
-            let adjacent = &neighbours[neighbour_ptr[a]..neighbour_ptr[a + 1]];
+            let adjacent = graph.neighbours(a);
             for _ in 0..block {
                 for &b in adjacent {
                     row_idx.extend((0..block).map(|r| block * b + r));
@@ -97,14 +112,7 @@ impl SparsityPattern {
             }
         }
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Self {
-            graph: NodeGraph {
-                block,
-                neighbour_ptr,
-                neighbours,
-            },
-            symbolic,
-        }
+        Self { graph, symbolic }
     }
 
     /// The node graph alone, for a matrix that has taken a copy of the pattern: the

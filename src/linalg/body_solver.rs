@@ -25,10 +25,10 @@
 use faer::sparse::SparseColMat;
 use serde::{Deserialize, Serialize};
 
-use super::{Cholesky, LinalgError};
+use super::{Cholesky, LinalgError, RankRows};
 
 #[cfg(feature = "petsc")]
-use super::petsc::{CgAmg, CgAmgMatrix, Communicator};
+use super::petsc::{CgAmg, CgAmgMatrix};
 
 /// The body solver a case asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -128,7 +128,9 @@ impl BodySolver {
     }
 
     /// [`Self::cg_amg`] in two steps: PETSc's copy of `matrix` now, its multigrid hierarchy
-    /// by [`PendingCgAmg::set_up`], so that the caller can free `matrix` in between.
+    /// by [`PendingCgAmg::set_up`], so that the caller can free `matrix` in between. The
+    /// matrix is whole on this process; a distributed run's bodies go by
+    /// [`Self::cg_amg_rows`].
     #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
     pub fn cg_amg_matrix(
         matrix: &SparseColMat<usize, f64>,
@@ -138,8 +140,21 @@ impl BodySolver {
     ) -> Result<PendingCgAmg, LinalgError> {
         #[cfg(feature = "petsc")]
         {
-            CgAmgMatrix::new(Communicator::of_run()?, matrix, dim, coords, rtol)
-                .map(|matrix| PendingCgAmg { matrix })
+            CgAmgMatrix::new(matrix, dim, coords, rtol).map(|matrix| PendingCgAmg { matrix })
+        }
+        #[cfg(not(feature = "petsc"))]
+        {
+            Err(LinalgError::PetscUnavailable)
+        }
+    }
+
+    /// CG + AMG on a body shared among the ranks of a distributed run, from this rank's `rows`
+    /// (collective), its hierarchy by [`PendingCgAmg::set_up`].
+    #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
+    pub fn cg_amg_rows(rows: RankRows, rtol: f64) -> Result<PendingCgAmg, LinalgError> {
+        #[cfg(feature = "petsc")]
+        {
+            CgAmgMatrix::distributed(rows, rtol).map(|matrix| PendingCgAmg { matrix })
         }
         #[cfg(not(feature = "petsc"))]
         {

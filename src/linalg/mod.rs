@@ -5,6 +5,7 @@
 
 mod body_solver;
 mod cholesky;
+mod distribution;
 pub mod gmres;
 mod ordering;
 #[cfg(feature = "petsc")]
@@ -14,6 +15,7 @@ pub use body_solver::{
     AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE, PendingCgAmg,
 };
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
+pub use distribution::{Distribution, RankRows};
 
 use faer::sparse::SparseColMat;
 use thiserror::Error;
@@ -24,6 +26,8 @@ pub enum LinalgError {
     NotPositiveDefinite { pivot: usize },
     #[error("fill-reducing ordering failed: {0}")]
     Ordering(String),
+    #[error("MPI: {0}")]
+    Mpi(String),
     #[error("partitioning a body among the MPI ranks failed: {0}")]
     Partition(String),
     #[error("sparse factorization failed: {0}")]
@@ -72,7 +76,11 @@ pub fn mat_vec(a: &SparseColMat<usize, f64>, x: &[f64]) -> Vec<f64> {
 
 /// `||A x - b|| / ||b||` (0 when `b = 0` and `x = 0`).
 pub fn relative_residual(a: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> f64 {
-    let ax = mat_vec(a, x);
+    relative_difference(&mat_vec(a, x), b)
+}
+
+/// `||ax - b|| / ||b||` (`||ax||` when `b = 0`): a relative residual from the product `A x`.
+pub fn relative_difference(ax: &[f64], b: &[f64]) -> f64 {
     let r: f64 = ax
         .iter()
         .zip(b)

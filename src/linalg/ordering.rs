@@ -73,7 +73,6 @@ pub fn nested_dissection(graph: &NodeGraph) -> Result<(Vec<usize>, Vec<usize>), 
 /// `neighbours[a]` (symmetric, without `a`): METIS's k-way partition, parts of nearly equal
 /// size (METIS's default imbalance, 3%) with few edges cut. The same graph always gets the same
 /// parts.
-#[cfg_attr(not(feature = "petsc"), allow(dead_code))]
 pub fn partition(neighbours: &[Vec<usize>], parts: usize) -> Result<Vec<usize>, LinalgError> {
     let n = neighbours.len();
     if parts <= 1 || n == 0 {

@@ -55,11 +55,11 @@
 //!   `PetscFPTrapPush` stack and `PetscCitationsRegister` are reached only in set-up
 //!   (Chebyshev's eigenvalue estimate in `KSPSetUp`); no MPI call is on the path on
 //!   `PETSC_COMM_SELF`.
-//! - Objects are created on a communicator given by the caller: [`Communicator::solo`], or
-//!   in a distributed run ([`crate::parallel`]) [`Communicator::world`], every rank. Then a
-//!   `Distribution` shares the body's rows among the ranks, each rank hands PETSc only its
-//!   own rows, and a solve or a V-cycle takes and returns whole vectors in our numbering (each
-//!   rank passes its rows in, and receives every rank's rows of the result). Every call on
+//! - A whole matrix ([`CgAmgMatrix::new`]) goes to PETSc on `PETSC_COMM_SELF`; in a
+//!   distributed run ([`crate::parallel`]) each rank hands PETSc only its own rows of a body
+//!   ([`CgAmgMatrix::distributed`], on `PETSC_COMM_WORLD`; `crate::linalg::Distribution`),
+//!   and a solve or a V-cycle takes and returns whole vectors in our numbering (each rank
+//!   passes its rows in, and receives every rank's rows of the result). Every call on
 //!   such an object is collective: a distributed run has one thread per rank, so every rank
 //!   makes them in the same order, and V-cycles never overlap.
 
@@ -69,11 +69,8 @@ use std::sync::{Mutex, OnceLock, PoisonError, RwLock, RwLockWriteGuard};
 
 use faer::sparse::SparseColMat;
 
-use super::LinalgError;
+use super::{Distribution, LinalgError, RankRows};
 use crate::parallel::Ranks;
-
-mod distribution;
-use distribution::Distribution;
 
 /// MPI's Fortran communicator handle (`MPI_Fint`, an `int` in Open MPI and MPICH alike).
 type MpiFint = c_int;
@@ -210,14 +207,14 @@ fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
 
 /// The communicator PETSc objects are created on, with this process's place in it.
 #[derive(Debug, Clone, Copy)]
-pub struct Communicator {
+struct Communicator {
     handle: MpiFint,
     ranks: Ranks,
 }
 
 impl Communicator {
     /// `PETSC_COMM_SELF`: this process alone (initializes PETSc if needed).
-    pub fn solo() -> Result<Self, LinalgError> {
+    fn solo() -> Result<Self, LinalgError> {
         let _lock = petsc()?;
         Ok(Self {
             // SAFETY: PETSc is initialized.
@@ -227,7 +224,7 @@ impl Communicator {
     }
 
     /// `PETSC_COMM_WORLD`: every rank of the run (initializes PETSc, and MPI, if needed).
-    pub fn world() -> Result<Self, LinalgError> {
+    fn world() -> Result<Self, LinalgError> {
         let ranks = world_ranks()?;
         let _lock = petsc()?;
         Ok(Self {
@@ -235,14 +232,6 @@ impl Communicator {
             handle: unsafe { internodes_petsc_comm_world() },
             ranks,
         })
-    }
-
-    /// The run's: [`Self::world`] in a distributed run, [`Self::solo`] otherwise.
-    pub fn of_run() -> Result<Self, LinalgError> {
-        match crate::parallel::distributed() {
-            true => Self::world(),
-            false => Self::solo(),
-        }
     }
 }
 
@@ -389,36 +378,9 @@ pub struct CgAmgMatrix(CgAmg);
 
 impl CgAmgMatrix {
     /// PETSc's copy of `matrix` (symmetric positive definite; its compressed columns are read
-    /// as compressed rows; on several ranks, this rank's rows) with `dim` dofs per node,
-    /// interleaved, the nodes at `coords` (`dim` per node), on `comm`. Solves will stop at the
-    /// relative residual `rtol`.
+    /// as compressed rows), whole on this process, with `dim` dofs per node, interleaved, the
+    /// nodes at `coords` (`dim` per node). Solves will stop at the relative residual `rtol`.
     pub fn new(
-        comm: Communicator,
-        matrix: &SparseColMat<usize, f64>,
-        dim: usize,
-        coords: &[f64],
-        rtol: f64,
-    ) -> Result<Self, LinalgError> {
-        CgAmg::build(comm, matrix, dim, coords, rtol).map(Self)
-    }
-
-    /// Builds the GAMG hierarchy: the solver is ready.
-    pub fn set_up(self) -> Result<CgAmg, LinalgError> {
-        let _lock = petsc()?;
-        let mut step = std::ptr::null();
-        // SAFETY: `raw` is alive and built; the lock is held.
-        let code = unsafe { internodes_cgamg_set_up(self.0.raw.as_ptr(), &mut step) };
-        match code {
-            0 => Ok(self.0),
-            _ => Err(petsc_error(step, code)),
-        }
-    }
-}
-
-impl CgAmg {
-    /// [`CgAmgMatrix::new`]'s PETSc objects, without the hierarchy.
-    fn build(
-        comm: Communicator,
         matrix: &SparseColMat<usize, f64>,
         dim: usize,
         coords: &[f64],
@@ -444,42 +406,98 @@ impl CgAmg {
         // here (checked below), and its values, counts of allocated entries, are below
         // i64::MAX. A converted copy would cost 8 bytes per stored entry at the peak.
         const _: () = assert!(size_of::<usize>() == size_of::<i64>());
-        let distribution = match comm.ranks.size {
-            1 => None,
-            _ => Some(Distribution::new(matrix, dim, comm.ranks)?),
+        let rows = LocalRows {
+            num_rows: n,
+            row_ptr: symbolic.col_ptr().as_ptr().cast::<i64>(),
+            columns: symbolic.row_idx().as_ptr().cast::<i64>(),
+            values,
+            coords,
         };
-        // This rank's rows: all of them as they are on one process, else in PETSc's numbering.
-        let local_rows = distribution.as_ref().map(|d| d.local_rows(matrix, coords));
-        let (local, row_ptr, col_idx, values, coords) = match &local_rows {
-            None => (
-                n,
-                symbolic.col_ptr().as_ptr().cast::<i64>(),
-                symbolic.row_idx().as_ptr().cast::<i64>(),
-                values,
-                coords,
-            ),
-            Some((row_ptr, col_idx, values, coords)) => (
-                row_ptr.len() - 1,
-                row_ptr.as_ptr(),
-                col_idx.as_ptr(),
-                &values[..],
-                &coords[..],
-            ),
+        CgAmg::build(Communicator::solo()?, n, dim, rows, None, rtol).map(Self)
+    }
+
+    /// PETSc's copy of a body shared among the ranks of the run, from this rank's `rows`
+    /// (collective: every rank calls it with its own). Solves will stop at the relative
+    /// residual `rtol`.
+    pub fn distributed(rows: RankRows, rtol: f64) -> Result<Self, LinalgError> {
+        let (n, dim) = (rows.num_dofs(), rows.block());
+        if rows.coords.len() != rows.num_rows() || rows.columns.len() != rows.values.len() {
+            return Err(LinalgError::Sizes(format!(
+                "CG + AMG of {} rows with {} coordinates, {} columns and {} values",
+                rows.num_rows(),
+                rows.coords.len(),
+                rows.columns.len(),
+                rows.values.len()
+            )));
+        }
+        let local = LocalRows {
+            num_rows: rows.num_rows(),
+            row_ptr: rows.row_ptr.as_ptr(),
+            columns: rows.columns.as_ptr(),
+            values: &rows.values,
+            coords: &rows.coords,
         };
+        CgAmg::build(
+            Communicator::world()?,
+            n,
+            dim,
+            local,
+            Some(rows.distribution),
+            rtol,
+        )
+        .map(Self)
+    }
+
+    /// Builds the GAMG hierarchy: the solver is ready.
+    pub fn set_up(self) -> Result<CgAmg, LinalgError> {
+        let _lock = petsc()?;
+        let mut step = std::ptr::null();
+        // SAFETY: `raw` is alive and built; the lock is held.
+        let code = unsafe { internodes_cgamg_set_up(self.0.raw.as_ptr(), &mut step) };
+        match code {
+            0 => Ok(self.0),
+            _ => Err(petsc_error(step, code)),
+        }
+    }
+}
+
+/// The rows this process hands PETSc, as the shim reads them: `num_rows + 1` row pointers from
+/// 0, each entry's global column and value, and the coordinates of the rows' nodes (`dim` per
+/// node: one value per row).
+struct LocalRows<'a> {
+    num_rows: usize,
+    row_ptr: *const i64,
+    columns: *const i64,
+    values: &'a [f64],
+    coords: &'a [f64],
+}
+
+impl CgAmg {
+    /// The PETSc objects of [`CgAmgMatrix`], without the hierarchy: a matrix of `n` unknowns
+    /// (`dim` per node) of which this process holds `rows`, shared as `distribution` says
+    /// (`None`: all on this process, in our numbering).
+    fn build(
+        comm: Communicator,
+        n: usize,
+        dim: usize,
+        rows: LocalRows,
+        distribution: Option<Distribution>,
+        rtol: f64,
+    ) -> Result<Self, LinalgError> {
         let _lock = petsc()?;
         let mut raw = std::ptr::null_mut();
         let mut step = std::ptr::null();
-        // SAFETY: the arrays have the lengths the shim reads (local + 1, nnz, nnz, local), it
-        // copies them, and the lock is held.
+        // SAFETY: the arrays have the lengths the shim reads (num_rows + 1, nnz, nnz,
+        // num_rows: checked by the callers), it copies them, and the lock is held.
         let code = unsafe {
             internodes_cgamg_create(
                 comm.handle,
-                local as i64,
+                rows.num_rows as i64,
                 dim as i64,
-                row_ptr,
-                col_idx,
-                values.as_ptr(),
-                coords.as_ptr(),
+                rows.row_ptr,
+                rows.columns,
+                rows.values.as_ptr(),
+                rows.coords.as_ptr(),
                 rtol,
                 MAX_ITERATIONS,
                 &mut raw,
@@ -489,6 +507,7 @@ impl CgAmg {
         if code != 0 {
             return Err(petsc_error(step, code));
         }
+        debug_assert_eq!(comm.ranks.size > 1, distribution.is_some());
         let raw = NonNull::new(raw).ok_or_else(|| petsc_error(step, 0))?;
         Ok(Self {
             raw,

@@ -1,0 +1,461 @@
+//! A body's discrete system: `K` and `f` assembled, the Dirichlet conditions applied
+//! (`K_c u = f_c`), and the force-controlled components' borders ([`RigidColumn`]).
+//!
+//! One process assembles the whole `K_c`. A rank of a distributed run (`crate::parallel`)
+//! assembles only the rows of its own nodes (`crate::linalg::Distribution`: a METIS partition
+//! of the body's nodes), which go to PETSc; what every rank needs whole is small or a vector:
+//! `f_c` (each rank computes its rows, then all are gathered), the rows of `K` at the
+//! prescribed dofs (every rank assembles those columns: the cells along the Dirichlet groups)
+//! and the largest diagonal entry (the largest of the ranks').
+
+use std::collections::HashMap;
+
+use faer::sparse::SparseColMat;
+
+use super::solve::timed;
+use super::{ElasticProblem, ProblemError, SolveError, SolveStats};
+use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_pattern};
+use crate::fem::loads::{add_body_force, add_surface_load};
+use crate::fem::{Constraints, NodeColumns, NodeGraph};
+use crate::linalg::{Distribution, LinalgError, RankRows};
+use crate::parallel::Ranks;
+
+/// The prescribed dofs and values of a problem; conflicting values on shared nodes are errors.
+pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, ProblemError> {
+    let body = problem.body;
+    let dim = body.dim;
+    let mut constraints = Constraints::new(body.num_dofs());
+    for condition in &problem.dirichlet {
+        let nodes = body
+            .group_nodes(&condition.group)
+            .expect("groups are checked first");
+        for node in nodes {
+            for (component, value) in condition.components.iter().enumerate().take(dim) {
+                if let Some(value) = *value {
+                    constraints
+                        .prescribe(dim * node + component, value)
+                        .map_err(|first| ProblemError::ConflictingDirichlet {
+                            body: body.name.clone(),
+                            group: condition.group.clone(),
+                            node_tag: body.node_tags[node],
+                            component,
+                            first,
+                            second: value,
+                        })?;
+                }
+            }
+        }
+    }
+    // A force-controlled dof is held at 0 in `K_c`: its displacement is the group's unknown,
+    // which enters through its column (`RigidColumn`).
+    let mut forced_by: HashMap<usize, String> = HashMap::new();
+    for forced in forced_components(problem) {
+        for &dof in &forced.dofs {
+            if let Some(value) = constraints.value(dof) {
+                let other = match forced_by.get(&dof) {
+                    Some(group) => format!("by group '{group}'"),
+                    None => format!("prescribed {value} by a Dirichlet condition"),
+                };
+                return Err(ProblemError::ForcedTwice {
+                    body: body.name.clone(),
+                    group: forced.group.clone(),
+                    node_tag: body.node_tags[dof / dim],
+                    component: forced.component,
+                    other,
+                });
+            }
+            constraints
+                .prescribe(dof, 0.0)
+                .expect("the dof was free: checked above");
+            forced_by.insert(dof, forced.group.clone());
+        }
+    }
+    Ok(constraints)
+}
+
+/// One force-controlled component of a group: its dofs (one per node of the group) and force;
+/// or a rigid-mode pin (`ElasticProblem::pins`), one dof with no force.
+pub(crate) struct ForcedComponent {
+    pub group: String,
+    pub component: usize,
+    pub force: f64,
+    pub dofs: Vec<usize>,
+    pub pin: bool,
+}
+
+/// The force-controlled components of `problem`, group after group, component after component.
+pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent> {
+    let body = problem.body;
+    let dim = body.dim;
+    let mut out = Vec::new();
+    for condition in &problem.forces {
+        let nodes = body
+            .group_nodes(&condition.group)
+            .expect("groups are checked first");
+        for (component, force) in condition.components.iter().enumerate().take(dim) {
+            if let Some(force) = *force {
+                out.push(ForcedComponent {
+                    group: condition.group.clone(),
+                    component,
+                    force,
+                    dofs: nodes.iter().map(|&node| dim * node + component).collect(),
+                    pin: false,
+                });
+            }
+        }
+    }
+    for &(node, component) in &problem.pins {
+        out.push(ForcedComponent {
+            group: format!("rigid-mode pin at node {}", body.node_tags[node]),
+            component,
+            force: 0.0,
+            dofs: vec![dim * node + component],
+            pin: true,
+        });
+    }
+    out
+}
+
+/// A body's assembled system: `f` as assembled, the Dirichlet-constrained `K_c` (on the
+/// pattern of `K`) and `f_c`, and what the reactions need of `K`.
+pub struct AssembledBody {
+    /// Dofs per node.
+    pub dim: usize,
+    /// Node coordinates, `dim` per node: the rigid-body modes an iterative solver's
+    /// multigrid needs (its near-null space).
+    pub coordinates: Vec<f64>,
+    /// The node graph of `K_c`'s pattern (for a fill-reducing ordering, or a partition).
+    pub graph: NodeGraph,
+    /// The rows of the unconstrained `K` at the prescribed dofs, `(dof, [(column, value)])`:
+    /// all the reactions need of it. The whole `K` is not kept: at a million DOFs it is a
+    /// gigabyte beside `K_c` and the solver's own copies.
+    pub prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
+    pub f: Vec<f64>,
+    pub constraints: Constraints,
+    /// The constrained stiffness `K_c`: whole, or this rank's rows of it.
+    pub stiffness: Stiffness,
+    /// The largest diagonal entry of `K_c` (the contact system's scale).
+    pub k_scale: f64,
+    pub f_c: Vec<f64>,
+    /// The force-controlled components of the body, in the order of
+    /// [`forced_components`]: their dofs are held at 0 in `K_c` and move by unknowns of the
+    /// contact solve.
+    pub rigid: Vec<RigidColumn>,
+}
+
+/// A body's constrained stiffness `K_c` as this process holds it.
+pub enum Stiffness {
+    /// All of it (one process).
+    Whole(SparseColMat<usize, f64>),
+    /// This rank's rows (a distributed run), until its solver takes them.
+    Rows(RankRows),
+    /// Taken by its distributed solver (PETSc), which makes the products.
+    Released,
+}
+
+impl Stiffness {
+    /// The whole matrix, if this process holds it.
+    pub fn whole(&self) -> Option<&SparseColMat<usize, f64>> {
+        match self {
+            Self::Whole(k_c) => Some(k_c),
+            _ => None,
+        }
+    }
+
+    /// This rank's rows, taken for its distributed solver (`Released` is left); `None`, and
+    /// nothing changed, if this process holds no rows.
+    pub fn take_rows(&mut self) -> Option<RankRows> {
+        match std::mem::replace(self, Self::Released) {
+            Self::Rows(rows) => Some(rows),
+            other => {
+                *self = other;
+                None
+            }
+        }
+    }
+}
+
+/// A force-controlled component of a group (`super::ForceCondition`) in the constrained
+/// system. Its dofs `G` move together by one unknown `a` and are held at 0 in `K_c`; with `e`
+/// the indicator of `G` and `s` the load factor (loads, prescribed values and forces scale
+/// alike), the body's equations are
+///
+/// ```text
+/// K_c u + k a               = s f_c(1)       k = K_FG e (free rows F)
+/// k^T u + d a + sum_b c_b b = s (force + applied)
+/// ```
+///
+/// with `d = e^T K_GG e`, `c_b = e^T K_GH e_H` for the body's other force-controlled components
+/// `b` (dofs `H`), and `applied = e^T f_G - e^T K_GD g_D` (the loads on `G` and the pull of the
+/// prescribed dofs `D`). The second equation is the group's reaction `e^T (K u - f)_G` set to
+/// the force. `K` is symmetric, so `k` is both the column of `a` and its row.
+#[derive(Debug, Clone)]
+pub struct RigidColumn {
+    pub group: String,
+    pub component: usize,
+    pub force: f64,
+    pub dofs: Vec<usize>,
+    /// `k`: `(free dof, value)`, by dof.
+    pub column: Vec<(usize, f64)>,
+    pub diagonal: f64,
+    /// `(b, c_b)`: the couplings to the body's other force-controlled components.
+    pub coupled: Vec<(usize, f64)>,
+    pub applied: f64,
+    /// A rigid-mode pin of a floating body (`ElasticProblem::pins`), not a group of the case.
+    pub pin: bool,
+}
+
+/// The [`RigidColumn`]s of `forced`, read from the rows of the unconstrained `K` at the
+/// prescribed dofs and from `f`.
+fn rigid_columns(
+    forced: Vec<ForcedComponent>,
+    prescribed_rows: &[(usize, Vec<(usize, f64)>)],
+    constraints: &Constraints,
+    f: &[f64],
+) -> Vec<RigidColumn> {
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for (r, component) in forced.iter().enumerate() {
+        owner.extend(component.dofs.iter().map(|&dof| (dof, r)));
+    }
+    let row = |dof: usize| {
+        let at = prescribed_rows
+            .binary_search_by_key(&dof, |(d, _)| *d)
+            .expect("a forced dof is prescribed");
+        &prescribed_rows[at].1
+    };
+    (forced.into_iter().enumerate())
+        .map(|(r, component)| {
+            let mut column: HashMap<usize, f64> = HashMap::new();
+            let mut coupled: HashMap<usize, f64> = HashMap::new();
+            let (mut diagonal, mut applied) = (0.0, 0.0);
+            for &d in &component.dofs {
+                applied += f[d];
+                for &(j, value) in row(d) {
+                    match (constraints.value(j), owner.get(&j)) {
+                        (None, _) => *column.entry(j).or_default() += value,
+                        (Some(_), Some(&b)) if b == r => diagonal += value,
+                        (Some(_), Some(&b)) => *coupled.entry(b).or_default() += value,
+                        (Some(g), None) => applied -= value * g,
+                    }
+                }
+            }
+            let mut column: Vec<(usize, f64)> = column.into_iter().collect();
+            column.sort_unstable_by_key(|e| e.0);
+            let mut coupled: Vec<(usize, f64)> = coupled.into_iter().collect();
+            coupled.sort_unstable_by_key(|e| e.0);
+            RigidColumn {
+                group: component.group,
+                component: component.component,
+                force: component.force,
+                dofs: component.dofs,
+                column,
+                diagonal,
+                coupled,
+                applied,
+                pin: component.pin,
+            }
+        })
+        .collect()
+}
+
+/// Assembles `f` and `K`, and applies the Dirichlet conditions, timing each phase into
+/// `stats`: the whole `K_c` on one process, this rank's rows of it in a distributed run.
+pub fn assemble(
+    problem: &ElasticProblem,
+    stats: &mut SolveStats,
+    verbose: bool,
+) -> Result<AssembledBody, SolveError> {
+    let body = problem.body;
+    let dim = body.dim;
+    stats.num_dofs = body.num_dofs();
+    let constraints = constraints(problem)?;
+    stats.num_prescribed_dofs = constraints.num_fixed();
+    let coordinates: Vec<f64> = body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect();
+
+    // 1. Load vector f: surface loads and body force.
+    let f = timed(stats, verbose, "assemble loads", || {
+        let mut f = vec![0.0; body.num_dofs()];
+        for load in &problem.loads {
+            let group = body
+                .boundary_group(&load.group)
+                .expect("groups are checked first");
+            add_surface_load(body, group, &load.load, &mut f);
+        }
+        if let Some(b) = &problem.body_force {
+            add_body_force(body, b, &mut f);
+        }
+        f
+    });
+
+    // 2. K_c and f_c, and the rows of K at the prescribed dofs.
+    let ranks = crate::parallel::ranks();
+    let constrained = match ranks.size {
+        1 => whole_stiffness(problem, &constraints, &f, stats, verbose),
+        _ => rank_stiffness(
+            problem,
+            &constraints,
+            &f,
+            &coordinates,
+            ranks,
+            stats,
+            verbose,
+        )
+        .map_err(|source| SolveError::Linalg {
+            body: body.name.clone(),
+            source,
+        })?,
+    };
+    let rigid = rigid_columns(
+        forced_components(problem),
+        &constrained.prescribed_rows,
+        &constraints,
+        &f,
+    );
+    Ok(AssembledBody {
+        dim,
+        coordinates,
+        graph: constrained.graph,
+        prescribed_rows: constrained.prescribed_rows,
+        f,
+        constraints,
+        stiffness: constrained.stiffness,
+        k_scale: constrained.k_scale,
+        f_c: constrained.f_c,
+        rigid,
+    })
+}
+
+/// `K_c` as this process holds it, with what the rest of the system needs of `K`.
+struct ConstrainedStiffness {
+    graph: NodeGraph,
+    stiffness: Stiffness,
+    f_c: Vec<f64>,
+    prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
+    k_scale: f64,
+}
+
+/// The whole `K_c`: `K` on its pattern, then the Dirichlet conditions eliminated symmetrically
+/// in `K`'s storage; the rows of `K` at the prescribed dofs are kept first, for the reactions
+/// (`K` is symmetric: the row of a dof is its column).
+fn whole_stiffness(
+    problem: &ElasticProblem,
+    constraints: &Constraints,
+    f: &[f64],
+    stats: &mut SolveStats,
+    verbose: bool,
+) -> ConstrainedStiffness {
+    let body = problem.body;
+    let pattern = timed(stats, verbose, "sparsity pattern", || {
+        stiffness_pattern(body)
+    });
+    let k = timed(stats, verbose, "assemble stiffness", || {
+        assemble_stiffness(body, &problem.material, &pattern)
+    });
+    stats.stiffness_nnz = pattern.nnz();
+    // K holds the pattern now; the solvers need only its node graph besides.
+    let graph = pattern.into_graph();
+    let prescribed_rows = {
+        let (symbolic, values) = k.parts();
+        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+        (0..symbolic.ncols())
+            .filter(|&d| constraints.is_fixed(d))
+            .map(|d| {
+                let row = (col_ptr[d]..col_ptr[d + 1]).map(|p| (row_idx[p], values[p]));
+                (d, row.collect())
+            })
+            .collect()
+    };
+    let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
+        constraints.apply(k, f)
+    });
+    ConstrainedStiffness {
+        graph,
+        k_scale: largest_diagonal(&k_c),
+        stiffness: Stiffness::Whole(k_c),
+        f_c,
+        prescribed_rows,
+    }
+}
+
+/// This rank's rows of `K_c` in a distributed run: the body's nodes are partitioned, the
+/// columns of this rank's nodes assembled and constrained (its rows: `K` is symmetric), and
+/// its rows of `f_c` computed and gathered whole on every rank. Every rank assembles the
+/// columns at the prescribed dofs too (the cells along the Dirichlet groups), for the
+/// reactions. Collective: every rank calls it for every body, in the same order.
+fn rank_stiffness(
+    problem: &ElasticProblem,
+    constraints: &Constraints,
+    f: &[f64],
+    coordinates: &[f64],
+    ranks: Ranks,
+    stats: &mut SolveStats,
+    verbose: bool,
+) -> Result<ConstrainedStiffness, LinalgError> {
+    let body = problem.body;
+    let dim = body.dim;
+    // The symbolic phase of a rank: the node graph, and which nodes are whose.
+    let (graph, distribution) = timed(stats, verbose, "sparsity pattern", || {
+        let graph = stiffness_graph(body);
+        Distribution::new(&graph, ranks).map(|distribution| (graph, distribution))
+    })?;
+    let mut columns = timed(stats, verbose, "assemble stiffness", || {
+        NodeColumns::assemble(body, &problem.material, &graph, distribution.nodes())
+    });
+    let nnz = crate::parallel::gather(columns.nnz() as f64).map_err(mpi)?;
+    stats.stiffness_nnz = nnz.iter().sum::<f64>() as usize;
+
+    let prescribed_nodes = (0..body.num_nodes())
+        .filter(|&a| (0..dim).any(|c| constraints.is_fixed(dim * a + c)))
+        .collect();
+    let prescribed = NodeColumns::assemble(body, &problem.material, &graph, prescribed_nodes);
+    let prescribed_rows = (0..prescribed.num_columns())
+        .filter(|&q| constraints.is_fixed(prescribed.dof(q)))
+        .map(|q| {
+            let (rows, values) = prescribed.column(q);
+            let row = rows.iter().copied().zip(values.iter().copied());
+            (prescribed.dof(q), row.collect())
+        })
+        .collect();
+    drop(prescribed);
+
+    let mut f_c = vec![0.0; f.len()];
+    let local_largest = timed(stats, verbose, "apply Dirichlet conditions", || {
+        let local_f_c = constraints.apply_to_columns(&mut columns, f);
+        distribution.gather(&local_f_c, &mut f_c)?;
+        Ok::<_, LinalgError>(
+            (0..columns.num_columns())
+                .flat_map(|q| {
+                    let dof = columns.dof(q);
+                    let (rows, values) = columns.column(q);
+                    rows.iter().zip(values).filter(move |(i, _)| **i == dof)
+                })
+                .map(|(_, value)| value.abs())
+                .fold(0.0, f64::max),
+        )
+    })?;
+    let k_scale = (crate::parallel::gather(local_largest).map_err(mpi)?)
+        .into_iter()
+        .fold(0.0, f64::max);
+    let rows = distribution.rows(&columns, coordinates);
+    Ok(ConstrainedStiffness {
+        graph,
+        stiffness: Stiffness::Rows(rows),
+        f_c,
+        prescribed_rows,
+        k_scale,
+    })
+}
+
+fn mpi(e: crate::parallel::ParallelError) -> LinalgError {
+    LinalgError::Mpi(e.to_string())
+}
+
+/// The largest absolute diagonal entry of `k`.
+fn largest_diagonal(k: &SparseColMat<usize, f64>) -> f64 {
+    let (symbolic, values) = k.parts();
+    let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
+    (0..symbolic.ncols())
+        .flat_map(|j| (col_ptr[j]..col_ptr[j + 1]).filter(move |&p| row_idx[p] == j))
+        .map(|p| values[p].abs())
+        .fold(0.0, f64::max)
+}

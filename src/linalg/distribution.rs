@@ -1,0 +1,177 @@
+//! How one body's unknowns are shared among the ranks of a distributed run, and the rows a
+//! rank hands to PETSc.
+//!
+//! The body's nodes are split into one part per rank by METIS (`METIS_PartGraphKway` on the
+//! node graph of the stiffness: parts of nearly equal size with few edges between them, so
+//! that a matrix-vector product or a V-cycle exchanges little). PETSc owns its rows by
+//! contiguous ranges, so PETSc's numbering puts the nodes of rank 0 first, then those of rank
+//! 1, and so on, each in our order, each node's `dim` unknowns together (the block structure
+//! GAMG aggregates by). Every rank computes the same partition (METIS is deterministic for a
+//! given graph), assembles the columns of its own nodes only
+//! ([`crate::fem::NodeColumns`]: its rows, `K` being symmetric) and hands them to PETSc as
+//! [`RankRows`].
+//!
+//! Vectors cross between the two numberings here: [`Distribution::local_part`] takes this
+//! rank's rows out of a whole vector in our numbering, [`Distribution::gather`] puts every
+//! rank's rows back into one whole vector on every rank (`MPI_Allgatherv`).
+
+use super::LinalgError;
+use super::ordering::partition;
+use crate::fem::{NodeColumns, NodeGraph};
+use crate::parallel::Ranks;
+
+#[derive(Debug)]
+pub struct Distribution {
+    /// Our unknown at each of PETSc's rows: `ours[p]`.
+    ours: Vec<usize>,
+    /// The rows of each rank (unknowns), in rank order.
+    counts: Vec<usize>,
+    /// PETSc's first row of this rank.
+    first: usize,
+    /// This rank's number of rows.
+    local: usize,
+    /// Unknowns per node.
+    block: usize,
+}
+
+impl Distribution {
+    /// The distribution over `ranks` of the unknowns of the body whose stiffness has the node
+    /// graph `graph`.
+    pub fn new(graph: &NodeGraph, ranks: Ranks) -> Result<Self, LinalgError> {
+        let block = graph.block();
+        let nodes = graph.num_nodes();
+        let neighbours: Vec<Vec<usize>> = (0..nodes)
+            .map(|a| {
+                graph
+                    .neighbours(a)
+                    .iter()
+                    .copied()
+                    .filter(|&b| b != a)
+                    .collect()
+            })
+            .collect();
+        let part = partition(&neighbours, ranks.size)?;
+        drop(neighbours);
+        let mut ours = Vec::with_capacity(nodes * block);
+        let mut counts = vec![0; ranks.size];
+        for (rank, count) in counts.iter_mut().enumerate() {
+            for node in (0..nodes).filter(|&a| part[a] == rank) {
+                ours.extend((0..block).map(|c| node * block + c));
+                *count += block;
+            }
+        }
+        let first = counts[..ranks.rank].iter().sum();
+        let local = counts[ranks.rank];
+        Ok(Self {
+            ours,
+            counts,
+            first,
+            local,
+            block,
+        })
+    }
+
+    /// Each rank's number of unknowns, in rank order.
+    pub fn counts(&self) -> &[usize] {
+        &self.counts
+    }
+
+    /// This rank's number of unknowns.
+    pub fn local(&self) -> usize {
+        self.local
+    }
+
+    /// This rank's nodes, increasing: the columns ([`NodeColumns`]) it assembles.
+    pub fn nodes(&self) -> Vec<usize> {
+        self.ours[self.first..self.first + self.local]
+            .iter()
+            .step_by(self.block)
+            .map(|&dof| dof / self.block)
+            .collect()
+    }
+
+    /// This rank's rows for PETSc: `columns` (of this rank's [`Self::nodes`], constrained)
+    /// read as rows, with global column indices in PETSc's numbering, sorted in each row, and
+    /// `coords` (`block` values per node, in our order) of this rank's nodes.
+    pub fn rows(self, columns: &NodeColumns, coords: &[f64]) -> RankRows {
+        let rows = &self.ours[self.first..self.first + self.local];
+        debug_assert_eq!(columns.num_columns(), rows.len());
+        let mut petsc_of = vec![0usize; self.ours.len()];
+        for (p, &ours) in self.ours.iter().enumerate() {
+            petsc_of[ours] = p;
+        }
+        let mut row_ptr = Vec::with_capacity(rows.len() + 1);
+        let mut petsc_columns = Vec::with_capacity(columns.nnz());
+        let mut values = Vec::with_capacity(columns.nnz());
+        let mut row: Vec<(i64, f64)> = Vec::new();
+        row_ptr.push(0i64);
+        for (q, &ours) in rows.iter().enumerate() {
+            debug_assert_eq!(columns.dof(q), ours);
+            let (entries, entry_values) = columns.column(q);
+            row.clear();
+            row.extend(
+                (entries.iter().zip(entry_values))
+                    .map(|(&column, &value)| (petsc_of[column] as i64, value)),
+            );
+            row.sort_unstable_by_key(|&(column, _)| column);
+            petsc_columns.extend(row.iter().map(|&(column, _)| column));
+            values.extend(row.iter().map(|&(_, value)| value));
+            row_ptr.push(petsc_columns.len() as i64);
+        }
+        let coords = rows.iter().map(|&ours| coords[ours]).collect();
+        RankRows {
+            distribution: self,
+            row_ptr,
+            columns: petsc_columns,
+            values,
+            coords,
+        }
+    }
+
+    /// This rank's rows of `whole` (our numbering), in PETSc's order.
+    pub fn local_part(&self, whole: &[f64]) -> Vec<f64> {
+        self.ours[self.first..self.first + self.local]
+            .iter()
+            .map(|&ours| whole[ours])
+            .collect()
+    }
+
+    /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank.
+    pub fn gather(&self, local: &[f64], whole: &mut [f64]) -> Result<(), LinalgError> {
+        let petsc = crate::parallel::all_gather(local, &self.counts)
+            .map_err(|e| LinalgError::Mpi(e.to_string()))?;
+        for (&ours, value) in self.ours.iter().zip(petsc) {
+            whole[ours] = value;
+        }
+        Ok(())
+    }
+}
+
+/// One rank's rows of a body's constrained stiffness, as PETSc takes them: compressed rows
+/// (pointers from 0, global columns in PETSc's numbering, values), with the coordinates of the
+/// rank's nodes (the near-null space), and how the body is distributed.
+#[derive(Debug)]
+pub struct RankRows {
+    pub distribution: Distribution,
+    pub row_ptr: Vec<i64>,
+    pub columns: Vec<i64>,
+    pub values: Vec<f64>,
+    pub coords: Vec<f64>,
+}
+
+impl RankRows {
+    /// The number of this rank's rows.
+    pub fn num_rows(&self) -> usize {
+        self.row_ptr.len() - 1
+    }
+
+    /// The body's number of unknowns (every rank's rows).
+    pub fn num_dofs(&self) -> usize {
+        self.distribution.counts().iter().sum()
+    }
+
+    /// The block size (unknowns per node).
+    pub fn block(&self) -> usize {
+        self.distribution.block
+    }
+}
