@@ -1,0 +1,107 @@
+#!/usr/bin/python3
+"""Where the memory of a run goes, per rank: heaptrack at the heap's peak, grouped by part.
+
+Runs ``internodes solve CASE`` under heaptrack (Debian's ``heaptrack``), on ``--ranks N``
+MPI ranks (``mpirun``) or one process, then reads each rank's profile with
+``heaptrack_print --flamegraph-cost-type peak`` (the bytes each call stack holds at the
+moment the heap is largest: the rows sum to the peak) and sums the stacks by the first
+function below that names a part of the solver (table ``PARTS``). Prints one table: a row per
+part, a column per rank (in an order of their own: heaptrack names a profile by process id),
+in MB.
+
+The heap counts what was allocated; the resident memory (``summary.json``'s
+``rank_peak_memory_mb``) counts the pages written, and can be smaller (memory allocated and
+never touched) or larger (freed memory the allocator keeps).
+
+Usage:  /usr/bin/python3 validation/memory_breakdown.py CASE.toml [--ranks 2] [--binary PATH]
+Example (the 1M-DOF case of the contact benchmark, after ``make bench``):
+        /usr/bin/python3 validation/memory_breakdown.py \\
+            validation/build/contact_bench/1M/hemisphere_on_block_default_one.toml --ranks 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+
+# (part, a function name in the stack): the first part whose function is on a stack takes it.
+PARTS = [
+    ("PETSc: GAMG hierarchy (set-up)", "internodes_cgamg_set_up"),
+    ("PETSc: matrix, KSP (create)", "internodes_cgamg_create"),
+    ("RBF interpolation: sparse LU of Phi_MM", "Interpolation::new"),
+    ("RBF interpolation: rows and columns", "rbf::Interpolation::"),
+    ("coupled system blocks", "CoupledSystem::assemble"),
+    ("interface coupling", "InterfaceOperators::coupling"),
+    ("interface operators (other)", "InterfaceOperators::"),
+    ("half-space predictor", "HalfSpace::new"),
+    ("GMRES basis and vectors", "gmres::"),
+    ("coupled Krylov solve (other)", "coupled_krylov::"),
+    ("mesh", "internodes::mesh::"),
+    ("assembly: graph, partition, rows, loads", "internodes::elastic::"),
+    ("assembly: graph, partition, rows, loads", "internodes::fem::"),
+    ("assembly: graph, partition, rows, loads", "Distribution::"),
+    ("contact (other)", "internodes::contact::"),
+    ("output", "internodes::output::"),
+    ("PETSc and MPI initialization", "internodes_petsc_initialize"),
+]
+
+
+def grouped(stacks: Path) -> dict[str, int]:
+    """Bytes at the heap's peak per part, from one flame-graph file of heaptrack_print."""
+    out: dict[str, int] = {}
+    for line in stacks.read_text().splitlines():
+        stack, _, count = line.rpartition(" ")
+        part = next((name for name, function in PARTS if function in stack), "other")
+        out[part] = out.get(part, 0) + int(count)
+    return out
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("case", type=Path)
+    parser.add_argument("--ranks", type=int, default=1)
+    parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        command = ["heaptrack", str(args.binary.resolve()), "solve", str(args.case.resolve()),
+                   "-o", str(work / "out"), "--quiet"]
+        if args.ranks > 1:
+            command = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(args.ranks), *command]
+        run = subprocess.run(command, cwd=work, capture_output=True, text=True)
+        if run.returncode not in (0, 2, 3):
+            print(run.stdout + run.stderr, file=sys.stderr)
+            return 1
+        profiles = sorted(work.glob("heaptrack.internodes.*.zst"), key=lambda p: int(p.name.split(".")[2]))
+        if len(profiles) != args.ranks:
+            print(f"expected {args.ranks} heaptrack profiles, found {len(profiles)}", file=sys.stderr)
+            return 1
+        columns = []
+        for profile in profiles:
+            stacks = profile.with_suffix(".stacks")
+            subprocess.run(["heaptrack_print", "-f", str(profile), "--flamegraph-cost-type", "peak",
+                            "-F", str(stacks)], check=True, capture_output=True)
+            columns.append(grouped(stacks))
+    parts = [name for name, _ in PARTS] + ["other"]
+    parts = list(dict.fromkeys(p for p in parts if any(p in c for c in columns)))
+    parts.sort(key=lambda p: -max(c.get(p, 0) for c in columns))
+    # heaptrack names a profile by process id, not by rank: the columns are the ranks in an
+    # order of their own.
+    ranks = [f"a rank ({p + 1})" for p in range(len(columns))] if len(columns) > 1 else ["the process"]
+    print(f"Heap at its peak, MB: {args.case} on {args.ranks} rank(s)")
+    print()
+    print("| part | " + " | ".join(ranks) + " |")
+    print("|---|" + "---:|" * len(ranks))
+    for part in parts:
+        print(f"| {part} | " + " | ".join(f"{c.get(part, 0) / 1e6:.0f}" for c in columns) + " |")
+    print("| **total (the heap's peak)** | " + " | ".join(f"**{sum(c.values()) / 1e6:.0f}**" for c in columns) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
