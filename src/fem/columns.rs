@@ -68,21 +68,8 @@ impl NodeColumns {
             element_stiffness(body, material, cell, &mut element);
             for (ja, &a) in cell.iter().enumerate() {
                 let q = position[a];
-                if q == usize::MAX {
-                    continue;
-                }
-                let adjacent = graph.neighbours(a);
-                for (ib, &b) in cell.iter().enumerate() {
-                    let k = adjacent
-                        .binary_search(&b)
-                        .expect("cell nodes are neighbours in the graph built from the cells");
-                    for c in 0..block {
-                        let base = col_ptr[block * q + c] + block * k;
-                        let column = &element[n * (block * ja + c) + block * ib..];
-                        for r in 0..block {
-                            values[base + r] += column[r];
-                        }
-                    }
+                if q != usize::MAX {
+                    graph.add_node_columns(cell, ja, &element, &col_ptr[block * q..], &mut values);
                 }
             }
         }

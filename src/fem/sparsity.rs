@@ -79,6 +79,35 @@ impl NodeGraph {
     pub fn neighbours(&self, a: usize) -> &[usize] {
         &self.neighbours[self.neighbour_ptr[a]..self.neighbour_ptr[a + 1]]
     }
+
+    /// Adds the `block` columns of element node `ja` (node `nodes[ja]`) of a dense element
+    /// matrix (column-major, `block * nodes.len()` square, unknowns interleaved per node) into
+    /// `values`, where that node's columns start at `starts[0..block]` and hold, like every
+    /// column of a pattern built on this graph, `block` rows per neighbour in neighbour order.
+    pub(super) fn add_node_columns(
+        &self,
+        nodes: &[usize],
+        ja: usize,
+        element: &[f64],
+        starts: &[usize],
+        values: &mut [f64],
+    ) {
+        let block = self.block;
+        let n = block * nodes.len();
+        let adjacent = self.neighbours(nodes[ja]);
+        for (ib, b) in nodes.iter().enumerate() {
+            let k = adjacent
+                .binary_search(b)
+                .expect("element nodes are neighbours in the graph built from the elements");
+            for c in 0..block {
+                let base = starts[c] + block * k;
+                let column = &element[n * (block * ja + c) + block * ib..];
+                for r in 0..block {
+                    values[base + r] += column[r];
+                }
+            }
+        }
+    }
 }
 
 /// Compressed-column pattern of a finite element matrix, with the node graph it came from.
@@ -150,23 +179,11 @@ impl SparsityPattern {
     /// interleaved per node) into `values`, the value array of this pattern.
     pub fn add_element(&self, nodes: &[usize], element: &[f64], values: &mut [f64]) {
         let block = self.graph.block;
-        let n = block * nodes.len();
-        debug_assert_eq!(element.len(), n * n);
+        debug_assert_eq!(element.len(), (block * nodes.len()).pow(2));
         let col_ptr = self.symbolic.col_ptr();
         for (ja, &a) in nodes.iter().enumerate() {
-            let adjacent = self.neighbours(a);
-            for (ib, &b) in nodes.iter().enumerate() {
-                let k = adjacent
-                    .binary_search(&b)
-                    .expect("element nodes are neighbours in the pattern built from the elements");
-                for c in 0..block {
-                    let base = col_ptr[block * a + c] + block * k;
-                    let column = &element[n * (block * ja + c) + block * ib..];
-                    for r in 0..block {
-                        values[base + r] += column[r];
-                    }
-                }
-            }
+            self.graph
+                .add_node_columns(nodes, ja, element, &col_ptr[block * a..], values);
         }
     }
 
