@@ -1,7 +1,9 @@
 //! The active set of the loop (`super::solve`): where it starts, and its primal-dual update
 //! from an iterate's pressures and gaps.
 
-use std::collections::{BTreeSet, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashSet};
+
+use super::law::NodeStates;
 
 use super::ContactProblem;
 use super::gap::GapRow;
@@ -15,18 +17,37 @@ pub(super) const SETTLED: f64 = 0.01;
 
 /// Where an active-set loop starts: the active primary candidates (surface indices) and the
 /// linearization point of their constraints: the gap rows of every primary candidate
-/// (frictionless, `super::gap`) or the gap corrections `e` (tied,
-/// `super::interface`).
+/// (frictionless and Coulomb, `super::gap`) or the gap corrections `e` (tied,
+/// `super::interface`); for a Coulomb pair, the history the next load step starts from.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ActiveSet {
     pub nodes: BTreeSet<usize>,
     pub rows: Vec<GapRow>,
     pub corrections: Vec<f64>,
+    /// Coulomb: the slipping nodes and the direction of their friction traction.
+    pub slip: BTreeMap<usize, [f64; 3]>,
+    /// Coulomb: the two bodies' displacements at the end of the step (the start of the
+    /// next one's slip), and each primary candidate's accumulated slip (the length of its
+    /// tangential slip path over the steps).
+    pub history: Option<FrictionHistory>,
+}
+
+/// What a Coulomb pair's next load step starts from.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FrictionHistory {
+    /// The primary's and the secondary's displacements (body dofs).
+    pub displacements: [Vec<f64>; 2],
+    /// The accumulated slip of every primary candidate.
+    pub accumulated_slip: Vec<f64>,
 }
 
 /// The active-set update of one iteration (step 4 of the loop, `super::solve`), in surface indices.
 pub(super) struct Update {
-    pub(super) next: BTreeSet<usize>,
+    pub(super) next: NodeStates,
+    /// Coulomb pairs: the direction of each node slipping next (loop indices), and the
+    /// largest change of a slipping node's direction ([`super::law::coulomb`]).
+    pub(super) directions: BTreeMap<usize, [f64; 3]>,
+    pub(super) max_direction_change: f64,
     /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
     pub(super) tension: Vec<(usize, f64)>,
     /// Inactive nodes with `g_i < -tol_p h_i`, with their penetration over `h_i`: every
@@ -91,7 +112,9 @@ impl Update {
         }
         next.extend(penetrating.iter().map(|&(i, _)| i));
         Self {
-            next,
+            next: NodeStates::in_contact(next),
+            directions: BTreeMap::new(),
+            max_direction_change: 0.0,
             settled: max_gap_error_over_h <= SETTLED * settings.penetration_tolerance,
             within_tolerance: max_gap_error_over_h <= settings.penetration_tolerance,
             tension,
@@ -109,7 +132,9 @@ impl Update {
             v.iter().map(|&(i, x)| (offset + i, x)).collect()
         };
         let mut merged = Self {
-            next: BTreeSet::new(),
+            next: NodeStates::default(),
+            directions: BTreeMap::new(),
+            max_direction_change: 0.0,
             tension: Vec::new(),
             penetrating: Vec::new(),
             settled: true,
@@ -118,7 +143,13 @@ impl Update {
             max_gap_error_over_h: 0.0,
         };
         for (offset, update) in parts {
-            merged.next.extend(update.next.iter().map(|&i| offset + i));
+            let shifted =
+                |set: &BTreeSet<usize>| set.iter().map(|&i| offset + i).collect::<Vec<_>>();
+            merged.next.contact.extend(shifted(&update.next.contact));
+            merged.next.slip.extend(shifted(&update.next.slip));
+            (merged.directions).extend(update.directions.iter().map(|(&i, &d)| (offset + i, d)));
+            merged.max_direction_change =
+                merged.max_direction_change.max(update.max_direction_change);
             merged.tension.extend(shift(&update.tension, offset));
             merged
                 .penetrating
@@ -132,16 +163,17 @@ impl Update {
         merged
     }
 
-    /// The active set with only the worst violation switched, if any.
-    pub(super) fn single_switch(&self, active: &BTreeSet<usize>) -> Option<BTreeSet<usize>> {
+    /// The states `active` with only the worst violation of the normal conditions switched,
+    /// if any (the slipping nodes kept as they are).
+    pub(super) fn single_switch(&self, active: &NodeStates) -> Option<NodeStates> {
         let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
-        let mut next = active.clone();
+        let mut next = active.contact.clone();
         match (worst(&self.tension), worst(&self.penetrating)) {
             (Some(t), Some(p)) if p.1 >= t.1 => next.insert(p.0),
             (Some(t), _) => next.remove(&t.0),
             (None, Some(p)) => next.insert(p.0),
             (None, None) => return None,
         };
-        Some(next)
+        Some(active.with_contact(next))
     }
 }

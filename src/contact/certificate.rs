@@ -26,6 +26,13 @@ pub enum CheckKind {
     /// Equilibrium of the interface: the contact forces on the two bodies balance.
     #[serde(rename = "equilibrium")]
     Equilibrium,
+    /// Coulomb's dual feasibility: no tangential traction beyond `mu p` (over `mu p_max`).
+    #[serde(rename = "friction cone")]
+    FrictionCone,
+    /// Coulomb's slip rule: sticking nodes do not slip, slipping nodes slip against their
+    /// friction traction (over the spacing).
+    #[serde(rename = "slip")]
+    Slip,
     /// The secondary's sag between constrained primary nodes, over the indentation depth.
     #[serde(rename = "secondary sag")]
     SecondarySag,
@@ -52,6 +59,8 @@ impl CheckKind {
             Self::Tension => "tension",
             Self::Complementarity => "complementarity",
             Self::Equilibrium => "equilibrium",
+            Self::FrictionCone => "friction cone",
+            Self::Slip => "slip",
             Self::SecondarySag => "secondary sag",
             Self::Resolution => "resolution",
             Self::ForceCentre => "force centre",
@@ -69,13 +78,18 @@ impl CheckKind {
                 | Self::Tension
                 | Self::Complementarity
                 | Self::Equilibrium
+                | Self::FrictionCone
+                | Self::Slip
         )
     }
 
     /// The unit of the figure, for messages.
     fn unit(self) -> &'static str {
         match self {
-            Self::Penetration | Self::SecondaryPenetration | Self::Complementarity => " h",
+            Self::Penetration | Self::SecondaryPenetration | Self::Complementarity | Self::Slip => {
+                " h"
+            }
+            Self::FrictionCone => " of mu times the largest pressure",
             Self::Tension => " of the largest pressure",
             Self::SecondarySag => " of the indentation depth",
             Self::ForceCentre => {

@@ -55,9 +55,10 @@ use std::collections::HashSet;
 
 use super::certificate::{Certificate, CertificateCheck, CheckKind};
 use super::gap::{gap_rows, geometric_gaps};
+use super::law::{ContactLaw, Tangential};
 use super::solution::ContactStatus;
 use super::system::CoupledSolution;
-use super::{ContactProblem, ContactSurface, Formulation};
+use super::{ContactProblem, ContactSurface};
 
 /// How the loop's ending and the residual checks make the status: the one place that decides
 /// it. A loop that stopped converged has solved the discrete problem only if every residual,
@@ -179,11 +180,11 @@ fn complementarity(
 ) -> CertificateCheck {
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
-    let held: Vec<f64> = match problem.settings.formulation {
-        Formulation::Frictionless => (gap_rows(s1, s2, Some(u1), Some(u2)).into_iter())
+    let held: Vec<f64> = match ContactLaw::of(&problem.settings).holds_geometric_gap() {
+        true => (gap_rows(s1, s2, Some(u1), Some(u2)).into_iter())
             .map(|row| row.gap)
             .collect(),
-        Formulation::Tied => gaps1.to_vec(),
+        false => gaps1.to_vec(),
     };
     let mut worst = Worst::default();
     for &i in active {
@@ -191,6 +192,44 @@ fn complementarity(
     }
     let tolerance = problem.settings.penetration_tolerance;
     worst.check(CheckKind::Complementarity, tolerance)
+}
+
+/// The residuals of the Coulomb law at the answer of a Coulomb pair with coefficient `mu`,
+/// on every primary candidate in `state` (`None`: open) with its `pressure`, tangential
+/// traction `t_t` and slip increment `slip` over the step (`super::law::coulomb`):
+/// - **Friction cone** (dual feasibility): `(|t_T| - mu p) / (mu p_max)` at every node in
+///   contact, within `tension_tolerance` (the slack of the update);
+/// - **Slip**: a sticking node's slip `|v|`, and a slipping node's slip along its own
+///   friction traction `v . d` (it must slip against it), over its spacing, within
+///   `penetration_tolerance` (the bound that holds the normal gap).
+pub fn friction(
+    problem: &ContactProblem,
+    mu: f64,
+    state: &[Option<Tangential>],
+    pressure: &[f64],
+    t_t: &[[f64; 3]],
+    slip: &[[f64; 3]],
+) -> [CertificateCheck; 2] {
+    let s1 = &problem.primary_surface;
+    let settings = &problem.settings;
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let p_max = pressure.iter().copied().fold(0.0, f64::max);
+    let (mut cone, mut slipping) = (Worst::default(), Worst::default());
+    for (i, state) in state.iter().enumerate() {
+        let Some(state) = state else { continue };
+        if p_max > 0.0 {
+            cone.offer((norm(t_t[i]) - mu * pressure[i]) / (mu * p_max), s1, i);
+        }
+        let along = match state {
+            Tangential::Stick => norm(slip[i]),
+            Tangential::Slip { direction } => (0..3).map(|k| slip[i][k] * direction[k]).sum(),
+        };
+        slipping.offer(along / s1.spacing[i], s1, i);
+    }
+    [
+        cone.check(CheckKind::FrictionCone, settings.tension_tolerance),
+        slipping.check(CheckKind::Slip, settings.penetration_tolerance),
+    ]
 }
 
 /// Equilibrium: `|F1 + F2| / |F1|`, the total contact forces on the two bodies.

@@ -520,8 +520,8 @@ mod tests {
     use std::collections::BTreeMap;
 
     use super::*;
-    use crate::contact::Formulation;
     use crate::contact::half_space::compliance_factor;
+    use crate::contact::law::{ContactLaw, Tangential};
     use crate::contact::system::Coupling;
     use crate::elastic::{DirichletCondition, ElasticProblem, SolveStats, assemble, solve};
     use crate::fem::Material;
@@ -636,10 +636,14 @@ mod tests {
         let primary_nodes: Vec<usize> = (0..=NY).map(|j| i1 + j * (nx1 + 1)).collect();
         let secondary: Vec<usize> = (0..=NY).map(|j| i2 + j * (nx2 + 1)).collect();
         Coupling {
-            formulation: Formulation::Tied,
             normals: vec![[normal, 0.0, 0.0]; NY + 1],
             areas1: (0..=NY).map(area).collect(),
-            r12: secondary.iter().map(|&n| vec![(n, 1.0)]).collect(),
+            multipliers: vec![
+                ContactLaw::Tied.multipliers([normal, 0.0, 0.0], Tangential::Stick, 2);
+                NY + 1
+            ],
+            geometric: vec![Vec::new(); NY + 1],
+            interpolated: secondary.iter().map(|&n| vec![(n, 1.0)]).collect(),
             loads2: (0..=NY).map(|j| vec![(secondary[j], area(j))]).collect(),
             gaps: vec![[0.0; 3]; NY + 1],
             primary_nodes,

@@ -56,6 +56,20 @@ pub struct StepRecord {
     pub accurate: bool,
     /// The checks this step failed: residuals (`not-solved`) and accuracy indicators.
     pub failed_checks: Vec<CheckKind>,
+    /// A Coulomb pair's tangential answer at this step.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<StepFriction>,
+}
+
+/// A Coulomb pair's tangential answer at a load step ([`super::FrictionFields`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct StepFriction {
+    /// The tangential and the normal contact force on the primary (`dim` components).
+    pub tangential_force: Vec<f64>,
+    pub normal_force: f64,
+    /// The primary's nodes in contact that stick and that slip.
+    pub stick_nodes: usize,
+    pub slip_nodes: usize,
 }
 
 impl StepRecord {
@@ -556,6 +570,12 @@ fn solve_load_steps(
                 seconds,
                 accurate: solution.certificate.accurate(),
                 failed_checks: solution.certificate.failed(),
+                friction: (solution.primary_fields.friction.as_ref()).map(|f| StepFriction {
+                    tangential_force: f.tangential_force[..dim].to_vec(),
+                    normal_force: f.normal_force,
+                    stick_nodes: f.stick_nodes,
+                    slip_nodes: f.slip_nodes,
+                }),
             });
         }
         // A step whose active set settled is a valid start for the next one, whatever its

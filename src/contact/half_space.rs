@@ -2,17 +2,19 @@
 //! of the coupled Krylov solve's preconditioner (`super::coupled_krylov`).
 //!
 //! The Schur complement `S = D - C K^-1 B` of the coupled system maps the (scaled) multipliers to
-//! the (scaled) gaps they open: `(S lambda)_k = t s sum_l (e_k . e_l) c(x_k, x_l) A_l lambda_l`,
-//! with `c(x_k, x_l)` the relative displacement of the two bodies at `x_k`, along the direction
-//! `e_k` of multiplier `k`, under a unit force at `x_l` (the facet normal for frictionless
-//! contact, an axis for tied); `t`, `s` the system's scalings (`super::system`). Its spectrum
+//! the (scaled) gaps they open: `(S lambda)_k = t s sum_l (r_k . e_l) c(x_k, x_l) A_l lambda_l`,
+//! with `c(x_k, x_l)` the relative displacement of the two bodies at `x_k`, along the row
+//! direction `r_k` of multiplier `k`, under a unit force at `x_l` along the column direction
+//! `e_l` of multiplier `l` (the facet normal for frictionless contact, an axis for tied, the
+//! local normal and tangents at a sticking node; at a slipping node `e = n - mu d` and `r = n`,
+//! `super::law::coulomb`); `t`, `s` the system's scalings (`super::system`). Its spectrum
 //! spans the ratio of the contact zone to the spacing (the compliance operator is of order -1), so
 //! a diagonal approximation leaves iteration counts growing under refinement. The approximation
 //! is the same operator for two elastic half-spaces in contact (Boussinesq; Johnson, *Contact
 //! Mechanics*, 1985, 3.2 and 2.2), on the active nodes' reference positions:
 //!
 //! ```text
-//! S~_kl = t s c0 (e_k . e_l) G_kl A_l,        1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
+//! S~_kl = t s c0 (r_k . e_l) G_kl A_l,        1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
 //!   3D: c0 = 1 / (pi E*),   G_kl = 1 / |x_k - x_l|,          G_kk = 2 / a_k,        a_k = (A_k / pi)^(1/2)
 //!   2D: c0 = 2 / (pi E*),   G_kl = -ln(|x_k - x_l| / L),     G_kk = 1 - ln(a_k / L), a_k = A_k / 2
 //! ```
@@ -110,16 +112,18 @@ impl HalfSpace {
                     e[component] = *weight;
                 }
             }
+            let row = system.rows[system.pair_multipliers(pair).start + k];
             let mut x = [0.0; 3];
             x[..dim].copy_from_slice(&coordinates[dim * node..dim * node + dim]);
             let a = area.get(&node).copied().unwrap_or(0.0);
             coupled.push(k);
-            points.push((x, e, a));
+            points.push((x, row, e, a));
         }
-        let kernel = Kernel::new(dim, points.iter().map(|(x, _, a)| (*x, *a)));
+        let kernel = Kernel::new(dim, points.iter().map(|(x, _, _, a)| (*x, *a)));
         let scale = system.t * system.s * c0;
         let p = Mat::<f64>::from_fn(points.len(), points.len(), |i, j| {
-            let ((xi, ei, ai), (xj, ej, aj)) = (&points[i], &points[j]);
+            // Row i's direction against column j's: the same vector but at a slipping node.
+            let ((xi, ei, _, ai), (xj, _, ej, aj)) = (&points[i], &points[j]);
             let along: f64 = (0..3).map(|c| ei[c] * ej[c]).sum();
             if along == 0.0 {
                 return 0.0;

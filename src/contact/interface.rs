@@ -37,9 +37,10 @@
 use std::collections::HashMap;
 
 use super::gap::GapRow;
+use super::law::{ContactLaw, Tangential, coulomb};
 use super::rbf::{Interpolation, interpolation_radii};
 use super::system::Coupling;
-use super::{ContactError, ContactSurface, Formulation};
+use super::{ContactError, ContactSurface};
 
 /// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
 /// rows and columns of the transfers computed so far (an explicit cache: callers hold it `mut`).
@@ -150,12 +151,13 @@ impl InterfaceOperators {
     }
 
     /// The coupling of the active primary candidates `active` (surface indices) under
-    /// `constraint`: the traction columns of the transfers, and the constraint rows.
+    /// `constraint`: each node's multipliers as `law` lays them out, the traction columns of
+    /// the transfers, and the constraint rows.
     pub fn coupling(
         &mut self,
         primary: &ContactSurface,
         secondary: &ContactSurface,
-        formulation: Formulation,
+        law: ContactLaw,
         active: &[usize],
         constraint: Constraint,
     ) -> Coupling {
@@ -192,13 +194,13 @@ impl InterfaceOperators {
                 }
             })
             .collect();
-        let (rows, normals, gaps) = match constraint {
+        let dim = primary.dim;
+        let interpolated = |i: usize| to_body2(&self.rows12[&i], &|_, w| w);
+        let (geometric, interpolated, normals, gaps, multipliers) = match constraint {
             Constraint::Interpolated { corrections } => (
-                active
-                    .iter()
-                    .map(|i| to_body2(&self.rows12[i], &|_, w| w))
-                    .collect(),
-                active.iter().map(|&i| self.normals[i]).collect(),
+                vec![Vec::new(); active.len()],
+                active.iter().map(|&i| interpolated(i)).collect(),
+                active.iter().map(|&i| self.normals[i]).collect::<Vec<_>>(),
                 // Only the normal part is a gap: the tied constraint would otherwise impose
                 // the tangential offset between x_i and p_i (nonzero off a flat) as a
                 // spurious jump.
@@ -209,25 +211,58 @@ impl InterfaceOperators {
                         self.normals[i].map(|n| g * n)
                     })
                     .collect(),
-            ),
-            Constraint::Geometric { rows } => (
                 active
                     .iter()
-                    .map(|&i| to_body2(&rows[i].corners, &|_, b| b))
-                    .collect(),
-                active.iter().map(|&i| rows[i].normal).collect(),
-                active
-                    .iter()
-                    .map(|&i| rows[i].normal.map(|n| rows[i].target * n))
+                    .map(|&i| law.multipliers(self.normals[i], Tangential::Stick, dim))
                     .collect(),
             ),
+            Constraint::Geometric {
+                rows,
+                start_jumps,
+                tangential,
+            } => {
+                let state = |i: usize| tangential.map_or(Tangential::Stick, |states| states[i]);
+                let sticks = |i: usize| law.has_friction() && state(i) == Tangential::Stick;
+                (
+                    active
+                        .iter()
+                        .map(|&i| to_body2(&rows[i].corners, &|_, b| b))
+                        .collect(),
+                    (active.iter())
+                        .map(|&i| match sticks(i) {
+                            true => interpolated(i),
+                            false => Vec::new(),
+                        })
+                        .collect(),
+                    active.iter().map(|&i| rows[i].normal).collect(),
+                    active
+                        .iter()
+                        .map(|&i| {
+                            let n = rows[i].normal;
+                            let normal = n.map(|n| rows[i].target * n);
+                            match (sticks(i), start_jumps) {
+                                (true, Some(jumps)) => {
+                                    let t = coulomb::tangential_part(jumps[i], n);
+                                    std::array::from_fn(|k| normal[k] + t[k])
+                                }
+                                _ => normal,
+                            }
+                        })
+                        .collect(),
+                    active
+                        .iter()
+                        .map(|&i| law.multipliers(rows[i].normal, state(i), dim))
+                        .collect(),
+                )
+            }
         };
         Coupling {
-            formulation,
             primary_nodes: active.iter().map(|&i| primary.nodes[i]).collect(),
             normals,
             areas1: active.iter().map(|&i| primary.nodal_area[i]).collect(),
-            r12: rows,
+            multipliers,
+            geometric,
+            interpolated,
             loads2,
             gaps,
         }
@@ -275,9 +310,15 @@ pub enum Constraint<'a> {
     /// Tied contact: the rows of `R12`, `u1_i - (R12 u2)_i = (d_i + e_i) n_i`, with the gap
     /// correction `e` of the last iterate (module doc).
     Interpolated { corrections: &'a [f64] },
-    /// Frictionless contact: the geometric gap linearized at the last iterate, one row per
-    /// primary candidate ([`super::gap`]).
-    Geometric { rows: &'a [GapRow] },
+    /// Frictionless and Coulomb contact: the geometric gap linearized at the last iterate, one
+    /// row per primary candidate ([`super::gap`]); for Coulomb, the tangential state of every
+    /// primary candidate and its jump at the start of the load step ([`Self::jumps`]), which a
+    /// sticking node's tangential rows hold (`super::law::coulomb`).
+    Geometric {
+        rows: &'a [GapRow],
+        start_jumps: Option<&'a [[f64; 3]]>,
+        tangential: Option<&'a [Tangential]>,
+    },
 }
 
 /// The contact normal at a node: `(w_own n_own - w_other n_other) / |...|`, its outward normal

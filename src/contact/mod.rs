@@ -41,6 +41,7 @@ mod gap;
 mod half_space;
 mod hertz;
 mod interface;
+pub mod law;
 mod post;
 mod problem;
 pub mod projection;
@@ -55,14 +56,14 @@ pub mod system;
 pub use active_set::ActiveSet;
 pub use certificate::{Certificate, CertificateCheck, CheckKind, ErrorCoverage};
 pub use coupled_krylov::{KrylovError, KrylovFailure};
-pub use driver::{ContactRun, StepRecord, solve_contact};
+pub use driver::{ContactRun, StepFriction, StepRecord, solve_contact};
 pub use problem::{
     ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,
 };
 pub use settings::{ContactSettings, CoupledSolver, Formulation, SettingsError, Transfer};
 pub use solution::{
-    ContactSolution, ContactStatus, ForcedDisplacement, HertzFit, IterationRecord, LinearSolvers,
-    PhaseSeconds, SurfaceFields,
+    ContactSolution, ContactStatus, ForcedDisplacement, FrictionFields, FrictionState, HertzFit,
+    IterationRecord, LinearSolvers, PhaseSeconds, SurfaceFields,
 };
 pub use solve::ContactSolver;
 pub use surface::{ContactSurface, SurfaceError};

@@ -4,8 +4,8 @@
 use super::active_set::ActiveSet;
 use super::certificate::{Certificate, CheckKind};
 use super::solution::{
-    ContactSolution, ContactStatus, ForcedDisplacement, IterationRecord, LinearSolvers,
-    SurfaceFields,
+    ContactSolution, ContactStatus, ForcedDisplacement, FrictionFields, IterationRecord,
+    LinearSolvers, SurfaceFields,
 };
 use super::system::{CoupledSolution, Coupling};
 use super::{ContactError, ContactProblem, ContactSurface, hertz};
@@ -32,6 +32,8 @@ pub(super) struct LastIterate<'a> {
     pub solution: CoupledSolution,
     /// Where the next load step starts.
     pub active_set: ActiveSet,
+    /// A Coulomb pair's tangential answer.
+    pub friction: Option<FrictionFields>,
 }
 
 /// The solution of the last iterate, with surface fields, forces and the Hertz fit.
@@ -49,13 +51,15 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         coupling,
         solution,
         active_set,
+        friction,
     } = last;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let dim = s1.dim;
     let [gaps1, gaps2] = gaps;
-    let primary_fields = surface_fields(s1, &solution.contact_force[0], gaps1, |s| {
+    let mut primary_fields = surface_fields(s1, &solution.contact_force[0], gaps1, |s| {
         active_set.nodes.contains(&s)
     });
+    primary_fields.friction = friction;
     let mut secondary_fields = surface_fields(s2, &solution.contact_force[1], gaps2, |_| false);
     let touching = problem.settings.secondary_penetration_tolerance;
     secondary_fields.active = secondary_in_contact(s2, &secondary_fields, touching);
@@ -214,6 +218,7 @@ fn surface_fields(
         traction,
         normal_gap: gaps,
         active: (0..surface.len()).map(active).collect(),
+        friction: None,
     }
 }
 

@@ -2,9 +2,11 @@
 //! sets seen, the nodes kept active for good, the single switch, and the tests of the gap
 //! error on one active set (converged, stalled, unstable).
 
-use std::collections::{BTreeSet, HashSet};
+use std::collections::HashSet;
 
 use super::active_set::Update;
+use super::law::NodeStates;
+use super::law::coulomb::DIRECTION_SETTLED;
 use super::solution::ContactStatus;
 
 /// An active node this many spacings off the other surface after two solves in a row, the second
@@ -20,8 +22,8 @@ const UNSTABLE_GAP_OVER_H: f64 = 1.0;
 
 /// What the loop does after an iteration.
 pub(super) enum Step {
-    /// Solve again with this active set (possibly the same, with corrected gaps).
-    Solve(BTreeSet<usize>),
+    /// Solve again with these node states (possibly the same, with corrected gaps).
+    Solve(NodeStates),
     Stop(ContactStatus),
 }
 
@@ -29,7 +31,7 @@ pub(super) enum Step {
 /// tension, those of them added back for penetration, and those kept active for good.
 #[derive(Default)]
 pub(super) struct Safeguard {
-    pub(super) seen: HashSet<BTreeSet<usize>>,
+    pub(super) seen: HashSet<NodeStates>,
     released: HashSet<usize>,
     readded: HashSet<usize>,
     pub(super) pinned: HashSet<usize>,
@@ -79,7 +81,7 @@ const CONTRACTION: f64 = 0.5;
 const STALLED_AFTER: usize = 2;
 
 impl Safeguard {
-    pub(super) fn next(&mut self, active: &BTreeSet<usize>, update: &Update) -> Step {
+    pub(super) fn next(&mut self, active: &NodeStates, update: &Update) -> Step {
         let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
         let added_back = nodes(&update.penetrating);
         let released = &self.released;
@@ -108,8 +110,14 @@ impl Safeguard {
             }
         }
         if update.next == *active {
-            if update.settled {
+            // A slipping node's direction (3D Coulomb) is a fixed point of its own: the loop
+            // goes on with the same states until it stops moving (`super::law::coulomb`).
+            let directions_settled = update.max_direction_change <= DIRECTION_SETTLED;
+            if update.settled && directions_settled {
                 return Step::Stop(ContactStatus::Converged);
+            }
+            if !directions_settled {
+                return Step::Solve(active.clone());
             }
             let error = update.max_gap_error_over_h;
             let contracted = (self.best_error).is_none_or(|best| error <= CONTRACTION * best);
@@ -140,7 +148,9 @@ impl Safeguard {
                 .filter(|i| readded.contains(i))
                 .collect();
             self.pinned.extend(alternating.iter().copied());
-            next.extend(alternating);
+            let mut contact = next.contact.clone();
+            contact.extend(alternating);
+            next = next.with_contact(contact);
             if next == *active {
                 return Step::Solve(next);
             }
@@ -161,14 +171,16 @@ mod tests {
 
     /// An update that keeps `active` as it is, with the active nodes' gap error `error` (over
     /// h), settled or not.
-    fn unchanged(active: &BTreeSet<usize>, error: f64, settled: bool) -> Update {
+    fn unchanged(active: &NodeStates, error: f64, settled: bool) -> Update {
         Update {
             next: active.clone(),
+            directions: Default::default(),
+            max_direction_change: 0.0,
             tension: Vec::new(),
             penetrating: Vec::new(),
             settled,
             within_tolerance: error <= 1e-3,
-            active: active.len(),
+            active: active.contact.len(),
             max_gap_error_over_h: error,
         }
     }
@@ -182,7 +194,7 @@ mod tests {
 
     #[test]
     fn a_gap_error_that_stops_contracting_ends_stalled() {
-        let active: BTreeSet<usize> = [1, 2, 3].into();
+        let active = NodeStates::in_contact([1, 2, 3].into());
         let mut safeguard = Safeguard::default();
         // The first solve of a set has nothing to compare with; then 0.9 and 0.95 of the last.
         assert_eq!(
@@ -201,7 +213,7 @@ mod tests {
 
     #[test]
     fn an_alternating_gap_error_ends_the_loop() {
-        let active: BTreeSet<usize> = [1, 2].into();
+        let active = NodeStates::in_contact([1, 2].into());
         let mut safeguard = Safeguard::default();
         let errors = [4.6e-4, 9.6e-5, 2.9e-5, 9.6e-5, 2.9e-5];
         for error in &errors[..4] {
@@ -218,7 +230,7 @@ mod tests {
 
     #[test]
     fn active_nodes_off_the_surface_twice_without_contracting_end_unstable() {
-        let active: BTreeSet<usize> = [1, 2].into();
+        let active = NodeStates::in_contact([1, 2].into());
         // Once far off, then contracting by Newton's method: goes on.
         let mut safeguard = Safeguard::default();
         assert_eq!(
@@ -245,9 +257,9 @@ mod tests {
     fn an_active_set_that_wanders_without_progress_ends_stalled() {
         let mut safeguard = Safeguard::default();
         for k in 0..NO_PROGRESS_AFTER + 1 {
-            let active: BTreeSet<usize> = [k].into();
+            let active = NodeStates::in_contact([k].into());
             let mut update = unchanged(&active, 1e-4, false);
-            update.next = [k + 1].into();
+            update.next = NodeStates::in_contact([k + 1].into());
             update.penetrating = vec![(k + 1, 0.02)];
             let expected = (k == NO_PROGRESS_AFTER).then_some(ContactStatus::Stalled);
             assert_eq!(
@@ -260,7 +272,7 @@ mod tests {
 
     #[test]
     fn a_stalled_gap_error_within_the_tolerance_is_converged() {
-        let active: BTreeSet<usize> = [4].into();
+        let active = NodeStates::in_contact([4].into());
         let mut safeguard = Safeguard::default();
         for error in [1.2e-5, 1.1e-5] {
             assert_eq!(
@@ -276,7 +288,7 @@ mod tests {
 
     #[test]
     fn a_contracting_gap_error_goes_on_until_it_settles() {
-        let active: BTreeSet<usize> = [1, 2].into();
+        let active = NodeStates::in_contact([1, 2].into());
         let mut safeguard = Safeguard::default();
         for error in [1e-1, 4e-2, 1e-3, 1e-6] {
             assert_eq!(
@@ -292,7 +304,10 @@ mod tests {
 
     #[test]
     fn a_slow_iteration_on_a_new_active_set_starts_the_count_again() {
-        let (first, second): (BTreeSet<usize>, BTreeSet<usize>) = ([1, 2].into(), [1, 2, 3].into());
+        let (first, second) = (
+            NodeStates::in_contact([1, 2].into()),
+            NodeStates::in_contact([1, 2, 3].into()),
+        );
         let mut safeguard = Safeguard::default();
         assert_eq!(
             status(safeguard.next(&first, &unchanged(&first, 1e-2, false))),

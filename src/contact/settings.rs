@@ -13,6 +13,21 @@ pub enum Formulation {
     /// Vector constraint (the original INTERNODES contact system): active surfaces are glued
     /// together.
     Tied,
+    /// Coulomb friction with the pair's `friction_coefficient`: each active node sticks
+    /// (its tangential slip over the load step is zero) or slips (its tangential traction is
+    /// `mu` times its pressure, against its slip) (`super::law::coulomb`).
+    Coulomb,
+}
+
+impl Formulation {
+    /// The name used in case files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Frictionless => "frictionless",
+            Self::Tied => "tied",
+            Self::Coulomb => "coulomb",
+        }
+    }
 }
 
 /// How the multiplier's force reaches the secondary body (`docs/method.md` 2.4).
@@ -97,6 +112,9 @@ const KRYLOV_MAX_ITERATIONS_CAP: usize = 10_000;
 pub struct ContactSettings {
     /// Default: frictionless.
     pub formulation: Formulation,
+    /// The Coulomb friction coefficient `mu` (> 0, finite): required by `formulation =
+    /// "coulomb"`, refused by the others.
+    pub friction_coefficient: Option<f64>,
     /// How the multiplier's force reaches the secondary (default: auto, [`Transfer`]).
     pub transfer: Transfer,
     /// How each iteration's linear system is solved (default: `auto`, the interface Schur
@@ -169,6 +187,7 @@ impl Default for ContactSettings {
     fn default() -> Self {
         Self {
             formulation: Formulation::default(),
+            friction_coefficient: None,
             transfer: Transfer::default(),
             solver: CoupledSolver::default(),
             max_iterations: 50,
@@ -198,6 +217,27 @@ impl ContactSettings {
                 value,
             })
         };
+        match (self.formulation, self.friction_coefficient) {
+            (Formulation::Coulomb, None) => {
+                return error(
+                    "friction_coefficient",
+                    "given for formulation = \"coulomb\" (a finite number > 0)",
+                    f64::NAN,
+                );
+            }
+            (Formulation::Coulomb, Some(mu)) if !(mu > 0.0 && mu.is_finite()) => {
+                return error("friction_coefficient", "a finite number > 0", mu);
+            }
+            (Formulation::Frictionless | Formulation::Tied, Some(mu)) => {
+                return error(
+                    "friction_coefficient",
+                    "left out unless formulation = \"coulomb\" (frictionless and tied \
+                     contact have no friction coefficient)",
+                    mu,
+                );
+            }
+            _ => {}
+        }
         // The loop ends by itself within a few iterations of a repeat or a stall
         // (`super::solve`); a cap beyond this only postpones a status that is already due.
         if !(1..=MAX_ITERATIONS_CAP).contains(&self.max_iterations) {

@@ -97,6 +97,12 @@ pub struct IterationRecord {
     /// GMRES iterations of the iteration's interface solves (a loose solve and, when its
     /// answer keeps the active set, the exact one); `None` on the dense paths.
     pub krylov_iterations: Option<usize>,
+    /// Coulomb pairs: the nodes in contact that slip next, and the largest change of a
+    /// slipping node's direction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slipping: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_direction_change: Option<f64>,
     pub seconds: PhaseSeconds,
 }
 
@@ -118,7 +124,12 @@ impl IterationRecord {
             t.operators,
             t.solve,
             t.search
-        )
+        ) + &self.slipping.map_or(String::new(), |slip| {
+            format!(
+                "; slipping {slip}, direction change {:.1e}",
+                self.max_direction_change.unwrap_or(0.0)
+            )
+        })
     }
 }
 
@@ -139,6 +150,47 @@ pub struct SurfaceFields {
     /// to its closest point, negative inside the other body (defined at any distance).
     pub normal_gap: Vec<f64>,
     pub active: Vec<bool>,
+    /// A Coulomb pair's primary: the tangential answer at every node.
+    pub friction: Option<FrictionFields>,
+}
+
+/// The state of a primary candidate of a Coulomb pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FrictionState {
+    Open,
+    Stick,
+    Slip,
+}
+
+impl FrictionState {
+    /// The value written to the surface fields: 0 open, 1 stick, 2 slip.
+    pub fn code(self) -> f64 {
+        match self {
+            Self::Open => 0.0,
+            Self::Stick => 1.0,
+            Self::Slip => 2.0,
+        }
+    }
+}
+
+/// A Coulomb pair's tangential answer on its primary surface (`super::law::coulomb`), every
+/// candidate node in the order of [`SurfaceFields::nodes`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrictionFields {
+    pub state: Vec<FrictionState>,
+    /// The tangential traction on the primary, `t_T = lambda - (lambda . n) n`.
+    pub tangential_traction: Vec<[f64; 3]>,
+    /// The tangential slip of the primary relative to the secondary over the load step.
+    pub slip_increment: Vec<[f64; 3]>,
+    /// The length of each node's tangential slip path over all load steps so far.
+    pub accumulated_slip: Vec<f64>,
+    /// `sum A_i t_T,i` and `sum A_i p_i` over the primary's nodes: the tangential and the
+    /// normal contact force on the primary.
+    pub tangential_force: [f64; 3],
+    pub normal_force: f64,
+    pub stick_nodes: usize,
+    pub slip_nodes: usize,
 }
 
 /// Least-squares fit of the Hertz ellipse `p^2 = p0^2 (1 - r^2 / a^2)` to the mean pressures of

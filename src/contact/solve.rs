@@ -64,24 +64,26 @@
 //! surface on two solves in a row, the second not contracting (or followed by an interface
 //! system that cannot be solved accurately), is [`ContactStatus::Unstable`].
 
-use std::collections::{BTreeSet, HashMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::time::Instant;
 
-use super::active_set::{ActiveSet, Update};
-use super::checks::{certify, contact_status};
+use super::active_set::{ActiveSet, FrictionHistory, Update};
+use super::checks::{self, certify, contact_status};
 use super::coupled_krylov::Tightness;
 use super::coupled_solver::{self, BodyFactors};
 use super::gap::{GapRow, gap_rows, geometric_gaps};
 use super::half_space::{compliance_factor, force_controlled_set, predicted_set};
 use super::interface::{Constraint, InterfaceOperators};
+use super::law::{ContactLaw, NodeStates, Tangential, coulomb};
 use super::post::{self, LastIterate};
 use super::safeguard::{Safeguard, Step};
 use super::settings::CoupledSolver;
 use super::solution::{
-    ContactSolution, ContactStatus, IterationRecord, LinearSolvers, PhaseSeconds,
+    ContactSolution, ContactStatus, FrictionFields, FrictionState, IterationRecord, LinearSolvers,
+    PhaseSeconds,
 };
 use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
-use super::{ContactError, ContactProblem, ContactSettings, ContactSurface, Formulation, Transfer};
+use super::{ContactError, ContactProblem, ContactSettings, ContactSurface, Transfer};
 use crate::elastic::{AssembledBody, ElasticProblem, SolveStats, SolverSettings, assemble};
 use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::BodySolverKind;
@@ -192,6 +194,8 @@ pub struct ContactSolver<'a> {
     /// Each pair's operators, paired for the slide of the last solve; a solve without a start
     /// pairs them again unslid, so that it does not depend on earlier solves.
     operators: Vec<InterfaceOperators>,
+    /// Each pair's contact law.
+    laws: Vec<ContactLaw>,
 }
 
 /// The interface operators of `problem`, paired with the primary surface slid by `slid` over
@@ -377,6 +381,7 @@ impl<'a> ContactSolver<'a> {
             held_by_contact,
             free_motions,
             operators,
+            laws: pairs.iter().map(|p| ContactLaw::of(&p.settings)).collect(),
         })
     }
 
@@ -455,6 +460,8 @@ impl<'a> ContactSolver<'a> {
                         .collect(),
                     rows: gap_rows(s1, s2, None, None),
                     corrections: vec![0.0; s1.len()],
+                    slip: BTreeMap::new(),
+                    history: None,
                 }
             })
             .collect()
@@ -480,16 +487,27 @@ impl<'a> ContactSolver<'a> {
             Some(start) => start.to_vec(),
             None => self.initial_active_set(),
         };
-        let mut active = BTreeSet::new();
-        let (mut rows, mut corrections) = (Vec::new(), Vec::new());
+        let mut active = NodeStates::default();
+        let mut directions = BTreeMap::new();
+        let (mut rows, mut corrections, mut friction) = (Vec::new(), Vec::new(), Vec::new());
         for (p, set) in start.into_iter().enumerate() {
-            active.extend(set.nodes.iter().map(|&i| self.offsets[p] + i));
+            let offset = self.offsets[p];
+            active.contact.extend(set.nodes.iter().map(|&i| offset + i));
+            active.slip.extend(set.slip.keys().map(|&i| offset + i));
+            directions.extend(set.slip.iter().map(|(&i, &d)| (offset + i, d)));
+            friction.push(
+                self.laws[p]
+                    .has_friction()
+                    .then(|| self.start_of_step(p, set.history)),
+            );
             rows.push(set.rows);
             corrections.push(set.corrections);
         }
         let mut state = LoopState {
             solved: active.clone(),
             active,
+            directions,
+            friction,
             rows,
             corrections,
             safeguard: Safeguard::default(),
@@ -528,8 +546,13 @@ fn linked_bodies(pair_bodies: &[[usize; 2]], k: usize) -> Vec<usize> {
 
 /// The active-set loop between two iterations.
 struct LoopState {
-    /// The active set the next iteration solves on (all pairs: [`ContactSolver::offsets`]).
-    active: BTreeSet<usize>,
+    /// The node states the next iteration solves on (all pairs: [`ContactSolver::offsets`]).
+    active: NodeStates,
+    /// The direction of the friction traction of each slipping node (and of nodes that
+    /// slipped before: only those in `active.slip` are read).
+    directions: BTreeMap<usize, [f64; 3]>,
+    /// Each Coulomb pair's start of the load step.
+    friction: Vec<Option<StepStart>>,
     /// Each pair's gap rows and tied corrections.
     rows: Vec<Vec<GapRow>>,
     corrections: Vec<Vec<f64>>,
@@ -537,8 +560,8 @@ struct LoopState {
     history: Vec<IterationRecord>,
     /// The last iterate: each pair's coupling, and the solution.
     last: Option<(Vec<Coupling>, CoupledSolution)>,
-    /// The active set `last` was solved on (`active` moves on to the next one).
-    solved: BTreeSet<usize>,
+    /// The node states `last` was solved on (`active` moves on to the next one).
+    solved: NodeStates,
     /// Whether the solve started without an active set from an earlier one.
     cold: bool,
     /// Whether the loop has chosen where the bodies that only their contacts hold touch first
@@ -581,21 +604,15 @@ impl ContactSolver<'_> {
         self.first_contact(state, iteration, load_factor)?;
         // 1. The coupling of the active set: rows and columns of the fixed operators.
         let nodes: Vec<Vec<usize>> = (0..self.pairs.len())
-            .map(|p| self.pair_nodes(&state.active, p))
+            .map(|p| self.pair_nodes(&state.active.contact, p))
             .collect();
+        let tangential = self.tangential_states(&state.active, &state.directions);
         let couplings = timed(&mut seconds.operators, || {
-            self.couplings(&nodes, &state.rows, &state.corrections)
+            self.couplings(&nodes, state, &tangential)
         });
-        self.check_held(&couplings, &nodes)?;
-        // 2-4. The coupled solve, the gaps at the iterate, the active set update.
-        let iterate = self.iterate(
-            &couplings,
-            &state.active,
-            load_factor,
-            &state.safeguard,
-            &mut state.rows,
-            &mut seconds,
-        );
+        self.check_held(&couplings, &nodes, &tangential)?;
+        // 2-4. The coupled solve, the gaps at the iterate, the node states' update.
+        let iterate = self.iterate(&couplings, state, &tangential, load_factor, &mut seconds);
         let Iterate {
             solution,
             gaps,
@@ -622,13 +639,16 @@ impl ContactSolver<'_> {
                 pairing_drift(&self.operators[p].slid, &slid[p], s1, &nodes[p])
             })
             .collect();
-        for (p, problem) in self.pairs.iter().enumerate() {
-            if problem.settings.formulation == Formulation::Tied {
+        for p in 0..self.pairs.len() {
+            if !self.laws[p].holds_geometric_gap() {
                 state.corrections[p] = (gaps[p].iter().zip(&linear[p]))
                     .map(|(g, l)| g - l)
                     .collect();
             }
         }
+        state
+            .directions
+            .extend(update.directions.iter().map(|(&i, &d)| (i, d)));
         // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
         //    settled on a pairing the surfaces have slid away from is paired again where
         //    they touch, and solved again.
@@ -640,6 +660,14 @@ impl ContactSolver<'_> {
                 for &p in &drifted {
                     timed(&mut seconds.operators, || self.pair_again(p, slid[p]))?;
                     state.corrections[p] = self.corrections(p, &solution, &gaps[p]);
+                    if let Some(start) = state.friction[p].as_mut() {
+                        let (s1, s2) = (
+                            &self.pairs[p].primary_surface,
+                            &self.pairs[p].secondary_surface,
+                        );
+                        let [u1, u2] = &start.displacements;
+                        start.jumps = self.operators[p].jumps(s1, s2, u1, u2);
+                    }
                 }
                 state.safeguard = Safeguard::default();
                 Step::Solve(state.active.clone())
@@ -653,7 +681,7 @@ impl ContactSolver<'_> {
         };
         let residual = solution.relative_residual;
         let drift = drift.iter().copied().fold(0.0, f64::max);
-        let record = record(
+        let mut record = record(
             &update,
             iteration,
             residual,
@@ -661,6 +689,10 @@ impl ContactSolver<'_> {
             krylov_iterations,
             seconds,
         );
+        if self.laws.iter().any(ContactLaw::has_friction) {
+            record.slipping = Some(update.next.slip.len());
+            record.max_direction_change = Some(update.max_direction_change);
+        }
         if self.solver.verbose {
             log::info!("{}", record.line());
         }
@@ -688,7 +720,8 @@ impl ContactSolver<'_> {
         }
         let touches = |k: usize| {
             (0..self.pairs.len()).any(|p| {
-                self.pair_bodies[p].contains(&k) && !self.pair_nodes(&state.active, p).is_empty()
+                self.pair_bodies[p].contains(&k)
+                    && !self.pair_nodes(&state.active.contact, p).is_empty()
             })
         };
         let untouched = (self.held_by_contact.iter()).find(|&&(k, _)| !touches(k));
@@ -733,7 +766,7 @@ impl ContactSolver<'_> {
             let mut zone = force_controlled_set(s1, &gaps, force, c0);
             if zone.is_empty() {
                 // No force to place: the nodes that touch already, or the closest one.
-                zone = self.pair_nodes(&state.active, p);
+                zone = self.pair_nodes(&state.active.contact, p);
             }
             if zone.is_empty() {
                 let closest = (0..s1.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]));
@@ -748,7 +781,8 @@ impl ContactSolver<'_> {
                     zone.len()
                 );
             }
-            state.active = self.with_pair_nodes(&state.active, p, zone);
+            let contact = self.with_pair_nodes(&state.active.contact, p, zone);
+            state.active = state.active.with_contact(contact);
         }
         state.first_contact = true;
         Ok(())
@@ -783,7 +817,12 @@ impl ContactSolver<'_> {
     /// `x_i` and the free motions `V`, the Gram matrix `sum (h_i V)^T (h_i V)` must have no
     /// eigenvalue below [`HELD_PER_ROW`] times the number of rows (each `h_i` has a unit
     /// translation part, and the rotations are scaled by the body's size).
-    fn check_held(&self, couplings: &[Coupling], nodes: &[Vec<usize>]) -> Result<(), ContactError> {
+    fn check_held(
+        &self,
+        couplings: &[Coupling],
+        nodes: &[Vec<usize>],
+        tangential: &[Option<Vec<Tangential>>],
+    ) -> Result<(), ContactError> {
         for (k, motions) in &self.free_motions {
             let free = motions.ncols();
             if free == 0 {
@@ -796,10 +835,13 @@ impl ContactSolver<'_> {
             let mut sets: [Vec<HeldRow>; 2] = [Vec::new(), Vec::new()];
             for p in (0..self.pairs.len()).filter(|&p| self.pair_bodies[p].contains(k)) {
                 let side = usize::from(self.pair_bodies[p][0] != *k);
-                for (set, rows) in
-                    sets.iter_mut()
-                        .zip(self.held_rows(p, side, &couplings[p], &nodes[p]))
-                {
+                for (set, rows) in sets.iter_mut().zip(self.held_rows(
+                    p,
+                    side,
+                    &couplings[p],
+                    &nodes[p],
+                    tangential[p].as_deref(),
+                )) {
                     set.extend(rows);
                 }
             }
@@ -850,15 +892,18 @@ impl ContactSolver<'_> {
         side: usize,
         coupling: &Coupling,
         nodes: &[usize],
+        tangential: Option<&[Tangential]>,
     ) -> [Vec<HeldRow>; 2] {
         let problem = &self.pairs[p];
         let s1 = &problem.primary_surface;
         let dim = s1.dim;
+        let law = self.laws[p];
         let points: Vec<[f64; 3]> = nodes.iter().map(|&i| s1.coords[i]).collect();
-        if problem.settings.formulation == Formulation::Tied {
-            let axes: Vec<[f64; 3]> = (0..dim)
-                .map(|c| std::array::from_fn(|j| f64::from(u8::from(j == c))))
-                .collect();
+        let axes: Vec<[f64; 3]> = (0..dim)
+            .map(|c| std::array::from_fn(|j| f64::from(u8::from(j == c))))
+            .collect();
+        let state = |i: usize| tangential.map_or(Tangential::Stick, |states| states[i]);
+        if law == ContactLaw::Tied {
             let rows: Vec<_> = points.iter().map(|&x| (x, axes.clone())).collect();
             return [rows.clone(), rows];
         }
@@ -870,7 +915,7 @@ impl ContactSolver<'_> {
                 let s2 = &problem.secondary_surface;
                 let surface_index: HashMap<usize, usize> =
                     s2.nodes.iter().enumerate().map(|(s, &n)| (n, s)).collect();
-                (coupling.r12.iter())
+                (coupling.geometric.iter())
                     .map(|row| {
                         let mut n = [0.0; 3];
                         for &(node, w) in row {
@@ -884,10 +929,17 @@ impl ContactSolver<'_> {
                     .collect()
             }
         };
-        let constraint = (points.iter().zip(&coupling.normals))
-            .map(|(&x, &n)| (x, vec![n]))
+        // A sticking node (Coulomb) holds every direction, a sliding one its normal alone.
+        let held = |i: usize, n: [f64; 3]| match law.holds_every_direction(state(i)) {
+            true => axes.clone(),
+            false => vec![n],
+        };
+        let constraint = (nodes.iter().zip(&points).zip(&coupling.normals))
+            .map(|((&i, &x), &n)| (x, held(i, n)))
             .collect();
-        let own = points.iter().zip(own).map(|(&x, n)| (x, vec![n])).collect();
+        let own = (nodes.iter().zip(&points).zip(own))
+            .map(|((&i, &x), n)| (x, held(i, n)))
+            .collect();
         [constraint, own]
     }
 
@@ -897,16 +949,17 @@ impl ContactSolver<'_> {
     /// `next`'s nodes of a pair where the model predicts no contact.
     fn predicted(
         &self,
-        next: &BTreeSet<usize>,
+        next: &NodeStates,
         update: &Update,
         nodes: &[Vec<usize>],
         solution: &CoupledSolution,
         couplings: &[Coupling],
         gaps: &[Vec<f64>],
-    ) -> BTreeSet<usize> {
-        let mut predicted_all = next.clone();
+    ) -> NodeStates {
+        let mut predicted_all = next.contact.clone();
+        let next = &next.contact;
         for (p, problem) in self.pairs.iter().enumerate() {
-            if problem.settings.formulation != Formulation::Frictionless {
+            if !self.laws[p].predicts_zone() {
                 continue;
             }
             let s1 = &problem.primary_surface;
@@ -939,7 +992,7 @@ impl ContactSolver<'_> {
                 predicted_all = self.with_pair_nodes(&predicted_all, p, predicted);
             }
         }
-        predicted_all
+        NodeStates::in_contact(predicted_all)
     }
 
     /// Pair `p`'s tied corrections of its current operators at `solution`, whose geometric
@@ -956,28 +1009,171 @@ impl ContactSolver<'_> {
 
 impl ContactSolver<'_> {
     /// The coupling of each pair's active primary nodes `nodes` (surface indices): rows and
-    /// columns of its fixed operators, the constraint linearized by `rows` (frictionless) or
-    /// corrected by `corrections` (tied).
+    /// columns of its fixed operators, each node's multipliers as its pair's law lays them
+    /// out, the constraint linearized by the state's gap rows (frictionless, Coulomb) or
+    /// corrected by its corrections (tied); a Coulomb pair's sticking nodes hold their
+    /// tangential jumps at the start of the step.
     fn couplings(
         &mut self,
         nodes: &[Vec<usize>],
-        rows: &[Vec<GapRow>],
-        corrections: &[Vec<f64>],
+        state: &LoopState,
+        tangential: &[Option<Vec<Tangential>>],
     ) -> Vec<Coupling> {
         let mut couplings = Vec::with_capacity(self.pairs.len());
         for (p, problem) in self.pairs.iter().enumerate() {
-            let formulation = problem.settings.formulation;
-            let constraint = match formulation {
-                Formulation::Frictionless => Constraint::Geometric { rows: &rows[p] },
-                Formulation::Tied => Constraint::Interpolated {
-                    corrections: &corrections[p],
+            let law = self.laws[p];
+            let constraint = match law.holds_geometric_gap() {
+                true => Constraint::Geometric {
+                    rows: &state.rows[p],
+                    start_jumps: state.friction[p].as_ref().map(|start| &start.jumps[..]),
+                    tangential: tangential[p].as_deref(),
+                },
+                false => Constraint::Interpolated {
+                    corrections: &state.corrections[p],
                 },
             };
             let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
             let operators = &mut self.operators[p];
-            couplings.push(operators.coupling(s1, s2, formulation, &nodes[p], constraint));
+            couplings.push(operators.coupling(s1, s2, law, &nodes[p], constraint));
         }
         couplings
+    }
+
+    /// Each Coulomb pair's tangential state of every primary candidate in `states` (a
+    /// slipping node's direction from `directions`); `None` for the other pairs.
+    fn tangential_states(
+        &self,
+        states: &NodeStates,
+        directions: &BTreeMap<usize, [f64; 3]>,
+    ) -> Vec<Option<Vec<Tangential>>> {
+        (0..self.pairs.len())
+            .map(|p| {
+                self.laws[p].has_friction().then(|| {
+                    let offset = self.offsets[p];
+                    (offset..self.offsets[p + 1])
+                        .map(|i| match (states.slip.contains(&i), directions.get(&i)) {
+                            (true, Some(&direction)) => Tangential::Slip { direction },
+                            _ => Tangential::Stick,
+                        })
+                        .collect()
+                })
+            })
+            .collect()
+    }
+
+    /// Coulomb pair `p`'s tangential answer on every primary candidate at the last iterate
+    /// `view` (the pair's own solution) on the active `nodes` in `tangential` states.
+    fn friction_fields(
+        &self,
+        p: usize,
+        nodes: &[usize],
+        view: &CoupledSolution,
+        coupling: &Coupling,
+        start: &StepStart,
+        tangential: &[Tangential],
+    ) -> PairFriction {
+        let problem = &self.pairs[p];
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let jumps = self.operators[p].jumps(s1, s2, &view.u[0], &view.u[1]);
+        let len = s1.len();
+        let mut answer = PairFriction {
+            state: vec![None; len],
+            tangential_traction: vec![[0.0; 3]; len],
+            pressure: vec![0.0; len],
+            slip_increment: vec![[0.0; 3]; len],
+            accumulated_slip: start.accumulated_slip.clone(),
+            area: s1.nodal_area.clone(),
+        };
+        for (k, &i) in nodes.iter().enumerate() {
+            let (t, n) = (view.traction[0][k], coupling.normals[k]);
+            let increment: [f64; 3] = std::array::from_fn(|c| jumps[i][c] - start.jumps[i][c]);
+            let slip = coulomb::tangential_part(increment, n);
+            answer.state[i] = Some(tangential[i]);
+            answer.tangential_traction[i] = coulomb::tangential_part(t, n);
+            answer.pressure[i] = -(0..3).map(|c| t[c] * n[c]).sum::<f64>();
+            answer.slip_increment[i] = slip;
+            answer.accumulated_slip[i] += coulomb::norm(slip);
+        }
+        answer
+    }
+
+    /// Where a Coulomb pair `p`'s load step starts: the displacements the last step ended
+    /// with (`history`; none: at rest), and the jumps there through the current operators.
+    fn start_of_step(&self, p: usize, history: Option<FrictionHistory>) -> StepStart {
+        let problem = &self.pairs[p];
+        let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
+        let [a, b] = self.pair_bodies[p];
+        let history = history.unwrap_or_else(|| FrictionHistory {
+            displacements: [
+                vec![0.0; self.bodies[a].f_c.len()],
+                vec![0.0; self.bodies[b].f_c.len()],
+            ],
+            accumulated_slip: vec![0.0; s1.len()],
+        });
+        let [u1, u2] = &history.displacements;
+        StepStart {
+            jumps: self.operators[p].jumps(s1, s2, u1, u2),
+            displacements: history.displacements,
+            accumulated_slip: history.accumulated_slip,
+        }
+    }
+
+    /// The tangential part of the update (`super::law::coulomb`) of Coulomb pair `p`'s
+    /// active `nodes` at the iterate whose jumps are `jumps`, gap-row normals `normals` and
+    /// geometric gaps `gaps`, added to the pair's `update`: which nodes in contact next slip,
+    /// and along which direction. A node the update adds (it penetrates by `-g`) has no
+    /// traction yet: it is judged as the complementarity function of Hüeber, Stadler and
+    /// Wohlmuth judges it, by its augmented pressure `c (-g)` (`c = E* / h`, as `c_t`): it
+    /// slips, against its slip over the step, if `|v| > mu |g|`, and sticks otherwise.
+    #[allow(clippy::too_many_arguments)]
+    fn friction_update(
+        &self,
+        p: usize,
+        nodes: &[usize],
+        traction: &[[f64; 3]],
+        coupling: &Coupling,
+        [jumps, normals]: [&[[f64; 3]]; 2],
+        gaps: &[f64],
+        start: &StepStart,
+        tangential: &[Tangential],
+        update: &mut Update,
+    ) {
+        let ContactLaw::Coulomb {
+            friction_coefficient: mu,
+        } = self.laws[p]
+        else {
+            return;
+        };
+        let problem = &self.pairs[p];
+        let s1 = &problem.primary_surface;
+        let e_star = problem.contact_modulus();
+        let pressure = |t: &[f64; 3], n: &[f64; 3]| -(0..3).map(|k| t[k] * n[k]).sum::<f64>();
+        let p_max = (traction.iter().zip(&coupling.normals))
+            .map(|(t, n)| pressure(t, n))
+            .fold(0.0, f64::max);
+        let slack = problem.settings.tension_tolerance * mu * p_max;
+        let active: HashMap<usize, usize> =
+            nodes.iter().enumerate().map(|(k, &i)| (i, k)).collect();
+        let next: Vec<usize> = update.next.contact.iter().copied().collect();
+        for i in next {
+            let c = e_star / s1.spacing[i];
+            let increment: [f64; 3] = std::array::from_fn(|k| jumps[i][k] - start.jumps[i][k]);
+            let (state, p_i, t_t, n) = match active.get(&i) {
+                Some(&k) => {
+                    let (t, n) = (traction[k], coupling.normals[k]);
+                    let t_t = coulomb::tangential_part(t, n);
+                    (tangential[i], pressure(&t, &n), t_t, n)
+                }
+                None => (Tangential::Stick, -c * gaps[i], [0.0; 3], normals[i]),
+            };
+            let v = coulomb::tangential_part(increment, n);
+            let node = coulomb::update(state, p_i, t_t, v, mu, c, slack);
+            update.max_direction_change = update.max_direction_change.max(node.direction_change);
+            if let Tangential::Slip { direction } = node.next {
+                update.next.slip.insert(i);
+                update.directions.insert(i, direction);
+            }
+        }
     }
 
     /// Steps 2-4 of the loop on the active set `active` with the pairs' `couplings`: the
@@ -987,16 +1183,15 @@ impl ContactSolver<'_> {
     /// ([`Tightness::Loose`]) and solved again tightly when its update would keep the active
     /// set or return to one seen before: no answer, status or check rests on a loose solve.
     /// The time of each phase is added to `seconds`.
-    #[allow(clippy::too_many_arguments)]
     fn iterate(
         &mut self,
         couplings: &[Coupling],
-        active: &BTreeSet<usize>,
+        state: &mut LoopState,
+        tangential: &[Option<Vec<Tangential>>],
         load_factor: f64,
-        safeguard: &Safeguard,
-        rows: &mut [Vec<GapRow>],
         seconds: &mut PhaseSeconds,
     ) -> Result<Iterate, ContactError> {
+        let (active, safeguard) = (&state.active, &state.safeguard);
         let mut loose = self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let mut krylov_iterations = None;
         loop {
@@ -1017,19 +1212,21 @@ impl ContactSolver<'_> {
                 let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
                 let [a, b] = self.pair_bodies[p];
                 let (u1, u2) = (&solution.u[a][..], &solution.u[b][..]);
-                let nodes = self.pair_nodes(active, p);
+                let nodes = self.pair_nodes(&active.contact, p);
                 let operators = &self.operators[p];
-                let (pair_gaps, pair_linear, pair_slid) = timed(&mut seconds.search, || {
+                let rows = &mut state.rows[p];
+                let (pair_gaps, jumps, pair_slid) = timed(&mut seconds.search, || {
                     let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                    rows[p] = gap_rows(s1, s2, Some(u1), Some(u2));
+                    *rows = gap_rows(s1, s2, Some(u1), Some(u2));
                     let jumps = operators.jumps(s1, s2, u1, u2);
                     let slid = operators.slide(s1, &jumps, &nodes);
-                    (gaps, operators.linearized_gaps(&jumps), slid)
+                    (gaps, jumps, slid)
                 });
+                let pair_linear = operators.linearized_gaps(&jumps);
                 // The gap each active node's constraint holds: the gap of its linearization.
-                let held: Vec<f64> = match problem.settings.formulation {
-                    Formulation::Frictionless => rows[p].iter().map(|r| r.gap).collect(),
-                    Formulation::Tied => pair_gaps.clone(),
+                let held: Vec<f64> = match self.laws[p].holds_geometric_gap() {
+                    true => rows.iter().map(|r| r.gap).collect(),
+                    false => pair_gaps.clone(),
                 };
                 let offset = self.offsets[p];
                 let update = timed(&mut seconds.checks, || {
@@ -1038,14 +1235,29 @@ impl ContactSolver<'_> {
                         .filter(|&&i| (offset..self.offsets[p + 1]).contains(&i))
                         .map(|&i| i - offset)
                         .collect();
-                    Update::new(
+                    let mut update = Update::new(
                         problem,
                         &nodes,
                         traction,
                         normals,
                         [&pair_gaps, &held],
                         &pinned,
-                    )
+                    );
+                    if let (Some(start), Some(states)) = (&state.friction[p], &tangential[p]) {
+                        let normals: Vec<[f64; 3]> = rows.iter().map(|r| r.normal).collect();
+                        self.friction_update(
+                            p,
+                            &nodes,
+                            traction,
+                            &couplings[p],
+                            [&jumps, &normals],
+                            &pair_gaps,
+                            start,
+                            states,
+                            &mut update,
+                        );
+                    }
+                    update
                 });
                 updates.push((offset, update));
                 gaps.push(pair_gaps);
@@ -1082,19 +1294,61 @@ impl ContactSolver<'_> {
         let mut answers = Vec::with_capacity(self.pairs.len());
         for (p, problem) in self.pairs.iter().enumerate() {
             let [a, b] = self.pair_bodies[p];
-            let nodes = self.pair_nodes(&state.active, p);
+            let nodes = self.pair_nodes(&state.active.contact, p);
             let pair = Pair {
                 primary: a,
                 secondary: b,
                 coupling: &couplings[p],
             };
             let view = solution.of_pair(p, &pair, dim);
-            let (certificate, gaps) = certify(problem, &view, &nodes);
+            let (mut certificate, gaps) = certify(problem, &view, &nodes);
+            let (slip, history, friction) = match (&state.friction[p], self.laws[p]) {
+                (
+                    Some(start),
+                    ContactLaw::Coulomb {
+                        friction_coefficient,
+                    },
+                ) => {
+                    let tangential = self.tangential_states(&state.solved, &state.directions);
+                    let fields = self.friction_fields(
+                        p,
+                        &nodes,
+                        &view,
+                        &couplings[p],
+                        start,
+                        tangential[p].as_deref().unwrap_or(&[]),
+                    );
+                    for check in checks::friction(
+                        problem,
+                        friction_coefficient,
+                        &fields.state,
+                        &fields.pressure,
+                        &fields.tangential_traction,
+                        &fields.slip_increment,
+                    ) {
+                        certificate.push(check);
+                    }
+                    let slip = (fields.state.iter().enumerate())
+                        .filter_map(|(i, s)| match s {
+                            Some(Tangential::Slip { direction }) => Some((i, *direction)),
+                            _ => None,
+                        })
+                        .collect();
+                    let history = FrictionHistory {
+                        displacements: [view.u[0].clone(), view.u[1].clone()],
+                        accumulated_slip: fields.accumulated_slip.clone(),
+                    };
+                    (slip, Some(history), Some(fields.into_solution()))
+                }
+                _ => (BTreeMap::new(), None, None),
+            };
             let status = contact_status(loop_end, &certificate, nodes.is_empty());
             let active_set = ActiveSet {
                 nodes: nodes.into_iter().collect(),
                 rows: state.rows[p].clone(),
                 corrections: state.corrections[p].clone(),
+                slip,
+                history,
             };
             answers.push(post::finish(LastIterate {
                 problem,
@@ -1112,6 +1366,7 @@ impl ContactSolver<'_> {
                 coupling: &couplings[p],
                 solution: view,
                 active_set,
+                friction,
             })?);
         }
         Ok(answers)
@@ -1178,6 +1433,61 @@ struct Iterate {
     krylov_iterations: Option<usize>,
 }
 
+/// A Coulomb pair's tangential answer on every primary candidate
+/// ([`ContactSolver::friction_fields`]).
+struct PairFriction {
+    /// `None` where open.
+    state: Vec<Option<Tangential>>,
+    tangential_traction: Vec<[f64; 3]>,
+    pressure: Vec<f64>,
+    slip_increment: Vec<[f64; 3]>,
+    accumulated_slip: Vec<f64>,
+    area: Vec<f64>,
+}
+
+impl PairFriction {
+    fn into_solution(self) -> FrictionFields {
+        let mut tangential_force = [0.0; 3];
+        let mut normal_force = 0.0;
+        for (i, t) in self.tangential_traction.iter().enumerate() {
+            (0..3).for_each(|c| tangential_force[c] += self.area[i] * t[c]);
+            normal_force += self.area[i] * self.pressure[i];
+        }
+        let count = |slips: bool| {
+            (self.state.iter())
+                .filter(|s| matches!(s, Some(Tangential::Slip { .. })) == slips && s.is_some())
+                .count()
+        };
+        FrictionFields {
+            stick_nodes: count(false),
+            slip_nodes: count(true),
+            state: (self.state.iter())
+                .map(|s| match s {
+                    None => FrictionState::Open,
+                    Some(Tangential::Stick) => FrictionState::Stick,
+                    Some(Tangential::Slip { .. }) => FrictionState::Slip,
+                })
+                .collect(),
+            tangential_traction: self.tangential_traction,
+            slip_increment: self.slip_increment,
+            accumulated_slip: self.accumulated_slip,
+            tangential_force,
+            normal_force,
+        }
+    }
+}
+
+/// Where a Coulomb pair's load step starts ([`ContactSolver::start_of_step`]).
+struct StepStart {
+    /// The primary's and the secondary's displacements at the end of the last step.
+    displacements: [Vec<f64>; 2],
+    /// The jump `u1_i - (R12 u2)_i` of every primary candidate there, through the current
+    /// operators (computed again when they are paired again).
+    jumps: Vec<[f64; 3]>,
+    /// The accumulated slip of every primary candidate at the end of the last step.
+    accumulated_slip: Vec<f64>,
+}
+
 /// Runs `f`, adding its wall-clock seconds to `slot`.
 fn timed<T>(slot: &mut f64, f: impl FnOnce() -> T) -> T {
     let clock = Instant::now();
@@ -1207,6 +1517,8 @@ fn record(
         pairing_drift_over_h,
         relative_residual: residual,
         krylov_iterations,
+        slipping: None,
+        max_direction_change: None,
         seconds,
     }
 }

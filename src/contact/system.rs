@@ -52,34 +52,43 @@ use std::ops::Range;
 
 use faer::sparse::{SparseColMat, Triplet};
 
+use super::ContactError;
 use super::compliance::MultiplierKey;
-use super::{ContactError, Formulation};
+use super::law::{Multiplier, Reads, Restates};
 use rayon::prelude::*;
 
 use crate::elastic::AssembledBody;
 use crate::linalg::{BodySolver, mat_vec};
 
 /// The interface operators of one pair in one iteration, on its active primary nodes I (built
-/// by `super::interface::InterfaceOperators::coupling`).
+/// by `super::interface::InterfaceOperators::coupling`, each node's multipliers laid out by the
+/// pair's contact law, `super::law`).
 pub struct Coupling {
-    pub formulation: Formulation,
     /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
-    /// Normal at each active node (pointing out of the primary). Frictionless: the normal of
-    /// the secondary facet the node is held on, the direction of both its constraint row (the
-    /// gradient of its gap, `super::gap`) and its traction `lambda_n n`. Tied: the contact
-    /// normal along which the gap is held.
+    /// Normal at each active node (pointing out of the primary), along which its pressure
+    /// `p = -lambda . n` is measured. Frictionless and Coulomb: the normal of the secondary
+    /// facet the node is held on, the direction of its normal constraint row (the gradient of
+    /// its gap, `super::gap`). Tied: the contact normal along which the gap is held.
     pub normals: Vec<[f64; 3]>,
     /// Lumped interface mass of each active node: its area `A_i`.
     pub areas1: Vec<f64>,
-    /// Constraint row of each active node: `(secondary body node, weight)`, a row of `R12`
-    /// (tied) or the P1 weights of the secondary facet it projects onto (frictionless).
-    pub r12: Vec<Vec<(usize, f64)>>,
+    /// The multipliers of each active node ([`Multiplier`]): their columns and rows.
+    pub multipliers: Vec<Vec<Multiplier>>,
+    /// The secondary point a geometric row of each active node reads: `(secondary body node,
+    /// weight)`, the P1 weights of the secondary facet it projects onto (empty where no row
+    /// of the node reads it).
+    pub geometric: Vec<Vec<(usize, f64)>>,
+    /// The same through the interpolation: the row of `R12` of each active node (empty where
+    /// no row of the node reads it).
+    pub interpolated: Vec<Vec<(usize, f64)>>,
     /// Column of `M2 R21` of each active node: `(secondary body node, A2_j R21[j, i])`, the
     /// force a unit traction at node `i` puts on the secondary's nodes (with the sign of
     /// `lambda_2 = -R21 lambda` applied by the system).
     pub loads2: Vec<Vec<(usize, f64)>>,
-    /// Gap each active node is held at, as a vector along its contact normal.
+    /// The target of each active node's rows, as a vector: row `r` holds `r . (u1_i -
+    /// u2(point)) = r . target_i` (the gap along its normal, and for a sticking node the
+    /// tangential jump at the start of the step).
     pub gaps: Vec<[f64; 3]>,
 }
 
@@ -158,34 +167,45 @@ impl CoupledSolution {
 }
 
 impl Coupling {
-    fn num_multipliers(&self, dim: usize) -> usize {
-        match self.formulation {
-            Formulation::Tied => dim * self.primary_nodes.len(),
-            Formulation::Frictionless => self.primary_nodes.len(),
-        }
+    fn num_multipliers(&self) -> usize {
+        self.multipliers.iter().map(Vec::len).sum()
     }
 
-    /// Whether multiplier `col` restates a Dirichlet condition of the `primary` (see the
-    /// module doc).
-    fn is_dropped(&self, col: usize, primary: &AssembledBody, dim: usize) -> bool {
+    /// The first multiplier of each active node (within the pair), then their number.
+    fn node_offsets(&self) -> Vec<usize> {
+        let mut offsets = Vec::with_capacity(self.multipliers.len() + 1);
+        offsets.push(0);
+        for node in &self.multipliers {
+            offsets.push(offsets.last().unwrap() + node.len());
+        }
+        offsets
+    }
+
+    /// Whether `multiplier` of active node `k` restates Dirichlet conditions of the
+    /// `primary` (see the module doc).
+    fn is_dropped(
+        &self,
+        k: usize,
+        multiplier: &Multiplier,
+        primary: &AssembledBody,
+        dim: usize,
+    ) -> bool {
         let prescribed = |dof: usize| {
             primary.constraints.is_fixed(dof)
                 && !(primary.rigid.iter()).any(|rigid| rigid.dofs.contains(&dof))
         };
-        match self.formulation {
-            Formulation::Tied => prescribed(dim * self.primary_nodes[col / dim] + col % dim),
-            Formulation::Frictionless => {
-                (0..dim).all(|c| prescribed(dim * self.primary_nodes[col] + c))
-            }
+        let node = self.primary_nodes[k];
+        match multiplier.restates {
+            Restates::Component(c) => prescribed(dim * node + c),
+            Restates::Node => (0..dim).all(|c| prescribed(dim * node + c)),
         }
     }
 
-    /// Column `(multiplier, component)` coefficients of the traction at node `b`:
-    /// tied `lambda(b, c)` is its own unknown; frictionless `lambda(b) n_b[c]`.
-    fn multiplier_terms(&self, b: usize, c: usize, dim: usize) -> (usize, f64) {
-        match self.formulation {
-            Formulation::Tied => (dim * b + c, 1.0),
-            Formulation::Frictionless => (b, self.normals[b][c]),
+    /// The secondary point the row of `multiplier` of active node `k` reads.
+    fn reads(&self, k: usize, multiplier: &Multiplier) -> &[(usize, f64)] {
+        match multiplier.reads {
+            Reads::Geometric => &self.geometric[k],
+            Reads::Interpolated => &self.interpolated[k],
         }
     }
 }
@@ -227,6 +247,10 @@ pub struct CoupledSystem {
     pub t: f64,
     /// Entries `(multiplier, column < offsets[N], value)` of C.
     pub c: Vec<(usize, usize, f64)>,
+    /// The direction of each pair multiplier's constraint row (zero for a force-controlled
+    /// component): the half-space preconditioner (`super::half_space`) pairs it with the
+    /// columns' directions, which differ from it at a slipping node (`super::law::coulomb`).
+    pub rows: Vec<[f64; 3]>,
     /// Diagonal of D.
     pub d: Vec<f64>,
     /// Off-diagonal entries `(row, column, value)` of D: the couplings between the
@@ -259,7 +283,7 @@ impl CoupledSystem {
         }
         let mut multiplier_offsets = vec![0];
         for pair in pairs {
-            let count = pair.coupling.num_multipliers(dim);
+            let count = pair.coupling.num_multipliers();
             multiplier_offsets.push(multiplier_offsets.last().unwrap() + count);
         }
         let m_pairs = *multiplier_offsets.last().unwrap();
@@ -307,6 +331,7 @@ impl CoupledSystem {
             s,
             t,
             c: blocks.c,
+            rows: blocks.rows,
             d: blocks.d,
             d_coupled: blocks.d_coupled,
             rigid_offsets,
@@ -476,12 +501,15 @@ impl CoupledSystem {
         for (p, pair) in pairs.iter().enumerate() {
             let coupling = pair.coupling;
             let multipliers = &x[n + self.multiplier_offsets[p]..];
+            let first = coupling.node_offsets();
             let on_pair: Vec<[f64; 3]> = (0..coupling.primary_nodes.len())
                 .map(|k| {
                     let mut lambda = [0.0; 3];
                     for (c, value) in lambda.iter_mut().enumerate().take(dim) {
-                        let (col, weight) = coupling.multiplier_terms(k, c, dim);
-                        *value = self.s * multipliers[col] * weight;
+                        for (j, multiplier) in coupling.multipliers[k].iter().enumerate() {
+                            let term = self.s * multipliers[first[k] + j] * multiplier.force[c];
+                            *value = if j == 0 { term } else { *value + term };
+                        }
                     }
                     lambda
                 })
@@ -536,6 +564,8 @@ struct PairBlocks {
     unit_loads: Vec<UnitLoad>,
     /// [`CoupledSystem::c`].
     c: Vec<(usize, usize, f64)>,
+    /// [`CoupledSystem::rows`].
+    rows: Vec<[f64; 3]>,
     /// [`CoupledSystem::d`].
     d: Vec<f64>,
     /// [`CoupledSystem::d_coupled`].
@@ -550,6 +580,7 @@ impl PairBlocks {
             columns: vec![Vec::new(); m],
             unit_loads: Vec::new(),
             c: Vec::new(),
+            rows: vec![[0.0; 3]; m],
             d: vec![0.0; m],
             d_coupled: Vec::new(),
             g: vec![0.0; m],
@@ -578,65 +609,74 @@ impl PairBlocks {
         t: f64,
     ) {
         let first = place.first_multiplier;
-        let count = coupling.num_multipliers(dim);
-        let dropped: Vec<bool> = (0..count)
-            .map(|col| coupling.is_dropped(col, primary, dim))
-            .collect();
-        for (col, _) in dropped.iter().enumerate().filter(|(_, dropped)| **dropped) {
-            self.d[first + col] = t;
-        }
         let sides = [
             Side::new(primary, place.primary, place.primary_rigid),
             Side::new(secondary, place.secondary, place.secondary_rigid),
         ];
+        let node_offsets = coupling.node_offsets();
         for (k, &node) in coupling.primary_nodes.iter().enumerate() {
-            for c in 0..dim {
-                let (col, weight) = coupling.multiplier_terms(k, c, dim);
-                if dropped[col] || weight == 0.0 {
+            for (j, law_multiplier) in coupling.multipliers[k].iter().enumerate() {
+                let multiplier = first + node_offsets[k] + j;
+                self.rows[multiplier] = law_multiplier.row;
+                if coupling.is_dropped(k, law_multiplier, primary, dim) {
+                    self.d[multiplier] = t;
                     continue;
                 }
-                let multiplier = first + col;
-                // The column: the unit force of component c at the node, on both bodies.
-                let mut load = Vec::new();
-                let dof = dim * node + c;
-                let forces = std::iter::once((0, dof, -coupling.areas1[k])).chain(
-                    (coupling.loads2[k].iter()).map(|&(node2, value)| (1, dim * node2 + c, value)),
-                );
-                for (side, dof, value) in forces {
-                    match sides[side].unknown(dof) {
-                        Unknown::Free(row) => load.push((row, value)),
-                        Unknown::Forced(a) => {
-                            self.d_coupled.push((a, multiplier, s * value * weight));
+                for c in 0..dim {
+                    let (weight, row_weight) = (law_multiplier.force[c], law_multiplier.row[c]);
+                    if weight == 0.0 && row_weight == 0.0 {
+                        continue;
+                    }
+                    let dof = dim * node + c;
+                    if weight != 0.0 {
+                        // The column: the unit force of component c at the node, on both
+                        // bodies.
+                        let mut load = Vec::new();
+                        let forces = std::iter::once((0, dof, -coupling.areas1[k])).chain(
+                            (coupling.loads2[k].iter())
+                                .map(|&(node2, value)| (1, dim * node2 + c, value)),
+                        );
+                        for (side, dof, value) in forces {
+                            match sides[side].unknown(dof) {
+                                Unknown::Free(row) => load.push((row, value)),
+                                Unknown::Forced(a) => {
+                                    self.d_coupled.push((a, multiplier, s * value * weight));
+                                }
+                                Unknown::Prescribed => {}
+                            }
                         }
-                        Unknown::Prescribed => {}
+                        let key = MultiplierKey::Traction {
+                            pair: place.pair,
+                            node,
+                            component: c,
+                        };
+                        self.columns[multiplier].push((key, weight));
+                        self.unit_loads.push(UnitLoad {
+                            key,
+                            multiplier,
+                            weight,
+                            load,
+                        });
                     }
-                }
-                let key = MultiplierKey::Traction {
-                    pair: place.pair,
-                    node,
-                    component: c,
-                };
-                self.columns[multiplier].push((key, weight));
-                self.unit_loads.push(UnitLoad {
-                    key,
-                    multiplier,
-                    weight,
-                    load,
-                });
-                // The row: the gap of component c between the node and its secondary point.
-                let reads = std::iter::once((0, dof, t * weight)).chain(
-                    (coupling.r12[k].iter())
-                        .map(|&(node2, w)| (1, dim * node2 + c, -t * w * weight)),
-                );
-                for (side, dof, value) in reads {
-                    match sides[side].unknown(dof) {
-                        Unknown::Forced(a) => self.d_coupled.push((multiplier, a, value)),
-                        // A prescribed dof's unknown holds its value (`K_c`'s row is its
-                        // diagonal).
-                        _ => self.c.push((multiplier, sides[side].offset + dof, value)),
+                    if row_weight == 0.0 {
+                        continue;
                     }
+                    // The row: component c of the jump between the node and its secondary
+                    // point, along the row's direction.
+                    let reads = std::iter::once((0, dof, t * row_weight)).chain(
+                        (coupling.reads(k, law_multiplier).iter())
+                            .map(|&(node2, w)| (1, dim * node2 + c, -t * w * row_weight)),
+                    );
+                    for (side, dof, value) in reads {
+                        match sides[side].unknown(dof) {
+                            Unknown::Forced(a) => self.d_coupled.push((multiplier, a, value)),
+                            // A prescribed dof's unknown holds its value (`K_c`'s row is its
+                            // diagonal).
+                            _ => self.c.push((multiplier, sides[side].offset + dof, value)),
+                        }
+                    }
+                    self.g[multiplier] += t * row_weight * coupling.gaps[k][c];
                 }
-                self.g[multiplier] += t * weight * coupling.gaps[k][c];
             }
         }
     }

@@ -310,6 +310,13 @@ fn pair_csv(steps: &[StepRecord]) -> String {
             c = forced.component
         );
     }
+    let friction = steps.iter().any(|s| s.friction.is_some());
+    if friction {
+        for axis in &axes[..dim] {
+            text += &format!(",tangential_force_{axis}");
+        }
+        text += ",normal_force,stick_nodes,slip_nodes";
+    }
     text += ",seconds,failed_checks\n";
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
     for s in steps {
@@ -331,6 +338,19 @@ fn pair_csv(steps: &[StepRecord]) -> String {
         );
         for forced in &s.forced {
             text += &format!(",{:.10e},{:.10e}", forced.force, forced.displacement);
+        }
+        match (&s.friction, friction) {
+            (Some(f), _) => {
+                for t in &f.tangential_force {
+                    text += &format!(",{t:.10e}");
+                }
+                text += &format!(
+                    ",{:.10e},{},{}",
+                    f.normal_force, f.stick_nodes, f.slip_nodes
+                );
+            }
+            (None, true) => text += &",".repeat(dim + 3),
+            (None, false) => {}
         }
         text += &format!(
             ",{:.3},{}\n",

@@ -7,7 +7,11 @@
 //! `/fields/von_mises` (C); in contact runs also `/fields/contact_traction` (N, 3),
 //! `/fields/contact_pressure` (N), `/fields/contact_mean_pressure` (N), `/fields/normal_gap` (N)
 //! and `/fields/contact_active` (N),
-//! zero at nodes off the candidate surfaces (gap NaN where the other surface is out of range).
+//! zero at nodes off the candidate surfaces (gap NaN where the other surface is out of range);
+//! in runs with a Coulomb pair also, on its primary surface, `/fields/friction_state` (N: 0
+//! open, 1 stick, 2 slip, -1 off a Coulomb primary surface), `/fields/tangential_traction`
+//! (N, 3), `/fields/slip_increment` (N, 3: over the last load step) and
+//! `/fields/accumulated_slip` (N: the slip path's length over all steps).
 
 use std::path::Path;
 
@@ -35,6 +39,7 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
     let dim = bodies.first().map_or(3, |b| b.mesh.dim);
     let grid = Grid::gather(bodies, dim);
     let (num_nodes, num_cells, contact) = (grid.num_nodes, grid.num_cells, grid.contact);
+    let friction = grid.friction;
     grid.write_h5(&h5_path, dim)
         .map_err(|source| OutputError::Hdf5 {
             path: h5_path.clone(),
@@ -44,7 +49,7 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
     let xdmf_path = dir.join(format!("{stem}.xdmf"));
     std::fs::write(
         &xdmf_path,
-        xdmf_text(stem, dim, num_nodes, num_cells, contact),
+        xdmf_text(stem, dim, num_nodes, num_cells, contact, friction),
     )
     .map_err(|source| OutputError::Io {
         path: xdmf_path,
@@ -73,6 +78,12 @@ struct Grid {
     mean_pressure: Vec<f64>,
     gap: Vec<f64>,
     active: Vec<i32>,
+    /// Whether any surface has a Coulomb pair's tangential fields.
+    friction: bool,
+    friction_state: Vec<i32>,
+    tangential_traction: Vec<f64>,
+    slip_increment: Vec<f64>,
+    accumulated_slip: Vec<f64>,
 }
 
 impl Grid {
@@ -98,6 +109,11 @@ impl Grid {
             mean_pressure: vec![0.0; num_nodes],
             gap: vec![0.0; num_nodes],
             active: vec![0i32; num_nodes],
+            friction: (bodies.iter().flat_map(|b| &b.surfaces)).any(|s| s.friction.is_some()),
+            friction_state: vec![-1i32; num_nodes],
+            tangential_traction: vec![0.0; 3 * num_nodes],
+            slip_increment: vec![0.0; 3 * num_nodes],
+            accumulated_slip: vec![0.0; num_nodes],
         };
         let mut offset = 0;
         for (id, body) in bodies.iter().enumerate() {
@@ -137,6 +153,14 @@ impl Grid {
             self.mean_pressure[row] = surface.mean_pressure[s];
             self.gap[row] = surface.normal_gap[s];
             self.active[row] = i32::from(surface.active[s]);
+            if let Some(friction) = &surface.friction {
+                self.friction_state[row] = friction.state[s].code() as i32;
+                let vector = 3 * row..3 * row + 3;
+                self.tangential_traction[vector.clone()]
+                    .copy_from_slice(&friction.tangential_traction[s]);
+                self.slip_increment[vector].copy_from_slice(&friction.slip_increment[s]);
+                self.accumulated_slip[row] = friction.accumulated_slip[s];
+            }
         }
     }
 
@@ -169,6 +193,15 @@ impl Grid {
             )?;
             write_dataset(&fields, "normal_gap", &Array1::from(self.gap))?;
             write_dataset(&fields, "contact_active", &Array1::from(self.active))?;
+        }
+        if self.friction {
+            let state = Array1::from(self.friction_state);
+            write_dataset(&fields, "friction_state", &state)?;
+            let traction = table(self.tangential_traction, 3);
+            write_dataset(&fields, "tangential_traction", &traction)?;
+            write_dataset(&fields, "slip_increment", &table(self.slip_increment, 3))?;
+            let accumulated = Array1::from(self.accumulated_slip);
+            write_dataset(&fields, "accumulated_slip", &accumulated)?;
         }
         file.close()
     }
@@ -300,7 +333,50 @@ const CONTACT_ATTRIBUTES: [Attribute; 5] = [
     ),
 ];
 
-fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize, contact: bool) -> String {
+/// The fields of a run with a Coulomb pair (module doc).
+const FRICTION_ATTRIBUTES: [Attribute; 4] = [
+    Attribute::new(
+        "friction_state",
+        "Scalar",
+        "Node",
+        1,
+        INT32,
+        "/fields/friction_state",
+    ),
+    Attribute::new(
+        "tangential_traction",
+        "Vector",
+        "Node",
+        3,
+        FLOAT64,
+        "/fields/tangential_traction",
+    ),
+    Attribute::new(
+        "slip_increment",
+        "Vector",
+        "Node",
+        3,
+        FLOAT64,
+        "/fields/slip_increment",
+    ),
+    Attribute::new(
+        "accumulated_slip",
+        "Scalar",
+        "Node",
+        1,
+        FLOAT64,
+        "/fields/accumulated_slip",
+    ),
+];
+
+fn xdmf_text(
+    stem: &str,
+    dim: usize,
+    num_nodes: usize,
+    num_cells: usize,
+    contact: bool,
+    friction: bool,
+) -> String {
     let h5 = format!("{stem}.h5");
     let item = |dims: String, number: &str, precision: u8, path: &str| {
         format!(
@@ -325,7 +401,8 @@ fn xdmf_text(stem: &str, dim: usize, num_nodes: usize, num_cells: usize, contact
         item(format!("{n} 3"), "Float", 8, "/mesh/geometry")
     );
     let extra: &[Attribute] = if contact { &CONTACT_ATTRIBUTES } else { &[] };
-    for a in ATTRIBUTES.iter().chain(extra) {
+    let frictional: &[Attribute] = if friction { &FRICTION_ATTRIBUTES } else { &[] };
+    for a in ATTRIBUTES.iter().chain(extra).chain(frictional) {
         let rows = if a.center == "Node" { n } else { c };
         let dims = match a.components {
             1 => rows.to_string(),

@@ -1,0 +1,137 @@
+//! The contact law of a pair: what holds at each of its active primary nodes, and how the
+//! loop decides each node's state. Everything the loop, the coupled system and the checks need
+//! to know about the law is asked here; nothing else matches on the formulation.
+//!
+//! Every law shares the normal part: a node is open (no multiplier) or in contact (its gap
+//! held at zero, its pressure `p = -lambda . n >= 0`), decided by the primal-dual active-set
+//! update of the active-set loop (`super::solve`). The laws differ in the tangential part:
+//!
+//! | law          | node state          | multipliers per node          | constraint rows |
+//! |--------------|---------------------|-------------------------------|-----------------|
+//! | frictionless | contact             | 1: `lambda_n n`               | the normal gap, node to segment (`super::gap`) |
+//! | tied         | contact             | `dim`: the traction's components | `u1 - R12 u2 = (d + e) n` (`super::interface`) |
+//! | Coulomb      | stick               | `dim`: `lambda_n n + sum lambda_a t_a` | the normal gap; `t_a . (u1 - R12 u2)` unchanged over the step |
+//! | Coulomb      | slip along `d`      | 1: `lambda_n (n - mu d)`      | the normal gap  |
+//!
+//! A multiplier ([`Multiplier`]) is a column (the traction one unit of it exerts on the
+//! primary) and a row (a direction of the constraint, read at a point of the secondary): the
+//! coupled system (`super::system`) assembles any such list, and only a slipping node's
+//! column differs from its row, which makes the system unsymmetric.
+
+pub mod coulomb;
+mod frictionless;
+mod state;
+mod tied;
+
+pub use state::NodeStates;
+
+use super::settings::{ContactSettings, Formulation};
+
+/// Which point of the secondary surface a constraint row reads: the P1 corners of the facet
+/// the node projects onto (the geometric gap linearized, `super::gap`), or the row of the
+/// interpolation `R12` at the node's paired point (`super::interface`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reads {
+    Geometric,
+    Interpolated,
+}
+
+/// When a multiplier only restates Dirichlet conditions of the primary (and is dropped from
+/// the system: its column would be empty, `super::system`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Restates {
+    /// When every component of its node is prescribed.
+    Node,
+    /// When this component of its node is prescribed.
+    Component(usize),
+}
+
+/// One multiplier of an active node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Multiplier {
+    /// The traction on the primary per unit of the multiplier: its column.
+    pub force: [f64; 3],
+    /// The direction of its constraint: `row . (u1_i - u2(point)) = row . target_i`.
+    pub row: [f64; 3],
+    pub reads: Reads,
+    pub restates: Restates,
+}
+
+/// The tangential state of an active node of a Coulomb pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tangential {
+    /// No slip over the load step.
+    Stick,
+    /// Slipping: the friction traction on the primary is `mu p d` (`d` a unit tangent).
+    Slip { direction: [f64; 3] },
+}
+
+/// The contact law of a pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactLaw {
+    Frictionless,
+    Tied,
+    Coulomb { friction_coefficient: f64 },
+}
+
+impl ContactLaw {
+    /// The law `settings` ask for (validated: a Coulomb pair has its coefficient).
+    pub fn of(settings: &ContactSettings) -> Self {
+        match settings.formulation {
+            Formulation::Frictionless => Self::Frictionless,
+            Formulation::Tied => Self::Tied,
+            Formulation::Coulomb => Self::Coulomb {
+                friction_coefficient: settings.friction_coefficient.unwrap_or(0.0),
+            },
+        }
+    }
+
+    /// The multipliers of an active node in `tangential` state (ignored but by Coulomb)
+    /// whose constraint acts along the unit normal `normal` (pointing out of the primary).
+    pub fn multipliers(
+        &self,
+        normal: [f64; 3],
+        tangential: Tangential,
+        dim: usize,
+    ) -> Vec<Multiplier> {
+        match *self {
+            Self::Frictionless => frictionless::multipliers(normal),
+            Self::Tied => tied::multipliers(dim),
+            Self::Coulomb {
+                friction_coefficient,
+            } => coulomb::multipliers(normal, tangential, friction_coefficient, dim),
+        }
+    }
+
+    /// Whether the normal gap of an active node is held node to segment (the geometric gap
+    /// linearized at the iterate, `super::gap`); otherwise (tied) through `R12` with the gap
+    /// correction `e` of the last iterate (`super::interface`).
+    pub fn holds_geometric_gap(&self) -> bool {
+        !matches!(self, Self::Tied)
+    }
+
+    /// Whether the tangential slip of an active node is constrained through `R12` and the
+    /// loop keeps a stick/slip state per node.
+    pub fn has_friction(&self) -> bool {
+        matches!(self, Self::Coulomb { .. })
+    }
+
+    /// The directions an active node in state `tangential` holds its body along, against the
+    /// body's rigid motions (`super::solve`, `check_held`): the normal alone, or every
+    /// direction (tied, and a sticking node).
+    pub fn holds_every_direction(&self, tangential: Tangential) -> bool {
+        match self {
+            Self::Frictionless => false,
+            Self::Tied => true,
+            Self::Coulomb { .. } => tangential == Tangential::Stick,
+        }
+    }
+
+    /// Whether the first iteration may start from the half-space model's prediction of the
+    /// contact zone (`super::half_space::predicted_set`): a model of frictionless contact
+    /// between half-spaces, which a tied or frictional zone's normal part follows only for
+    /// equal materials.
+    pub fn predicts_zone(&self) -> bool {
+        matches!(self, Self::Frictionless)
+    }
+}

@@ -1,0 +1,221 @@
+//! Coulomb friction (`formulation = "coulomb"`) on the half-disc pressed onto a block (2D,
+//! plane strain, R = 1): its limits (a vanishing coefficient is frictionless contact, a large
+//! one sticks like tied contact from rest) and the load path of Cattaneo and Mindlin (pressed,
+//! then sheared at a fixed approach), against Johnson's closed form for the stick zone, and full
+//! slip carrying exactly `mu` times the normal force.
+//!
+//! A load path here is a sequence of cases on the same meshes, each solved from the node states
+//! and displacements the last one ended in (`ContactSolution::active_set`).
+
+mod common;
+
+use common::case_builder::{Body, CaseFile, Dirichlet};
+use common::half_disc_on_block;
+use internodes::case::Case;
+use internodes::contact::{
+    ActiveSet, ContactSettings, ContactSolution, ContactSolver, ContactStatus, Formulation,
+    FrictionState,
+};
+use internodes::elastic::SolverSettings;
+use internodes::mesh::read_msh;
+
+const MU: f64 = 0.3;
+/// How far the disc's top is pushed down (R = 1: a / R about 0.11).
+const APPROACH: f64 = 0.02;
+
+/// The half-disc on the block, both of one material, the disc's top moved by `(shift,
+/// -APPROACH)`, under `formulation`; the disc is the primary.
+fn disc_on_block(shift: f64, formulation: &str, mu: Option<f64>) -> CaseFile {
+    let case = half_disc_on_block("half_disc_on_block_hertz.msh")
+        .with_body("disc", |_| {
+            Body::new("disc", 1000.0, 0.3)
+                .dirichlet(Dirichlet::on("disc_top").ux(shift).uy(-APPROACH))
+        })
+        .contact_setting("formulation", formulation);
+    match mu {
+        Some(mu) => case.contact_setting("friction_coefficient", mu),
+        None => case,
+    }
+}
+
+/// Solves the cases in turn, each from where the last one ended: one answer per case, and
+/// the coordinates of the primary's candidate nodes.
+fn along_path(cases: &[CaseFile]) -> (Vec<ContactSolution>, Vec<[f64; 3]>) {
+    let mut start: Option<Vec<ActiveSet>> = None;
+    let mut answers = Vec::new();
+    let mut coords = Vec::new();
+    for case in cases {
+        let (_dir, path) = case.write();
+        let case = Case::load(&path).unwrap();
+        let mesh = read_msh(&case.mesh).unwrap();
+        let problems = case.contact_problems(&mesh).unwrap();
+        let settings = SolverSettings {
+            verbose: false,
+            ..case.solver.clone()
+        };
+        coords = problems[0].primary_surface.coords.clone();
+        let mut solver = ContactSolver::new(&problems, &settings).unwrap();
+        let mut solutions = solver.solve(1.0, start.as_deref()).unwrap();
+        start = Some(solutions.iter().map(|s| s.active_set.clone()).collect());
+        for record in &solutions[0].history {
+            eprintln!("{}", record.line());
+        }
+        answers.push(solutions.remove(0));
+    }
+    (answers, coords)
+}
+
+fn one(case: CaseFile) -> ContactSolution {
+    along_path(&[case]).0.remove(0)
+}
+
+fn relative(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    norm(std::array::from_fn(|k| a[k] - b[k])) / norm(b)
+}
+
+/// The half-width of the stick zone: half the distance between its outermost nodes, and the
+/// largest spacing there (the resolution of that measure).
+fn stick_half_width(solution: &ContactSolution, coords: &[[f64; 3]]) -> (f64, f64) {
+    let friction = solution.primary_fields.friction.as_ref().unwrap();
+    let x: Vec<f64> = (friction.state.iter().zip(coords))
+        .filter(|(s, _)| **s == FrictionState::Stick)
+        .map(|(_, x)| x[0])
+        .collect();
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    let mut sorted = x.clone();
+    sorted.sort_by(f64::total_cmp);
+    let spacing = sorted.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    ((hi - lo) / 2.0, spacing)
+}
+
+#[test]
+fn a_vanishing_coefficient_is_frictionless_and_a_large_one_sticks_like_tied_contact() {
+    // Dissimilar materials, so that the frictionless and the tied answers differ: the block
+    // 20 times stiffer pulls the disc's surface inwards as they are pressed together.
+    // Each loop settles its active nodes on the other surface to 0.01 penetration_tolerance
+    // of a spacing (method.md 3.3), so two answers on different paths differ by that much: a
+    // tolerance of 1e-9 makes the differences of the laws themselves (of the order of mu)
+    // the ones measured.
+    let dissimilar = |formulation: &str, mu: Option<f64>| {
+        disc_on_block(0.0, formulation, mu)
+            .with_body("block", |b| Body {
+                youngs_modulus: 2.0e4,
+                ..b
+            })
+            .contact_setting("penetration_tolerance", 1e-9)
+    };
+    let frictionless = one(dissimilar("frictionless", None));
+    let tied = one(dissimilar("tied", None));
+    let sheared = relative(tied.force_primary, frictionless.force_primary);
+    assert!(sheared > 1e-3, "the two limits differ by {sheared:.2e}");
+    assert!(tied.max_tangential_traction > 1e-2 * tied.hertz_primary.unwrap().p0);
+
+    let small = one(dissimilar("coulomb", Some(1e-9)));
+    assert_eq!(small.status, ContactStatus::Converged);
+    let friction = small.primary_fields.friction.as_ref().unwrap();
+    assert_eq!(
+        friction.stick_nodes, 0,
+        "mu -> 0: every node in contact slips"
+    );
+    assert_eq!(
+        small.primary_fields.active,
+        frictionless.primary_fields.active
+    );
+    let off = relative(small.force_primary, frictionless.force_primary);
+    assert!(off < 1e-6, "mu = 1e-9 against frictionless: {off:.2e}");
+
+    let large = one(dissimilar("coulomb", Some(100.0)));
+    assert_eq!(large.status, ContactStatus::Converged);
+    let friction = large.primary_fields.friction.as_ref().unwrap();
+    assert_eq!(
+        friction.slip_nodes, 0,
+        "mu = 100: every node in contact sticks"
+    );
+    // Tied contact holds the whole jump through R12 and corrects the gap by the fixed point
+    // of section 3.2; Coulomb's sticking nodes hold the normal gap node to segment: the two
+    // agree to the settled gap tolerance, not to round-off.
+    let off = relative(large.force_primary, tied.force_primary);
+    assert!(off < 1e-4, "mu = 100 against tied: {off:.2e}");
+}
+
+#[test]
+fn a_disc_pressed_then_sheared_has_the_stick_zone_of_cattaneo_and_mindlin() {
+    // Pressed, then sheared in steps at the same approach: both bodies of one material, so that
+    // the shear does not change the pressure (Johnson 1985, 7.1): c = a sqrt(1 - Q / (mu P)).
+    let shifts = [0.0, 0.002, 0.004, 0.006];
+    let cases: Vec<CaseFile> = (shifts.iter())
+        .map(|&s| disc_on_block(s, "coulomb", Some(MU)))
+        .collect();
+    let (answers, coords) = along_path(&cases);
+    let pressed = &answers[0];
+    let a = pressed.hertz_primary.unwrap().a;
+    for (shift, answer) in shifts.iter().zip(&answers).skip(1) {
+        assert_eq!(answer.status, ContactStatus::Converged, "shift {shift}");
+        let friction = answer.primary_fields.friction.as_ref().unwrap();
+        let (q, p) = (friction.tangential_force[0].abs(), friction.normal_force);
+        let ratio = q / (MU * p);
+        let (c, h) = stick_half_width(answer, &coords);
+        let expected = a * (1.0 - ratio).sqrt();
+        eprintln!(
+            "shift {shift}: Q/(mu P) = {ratio:.3}, c = {c:.4}, Johnson {expected:.4}, a = {a:.4}, h = {h:.4}, stick {} slip {}",
+            friction.stick_nodes, friction.slip_nodes
+        );
+        assert!(ratio > 0.05 && ratio < 0.95, "shift {shift}: partial slip");
+        // The measured half-width lies between nodes: within a spacing of the closed form,
+        // plus the spacing of the Hertz fit's a.
+        assert!(
+            (c - expected).abs() <= 1.5 * h,
+            "shift {shift}: c = {c:.4} against {expected:.4} (h = {h:.4})"
+        );
+    }
+}
+
+#[test]
+fn a_disc_dragged_in_full_slip_carries_mu_times_its_normal_force() {
+    let (answers, _) = along_path(&[
+        disc_on_block(0.0, "coulomb", Some(MU)),
+        disc_on_block(0.03, "coulomb", Some(MU)),
+    ]);
+    let dragged = &answers[1];
+    assert_eq!(dragged.status, ContactStatus::Converged);
+    let friction = dragged.primary_fields.friction.as_ref().unwrap();
+    assert_eq!(friction.stick_nodes, 0);
+    let (q, p) = (friction.tangential_force[0].abs(), friction.normal_force);
+    assert!(
+        (q - MU * p).abs() <= 1e-9 * p,
+        "full slip: Q = {q:.6e} against mu P = {:.6e}",
+        MU * p
+    );
+    // The friction on the disc opposes its slip (the disc is dragged along +x).
+    assert!(friction.tangential_force[0] < 0.0);
+}
+
+#[test]
+fn a_friction_coefficient_is_refused_without_coulomb_and_required_with_it() {
+    for (formulation, mu) in [
+        ("frictionless", Some(0.3)),
+        ("tied", Some(0.3)),
+        ("coulomb", None),
+    ] {
+        let (_dir, path) = disc_on_block(0.0, formulation, mu).write();
+        let error = (Case::load(&path).err().map(|e| e.to_string())).unwrap_or_default();
+        assert!(
+            error.contains("friction_coefficient") && error.contains("[contact]"),
+            "{formulation}: {error}"
+        );
+    }
+    for mu in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+        let settings = ContactSettings {
+            formulation: Formulation::Coulomb,
+            friction_coefficient: Some(mu),
+            ..ContactSettings::default()
+        };
+        let error = settings.validate().unwrap_err().to_string();
+        assert!(error.contains("friction_coefficient"), "mu = {mu}: {error}");
+    }
+}
