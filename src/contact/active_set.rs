@@ -48,6 +48,9 @@ pub(super) struct Update {
     /// largest change of a slipping node's direction ([`super::law::coulomb`]).
     pub(super) directions: BTreeMap<usize, [f64; 3]>,
     pub(super) max_direction_change: f64,
+    /// Coulomb pairs: the nodes in contact whose tangential state changes (stick to slip or
+    /// back), with how far beyond the edge of the cone the update found them, over `mu p_max`.
+    pub(super) switching: Vec<(usize, f64)>,
     /// Active nodes (not pinned) with `p_i < -tol_t p_max`, with their tension over `p_max`.
     pub(super) tension: Vec<(usize, f64)>,
     /// Inactive nodes with `g_i < -tol_p h_i`, with their penetration over `h_i`: every
@@ -115,6 +118,7 @@ impl Update {
             next: NodeStates::in_contact(next),
             directions: BTreeMap::new(),
             max_direction_change: 0.0,
+            switching: Vec::new(),
             settled: max_gap_error_over_h <= SETTLED * settings.penetration_tolerance,
             within_tolerance: max_gap_error_over_h <= settings.penetration_tolerance,
             tension,
@@ -135,6 +139,7 @@ impl Update {
             next: NodeStates::default(),
             directions: BTreeMap::new(),
             max_direction_change: 0.0,
+            switching: Vec::new(),
             tension: Vec::new(),
             penetrating: Vec::new(),
             settled: true,
@@ -150,6 +155,7 @@ impl Update {
             (merged.directions).extend(update.directions.iter().map(|(&i, &d)| (offset + i, d)));
             merged.max_direction_change =
                 merged.max_direction_change.max(update.max_direction_change);
+            merged.switching.extend(shift(&update.switching, offset));
             merged.tension.extend(shift(&update.tension, offset));
             merged
                 .penetrating
@@ -164,9 +170,18 @@ impl Update {
     }
 
     /// The states `active` with only the worst violation of the normal conditions switched,
-    /// if any (the slipping nodes kept as they are).
+    /// if any (the slipping nodes kept as they are); without one, only the tangential state of
+    /// the node furthest beyond the cone's edge.
     pub(super) fn single_switch(&self, active: &NodeStates) -> Option<NodeStates> {
         let worst = |v: &[(usize, f64)]| v.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+        if self.tension.is_empty() && self.penetrating.is_empty() {
+            let (node, _) = worst(&self.switching)?;
+            let mut next = active.clone();
+            if !next.slip.remove(&node) {
+                next.slip.insert(node);
+            }
+            return Some(next);
+        }
         let mut next = active.contact.clone();
         match (worst(&self.tension), worst(&self.penetrating)) {
             (Some(t), Some(p)) if p.1 >= t.1 => next.insert(p.0),

@@ -176,6 +176,7 @@ mod tests {
             next: active.clone(),
             directions: Default::default(),
             max_direction_change: 0.0,
+            switching: Vec::new(),
             tension: Vec::new(),
             penetrating: Vec::new(),
             settled,

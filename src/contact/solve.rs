@@ -1169,6 +1169,10 @@ impl ContactSolver<'_> {
             let v = coulomb::tangential_part(increment, n);
             let node = coulomb::update(state, p_i, t_t, v, mu, c, slack);
             update.max_direction_change = update.max_direction_change.max(node.direction_change);
+            let slips = |s: Tangential| matches!(s, Tangential::Slip { .. });
+            if active.contains_key(&i) && slips(state) != slips(node.next) && p_max > 0.0 {
+                update.switching.push((i, node.margin / (mu * p_max)));
+            }
             if let Tangential::Slip { direction } = node.next {
                 update.next.slip.insert(i);
                 update.directions.insert(i, direction);

@@ -64,9 +64,11 @@ pub(super) fn multipliers(
     };
     match tangential {
         Tangential::Slip { direction } => {
-            vec![normal_row(std::array::from_fn(|k| {
-                normal[k] - mu * direction[k]
-            }))]
+            // The direction was chosen tangent to the last iterate's normal; made tangent to
+            // this one, so that the traction's normal part is the pressure and its tangential
+            // part exactly `mu p` (the cone's edge).
+            let d = unit(tangential_part(direction, normal));
+            vec![normal_row(std::array::from_fn(|k| normal[k] - mu * d[k]))]
         }
         Tangential::Stick => std::iter::once(normal_row(normal))
             .chain(tangents(normal, dim).into_iter().map(|t| Multiplier {
@@ -83,6 +85,8 @@ pub(super) fn multipliers(
 #[derive(Debug, Clone, Copy)]
 pub struct NodeUpdate {
     pub next: Tangential,
+    /// How far from the cone's edge the test found the node, `| |xi| - mu p |` (a traction).
+    pub margin: f64,
     /// `|d_next - d|` for a node that slips before and after (0 otherwise).
     pub direction_change: f64,
 }
@@ -107,9 +111,11 @@ pub fn update(
         Tangential::Stick => size <= bound + slack,
         Tangential::Slip { .. } => size < bound - slack,
     };
+    let margin = (size - bound).abs();
     if stick || size == 0.0 {
         return NodeUpdate {
             next: Tangential::Stick,
+            margin,
             direction_change: 0.0,
         };
     }
@@ -120,6 +126,7 @@ pub fn update(
     };
     NodeUpdate {
         next: Tangential::Slip { direction },
+        margin,
         direction_change,
     }
 }
