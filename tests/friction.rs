@@ -10,7 +10,7 @@
 mod common;
 
 use common::case_builder::{Body, CaseFile, Dirichlet};
-use common::contact::stacked_blocks;
+use common::contact::{hemisphere_on_block, stacked_blocks};
 use common::half_disc_on_block;
 use internodes::case::Case;
 use internodes::contact::{
@@ -58,6 +58,11 @@ fn along_path(cases: &[CaseFile]) -> (Vec<ContactSolution>, Vec<[f64; 3]>) {
         let mut solver = ContactSolver::new(&problems, &settings).unwrap();
         let mut solutions = solver.solve(1.0, start.as_deref()).unwrap();
         start = Some(solutions.iter().map(|s| s.active_set.clone()).collect());
+        if std::env::var_os("FRICTION_HISTORY").is_some() {
+            for record in &solutions[0].history {
+                eprintln!("{}", record.line());
+            }
+        }
         answers.push(solutions.remove(0));
     }
     (answers, coords)
@@ -248,5 +253,58 @@ fn a_friction_coefficient_is_refused_without_coulomb_and_required_with_it() {
         };
         let error = settings.validate().unwrap_err().to_string();
         assert!(error.contains("friction_coefficient"), "mu = {mu}: {error}");
+    }
+}
+
+#[test]
+fn a_sphere_pressed_then_sheared_has_the_stick_zone_of_mindlin() {
+    // 3D: the hemisphere (R = 1, the contact zone meshed at R/67) pressed 0.01 into the block
+    // of the same material, then sheared along x at the same approach:
+    // c = a (1 - Q / (mu P))^(1/3) (Mindlin 1949; Johnson 1985, 7.2).
+    let sphere = |shift: f64| {
+        hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
+            .with_body("sphere", |_| {
+                Body::new("sphere", 1000.0, 0.3)
+                    .dirichlet(Dirichlet::on("sphere_top").ux(shift).uy(0.0).uz(-0.01))
+            })
+            .contact_setting("formulation", "coulomb")
+            .contact_setting("friction_coefficient", MU)
+    };
+    let shifts = [0.0, 0.0012];
+    let cases: Vec<CaseFile> = shifts.iter().map(|&s| sphere(s)).collect();
+    let (answers, coords) = along_path(&cases);
+    let fit = answers[0].hertz_primary.unwrap();
+    for (shift, answer) in shifts.iter().zip(&answers).skip(1) {
+        assert_eq!(answer.status, ContactStatus::Converged, "shift {shift}");
+        let friction = answer.primary_fields.friction.as_ref().unwrap();
+        let (q, p) = (friction.tangential_force[0].abs(), friction.normal_force);
+        let ratio = q / (MU * p);
+        // The stick zone's radius: the largest distance from the zone's centre of a sticking
+        // node, against the smallest of a node in contact that slips.
+        let radius = |i: usize| {
+            let x = coords[i];
+            ((x[0] - fit.center[0]).powi(2) + (x[1] - fit.center[1]).powi(2)).sqrt()
+        };
+        let (mut stick, mut slip) = (0.0_f64, f64::INFINITY);
+        for (i, state) in friction.state.iter().enumerate() {
+            match state {
+                FrictionState::Stick => stick = stick.max(radius(i)),
+                FrictionState::Slip => slip = slip.min(radius(i)),
+                FrictionState::Open => {}
+            }
+        }
+        let expected = fit.a * (1.0 - ratio).cbrt();
+        eprintln!(
+            "shift {shift}: Q/(mu P) = {ratio:.3}, stick to r = {stick:.4}, slip from r = {slip:.4}, Mindlin c = {expected:.4}, a = {:.4}",
+            fit.a
+        );
+        assert!(ratio > 0.1 && ratio < 0.9, "shift {shift}: partial slip");
+        // The edge lies between the outermost sticking node and the innermost slipping one,
+        // within a spacing (R/67 = 0.015) of each.
+        let h = 0.015;
+        assert!(
+            stick <= expected + h && slip >= expected - h,
+            "shift {shift}: stick to {stick:.4}, slip from {slip:.4}, Mindlin {expected:.4}"
+        );
     }
 }

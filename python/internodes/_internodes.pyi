@@ -7,7 +7,7 @@ from typing import Any, Mapping, Optional, Sequence, Union, final
 import numpy as np
 import numpy.typing as npt
 
-from .summary import Contact, ForcedDisplacement, Summary
+from .summary import Contact, ForcedDisplacement, StepFriction, Summary
 
 __all__ = [
     "__version__",
@@ -203,6 +203,8 @@ class Step:
     hertz_p0: Optional[float]
     forced: list[ForcedDisplacement]
     """Each force-controlled group's force at this step and the displacement it gave."""
+    friction: Optional[StepFriction]
+    """A Coulomb pair's tangential answer at this step; None for the other laws."""
     seconds: float
 
 @final

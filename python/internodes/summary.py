@@ -8,7 +8,7 @@ their types, with what each means (docs/output.md has the file's description)::
     reason = summary["contact"]["primary_choice"]["reason"]
 """
 
-from typing import Optional, TypedDict
+from typing import NotRequired, Optional, TypedDict
 
 
 class _CheckNote(TypedDict, total=False):
@@ -110,6 +110,17 @@ class ForcedDisplacement(TypedDict):
     """The group's displacement along the component: what the force gave."""
 
 
+class StepFriction(TypedDict):
+    """A Coulomb pair's tangential answer at one load step."""
+
+    tangential_force: list[float]
+    """The tangential contact force on the primary body."""
+    normal_force: float
+    """The normal contact force on the primary body (nodal areas times pressures)."""
+    stick_nodes: int
+    slip_nodes: int
+
+
 class StepRecord(TypedDict):
     """How one load step ended (also a row of force_displacement.csv)."""
 
@@ -127,6 +138,8 @@ class StepRecord(TypedDict):
     seconds: float
     accurate: bool
     failed_checks: list[str]
+    friction: NotRequired[StepFriction]
+    """Coulomb pairs only."""
 
 
 class Contact(TypedDict):

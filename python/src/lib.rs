@@ -1180,6 +1180,10 @@ struct Step {
     /// Each force-controlled group's force at this step and the displacement it gave: a
     /// `list` of `dict`s with the keys `body`, `group`, `component`, `force`, `displacement`.
     forced: Py<PyAny>,
+    /// A Coulomb pair's tangential answer at this step, `None` for the other laws: a `dict`
+    /// with `tangential_force` (`(dim,)`, on the primary), `normal_force`, `stick_nodes` and
+    /// `slip_nodes`.
+    friction: Option<Py<PyAny>>,
     seconds: f64,
 }
 
@@ -1211,6 +1215,18 @@ impl Step {
                     list.append(dict)?;
                 }
                 list.into_any().unbind()
+            },
+            friction: match &record.friction {
+                None => None,
+                Some(friction) => {
+                    let dict = PyDict::new(py);
+                    let tangential = friction.tangential_force.clone();
+                    dict.set_item("tangential_force", array(py, tangential, &[dim])?)?;
+                    dict.set_item("normal_force", friction.normal_force)?;
+                    dict.set_item("stick_nodes", friction.stick_nodes)?;
+                    dict.set_item("slip_nodes", friction.slip_nodes)?;
+                    Some(dict.into_any().unbind())
+                }
             },
             seconds: record.seconds,
         })

@@ -10,13 +10,13 @@ from conftest import REPO
 MESH = REPO / "tests" / "fixtures" / "half_disc_on_block.msh"
 
 
-def case(load_steps, disc_top=None):
+def case(load_steps, disc_top=None, **contact):
     """The half-disc pressed onto the block, its top held by `disc_top` (default: pushed down by
-    0.02)."""
+    0.02); `contact`: more settings of the pair."""
     disc_top = disc_top or {"dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02}]}
     return internodes.Case.from_dict({
         "contact": {"bodies": ["disc", "block"], "surfaces": ["disc_contact", "block_contact"],
-                    "load_steps": load_steps},
+                    "load_steps": load_steps, **contact},
         "body": [{"name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3, **disc_top},
                  {"name": "block", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
                   "dirichlet": [{"group": "block_base", "ux": 0.0, "uy": 0.0}]}]})
@@ -79,3 +79,21 @@ def test_each_step_gives_the_displacement_of_its_force():
     # in the force's square root, and the bulk adds a linear part).
     half, full = (s.forced[0]["displacement"] for s in result.steps)
     assert full < half < 0 and 0.4 < half / full < 0.6
+
+
+def test_a_coulomb_pair_gives_each_step_its_tangential_answer():
+    # The disc pushed down and sideways in two steps: friction against the slide.
+    sideways = {"dirichlet": [{"group": "disc_top", "ux": 0.004, "uy": -0.02}]}
+    frictional = case([0.5, 1.0], sideways, formulation="coulomb", friction_coefficient=0.3)
+    result = internodes.solve(frictional, mesh=internodes.Mesh.from_msh(MESH))
+    records = result.summary["contact"]["steps"]
+    for step, record in zip(result.steps, records):
+        assert step.friction is not None and record["friction"]["stick_nodes"] == step.friction["stick_nodes"]
+        assert np.array_equal(step.friction["tangential_force"], record["friction"]["tangential_force"])
+        # |Q| <= mu P: the Coulomb cone, summed over the nodes.
+        assert np.linalg.norm(step.friction["tangential_force"]) <= 0.3 * step.friction["normal_force"] * (1 + 1e-9)
+        assert step.friction["stick_nodes"] + step.friction["slip_nodes"] > 0
+    # The friction on the disc opposes its slide (+x).
+    assert result.steps[-1].friction["tangential_force"][0] < 0.0
+    # Frictionless pairs have none.
+    assert internodes.solve(case([1.0]), mesh=internodes.Mesh.from_msh(MESH)).steps[0].friction is None

@@ -9,6 +9,9 @@
 //!   an iterate);
 //! - `settings.rs` (every setting, its default and range) and `problem.rs` (the two bodies,
 //!   their surfaces, which one is primary, which transfer);
+//! - the contact law, `law/` (frictionless, tied, Coulomb): each active node's multipliers
+//!   (column and row), the tangential state of a Coulomb node (stick, slip) and its update, and
+//!   the loop's per-node state; the only place that tells the laws apart;
 //! - the linear algebra of an iteration, for any number of bodies and pairs: `compliance.rs` (the bodies' responses to unit tractions),
 //!   `system.rs` (the coupled system of an active set), `interface.rs` (the
 //!   interface operators, built once over all candidates: the interpolation evaluated at each
