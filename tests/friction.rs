@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::case_builder::{Body, CaseFile, Dirichlet};
+use common::case_builder::{Body, CaseFile, Dirichlet, Force};
 use common::contact::{hemisphere_on_block, stacked_blocks};
 use common::half_disc_on_block;
 use internodes::case::Case;
@@ -307,4 +307,52 @@ fn a_sphere_pressed_then_sheared_has_the_stick_zone_of_mindlin() {
             "shift {shift}: stick to {stick:.4}, slip from {slip:.4}, Mindlin {expected:.4}"
         );
     }
+}
+
+/// The upper of the two stacked blocks pushed down by `push` and sideways by `shear` (total
+/// forces on its top, which moves rigidly), held sideways by nothing but friction.
+fn block_pushed(push: f64, shear: f64) -> CaseFile {
+    stacked_blocks(2)
+        .with_body("upper", |_| {
+            Body::new("upper", 1000.0, 0.3).force(Force {
+                group: "upper_top".to_string(),
+                fx: Some(shear),
+                fy: Some(-push),
+                fz: None,
+            })
+        })
+        .support("lower", Dirichlet::on("lower_base").ux(0.0))
+        .contact_setting("transfer", "conservative")
+        .contact_setting("formulation", "coulomb")
+        .contact_setting("friction_coefficient", MU)
+}
+
+#[test]
+fn a_block_held_sideways_by_friction_alone_is_accepted_while_it_sticks_and_refused_by_name_beyond()
+{
+    // Below the cone (shear = mu push / 2) the friction holds the block: a solved answer whose
+    // contact carries the whole shear.
+    let held = one(block_pushed(10.0, 0.5 * MU * 10.0));
+    assert_eq!(held.status, ContactStatus::Converged);
+    let friction = held.primary_fields.friction.as_ref().unwrap();
+    let q = friction.tangential_force[0];
+    assert!((q + 0.5 * MU * 10.0).abs() < 1e-6 * 10.0, "Q = {q:.9e}");
+    // Beyond it (shear = 1.5 mu push) every node slips and nothing holds the block sideways.
+    let (_dir, path) = block_pushed(10.0, 1.5 * MU * 10.0).write();
+    let case = Case::load(&path).unwrap();
+    let mesh = read_msh(&case.mesh).unwrap();
+    let problems = case.contact_problems(&mesh).unwrap();
+    let settings = SolverSettings {
+        verbose: false,
+        ..case.solver.clone()
+    };
+    let error = ContactSolver::new(&problems, &settings)
+        .and_then(|mut solver| solver.solve(1.0, None))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        error.contains("'upper'") && error.contains("friction"),
+        "{error}"
+    );
 }

@@ -124,7 +124,8 @@ pub enum ContactError {
         "body '{body}' is held by its contact alone along {free} of its rigid motions, and the \
          contact at this iteration's {active} active nodes does not hold it there \
          (frictionless contact cannot hold a sliding along a flat contact surface or the \
-         rotation of a round body; nothing else does): support the body along them"
+         rotation of a round body, nor can friction once every node slips: a tangential load \
+         beyond what friction holds; nothing else does): support the body along them"
     )]
     NotHeld {
         body: String,
