@@ -159,7 +159,7 @@ pub fn solve_contact_steps<'m>(
                 load_path[0].paths.keys().collect::<Vec<_>>()
             )));
         }
-        check_paths(&problems, factors)?;
+        (problems.iter()).try_for_each(|pair| pair.check_paths(factors))?;
     }
     let mut log = Log {
         verbose: solver.verbose,
@@ -628,27 +628,6 @@ fn solve_load_steps(
         }
     }
     Ok((last.expect("solve_contact checks the load factors"), steps))
-}
-
-/// An error unless `factors` gives every named load path a condition of `pairs`' bodies
-/// follows.
-pub(super) fn check_paths(
-    pairs: &[ContactProblem],
-    factors: &StepFactors,
-) -> Result<(), ContactError> {
-    for problem in pairs {
-        for elastic in [&problem.primary, &problem.secondary] {
-            if let Some(path) = factors.missing(elastic.paths()) {
-                return Err(ContactError::LoadPath(format!(
-                    "body '{}' has a condition that follows the path '{path}', and the load \
-                     steps give no factor for it (their paths: {:?})",
-                    elastic.body.name,
-                    factors.paths.keys().collect::<Vec<_>>()
-                )));
-            }
-        }
-    }
-    Ok(())
 }
 
 /// A step record's force (`dim` components) as a 3-vector.

@@ -471,7 +471,7 @@ impl<'a> ContactSolver<'a> {
         factors: &StepFactors,
         start: Option<&[ActiveSet]>,
     ) -> Result<Vec<ContactSolution>, ContactError> {
-        super::driver::check_paths(self.pairs, factors)?;
+        (self.pairs.iter()).try_for_each(|pair| pair.check_paths(factors))?;
         if start.is_none() {
             for p in 0..self.pairs.len() {
                 if self.operators[p].slid != [0.0; 3] {
