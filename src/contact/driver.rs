@@ -130,10 +130,10 @@ pub fn solve_contact<'m>(
     solve_contact_steps(problems, solver, &steps)
 }
 
-/// [`solve_contact`] along a load path: at each step every load, force and prescribed
-/// displacement is scaled by its path's factor in that step of `load_path` (the default path's, or the named
-/// one its condition follows). Every step must give every named path the problems use, and
-/// the same ones; the factors must be finite.
+/// [`solve_contact`] along a load path: at each step of `load_path` every load, force and
+/// prescribed displacement is scaled by its path's factor (the default path's, or that of the
+/// named path its condition follows). Every step must give every named path the problems use,
+/// and the same ones; the factors must be finite.
 pub fn solve_contact_steps<'m>(
     problems: Vec<ContactProblem<'m>>,
     solver: &SolverSettings,
