@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use internodes::case::Case;
 use internodes::contact::ContactSolver;
-use internodes::elastic::{SolveStats, assemble, solve};
+use internodes::elastic::{SolveStats, StepFactors, assemble, solve};
 use internodes::fem::assembly::{assemble_stiffness, stiffness_pattern};
 use internodes::linalg::{Cholesky, CholeskySymbolic};
 use internodes::mesh::{mesh_geo, read_msh};
@@ -145,8 +145,12 @@ fn main() {
                             ContactSolver::new(std::slice::from_ref(problem), &case.solver).unwrap()
                         });
                         record("contact set-up".into(), threads, seconds);
-                        let (seconds, solution) =
-                            timed(|| solver.solve(1.0, None).unwrap().remove(0));
+                        let (seconds, solution) = timed(|| {
+                            solver
+                                .solve(&StepFactors::uniform(1.0), None)
+                                .unwrap()
+                                .remove(0)
+                        });
                         record(
                             format!(
                                 "contact solve ({} iterations, {} active)",

@@ -36,6 +36,7 @@ fn hertz_block(body: &BodyMesh) -> ElasticProblem<'_> {
         vec![DirichletCondition {
             group: "block_base".into(),
             components: [Some(0.0), Some(0.0), (dim == 3).then_some(0.0)],
+            path: None,
         }],
         vec![LoadCondition {
             group: "block_top".into(),
@@ -44,6 +45,7 @@ fn hertz_block(body: &BodyMesh) -> ElasticProblem<'_> {
                 a: 0.5,
                 center: [0.0; 3],
             }),
+            path: None,
         }],
         Some([0.0, 0.0, 0.0]),
     )

@@ -7,7 +7,7 @@ use common::contact::{half_disc_on_block, solve, stiff_block};
 use common::{fixture, run_solve};
 use internodes::case::Case;
 use internodes::contact::{ContactSolver, ContactStatus};
-use internodes::elastic::SolverSettings;
+use internodes::elastic::{SolverSettings, StepFactors};
 use internodes::mesh::read_msh;
 
 #[test]
@@ -24,9 +24,15 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
         ..case.solver
     };
     let mut solver = ContactSolver::new(std::slice::from_ref(&problem), &settings).unwrap();
-    let half = solver.solve(0.5, None).unwrap().remove(0);
+    let half = solver
+        .solve(&StepFactors::uniform(0.5), None)
+        .unwrap()
+        .remove(0);
     let start = [half.active_set.clone()];
-    let full = solver.solve(1.0, Some(&start)).unwrap().remove(0);
+    let full = solver
+        .solve(&StepFactors::uniform(1.0), Some(&start))
+        .unwrap()
+        .remove(0);
     let max = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     // Both paths end when every active node lies within 0.01 tol_p h of the other surface
     // (the loop's stopping rule, tol_p = 1e-3): their displacements agree to that order.
@@ -38,7 +44,10 @@ fn load_steps_reuse_the_set_up_and_match_independent_solves() {
         .fold(f64::INFINITY, f64::min);
     let settled = 1e-2 * 1e-3 * h_min;
     for (factor, stepped) in [(0.5, &half), (1.0, &full)] {
-        let alone = solver.solve(factor, None).unwrap().remove(0);
+        let alone = solver
+            .solve(&StepFactors::uniform(factor), None)
+            .unwrap()
+            .remove(0);
         assert_eq!(stepped.status, ContactStatus::Converged);
         assert_eq!(
             stepped.primary_fields.active, alone.primary_fields.active,

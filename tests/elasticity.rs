@@ -212,15 +212,18 @@ fn uniaxial_strain_under_uniform_pressure_is_exact() {
                 DirichletCondition {
                     group: "block_base".into(),
                     components: base,
+                    path: None,
                 },
                 DirichletCondition {
                     group: "block_sides".into(),
                     components: sides,
+                    path: None,
                 },
             ],
             vec![LoadCondition {
                 group: "block_top".into(),
                 load: SurfaceLoad::Pressure(PressureField::Uniform(p)),
+                path: None,
             }],
             None,
         )
@@ -274,10 +277,12 @@ fn reactions_balance_a_hertzian_load() {
             vec![DirichletCondition {
                 group: "block_base".into(),
                 components: [Some(0.0), Some(0.0), (dim == 3).then_some(0.0)],
+                path: None,
             }],
             vec![LoadCondition {
                 group: "block_top".into(),
                 load: SurfaceLoad::Pressure(hertz.clone()),
+                path: None,
             }],
             None,
         )
@@ -310,10 +315,12 @@ fn orderings_give_the_same_solution() {
         vec![DirichletCondition {
             group: "block_base".into(),
             components: [Some(0.0); 3],
+            path: None,
         }],
         vec![LoadCondition {
             group: "block_top".into(),
             load: SurfaceLoad::Traction([0.1, 0.0, -1.0]),
+            path: None,
         }],
         Some([0.0, 0.0, -0.5]),
     )

@@ -17,7 +17,7 @@ use internodes::contact::{
     ActiveSet, ContactSettings, ContactSolution, ContactSolver, ContactStatus, Formulation,
     FrictionState,
 };
-use internodes::elastic::SolverSettings;
+use internodes::elastic::{SolverSettings, StepFactors};
 use internodes::mesh::read_msh;
 
 const MU: f64 = 0.3;
@@ -56,7 +56,7 @@ fn along_path(cases: &[CaseFile]) -> (Vec<ContactSolution>, Vec<[f64; 3]>) {
         };
         coords = problems[0].primary_surface.coords.clone();
         let mut solver = ContactSolver::new(&problems, &settings).unwrap();
-        let mut solutions = solver.solve(1.0, start.as_deref()).unwrap();
+        let mut solutions = (solver.solve(&StepFactors::uniform(1.0), start.as_deref())).unwrap();
         start = Some(solutions.iter().map(|s| s.active_set.clone()).collect());
         if std::env::var_os("FRICTION_HISTORY").is_some() {
             for record in &solutions[0].history {
@@ -347,7 +347,7 @@ fn a_block_held_sideways_by_friction_alone_is_accepted_while_it_sticks_and_refus
         ..case.solver.clone()
     };
     let error = ContactSolver::new(&problems, &settings)
-        .and_then(|mut solver| solver.solve(1.0, None))
+        .and_then(|mut solver| solver.solve(&StepFactors::uniform(1.0), None))
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();

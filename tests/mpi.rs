@@ -78,9 +78,20 @@ fn text(output: &Output) -> String {
 /// The example case `geo/<name>.toml`, its mesh path made absolute, with `extra` appended,
 /// written into `dir`.
 fn example_case(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    edited_example_case(dir, name, extra, &|_| {})
+}
+
+/// [`example_case`] with `edit` applied to its table first.
+fn edited_example_case(
+    dir: &Path,
+    name: &str,
+    extra: &str,
+    edit: &dyn Fn(&mut toml::Table),
+) -> PathBuf {
     let geo = Path::new(env!("CARGO_MANIFEST_DIR")).join("geo");
     let original = std::fs::read_to_string(geo.join(format!("{name}.toml"))).unwrap();
     let mut case: toml::Table = toml::from_str(&original).unwrap();
+    edit(&mut case);
     let mesh = case["mesh"].as_str().unwrap().to_string();
     case.insert("mesh".into(), geo.join(mesh).display().to_string().into());
     let mut text = toml::to_string(&case).unwrap();
@@ -140,8 +151,20 @@ fn ranks_give_the_serial_answer(
     contact_settings: &str,
     laterals_from_step: usize,
 ) {
+    ranks_give_the_serial_answer_of(ranks, name, contact_settings, laterals_from_step, &|_| {});
+}
+
+/// [`ranks_give_the_serial_answer`] with `edit` applied to the example's table.
+fn ranks_give_the_serial_answer_of(
+    ranks: usize,
+    name: &str,
+    contact_settings: &str,
+    laterals_from_step: usize,
+    edit: &dyn Fn(&mut toml::Table),
+) {
     let dir = tempfile::tempdir().unwrap();
-    let case = example_case(dir.path(), name, "\n[solver]\nbody = \"cg-amg\"\n");
+    let cg_amg = "\n[solver]\nbody = \"cg-amg\"\n";
+    let case = edited_example_case(dir.path(), name, cg_amg, edit);
     if !contact_settings.is_empty() {
         let text = std::fs::read_to_string(&case).unwrap();
         let text = text
@@ -271,6 +294,27 @@ fn ranks_give_the_serial_answer(
 fn the_demo_on_two_ranks_gives_the_serial_answer() {
     // 3D Hertz, five load steps; the mesh made by gmsh on rank 0 and sent to rank 1.
     ranks_give_the_serial_answer(2, "hemisphere_on_block", "", 1);
+}
+
+#[test]
+fn a_load_path_on_two_ranks_gives_the_serial_answer() {
+    // The demo's sphere pushed down along a load path that presses, then releases part way,
+    // its lateral supports on the default path: each path's part of f_c is lifted from the
+    // rows of K at the prescribed dofs, which every rank holds whole.
+    ranks_give_the_serial_answer_of(2, "hemisphere_on_block", "", 1, &|case| {
+        case["contact"].as_table_mut().unwrap().remove("load_steps");
+        let paths: toml::Table = toml::from_str("press = [0.4, 1.0, 0.7]").unwrap();
+        case.insert("load_path".into(), paths.into());
+        let sphere = &mut case["body"].as_array_mut().unwrap()[0];
+        let top = sphere["dirichlet"].as_array_mut().unwrap();
+        let mut pushed = top[0].as_table().unwrap().clone();
+        for key in ["ux", "uy"] {
+            pushed.remove(key);
+        }
+        pushed.insert("path".into(), "press".into());
+        top[0].as_table_mut().unwrap().remove("uz");
+        top.push(pushed.into());
+    });
 }
 
 #[test]

@@ -122,6 +122,7 @@ fn clamped_cube(body: &BodyMesh) -> ElasticProblem<'_> {
         vec![DirichletCondition {
             group: "base".into(),
             components: [Some(0.0); 3],
+            path: None,
         }],
         Vec::new(),
         Some([0.3, 0.1, -1.0]),

@@ -91,7 +91,13 @@ class Case:
         """The bodies' names, in the case's order."""
     @property
     def load_steps(self) -> list[float]:
-        """The contact solve's load factors ([1.0] unless the case lists steps)."""
+        """The contact solve's load factors ([1.0] unless the case lists steps); with a
+        [load_path], those of the entries without `path` (1.0 at each step unless the case
+        lists steps)."""
+    @property
+    def load_path(self) -> dict[str, list[float]]:
+        """The case's [load_path]: each named path's factors, one per load step (empty
+        without one)."""
     @property
     def pairs(self) -> list[str]:
         """The contact pairs' names, in the case's order ([contact] name, default
@@ -186,6 +192,9 @@ class Step:
     step: int
     """1, 2, ... in the order solved."""
     load_factor: float
+    """The factor of the loads, forces and prescribed displacements without a load path."""
+    path_factors: dict[str, float]
+    """Each named load path's factor at this step (empty without a [load_path])."""
     status: str
     """This step's contact status ("converged", "not-solved", ...)."""
     solved: bool

@@ -105,7 +105,7 @@ class ForcedDisplacement(TypedDict):
     component: str
     """"x", "y" or "z"."""
     force: float
-    """The prescribed force times the step's load factor."""
+    """The prescribed force times the step's factor of its load path."""
     displacement: float
     """The group's displacement along the component: what the force gave."""
 
@@ -121,11 +121,18 @@ class StepFriction(TypedDict):
     slip_nodes: int
 
 
-class StepRecord(TypedDict):
+
+class _StepPath(TypedDict, total=False):
+    path_factors: dict[str, float]
+    """Each named load path's factor at this step (only with a [load_path])."""
+
+
+class StepRecord(_StepPath):
     """How one load step ended (also a row of force_displacement.csv)."""
 
     step: int
     load_factor: float
+    """The factor of the loads, forces and prescribed displacements without a load path."""
     status: str
     iterations: int
     force_primary: list[float]

@@ -207,10 +207,19 @@ impl Case {
         self.file.bodies.iter().map(|b| b.name.clone()).collect()
     }
 
-    /// The load factors of the contact solve (`[1.0]` unless the case lists steps).
+    /// The load factors of the contact solve (`[1.0]` unless the case lists steps); with a
+    /// `[load_path]`, those of the entries without `path` (1 at each step unless the case
+    /// lists steps).
     #[getter]
     fn load_steps(&self) -> Vec<f64> {
         self.file.load_steps()
+    }
+
+    /// The case's `[load_path]`: each named path's factors, one per load step (empty without
+    /// one).
+    #[getter]
+    fn load_path(&self) -> BTreeMap<String, Vec<f64>> {
+        self.file.load_path.clone().unwrap_or_default()
     }
 
     /// The contact pairs' names, in the case's order (`[contact] name`, default
@@ -1159,7 +1168,10 @@ impl Study {
 struct Step {
     /// 1, 2, ... in the order solved.
     step: usize,
+    /// The factor of the loads, forces and prescribed displacements without a load path.
     load_factor: f64,
+    /// Each named load path's factor at this step (empty without a `[load_path]`).
+    path_factors: BTreeMap<String, f64>,
     /// The contact status of this step (`"converged"`, `"not-solved"`, ...).
     status: &'static str,
     /// Whether the status is a solution (`"converged"` or `"no-contact"`).
@@ -1193,6 +1205,7 @@ impl Step {
         Ok(Step {
             step: record.step,
             load_factor: record.load_factor,
+            path_factors: record.path_factors.clone(),
             status: record.status.name(),
             solved: record.status.is_solution(),
             accurate: record.accurate,

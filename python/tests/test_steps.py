@@ -97,3 +97,31 @@ def test_a_coulomb_pair_gives_each_step_its_tangential_answer():
     assert result.steps[-1].friction["tangential_force"][0] < 0.0
     # Frictionless pairs have none.
     assert internodes.solve(case([1.0]), mesh=internodes.Mesh.from_msh(MESH)).steps[0].friction is None
+
+
+def test_a_load_path_from_a_dict():
+    # The disc's top pushed down along "press": a dict case takes [load_path] and `path` as a
+    # case file does, and each step records its paths' factors.
+    paths = {"dirichlet": [{"group": "disc_top", "ux": 0.0, "uy": -0.02, "path": "press"}]}
+    table = {
+        "load_path": {"press": [0.5, 1.0]},
+        "contact": {"bodies": ["disc", "block"], "surfaces": ["disc_contact", "block_contact"]},
+        "body": [{"name": "disc", "youngs_modulus": 1e3, "poisson_ratio": 0.3, **paths},
+                 {"name": "block", "youngs_modulus": 1e3, "poisson_ratio": 0.3,
+                  "dirichlet": [{"group": "block_base", "ux": 0.0, "uy": 0.0}]}]}
+    along = internodes.Case.from_dict(table)
+    assert along.load_path == {"press": [0.5, 1.0]} and along.load_steps == [1.0, 1.0]
+    result = internodes.solve(along, mesh=internodes.Mesh.from_msh(MESH))
+    result.raise_for_status()
+    assert [s.path_factors for s in result.steps] == [{"press": 0.5}, {"press": 1.0}]
+    records = result.summary["contact"]["steps"]
+    assert [r["path_factors"] for r in records] == [{"press": 0.5}, {"press": 1.0}]
+    # The same answer as load steps of the same factors.
+    stepped = internodes.solve(case([0.5, 1.0]), mesh=internodes.Mesh.from_msh(MESH))
+    for step, reference in zip(result.steps, stepped.steps):
+        assert np.allclose(step.force_primary, reference.force_primary, rtol=1e-6)
+    assert stepped.steps[0].path_factors == {}
+    # A path the [load_path] does not have is an InputError naming it.
+    table["body"][0]["dirichlet"][0]["path"] = "shear"
+    with pytest.raises(internodes.InputError, match="no path 'shear'"):
+        internodes.Case.from_dict(table)

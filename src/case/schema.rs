@@ -8,7 +8,7 @@ use serde::Deserialize;
 use super::CaseError;
 use crate::contact::{ContactProblem, ContactSettings, ContactSide, ContactSurface, PrimaryChoice};
 use crate::elastic::{
-    DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, SolverSettings,
+    DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, SolverSettings, StepFactors,
 };
 use crate::fem::Material;
 use crate::fem::loads::{PressureField, SurfaceLoad};
@@ -57,8 +57,13 @@ pub struct Case {
     /// The load factors of the contact solve, applied in turn to every load, force and
     /// prescribed displacement; each step starts from the previous active sets and reuses every
     /// factorization. Default: one step at factor 1. (A single `[contact]` table may hold them
-    /// instead.)
+    /// instead.) With a `[load_path]`, the factors of the entries that name no path.
     pub load_steps: Option<Vec<f64>>,
+    /// `[load_path]`: named lists of load factors, all of one length, the number of load steps.
+    /// A `[[body.dirichlet]]`, `[[body.load]]` or `[[body.force]]` entry with `path = "NAME"`
+    /// is scaled at each step by that list's factor; an entry without `path` by `load_steps`,
+    /// or by 1 at every step when the case gives no `load_steps`. See [`Case::step_factors`].
+    pub load_path: Option<BTreeMap<String, Vec<f64>>>,
     /// The case file itself, set by [`Case::load`].
     #[serde(skip)]
     pub path: PathBuf,
@@ -172,6 +177,8 @@ pub struct DirichletSpec {
     pub ux: Option<f64>,
     pub uy: Option<f64>,
     pub uz: Option<f64>,
+    /// The `[load_path]` list that scales the values (default: `load_steps`).
+    pub path: Option<String>,
 }
 
 /// A prescribed total force on a group, per component; omitted components are not
@@ -184,6 +191,8 @@ pub struct ForceSpec {
     pub fx: Option<f64>,
     pub fy: Option<f64>,
     pub fz: Option<f64>,
+    /// The `[load_path]` list that scales the force (default: `load_steps`).
+    pub path: Option<String>,
 }
 
 /// A surface load: exactly one of `traction`, `pressure`, `hertz_pressure`.
@@ -197,6 +206,8 @@ pub struct LoadSpec {
     pub pressure: Option<f64>,
     /// Hertzian pressure `p0 sqrt(1 - r^2 / a^2)`, `r = |x - center|`.
     pub hertz_pressure: Option<HertzSpec>,
+    /// The `[load_path]` list that scales the load (default: `load_steps`).
+    pub path: Option<String>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -281,6 +292,7 @@ impl Case {
         case.check_pairs()?;
         case.check_geo_parameters()?;
         case.check_load_steps()?;
+        case.check_load_path()?;
         Ok(case)
     }
 
@@ -466,6 +478,142 @@ impl Case {
         Ok(())
     }
 
+    /// `[load_path]`: named non-empty lists of finite factors, of one length, which
+    /// `load_steps` (if given) shares, in a contact case; and each entry's `path` the name of
+    /// one of them, on a body in contact.
+    fn check_load_path(&self) -> Result<(), CaseError> {
+        if let Some(paths) = &self.load_path {
+            if paths.is_empty() {
+                return Err(self.invalid(
+                    "[load_path]",
+                    "the table names no path; give one list of factors per path, e.g. \
+                     press = [0.5, 1.0]",
+                ));
+            }
+            if self.contacts.is_empty() {
+                return Err(self.invalid(
+                    "[load_path]",
+                    "load paths scale the load steps of a contact solve, and the case has no \
+                     [contact] table (a body solved alone is solved once, with every load at \
+                     its full value)",
+                ));
+            }
+            if paths.contains_key("load_steps") {
+                return Err(self.invalid(
+                    "[load_path] load_steps",
+                    "a path named load_steps: a `load_steps = [...]` line after `[load_path]` \
+                     belongs to that table; write load_steps before the first table (or name \
+                     the path otherwise)",
+                ));
+            }
+            for (name, factors) in paths {
+                let key = format!("[load_path] {name}");
+                let allowed = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
+                if name.is_empty() || !name.chars().all(allowed) {
+                    return Err(self.invalid(
+                        format!("[load_path] '{name}'"),
+                        "a path's name goes into the column path_<name> of \
+                         force_displacement.csv: use letters, digits, '_' and '-' only",
+                    ));
+                }
+                if factors.len() > MAX_LOAD_STEPS {
+                    return Err(self.invalid(
+                        key,
+                        format!(
+                            "{} factors; at most {MAX_LOAD_STEPS} load steps are allowed (each \
+                             step is a whole contact solve)",
+                            factors.len()
+                        ),
+                    ));
+                }
+                if factors.is_empty() || factors.iter().any(|&f| !in_range(f)) {
+                    return Err(self.invalid(
+                        key,
+                        format!(
+                            "expected a non-empty list of finite factors {}, got {}",
+                            magnitude_range(),
+                            match factors.iter().find(|&&f| !in_range(f)) {
+                                Some(f) => format!("{f:e}"),
+                                None => "an empty list".to_string(),
+                            }
+                        ),
+                    ));
+                }
+            }
+            let (first, steps) = paths.iter().next().expect("checked non-empty");
+            if let Some((other, factors)) = paths.iter().find(|(_, f)| f.len() != steps.len()) {
+                return Err(self.invalid(
+                    "[load_path]",
+                    format!(
+                        "'{first}' has {} factors and '{other}' {}: each path gives one factor \
+                         per load step, so every list has the same length",
+                        steps.len(),
+                        factors.len()
+                    ),
+                ));
+            }
+            if let Some(given) = self.given_load_steps().filter(|l| l.len() != steps.len()) {
+                let key = match self.load_steps {
+                    Some(_) => "load_steps",
+                    None => "[contact] load_steps",
+                };
+                return Err(self.invalid(
+                    key,
+                    format!(
+                        "{} factors, and the [load_path] lists have {}: with a [load_path], \
+                         load_steps gives the factor of the entries without `path` at each of \
+                         its steps, so it has the same length (or leave it out: those entries \
+                         then keep the factor 1)",
+                        given.len(),
+                        steps.len()
+                    ),
+                ));
+            }
+        }
+        for spec in &self.bodies {
+            let entries = (spec.dirichlet.iter())
+                .map(|d| ("Dirichlet condition", &d.group, &d.path))
+                .chain(spec.forces.iter().map(|f| ("force", &f.group, &f.path)))
+                .chain(spec.loads.iter().map(|l| ("load", &l.group, &l.path)));
+            for (kind, group, path) in entries {
+                let Some(path) = path else { continue };
+                let context = format!("body '{}', {kind} on '{group}', path", spec.name);
+                let Some(paths) = &self.load_path else {
+                    return Err(self.invalid(
+                        context,
+                        format!(
+                            "'{path}' names a load path, but the case has no [load_path] table; \
+                             add one with a list of factors named '{path}' (one per load step), \
+                             or remove `path`"
+                        ),
+                    ));
+                };
+                if !paths.contains_key(path) {
+                    let known: Vec<&str> = paths.keys().map(String::as_str).collect();
+                    return Err(self.invalid(
+                        context,
+                        format!(
+                            "the [load_path] table has no path '{path}' (its paths: {})",
+                            known.join(", ")
+                        ),
+                    ));
+                }
+                if !(self.contacts.iter()).any(|c| c.bodies.contains(&spec.name)) {
+                    return Err(self.invalid(
+                        context,
+                        format!(
+                            "body '{}' is in no contact pair: it is solved alone, once, with \
+                             every load at its full value; a load path scales the load steps \
+                             of a contact solve",
+                            spec.name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Builds the problem of every body, so that a wrong group, material, load or support of
     /// any body is an error before anything is solved or written.
     pub fn check_bodies(&self, mesh: &Mesh) -> Result<(), CaseError> {
@@ -640,6 +788,7 @@ impl Case {
             .map(|d| DirichletCondition {
                 group: d.group.clone(),
                 components: [d.ux, d.uy, d.uz],
+                path: d.path.clone(),
             })
             .collect();
         let mut loads = Vec::new();
@@ -658,6 +807,7 @@ impl Case {
             .map(|f| ForceCondition {
                 group: f.group.clone(),
                 components: [f.fx, f.fy, f.fz],
+                path: f.path.clone(),
             })
             .collect();
         let problem = match in_contact {
@@ -696,11 +846,34 @@ impl Case {
         Ok(material)
     }
 
-    /// The load factors of the contact solve (default: one step at 1).
+    /// The load factors of the contact solve (default: one step at 1); with a `[load_path]`,
+    /// those of the entries without `path` (default: 1 at each of its steps).
     pub fn load_steps(&self) -> Vec<f64> {
-        (self.load_steps.clone())
-            .or_else(|| self.contacts.first().and_then(|c| c.load_steps.clone()))
-            .unwrap_or_else(|| vec![1.0])
+        let steps = match &self.load_path {
+            Some(paths) => paths.values().next().map_or(1, Vec::len),
+            None => 1,
+        };
+        (self.given_load_steps().cloned()).unwrap_or_else(|| vec![1.0; steps])
+    }
+
+    /// `load_steps` as the case gives them, at the top or in its `[contact]` table.
+    fn given_load_steps(&self) -> Option<&Vec<f64>> {
+        (self.load_steps.as_ref())
+            .or_else(|| self.contacts.first().and_then(|c| c.load_steps.as_ref()))
+    }
+
+    /// The factors of each load step: [`Self::load_steps`] for the entries without `path`,
+    /// and each `[load_path]` list's factor at that step for the entries that name it.
+    pub fn step_factors(&self) -> Vec<StepFactors> {
+        let paths = self.load_path.clone().unwrap_or_default();
+        (self.load_steps().into_iter().enumerate())
+            .map(|(k, default)| StepFactors {
+                default,
+                paths: (paths.iter())
+                    .map(|(name, factors)| (name.clone(), factors[k]))
+                    .collect(),
+            })
+            .collect()
     }
 
     /// The contact problem of each pair, in the case's order, with its primary body chosen
@@ -858,6 +1031,7 @@ impl BodyValues<'_> {
         Ok(LoadCondition {
             group: l.group.clone(),
             load: self.surface_load(l, &what)?,
+            path: l.path.clone(),
         })
     }
 

@@ -27,7 +27,8 @@
 //! # Start and stop
 //!
 //! Every solve starts from the last one: its displacements (scaled by the ratio of the load
-//! factors, since the loads enter linearly) and its tractions mapped by node and component,
+//! factors, since the loads enter linearly; as they are when the load paths' factors changed
+//! in other proportions) and its tractions mapped by node and component,
 //! projected on each multiplier's direction, `lambda_k = (e_k . t_node) / s` (a multiplier
 //! that is new starts at 0). A solve stops when the true relative residual `|[f; g] - A x| /
 //! |[f; g]|` is at most [`Tightness::relative`]: [`TIGHT_RTOL`] for an answer that may be
@@ -47,7 +48,7 @@ use super::compliance::MultiplierKey;
 use super::half_space::HalfSpace;
 use super::system::{CoupledSystem, Pair, stiffness_product};
 use crate::cancel::Cancel;
-use crate::elastic::AssembledBody;
+use crate::elastic::{AssembledBody, StepFactors};
 use crate::linalg::BodySolver;
 use crate::linalg::gmres::{self, GmresFailure, GmresSettings, GmresStats, Operators};
 
@@ -159,8 +160,9 @@ pub struct KrylovStats {
 /// What the Krylov path keeps between active-set iterations and load steps.
 #[derive(Default)]
 pub struct KrylovState {
-    /// The bodies' displacements of the last solve and the load factor it was solved at.
-    displacements: Option<(f64, Vec<f64>)>,
+    /// The bodies' displacements of the last solve and the load step's factors it was solved
+    /// at.
+    displacements: Option<(StepFactors, Vec<f64>)>,
     /// Traction of the last solve per (pair, primary node, component), unscaled.
     tractions: HashMap<MultiplierKey, f64>,
     /// The last solve's figures.
@@ -273,15 +275,16 @@ pub fn solve(
     Ok(x)
 }
 
-/// The last solve's displacements (scaled to this load factor) and tractions, along each
-/// multiplier's direction; an uncoupled multiplier's exact value.
+/// The last solve's displacements (scaled to this load step's factors:
+/// `StepFactors::scale_from`) and tractions, along each multiplier's direction; an uncoupled
+/// multiplier's exact value.
 fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
     let n = system.num_displacements();
     let mut x = match &state.displacements {
-        Some((factor, u)) if *factor != 0.0 && u.len() == n => {
-            let scale = system.load_factor / factor;
-            u.iter().map(|u| scale * u).collect()
-        }
+        Some((factors, u)) if u.len() == n => match system.factors.scale_from(factors) {
+            Some(scale) => u.iter().map(|u| scale * u).collect(),
+            None => vec![0.0; n],
+        },
         _ => vec![0.0; n],
     };
     x.resize(n + system.m, 0.0);
@@ -305,7 +308,7 @@ fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
 /// Keeps the displacements and tractions of `x` for the next solve's start.
 fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
     let n = system.num_displacements();
-    state.displacements = Some((system.load_factor, x[..n].to_vec()));
+    state.displacements = Some((system.factors.clone(), x[..n].to_vec()));
     state.tractions.clear();
     for (k, column) in system.columns.iter().enumerate() {
         for (key, weight) in column {

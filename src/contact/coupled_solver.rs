@@ -523,7 +523,9 @@ mod tests {
     use crate::contact::half_space::compliance_factor;
     use crate::contact::law::{ContactLaw, Tangential};
     use crate::contact::system::Coupling;
-    use crate::elastic::{DirichletCondition, ElasticProblem, SolveStats, assemble, solve};
+    use crate::elastic::{
+        DirichletCondition, ElasticProblem, SolveStats, StepFactors, assemble, solve,
+    };
     use crate::fem::Material;
     use crate::mesh::{BodyMesh, FacetGroup};
 
@@ -620,6 +622,7 @@ mod tests {
         let held = |group: &str, components| DirichletCondition {
             group: group.into(),
             components,
+            path: None,
         };
         let dirichlet = vec![
             held("base", [Some(0.0), Some(0.0), None]),
@@ -677,7 +680,8 @@ mod tests {
                 coupling: &couplings[1],
             },
         ];
-        let system = CoupledSystem::assemble(&bodies, &pairs, 2, 1.0).unwrap();
+        let system =
+            CoupledSystem::assemble(&bodies, &pairs, 2, &StepFactors::uniform(1.0)).unwrap();
 
         // The references: the 3 x 1 block, and the fourth body alone.
         let settings = SolverSettings {

@@ -24,6 +24,7 @@
 //! alternative in the pairs concerned, the others as they are. They live here, not in the
 //! command line, so that every caller of [`solve_contact`] gets the same answer.
 
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -34,13 +35,19 @@ use super::{
     ActiveSet, CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver,
     ContactStatus, ForcedDisplacement, OtherPrimary, Transfer,
 };
-use crate::elastic::SolverSettings;
+use crate::elastic::{SolverSettings, StepFactors};
 
 /// How one load step ended.
 #[derive(Debug, Clone, Serialize)]
 pub struct StepRecord {
     pub step: usize,
+    /// The factor of the loads, forces and prescribed displacements without a load path
+    /// (`load_steps`).
     pub load_factor: f64,
+    /// The factor of each named load path (`[load_path]`; empty, and left out of
+    /// `summary.json`, without one).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub path_factors: BTreeMap<String, f64>,
     pub status: ContactStatus,
     pub iterations: usize,
     /// Total contact force on each body (the CSV has the primary's).
@@ -120,7 +127,9 @@ pub struct ContactRun<'m> {
 /// Solves the contact `problems` (one or several pairs, decided together) at each of
 /// `load_factors` in turn (each step starting from the previous active sets), with the retry
 /// and the agreement checks of the module doc for each pair that needs them. Progress goes to
-/// the `log` crate (level info) when `solver.verbose`.
+/// the `log` crate (level info) when `solver.verbose`. Every load, force and prescribed
+/// displacement is scaled by the step's factor: [`solve_contact_steps`] with no named load
+/// path.
 pub fn solve_contact<'m>(
     problems: Vec<ContactProblem<'m>>,
     solver: &SolverSettings,
@@ -129,12 +138,49 @@ pub fn solve_contact<'m>(
     if load_factors.is_empty() || !load_factors.iter().all(|f| f.is_finite()) {
         return Err(ContactError::LoadFactors(load_factors.to_vec()));
     }
+    let steps: Vec<StepFactors> = (load_factors.iter())
+        .map(|&f| StepFactors::uniform(f))
+        .collect();
+    solve_contact_steps(problems, solver, &steps)
+}
+
+/// [`solve_contact`] along a load path: at each step of `load_path` every load, force and
+/// prescribed displacement is scaled by its path's factor (the default path's, or that of the
+/// named path its condition follows). Every step must give every named path the problems use,
+/// and the same ones; the factors must be finite.
+pub fn solve_contact_steps<'m>(
+    problems: Vec<ContactProblem<'m>>,
+    solver: &SolverSettings,
+    load_path: &[StepFactors],
+) -> Result<ContactRun<'m>, ContactError> {
+    if load_path.is_empty() || !load_path.iter().all(|f| f.default.is_finite()) {
+        return Err(ContactError::LoadFactors(
+            load_path.iter().map(|f| f.default).collect(),
+        ));
+    }
+    for (k, factors) in load_path.iter().enumerate() {
+        if let Some((name, f)) = factors.paths.iter().find(|(_, f)| !f.is_finite()) {
+            return Err(ContactError::LoadPath(format!(
+                "step {}: path '{name}' has the factor {f}, expected a finite number",
+                k + 1
+            )));
+        }
+        if !factors.paths.keys().eq(load_path[0].paths.keys()) {
+            return Err(ContactError::LoadPath(format!(
+                "step {} names the paths {:?}, step 1 {:?}: every step gives the same paths",
+                k + 1,
+                factors.paths.keys().collect::<Vec<_>>(),
+                load_path[0].paths.keys().collect::<Vec<_>>()
+            )));
+        }
+        (problems.iter()).try_for_each(|pair| pair.check_paths(factors))?;
+    }
     let mut log = Log {
         verbose: solver.verbose,
         timings: Vec::new(),
     };
     // 1. The chosen primaries.
-    let (solutions, steps) = solve_load_steps(&problems, solver, load_factors, "", &mut log)?;
+    let (solutions, steps) = solve_load_steps(&problems, solver, load_path, "", &mut log)?;
     let mut run = Answer {
         problems,
         solutions,
@@ -149,7 +195,7 @@ pub fn solve_contact<'m>(
         })
         .collect();
     if !retried.is_empty() {
-        run = retry_with_other_primary(run, &retried, solver, load_factors, &mut log);
+        run = retry_with_other_primary(run, &retried, solver, load_path, &mut log);
     }
     // The retry and the checks go on after an error of their own: a cancelled one ends here.
     solver.cancel.check()?;
@@ -172,7 +218,7 @@ pub fn solve_contact<'m>(
             })
             .collect();
         if !due.is_empty() {
-            check_against(&mut run, alternative, &due, solver, load_factors, &mut log);
+            check_against(&mut run, alternative, &due, solver, load_path, &mut log);
             solver.cancel.check()?;
         }
     }
@@ -221,7 +267,7 @@ fn retry_with_other_primary<'m>(
     first: Answer<'m>,
     retried: &[usize],
     solver: &SolverSettings,
-    load_factors: &[f64],
+    load_path: &[StepFactors],
     log: &mut Log,
 ) -> Answer<'m> {
     let mut others = first.problems.clone();
@@ -236,7 +282,7 @@ fn retry_with_other_primary<'m>(
         ));
         others[p] = other;
     }
-    let retry = solve_load_steps(&others, solver, load_factors, "other primary: ", log);
+    let retry = solve_load_steps(&others, solver, load_path, "other primary: ", log);
     let retry = retry.map(|(solutions, steps)| {
         let solutions: Vec<ContactSolution> = (solutions.into_iter().enumerate())
             .map(|(p, second)| match retried.contains(&p) {
@@ -356,7 +402,7 @@ fn check_against(
     alternative: Alternative,
     due: &[usize],
     solver: &SolverSettings,
-    load_factors: &[f64],
+    load_path: &[StepFactors],
     log: &mut Log,
 ) {
     let other = OtherSolve::new(&run.problems, alternative, due);
@@ -370,7 +416,7 @@ fn check_against(
         [with] => format!("check with {with}: "),
         _ => "check with the other discretizations: ".to_string(),
     };
-    let solved = solve_load_steps(&other.problems, solver, load_factors, &label, log);
+    let solved = solve_load_steps(&other.problems, solver, load_path, &label, log);
     for (k, &p) in due.iter().enumerate() {
         let problem = &run.problems[p];
         let reference_is_better = match alternative {
@@ -511,7 +557,7 @@ impl<'m> OtherSolve<'m> {
 fn solve_load_steps(
     problems: &[ContactProblem],
     solver: &SolverSettings,
-    load_factors: &[f64],
+    load_path: &[StepFactors],
     label: &str,
     log: &mut Log,
 ) -> Result<(Vec<ContactSolution>, Vec<Vec<StepRecord>>), ContactError> {
@@ -530,19 +576,29 @@ fn solve_load_steps(
     }
     let mut steps = vec![Vec::new(); problems.len()];
     let mut last: Option<Vec<ContactSolution>> = None;
-    for (k, &factor) in load_factors.iter().enumerate() {
+    for (k, factors) in load_path.iter().enumerate() {
         solver.cancel.check()?;
-        if load_factors.len() > 1 {
+        if load_path.len() > 1 {
+            let paths: String = (factors.paths.iter())
+                .map(|(name, f)| format!(", path '{name}' {f}"))
+                .collect();
             log.say(format!(
-                "load step {}/{}: factor {factor}",
+                "load step {}/{}: factor {}{paths}",
                 k + 1,
-                load_factors.len()
+                load_path.len(),
+                factors.default
             ));
         }
         let phase = Instant::now();
         let start: Option<Vec<ActiveSet>> = (last.as_ref())
             .map(|solutions| solutions.iter().map(|s| s.active_set.clone()).collect());
-        let solutions = contact_solver.solve(factor, start.as_deref())?;
+        // The paths the bodies follow: one that none does changes nothing, not even the
+        // coupled solve's first guess (`StepFactors::scale_from`).
+        let used = problems
+            .iter()
+            .flat_map(|p| [&p.primary, &p.secondary])
+            .flat_map(|elastic| elastic.paths());
+        let solutions = contact_solver.solve(&factors.only(used), start.as_deref())?;
         let seconds = log.time(format!("{label}contact step {}", k + 1), phase);
         for ((problem, solution), steps) in problems.iter().zip(&solutions).zip(&mut steps) {
             let pair = match problems.len() {
@@ -558,7 +614,8 @@ fn solve_load_steps(
             ));
             steps.push(StepRecord {
                 step: k + 1,
-                load_factor: factor,
+                load_factor: factors.default,
+                path_factors: factors.paths.clone(),
                 status: solution.status,
                 iterations: solution.history.len(),
                 force_primary: solution.force_primary[..dim].to_vec(),

@@ -59,7 +59,7 @@ pub mod system;
 pub use active_set::ActiveSet;
 pub use certificate::{Certificate, CertificateCheck, CheckKind, ErrorCoverage};
 pub use coupled_krylov::{KrylovError, KrylovFailure};
-pub use driver::{ContactRun, StepFriction, StepRecord, solve_contact};
+pub use driver::{ContactRun, StepFriction, StepRecord, solve_contact, solve_contact_steps};
 pub use problem::{
     ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,
 };
@@ -81,6 +81,8 @@ use crate::elastic::{ProblemError, SolveError};
 pub enum ContactError {
     #[error("load factors: expected a non-empty list of finite numbers, got {0:?}")]
     LoadFactors(Vec<f64>),
+    #[error("load path: {0}")]
+    LoadPath(String),
     #[error("contact settings: {0}")]
     Settings(#[from] SettingsError),
     #[error(transparent)]

@@ -9,7 +9,9 @@ use super::solution::{
 };
 use super::system::{CoupledSolution, Coupling};
 use super::{ContactError, ContactProblem, ContactSurface, hertz};
-use crate::elastic::{AssembledBody, ElasticProblem, ElasticSolution, SolveStats, reactions};
+use crate::elastic::{
+    AssembledBody, ElasticProblem, ElasticSolution, SolveStats, StepFactors, reactions,
+};
 use crate::fem::stress::cell_fields;
 
 /// What an active-set loop hands over: the problem with its assembled bodies, and how the loop
@@ -22,7 +24,7 @@ pub(super) struct LastIterate<'a> {
     /// `solution` has this pair's alone.
     pub body_contact_force: [&'a [f64]; 2],
     pub linear_solvers: LinearSolvers,
-    pub load_factor: f64,
+    pub factors: &'a StepFactors,
     pub status: ContactStatus,
     pub history: Vec<IterationRecord>,
     pub certificate: Certificate,
@@ -43,7 +45,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         bodies: [(body1, stats1), (body2, stats2)],
         body_contact_force,
         linear_solvers,
-        load_factor,
+        factors,
         status,
         history,
         certificate,
@@ -85,15 +87,14 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
     ]
     .into_iter()
     .flat_map(|(name, body, a)| {
-        body.rigid
-            .iter()
+        (body.rigid.iter().enumerate())
             .zip(a)
-            .filter(|(rigid, _)| !rigid.pin)
-            .map(move |(rigid, &a)| ForcedDisplacement {
+            .filter(|((_, rigid), _)| !rigid.pin)
+            .map(move |((r, rigid), &a)| ForcedDisplacement {
                 body: name.to_string(),
                 group: rigid.group.clone(),
                 component: ["x", "y", "z"][rigid.component],
-                force: load_factor * rigid.force,
+                force: body.rigid_force(r, factors),
                 displacement: a,
             })
     })
@@ -106,7 +107,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         (body1, stats1),
         u1,
         body_contact_force[0],
-        load_factor,
+        factors,
         residual,
     );
     let secondary = body_solution(
@@ -114,7 +115,7 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         (body2, stats2),
         u2,
         body_contact_force[1],
-        load_factor,
+        factors,
         residual,
     );
     Ok(ContactSolution {
@@ -131,7 +132,8 @@ pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError>
         max_tangential_traction,
         certificate,
         hertz_primary,
-        load_factor,
+        load_factor: factors.default,
+        path_factors: factors.paths.clone(),
         forced,
         active_set,
     })
@@ -170,11 +172,11 @@ fn body_solution(
     (body, stats): (&AssembledBody, &SolveStats),
     u: Vec<f64>,
     contact_force: &[f64],
-    load_factor: f64,
+    factors: &StepFactors,
     residual: f64,
 ) -> ElasticSolution {
     ElasticSolution {
-        reactions: reactions(problem, body, &u, load_factor, contact_force),
+        reactions: reactions(problem, body, &u, factors, contact_force),
         cell_fields: cell_fields(problem.body, &problem.material, &u),
         displacement: u,
         stats: SolveStats {

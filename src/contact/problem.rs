@@ -3,9 +3,9 @@
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::ContactSurface;
 use super::settings::{ContactSettings, Transfer};
-use crate::elastic::ElasticProblem;
+use super::{ContactError, ContactSurface};
+use crate::elastic::{ElasticProblem, StepFactors};
 
 /// A secondary body whose share of the two bodies' compliance (`1 / E'`) is below this is
 /// nearly rigid: the contact zone need not be resolved on it (`super::checks`), and its load
@@ -107,6 +107,22 @@ pub struct ContactProblem<'m> {
 }
 
 impl<'m> ContactProblem<'m> {
+    /// An error unless `factors` gives every named load path a condition of its two bodies
+    /// follows.
+    pub fn check_paths(&self, factors: &StepFactors) -> Result<(), ContactError> {
+        for elastic in [&self.primary, &self.secondary] {
+            if let Some(path) = factors.missing(elastic.paths()) {
+                return Err(ContactError::LoadPath(format!(
+                    "body '{}' has a condition that follows the path '{path}', and the load \
+                     step gives no factor for it (its paths: {:?})",
+                    elastic.body.name,
+                    factors.paths.keys().collect::<Vec<_>>()
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// The same problem with the roles of the two bodies exchanged (the reason is kept).
     pub fn with_other_primary(self) -> Self {
         let [primary, secondary] = self.contact_spacing;

@@ -1,5 +1,7 @@
 //! How a contact solve ended, and what it found.
 
+use std::collections::BTreeMap;
+
 use serde::Serialize;
 
 use super::Formulation;
@@ -240,8 +242,12 @@ pub struct ContactSolution {
     /// The independent checks of the answer.
     pub certificate: Certificate,
     pub hertz_primary: Option<HertzFit>,
-    /// The factor the loads and prescribed displacements were scaled by.
+    /// The factor the loads and prescribed displacements were scaled by (those that follow the
+    /// default load path).
     pub load_factor: f64,
+    /// The factor of each named load path the solve was given (`solve_contact_steps` gives
+    /// those the pairs' bodies follow; empty without a `[load_path]`).
+    pub path_factors: BTreeMap<String, f64>,
     /// The displacement of each force-controlled component, primary's first.
     pub forced: Vec<ForcedDisplacement>,
     /// The active set at the end, from which a next load step starts.
@@ -255,7 +261,7 @@ pub struct ForcedDisplacement {
     pub group: String,
     /// `"x"`, `"y"` or `"z"`.
     pub component: &'static str,
-    /// The force at this load step: the prescribed one times the load factor.
+    /// The force at this load step: the prescribed one times its load path's factor.
     pub force: f64,
     /// The group's displacement along the component: the solve's unknown.
     pub displacement: f64,

@@ -84,7 +84,9 @@ use super::solution::{
 };
 use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use super::{ContactError, ContactProblem, ContactSettings, ContactSurface, Transfer};
-use crate::elastic::{AssembledBody, ElasticProblem, SolveStats, SolverSettings, assemble};
+use crate::elastic::{
+    AssembledBody, ElasticProblem, SolveStats, SolverSettings, StepFactors, assemble,
+};
 use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::BodySolverKind;
 
@@ -163,7 +165,8 @@ fn pairing_drift(
 /// Contact pairs set up once: each body in contact assembled once (and, on the Schur path,
 /// factored), however many pairs it is in, and each pair's interface operators built. Every
 /// load step reuses all of it: loads and prescribed displacements enter the system linearly,
-/// `f_c(s) = s f_c(1)`, while `K`, its factors and the interface geometry do not change.
+/// `f_c(s) = sum_p s_p f_c_p` over the load paths `p`, while `K`, its factors and the interface
+/// geometry do not change.
 ///
 /// The loop decides all pairs together: one coupled system, one active set. That set numbers
 /// the primary candidates of the pairs one after another (pair `p`'s node `i` is
@@ -467,14 +470,15 @@ impl<'a> ContactSolver<'a> {
             .collect()
     }
 
-    /// Runs the active-set loop with the loads and prescribed displacements scaled by
-    /// `load_factor`, from `start` (one active set per pair; default:
+    /// Runs the active-set loop with the loads and prescribed displacements scaled by the
+    /// step's `factors` (each by its load path's), from `start` (one active set per pair; default:
     /// [`Self::initial_active_set`]). One answer per pair, in the pairs' order.
     pub fn solve(
         &mut self,
-        load_factor: f64,
+        factors: &StepFactors,
         start: Option<&[ActiveSet]>,
     ) -> Result<Vec<ContactSolution>, ContactError> {
+        (self.pairs.iter()).try_for_each(|pair| pair.check_paths(factors))?;
         if start.is_none() {
             for p in 0..self.pairs.len() {
                 if self.operators[p].slid != [0.0; 3] {
@@ -519,12 +523,12 @@ impl<'a> ContactSolver<'a> {
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.loop_settings().max_iterations {
             self.solver.cancel.check()?;
-            if let Some(end) = self.iteration(&mut state, iteration, load_factor)? {
+            if let Some(end) = self.iteration(&mut state, iteration, factors)? {
                 status = end;
                 break;
             }
         }
-        self.finish(load_factor, status, state)
+        self.finish(factors, status, state)
     }
 }
 
@@ -598,10 +602,10 @@ impl ContactSolver<'_> {
         &mut self,
         state: &mut LoopState,
         iteration: usize,
-        load_factor: f64,
+        factors: &StepFactors,
     ) -> Result<Option<ContactStatus>, ContactError> {
         let mut seconds = PhaseSeconds::default();
-        self.first_contact(state, iteration, load_factor)?;
+        self.first_contact(state, iteration, factors)?;
         // 1. The coupling of the active set: rows and columns of the fixed operators.
         let nodes: Vec<Vec<usize>> = (0..self.pairs.len())
             .map(|p| self.pair_nodes(&state.active.contact, p))
@@ -612,7 +616,7 @@ impl ContactSolver<'_> {
         });
         self.check_held(&couplings, &nodes, &tangential)?;
         // 2-4. The coupled solve, the gaps at the iterate, the node states' update.
-        let iterate = self.iterate(&couplings, state, &tangential, load_factor, &mut seconds);
+        let iterate = self.iterate(&couplings, state, &tangential, factors, &mut seconds);
         let Iterate {
             solution,
             gaps,
@@ -713,7 +717,7 @@ impl ContactSolver<'_> {
         &self,
         state: &mut LoopState,
         iteration: usize,
-        load_factor: f64,
+        factors: &StepFactors,
     ) -> Result<(), ContactError> {
         if self.held_by_contact.is_empty() {
             return Ok(());
@@ -759,7 +763,7 @@ impl ContactSolver<'_> {
             // supports may carry part of it; the zone then errs on the large side, which the
             // loop corrects).
             let force = (sides.iter().filter(|&&k| held(k)))
-                .map(|&k| load_factor * self.resultant(k))
+                .map(|&k| self.bodies[k].resultant(factors))
                 .fold(0.0, f64::max);
             let materials = [&problem.primary.material, &problem.secondary.material];
             let c0 = compliance_factor(materials, s1.dim);
@@ -786,24 +790,6 @@ impl ContactSolver<'_> {
         }
         state.first_contact = true;
         Ok(())
-    }
-
-    /// The magnitude of the resultant of body `k`'s loads and of the forces on its
-    /// force-controlled groups, at load factor 1.
-    fn resultant(&self, k: usize) -> f64 {
-        let body = &self.bodies[k];
-        let dim = body.dim;
-        (0..dim)
-            .map(|c| {
-                let on_groups: f64 = (body.rigid.iter())
-                    .filter(|rigid| !rigid.pin && rigid.component == c)
-                    .map(|rigid| rigid.force)
-                    .sum();
-                let loads: f64 = body.f.iter().skip(c).step_by(dim).sum();
-                (on_groups + loads).powi(2)
-            })
-            .sum::<f64>()
-            .sqrt()
     }
 
     /// An error unless the contacts of the active nodes (with their `couplings`) hold each
@@ -1192,7 +1178,7 @@ impl ContactSolver<'_> {
         couplings: &[Coupling],
         state: &mut LoopState,
         tangential: &[Option<Vec<Tangential>>],
-        load_factor: f64,
+        factors: &StepFactors,
         seconds: &mut PhaseSeconds,
     ) -> Result<Iterate, ContactError> {
         let (active, safeguard) = (&state.active, &state.safeguard);
@@ -1205,7 +1191,7 @@ impl ContactSolver<'_> {
                 } else {
                     Tightness::Tight
                 };
-                self.coupled_solve(couplings, load_factor, tightness)
+                self.coupled_solve(couplings, factors, tightness)
             })?;
             if let Some(stats) = self.factors.as_ref().and_then(|f| f.last_krylov) {
                 *krylov_iterations.get_or_insert(0) += stats.iterations;
@@ -1289,7 +1275,7 @@ impl ContactSolver<'_> {
     /// fields and forces of `super::post`.
     fn finish(
         &self,
-        load_factor: f64,
+        factors: &StepFactors,
         loop_end: ContactStatus,
         state: LoopState,
     ) -> Result<Vec<ContactSolution>, ContactError> {
@@ -1362,7 +1348,7 @@ impl ContactSolver<'_> {
                 ],
                 body_contact_force: [&solution.contact_force[a], &solution.contact_force[b]],
                 linear_solvers: self.linear_solvers(),
-                load_factor,
+                factors,
                 status,
                 history: state.history.clone(),
                 certificate,
@@ -1392,7 +1378,7 @@ impl ContactSolver<'_> {
     fn coupled_solve(
         &mut self,
         couplings: &[Coupling],
-        load_factor: f64,
+        factors: &StepFactors,
         tightness: Tightness,
     ) -> Result<CoupledSolution, ContactError> {
         let dim = self.pairs[0].primary_surface.dim;
@@ -1404,7 +1390,7 @@ impl ContactSolver<'_> {
                 coupling,
             })
             .collect();
-        let system = CoupledSystem::assemble(&bodies, &pairs, dim, load_factor)?;
+        let system = CoupledSystem::assemble(&bodies, &pairs, dim, factors)?;
         let x = match self.factors.as_mut() {
             None => coupled_solver::solve_monolithic(&system, &bodies)?,
             Some(factors) => factors.solve(&system, &pairs, &bodies, tightness)?,

@@ -57,7 +57,7 @@ use super::compliance::MultiplierKey;
 use super::law::{Multiplier, Reads, Restates};
 use rayon::prelude::*;
 
-use crate::elastic::AssembledBody;
+use crate::elastic::{AssembledBody, StepFactors};
 use crate::linalg::{BodySolver, mat_vec};
 
 /// The interface operators of one pair in one iteration, on its active primary nodes I (built
@@ -263,19 +263,20 @@ pub struct CoupledSystem {
     pub rigid_offsets: Vec<usize>,
     /// The bodies' `f_k` (constrained), one after another, and `g`.
     pub f: Vec<f64>,
-    /// The factor `f` is scaled by: `f = load_factor [f_1(1); ...; f_N(1)]`.
-    pub load_factor: f64,
+    /// The load step's factors `f` and `g` are scaled by (each body's `f_k` by
+    /// `AssembledBody::rhs`).
+    pub factors: StepFactors,
     pub g: Vec<f64>,
 }
 
 impl CoupledSystem {
     /// Assembles the blocks of the coupled system of `bodies` and `pairs` (`docs/method.md`
-    /// 2.5), with the loads and prescribed displacements scaled by `load_factor`.
+    /// 2.5), with the loads and prescribed displacements scaled by the step's `factors`.
     pub fn assemble(
         bodies: &[&AssembledBody],
         pairs: &[Pair],
         dim: usize,
-        load_factor: f64,
+        factors: &StepFactors,
     ) -> Result<Self, ContactError> {
         let mut offsets = vec![0];
         for body in bodies {
@@ -316,12 +317,10 @@ impl CoupledSystem {
         }
         for (k, body) in bodies.iter().enumerate() {
             let first = rigid_offsets[k];
-            blocks.add_rigid(k, body, first, offsets[k], s, load_factor);
+            blocks.add_rigid(k, body, first, offsets[k], s, factors);
         }
         // Loads and prescribed displacements scale the constrained right-hand side linearly.
-        let f: Vec<f64> = (bodies.iter())
-            .flat_map(|body| body.f_c.iter().map(|v| load_factor * v))
-            .collect();
+        let f: Vec<f64> = (bodies.iter()).flat_map(|body| body.rhs(factors)).collect();
         Ok(Self {
             offsets,
             multiplier_offsets,
@@ -336,7 +335,7 @@ impl CoupledSystem {
             d_coupled: blocks.d_coupled,
             rigid_offsets,
             f,
-            load_factor,
+            factors: factors.clone(),
             g: blocks.g,
         })
     }
@@ -728,8 +727,8 @@ impl<'a> Side<'a> {
 impl PairBlocks {
     /// The blocks of `body`'s force-controlled components (the module doc), body `k` of the
     /// system, its unknowns from `offset`, its rigid unknowns from multiplier `first`; `s` is
-    /// the multipliers' scaling (which the weight `1 / s` cancels) and `load_factor` scales
-    /// the force.
+    /// the multipliers' scaling (which the weight `1 / s` cancels) and the step's `factors`
+    /// scale the force.
     fn add_rigid(
         &mut self,
         k: usize,
@@ -737,7 +736,7 @@ impl PairBlocks {
         first: usize,
         offset: usize,
         s: f64,
-        load_factor: f64,
+        factors: &StepFactors,
     ) {
         for (r, rigid) in body.rigid.iter().enumerate() {
             let multiplier = first + r;
@@ -761,7 +760,7 @@ impl PairBlocks {
                     .iter()
                     .map(|&(b, v)| (multiplier, first + b, v)),
             );
-            self.g[multiplier] = load_factor * (rigid.force + rigid.applied);
+            self.g[multiplier] = body.rigid_rhs(r, factors);
         }
     }
 }

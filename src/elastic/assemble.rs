@@ -13,7 +13,7 @@ use std::collections::HashMap;
 use faer::sparse::SparseColMat;
 
 use super::solve::timed;
-use super::{ElasticProblem, ProblemError, SolveError, SolveStats};
+use super::{ElasticProblem, ProblemError, SolveError, SolveStats, StepFactors};
 use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::{Constraints, NodeColumns, NodeGraph};
@@ -25,6 +25,10 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
     let body = problem.body;
     let dim = body.dim;
     let mut constraints = Constraints::new(body.num_dofs());
+    // The load path of each nonzero prescribed value, when some condition names one: a value
+    // follows one path (a 0 is 0 on every path).
+    let with_paths = problem.dirichlet.iter().any(|d| d.path.is_some());
+    let mut path_of: HashMap<usize, (Option<&str>, &str)> = HashMap::new();
     for condition in &problem.dirichlet {
         let nodes = body
             .group_nodes(&condition.group)
@@ -32,16 +36,37 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
         for node in nodes {
             for (component, value) in condition.components.iter().enumerate().take(dim) {
                 if let Some(value) = *value {
-                    constraints
-                        .prescribe(dim * node + component, value)
-                        .map_err(|first| ProblemError::ConflictingDirichlet {
+                    let dof = dim * node + component;
+                    constraints.prescribe(dof, value).map_err(|first| {
+                        ProblemError::ConflictingDirichlet {
                             body: body.name.clone(),
                             group: condition.group.clone(),
                             node_tag: body.node_tags[node],
                             component,
                             first,
                             second: value,
-                        })?;
+                        }
+                    })?;
+                    let path = condition.path.as_deref();
+                    if with_paths && value != 0.0 {
+                        let on = (path, condition.group.as_str());
+                        match path_of.insert(dof, on) {
+                            Some(first) if first.0 != path => {
+                                let name = |(path, group): (Option<&str>, &str)| match path {
+                                    None => format!("the default load path (on '{group}')"),
+                                    Some(name) => format!("load path '{name}' (on '{group}')"),
+                                };
+                                return Err(ProblemError::ConflictingPath {
+                                    body: body.name.clone(),
+                                    node_tag: body.node_tags[node],
+                                    component,
+                                    value,
+                                    paths: format!("{} and {}", name(first), name(on)),
+                                });
+                            }
+                            _ => {}
+                        }
+                    }
                 }
             }
         }
@@ -81,6 +106,8 @@ pub(crate) struct ForcedComponent {
     pub force: f64,
     pub dofs: Vec<usize>,
     pub pin: bool,
+    /// The load path the force follows (`None`: the default one).
+    pub path: Option<String>,
 }
 
 /// The force-controlled components of `problem`, group after group, component after component.
@@ -100,6 +127,7 @@ pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent
                     force,
                     dofs: nodes.iter().map(|&node| dim * node + component).collect(),
                     pin: false,
+                    path: condition.path.clone(),
                 });
             }
         }
@@ -111,6 +139,7 @@ pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent
             force: 0.0,
             dofs: vec![dim * node + component],
             pin: true,
+            path: None,
         });
     }
     out
@@ -141,6 +170,106 @@ pub struct AssembledBody {
     /// [`forced_components`]: their dofs are held at 0 in `K_c` and move by unknowns of the
     /// contact solve.
     pub rigid: Vec<RigidColumn>,
+    /// `f` and `f_c` split by load path, the default one first, then the named ones by name,
+    /// when a load or prescribed displacement of the body follows a named path (`[load_path]`);
+    /// empty otherwise, when everything follows the default path and `f`, `f_c` scale as they
+    /// are. The parts sum to `f` and `f_c` (up to round-off). See [`Self::rhs`].
+    pub parts: Vec<RhsPart>,
+}
+
+/// The part of a body's right-hand side that follows one load path
+/// ([`AssembledBody::parts`]).
+#[derive(Debug, Clone)]
+pub struct RhsPart {
+    /// The path: `None` the default one.
+    pub path: Option<String>,
+    /// The loads that follow it (with the body force on the default path), assembled.
+    pub f: Vec<f64>,
+    /// Its constrained right-hand side: at a free dof its loads less the pull of the values it
+    /// prescribes (`-K_FD g_D`), at a prescribed dof `K_dd g_d` of its own value (0 at the
+    /// dofs other paths prescribe), so that `sum_p s_p f_c(p)` is `f_c` of the loads and
+    /// values of step factors `s_p`.
+    pub f_c: Vec<f64>,
+}
+
+impl AssembledBody {
+    /// The constrained right-hand side at a load step of `factors`: `s f_c` without named
+    /// paths (`s` the default factor, the exact operations of one factor for all), else the
+    /// sum of each part's `f_c` times its path's factor.
+    pub fn rhs(&self, factors: &StepFactors) -> Vec<f64> {
+        if self.parts.is_empty() {
+            return self.f_c.iter().map(|v| factors.default * v).collect();
+        }
+        let mut rhs = vec![0.0; self.f_c.len()];
+        for part in &self.parts {
+            let s = factors.of(part.path.as_deref());
+            rhs.iter_mut().zip(&part.f_c).for_each(|(r, v)| *r += s * v);
+        }
+        rhs
+    }
+
+    /// The load (the step's `f`) at `dof` at a step of `factors`.
+    pub fn load(&self, dof: usize, factors: &StepFactors) -> f64 {
+        match self.parts.is_empty() {
+            true => factors.default * self.f[dof],
+            false => (self.parts.iter())
+                .map(|part| factors.of(part.path.as_deref()) * part.f[dof])
+                .sum(),
+        }
+    }
+
+    /// The right-hand side of the `r`-th force-controlled component at a step of `factors`,
+    /// `s (force + applied)` with each part scaled by its path's factor (`RigidColumn`).
+    pub fn rigid_rhs(&self, r: usize, factors: &StepFactors) -> f64 {
+        let rigid = &self.rigid[r];
+        if self.parts.is_empty() && rigid.path.is_none() {
+            return factors.default * (rigid.force + rigid.applied);
+        }
+        let force = self.rigid_force(r, factors);
+        match self.parts.is_empty() {
+            true => force + factors.default * rigid.applied,
+            false => (self.parts.iter().zip(&rigid.applied_parts)).fold(force, |g, (part, a)| {
+                g + factors.of(part.path.as_deref()) * a
+            }),
+        }
+    }
+
+    /// The force on the `r`-th force-controlled component at a step of `factors`.
+    pub fn rigid_force(&self, r: usize, factors: &StepFactors) -> f64 {
+        let rigid = &self.rigid[r];
+        factors.of(rigid.path.as_deref()) * rigid.force
+    }
+
+    /// The magnitude of the resultant of the body's loads and of the forces on its
+    /// force-controlled groups at a step of `factors`.
+    pub fn resultant(&self, factors: &StepFactors) -> f64 {
+        let dim = self.dim;
+        let sum = |f: &[f64], c: usize| -> f64 { f.iter().skip(c).step_by(dim).sum() };
+        let magnitude = |force: &dyn Fn(&RigidColumn) -> f64, loads: &dyn Fn(usize) -> f64| {
+            (0..dim)
+                .map(|c| {
+                    let on_groups: f64 = (self.rigid.iter())
+                        .filter(|rigid| !rigid.pin && rigid.component == c)
+                        .map(force)
+                        .sum();
+                    (on_groups + loads(c)).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt()
+        };
+        if self.parts.is_empty() && self.rigid.iter().all(|r| r.path.is_none()) {
+            // At factor 1, then scaled: the operations of one factor for all.
+            return factors.default * magnitude(&|rigid| rigid.force, &|c| sum(&self.f, c));
+        }
+        let force = |rigid: &RigidColumn| factors.of(rigid.path.as_deref()) * rigid.force;
+        let loads = |c: usize| match self.parts.is_empty() {
+            true => factors.default * sum(&self.f, c),
+            false => (self.parts.iter())
+                .map(|part| factors.of(part.path.as_deref()) * sum(&part.f, c))
+                .sum(),
+        };
+        magnitude(&force, &loads)
+    }
 }
 
 /// A body's constrained stiffness `K_c` as this process holds it.
@@ -203,15 +332,21 @@ pub struct RigidColumn {
     pub applied: f64,
     /// A rigid-mode pin of a floating body (`ElasticProblem::pins`), not a group of the case.
     pub pin: bool,
+    /// The load path the force follows (`None`: the default one); `applied` follows the paths
+    /// of the loads and values it comes from.
+    pub path: Option<String>,
+    /// `applied` split as [`AssembledBody::parts`] (empty without parts).
+    pub applied_parts: Vec<f64>,
 }
 
 /// The [`RigidColumn`]s of `forced`, read from the rows of the unconstrained `K` at the
-/// prescribed dofs and from `f`.
+/// prescribed dofs and from `f` (and each of `parts`, for `applied_parts`).
 fn rigid_columns(
     forced: Vec<ForcedComponent>,
     prescribed_rows: &[(usize, Vec<(usize, f64)>)],
     constraints: &Constraints,
     f: &[f64],
+    parts: &[PathLoads],
 ) -> Vec<RigidColumn> {
     let mut owner: HashMap<usize, usize> = HashMap::new();
     for (r, component) in forced.iter().enumerate() {
@@ -228,14 +363,23 @@ fn rigid_columns(
             let mut column: HashMap<usize, f64> = HashMap::new();
             let mut coupled: HashMap<usize, f64> = HashMap::new();
             let (mut diagonal, mut applied) = (0.0, 0.0);
+            let mut applied_parts = vec![0.0; parts.len()];
             for &d in &component.dofs {
                 applied += f[d];
+                for (a, part) in applied_parts.iter_mut().zip(parts) {
+                    *a += part.f[d];
+                }
                 for &(j, value) in row(d) {
                     match (constraints.value(j), owner.get(&j)) {
                         (None, _) => *column.entry(j).or_default() += value,
                         (Some(_), Some(&b)) if b == r => diagonal += value,
                         (Some(_), Some(&b)) => *coupled.entry(b).or_default() += value,
-                        (Some(g), None) => applied -= value * g,
+                        (Some(g), None) => {
+                            applied -= value * g;
+                            for (a, part) in applied_parts.iter_mut().zip(parts) {
+                                *a -= value * part.value(j);
+                            }
+                        }
                     }
                 }
             }
@@ -253,6 +397,8 @@ fn rigid_columns(
                 coupled,
                 applied,
                 pin: component.pin,
+                path: component.path,
+                applied_parts,
             }
         })
         .collect()
@@ -305,12 +451,18 @@ pub fn assemble(
             source,
         })?,
     };
+    // 3. With named load paths, f and f_c split by path.
+    let path_loads = path_loads(problem);
     let rigid = rigid_columns(
         forced_components(problem),
         &constrained.prescribed_rows,
         &constraints,
         &f,
+        &path_loads,
     );
+    let parts = (path_loads.into_iter())
+        .map(|part| part.constrained(&constraints, &constrained.prescribed_rows))
+        .collect();
     Ok(AssembledBody {
         dim,
         coordinates,
@@ -322,7 +474,106 @@ pub fn assemble(
         k_scale: constrained.k_scale,
         f_c: constrained.f_c,
         rigid,
+        parts,
     })
+}
+
+/// The loads and prescribed values of one load path ([`path_loads`]).
+struct PathLoads {
+    path: Option<String>,
+    f: Vec<f64>,
+    /// Its nonzero prescribed values, by dof.
+    values: HashMap<usize, f64>,
+}
+
+impl PathLoads {
+    /// The value this path prescribes at the prescribed dof `dof` (0 where another path
+    /// prescribes it).
+    fn value(&self, dof: usize) -> f64 {
+        self.values.get(&dof).copied().unwrap_or(0.0)
+    }
+
+    /// This path's part of the right-hand side: `f_c` of its loads and values, the rows of `K`
+    /// at the prescribed dofs giving the pull of the values on the free dofs (`K` is
+    /// symmetric: a row is a column), as [`Constraints::apply`] eliminates them. From the rows
+    /// every rank holds whole, so a distributed run computes it as one process does.
+    fn constrained(
+        self,
+        constraints: &Constraints,
+        prescribed_rows: &[(usize, Vec<(usize, f64)>)],
+    ) -> RhsPart {
+        let mut f_c = self.f.clone();
+        for (j, _) in prescribed_rows {
+            f_c[*j] = 0.0;
+        }
+        for (j, row) in prescribed_rows {
+            let g = self.value(*j);
+            if g == 0.0 {
+                continue;
+            }
+            for &(i, k) in row {
+                if i == *j {
+                    f_c[i] = k * g;
+                } else if !constraints.is_fixed(i) {
+                    f_c[i] -= k * g;
+                }
+            }
+        }
+        RhsPart {
+            path: self.path,
+            f: self.f,
+            f_c,
+        }
+    }
+}
+
+/// The loads and prescribed values of `problem` by load path, the default path first, then
+/// the named ones by name: empty unless a load or Dirichlet condition follows a named path
+/// (the forces' paths are their `RigidColumn`s'). The body force follows the default path.
+fn path_loads(problem: &ElasticProblem) -> Vec<PathLoads> {
+    let named: std::collections::BTreeSet<&str> = (problem.loads.iter())
+        .map(|l| l.path.as_deref())
+        .chain(problem.dirichlet.iter().map(|d| d.path.as_deref()))
+        .flatten()
+        .collect();
+    if named.is_empty() {
+        return Vec::new();
+    }
+    let body = problem.body;
+    let dim = body.dim;
+    let paths = std::iter::once(None).chain(named.into_iter().map(Some));
+    paths
+        .map(|path| {
+            let mut f = vec![0.0; body.num_dofs()];
+            for load in problem.loads.iter().filter(|l| l.path.as_deref() == path) {
+                let group = body
+                    .boundary_group(&load.group)
+                    .expect("groups are checked first");
+                add_surface_load(body, group, &load.load, &mut f);
+            }
+            if let (None, Some(b)) = (path, &problem.body_force) {
+                add_body_force(body, b, &mut f);
+            }
+            let mut values = HashMap::new();
+            for condition in (problem.dirichlet.iter()).filter(|d| d.path.as_deref() == path) {
+                let nodes = body
+                    .group_nodes(&condition.group)
+                    .expect("groups are checked first");
+                for node in nodes {
+                    for (c, value) in condition.components.iter().enumerate().take(dim) {
+                        if let Some(value) = value.filter(|&v| v != 0.0) {
+                            values.insert(dim * node + c, value);
+                        }
+                    }
+                }
+            }
+            PathLoads {
+                path: path.map(str::to_string),
+                f,
+                values,
+            }
+        })
+        .collect()
 }
 
 /// `K_c` as this process holds it, with what the rest of the system needs of `K`.

@@ -1,11 +1,13 @@
 //! Linear elasticity on one body: the problem, how it is solved, and the solution.
 
 mod assemble;
+mod factors;
 mod problem;
 mod solution;
 mod solve;
 
-pub use assemble::{AssembledBody, RigidColumn, Stiffness, assemble};
+pub use assemble::{AssembledBody, RhsPart, RigidColumn, Stiffness, assemble};
+pub use factors::StepFactors;
 pub use problem::{
     DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, ProblemError,
 };

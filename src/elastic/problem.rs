@@ -11,6 +11,8 @@ use crate::mesh::BodyMesh;
 pub struct DirichletCondition {
     pub group: String,
     pub components: [Option<f64>; 3],
+    /// The load path the values follow ([`super::StepFactors`]): `None` the default one.
+    pub path: Option<String>,
 }
 
 /// A prescribed total force on a group, along some components (`None` = not force-controlled).
@@ -21,6 +23,8 @@ pub struct DirichletCondition {
 pub struct ForceCondition {
     pub group: String,
     pub components: [Option<f64>; 3],
+    /// The load path the force follows ([`super::StepFactors`]): `None` the default one.
+    pub path: Option<String>,
 }
 
 /// A surface load on a boundary group.
@@ -28,6 +32,8 @@ pub struct ForceCondition {
 pub struct LoadCondition {
     pub group: String,
     pub load: SurfaceLoad,
+    /// The load path the load follows ([`super::StepFactors`]): `None` the default one.
+    pub path: Option<String>,
 }
 
 /// Linear elasticity on one body. Built with [`ElasticProblem::new`], which checks that every
@@ -101,6 +107,20 @@ pub enum ProblemError {
     ForceComponentOutOfRange { body: String, group: String },
     #[error("body '{body}': {what} is not finite")]
     NotFinite { body: String, what: String },
+    #[error(
+        "body '{body}': node {node_tag} component {component} is prescribed {value} by Dirichlet \
+         conditions that follow {paths}; a prescribed value follows one load path (conditions \
+         that prescribe 0 may share a dof)"
+    )]
+    ConflictingPath {
+        body: String,
+        node_tag: u64,
+        component: usize,
+        value: f64,
+        /// The two paths and groups: "the default load path (on 'top') and load path 'press'
+        /// (on 'edge')".
+        paths: String,
+    },
 }
 
 impl<'m> ElasticProblem<'m> {
@@ -195,6 +215,17 @@ impl<'m> ElasticProblem<'m> {
             });
         }
         Ok(problem)
+    }
+
+    /// The named load paths its loads, forces and prescribed displacements follow, each once,
+    /// in order of name.
+    pub fn paths(&self) -> Vec<&str> {
+        let dirichlet = self.dirichlet.iter().map(|d| d.path.as_deref());
+        let forces = self.forces.iter().map(|f| f.path.as_deref());
+        let loads = self.loads.iter().map(|l| l.path.as_deref());
+        let named: std::collections::BTreeSet<&str> =
+            dirichlet.chain(forces).chain(loads).flatten().collect();
+        named.into_iter().collect()
     }
 
     /// The components of one condition: at least one (else `none`), no z in 2D (else

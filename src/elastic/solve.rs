@@ -5,7 +5,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::{AssembledBody, ElasticProblem, ElasticSolution, ProblemError, SolveStats, assemble};
+use super::{
+    AssembledBody, ElasticProblem, ElasticSolution, ProblemError, SolveStats, StepFactors, assemble,
+};
 use crate::cancel::Cancel;
 use crate::fem::stress::cell_fields;
 use crate::linalg::{
@@ -123,15 +125,15 @@ pub(crate) fn timed<T>(
     value
 }
 
-/// Reaction of each Dirichlet and force-controlled group: `sum (K u - s f - f_other)` over its
-/// prescribed and force-controlled dofs, with `s` the load factor and `f_other` forces not in
-/// `f` (contact forces; empty for a single body). A group named by both kinds of condition has
-/// one entry.
+/// Reaction of each Dirichlet and force-controlled group: `sum (K u - f_s - f_other)` over its
+/// prescribed and force-controlled dofs, with `f_s` the loads at a step of `factors`
+/// ([`AssembledBody::load`]) and `f_other` forces not in `f` (contact forces; empty for a
+/// single body). A group named by both kinds of condition has one entry.
 pub fn reactions(
     problem: &ElasticProblem,
     system: &AssembledBody,
     u: &[f64],
-    load_factor: f64,
+    factors: &StepFactors,
     f_other: &[f64],
 ) -> Vec<(String, Vec<f64>)> {
     let body = problem.body;
@@ -159,7 +161,7 @@ pub fn reactions(
                 for c in (0..dim).filter(|&c| mask[c]) {
                     let d = dim * node + c;
                     total[c] +=
-                        r[d] - load_factor * system.f[d] - f_other.get(d).copied().unwrap_or(0.0);
+                        r[d] - system.load(d, factors) - f_other.get(d).copied().unwrap_or(0.0);
                 }
             }
             (group.clone(), total)
@@ -242,7 +244,8 @@ fn rigid_displacements(
     Ok(a.iter().copied().collect())
 }
 
-/// Solves the elastic problem of one body.
+/// Solves the elastic problem of one body, every load, force and prescribed displacement at
+/// its full value (a load path's at factor 1: the load paths scale the steps of a contact solve).
 pub fn solve(
     problem: &ElasticProblem,
     settings: &SolverSettings,
@@ -347,7 +350,12 @@ pub fn solve(
     }
 
     // 6. Reactions and cell fields.
-    let reactions = reactions(problem, &system, &u, 1.0, &[]);
+    // Every load and prescribed value at its full value: every path at factor 1.
+    let mut full = StepFactors::uniform(1.0);
+    full.paths = (problem.paths().into_iter())
+        .map(|path| (path.to_string(), 1.0))
+        .collect();
+    let reactions = reactions(problem, &system, &u, &full, &[]);
     let cell_fields = timed(&mut stats, verbose, "strain and stress", || {
         cell_fields(body, &problem.material, &u)
     });

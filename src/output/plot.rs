@@ -50,7 +50,8 @@ pub const PLOT_SIZE: (u32, u32) = (1200, 540);
 /// imposed approach at load factor 1 (the largest difference between two bodies' prescribed
 /// displacements); where no displacement is imposed (0: the bodies are loaded by forces) the x
 /// axis is the load factor. In a force-controlled run (`[[body.force]]`) the x axis is the
-/// displacement the first force-controlled group moved by, an output of each step.
+/// displacement the first force-controlled group moved by, an output of each step. Along a
+/// load path (`[load_path]`: the loads do not scale together) it is the step's number.
 pub fn write_force_displacement_png(
     path: &Path,
     title: &str,
@@ -59,7 +60,11 @@ pub fn write_force_displacement_png(
 ) -> Result<(), PlotError> {
     register_font()?;
     let draw_error = |e: &dyn std::fmt::Display| draw_error(path, e);
-    let (scale, x_desc) = if approach > 0.0 {
+    let along_path =
+        (curves.iter()).any(|(_, steps)| steps.iter().any(|s| !s.path_factors.is_empty()));
+    let (scale, x_desc) = if along_path {
+        (1.0, "load step (the case has a [load_path])".to_string())
+    } else if approach > 0.0 {
         (
             approach,
             format!("imposed approach (load factor x {approach})"),
@@ -85,6 +90,7 @@ pub fn write_force_displacement_png(
         });
         match moved {
             Some(g) => g.displacement.abs(),
+            None if along_path => s.step as f64,
             None => scale * s.load_factor,
         }
     };

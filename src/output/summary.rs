@@ -265,14 +265,18 @@ impl ContactSummary {
 
 /// The load steps of each pair of `curves` (its name and its steps) as
 /// `force_displacement.csv`: one header line, one row per step. One pair: the columns of
-/// [`pair_csv`]. Several: the step and load factor, then each pair's other columns, their
-/// names prefixed by the pair's (`upper-middle.contact_force_y`); the pairs share the loop, so
-/// they have the same steps.
+/// [`pair_csv`]. Several: the step and load factor (and each load path's factor), then each
+/// pair's other columns, their names prefixed by the pair's (`upper-middle.contact_force_y`);
+/// the pairs share the loop, so they have the same steps.
 pub fn force_displacement_csv(curves: &[(&str, &[StepRecord])]) -> String {
     let tables: Vec<String> = curves.iter().map(|(_, steps)| pair_csv(steps)).collect();
     if let [table] = &tables[..] {
         return table.clone();
     }
+    let paths = (curves.first())
+        .and_then(|(_, steps)| steps.first())
+        .map_or(0, |s| s.path_factors.len());
+    let shared = 2 + paths;
     let split = |line: &str| -> Vec<String> { line.split(',').map(str::to_string).collect() };
     let lines: Vec<Vec<Vec<String>>> = (tables.iter())
         .map(|table| table.lines().map(split).collect())
@@ -280,9 +284,9 @@ pub fn force_displacement_csv(curves: &[(&str, &[StepRecord])]) -> String {
     let rows = lines.iter().map(Vec::len).min().unwrap_or(0);
     let mut text = String::new();
     for row in 0..rows {
-        let mut fields: Vec<String> = lines[0][row][..2].to_vec();
+        let mut fields: Vec<String> = lines[0][row][..shared].to_vec();
         for ((name, _), table) in curves.iter().zip(&lines) {
-            fields.extend(table[row][2..].iter().map(|field| match row {
+            fields.extend(table[row][shared..].iter().map(|field| match row {
                 0 => format!("{name}.{field}"),
                 _ => field.clone(),
             }));
@@ -293,11 +297,21 @@ pub fn force_displacement_csv(curves: &[(&str, &[StepRecord])]) -> String {
     text
 }
 
-/// One pair's load steps as CSV: one header line, one row per step.
+/// One pair's load steps as CSV: one header line, one row per step. With a load path, each
+/// path's factor follows the load factor (`path_<name>`).
 fn pair_csv(steps: &[StepRecord]) -> String {
     let dim = steps.first().map_or(0, |s| s.force_primary.len());
     let axes = ["x", "y", "z"];
-    let mut text = String::from("step,load_factor,status,iterations");
+    let mut text = String::from("step,load_factor");
+    for name in steps
+        .first()
+        .map(|s| s.path_factors.keys())
+        .into_iter()
+        .flatten()
+    {
+        text += &format!(",path_{name}");
+    }
+    text += ",status,iterations";
     for axis in &axes[..dim] {
         text += &format!(",contact_force_{axis}");
     }
@@ -320,13 +334,11 @@ fn pair_csv(steps: &[StepRecord]) -> String {
     text += ",seconds,failed_checks\n";
     let optional = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.10e}"));
     for s in steps {
-        text += &format!(
-            "{},{},{},{}",
-            s.step,
-            s.load_factor,
-            s.status.name(),
-            s.iterations
-        );
+        text += &format!("{},{}", s.step, s.load_factor);
+        for factor in s.path_factors.values() {
+            text += &format!(",{factor}");
+        }
+        text += &format!(",{},{}", s.status.name(), s.iterations);
         for f in &s.force_primary {
             text += &format!(",{f:.10e}");
         }
@@ -373,5 +385,58 @@ impl CaseSummary {
             path: path.to_owned(),
             source,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(step: usize, paths: &[(&str, f64)]) -> StepRecord {
+        StepRecord {
+            step,
+            load_factor: 1.0,
+            path_factors: paths.iter().map(|&(n, f)| (n.to_string(), f)).collect(),
+            status: ContactStatus::Converged,
+            iterations: 3,
+            force_primary: vec![0.0, -1.0],
+            force_secondary: vec![0.0, 1.0],
+            force_imbalance: 0.0,
+            hertz_a: None,
+            hertz_p0: None,
+            forced: Vec::new(),
+            seconds: 0.5,
+            accurate: true,
+            failed_checks: Vec::new(),
+            friction: None,
+        }
+    }
+
+    #[test]
+    fn each_load_path_has_a_column_after_the_load_factor() {
+        let steps = [
+            record(1, &[("press", 0.5), ("shear", 0.0)]),
+            record(2, &[("press", 1.0), ("shear", 1.0)]),
+        ];
+        let one = force_displacement_csv(&[("pair", &steps)]);
+        let rows: Vec<&str> = one.lines().collect();
+        assert!(rows[0].starts_with("step,load_factor,path_press,path_shear,status,"));
+        assert!(rows[1].starts_with("1,1,0.5,0,converged,3,"), "{}", rows[1]);
+        // Several pairs share the step, the load factor and the paths' factors.
+        let two = force_displacement_csv(&[("a", &steps), ("b", &steps)]);
+        let rows: Vec<&str> = two.lines().collect();
+        assert!(
+            rows[0].starts_with("step,load_factor,path_press,path_shear,a.status,"),
+            "{}",
+            rows[0]
+        );
+        assert!(rows[0].contains(",b.status,"));
+        assert!(!rows[0].contains("b.path_"));
+        assert!(rows[2].starts_with("2,1,1,1,converged,"), "{}", rows[2]);
+        // Without a load path, the columns are as they were.
+        let plain = force_displacement_csv(&[("pair", &[record(1, &[])])]);
+        assert!(plain.starts_with("step,load_factor,status,iterations,contact_force_x,"));
+        let json = serde_json::to_string(&record(1, &[])).unwrap();
+        assert!(!json.contains("path_factors"));
     }
 }

@@ -5,7 +5,9 @@
 use std::time::Instant;
 
 use crate::case::{BodySpec, Case};
-use crate::contact::{ContactProblem, ContactRun, ContactSolution, SurfaceFields, solve_contact};
+use crate::contact::{
+    ContactProblem, ContactRun, ContactSolution, SurfaceFields, solve_contact_steps,
+};
 use crate::elastic::{DirichletCondition, ElasticSolution, solve};
 use crate::mesh::Mesh;
 use crate::output::{BodySummary, CaseSummary, ContactSummary, peak_memory_mb};
@@ -118,7 +120,7 @@ pub fn solve_case_on(
     })
 }
 
-/// The contact solve of the case's pairs ([`solve_contact`]: its load steps, and for a single
+/// The contact solve of the case's pairs ([`solve_contact_steps`]: its load steps, and for a single
 /// pair the other primary's solve when the first choice may be wrong), and the solution of
 /// each body in contact.
 fn solve_contact_pairs(
@@ -144,12 +146,13 @@ fn solve_contact_pairs(
             problem.primary_report.reason
         );
     }
-    let run = solve_contact(problems, &case.solver, &case.load_steps()).map_err(|source| {
-        RunError::Contact {
-            path: case.path.clone(),
-            source,
-        }
-    })?;
+    let run =
+        solve_contact_steps(problems, &case.solver, &case.step_factors()).map_err(|source| {
+            RunError::Contact {
+                path: case.path.clone(),
+                source,
+            }
+        })?;
     let ContactRun {
         problems,
         solutions,

@@ -5,7 +5,7 @@ use super::case_builder::{Body, CaseFile, Dirichlet};
 use super::run_solve;
 use internodes::case::Case;
 use internodes::contact::{ContactSolution, ContactSolver, solve_contact};
-use internodes::elastic::SolverSettings;
+use internodes::elastic::{SolverSettings, StepFactors};
 use internodes::mesh::read_msh;
 
 /// Solves the `[contact]` of `case` with the library's [`solve_contact`]
@@ -25,7 +25,9 @@ pub fn solve_with(case: &CaseFile, loop_only: bool) -> Result<ContactSolution, S
     if loop_only {
         let mut solver = ContactSolver::new(std::slice::from_ref(&problem), &settings)
             .map_err(|e| e.to_string())?;
-        let mut solutions = solver.solve(1.0, None).map_err(|e| e.to_string())?;
+        let mut solutions = solver
+            .solve(&StepFactors::uniform(1.0), None)
+            .map_err(|e| e.to_string())?;
         return Ok(solutions.remove(0));
     }
     let mut run =
