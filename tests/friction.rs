@@ -11,7 +11,7 @@ mod common;
 
 use common::case_builder::{Body, CaseFile, Dirichlet, Force};
 use common::contact::{hemisphere_on_block, stacked_blocks};
-use common::half_disc_on_block;
+use common::{half_disc_on_block, run_solve, write_case};
 use internodes::case::Case;
 use internodes::contact::{
     ActiveSet, ContactSettings, ContactSolution, ContactSolver, ContactStatus, Formulation,
@@ -355,4 +355,80 @@ fn a_block_held_sideways_by_friction_alone_is_accepted_while_it_sticks_and_refus
         error.contains("'upper'") && error.contains("friction"),
         "{error}"
     );
+}
+
+#[test]
+fn a_load_path_in_one_run_is_the_chain_of_its_steps_with_each_steps_friction_in_the_outputs() {
+    // The disc pressed (path "press"), then sheared (path "shear") in one run of the command
+    // line: each step starts from the last, as the library's chain of cases does.
+    let shifts = [0.0, 0.003, 0.006];
+    let chained = along_path(
+        &(shifts.iter())
+            .map(|&s| disc_on_block(s, "coulomb", Some(MU)))
+            .collect::<Vec<_>>(),
+    )
+    .0;
+    let case = disc_on_block(0.0, "coulomb", Some(MU)).with_body("disc", |_| {
+        Body::new("disc", 1000.0, 0.3)
+            .dirichlet(Dirichlet::on("disc_top").uy(-APPROACH))
+            .dirichlet(Dirichlet::on("disc_top").ux(0.006))
+    });
+    let mut table: toml::Table = toml::from_str(&case.to_toml()).unwrap();
+    let list = |v: &[f64]| toml::Value::Array(v.iter().map(|&f| toml::Value::Float(f)).collect());
+    let mut paths = toml::Table::new();
+    paths.insert("press".into(), list(&[1.0, 1.0, 1.0]));
+    paths.insert("shear".into(), list(&[0.0, 0.5, 1.0]));
+    table.insert("load_path".into(), toml::Value::Table(paths));
+    let entries = table["body"].as_array_mut().unwrap()[0]["dirichlet"]
+        .as_array_mut()
+        .unwrap();
+    for (entry, path) in entries.iter_mut().zip(["press", "shear"]) {
+        let entry = entry.as_table_mut().unwrap();
+        entry.insert("path".into(), toml::Value::String(path.into()));
+    }
+    let (dir, path) = write_case(&toml::to_string(&table).unwrap());
+    let output = run_solve(&path);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let steps = summary["contact"]["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 3);
+    for (step, chain) in steps.iter().zip(&chained) {
+        let friction = &step["friction"];
+        let expected = chain.primary_fields.friction.as_ref().unwrap();
+        let q = friction["tangential_force"][0].as_f64().unwrap();
+        // Both end when their active nodes settle within 0.01 penetration_tolerance h: the
+        // same answer to that precision, not to round-off.
+        let off = (q - expected.tangential_force[0]).abs() / (MU * expected.normal_force);
+        assert!(
+            off < 1e-4,
+            "step {}: Q {q:.6e} against {:.6e}",
+            step["step"],
+            expected.tangential_force[0]
+        );
+        assert_eq!(friction["stick_nodes"], expected.stick_nodes);
+        assert_eq!(friction["slip_nodes"], expected.slip_nodes);
+    }
+    // The CSV has the friction columns, and the XDMF the friction fields.
+    let csv = std::fs::read_to_string(dir.path().join("out/force_displacement.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .contains("tangential_force_x,tangential_force_y,normal_force,stick_nodes,slip_nodes"),
+        "{csv}"
+    );
+    let xdmf = std::fs::read_to_string(dir.path().join("out/solution.xdmf")).unwrap();
+    for field in [
+        "friction_state",
+        "tangential_traction",
+        "slip_increment",
+        "accumulated_slip",
+    ] {
+        assert!(xdmf.contains(&format!("Name=\"{field}\"")), "{field}");
+    }
 }
