@@ -114,9 +114,11 @@ class StepFriction(TypedDict):
     """A Coulomb pair's tangential answer at one load step."""
 
     tangential_force: list[float]
-    """The tangential contact force on the primary body."""
+    """The tangential contact force on the primary body: the total contact force less its
+    part along the zone's mean normal."""
     normal_force: float
-    """The normal contact force on the primary body (nodal areas times pressures)."""
+    """The normal contact force on the primary body: minus the total contact force along the
+    zone's mean normal."""
     stick_nodes: int
     slip_nodes: int
 

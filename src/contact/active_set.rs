@@ -45,7 +45,8 @@ pub struct FrictionHistory {
 pub(super) struct Update {
     pub(super) next: NodeStates,
     /// Coulomb pairs: the direction of each node slipping next (loop indices), and the
-    /// largest change of a slipping node's direction ([`super::law::coulomb`]).
+    /// largest change of a slipping node's direction weighed by its pressure over the largest
+    /// ([`super::law::coulomb::DIRECTION_SETTLED`]).
     pub(super) directions: BTreeMap<usize, [f64; 3]>,
     pub(super) max_direction_change: f64,
     /// Coulomb pairs: the nodes in contact whose tangential state changes (stick to slip or

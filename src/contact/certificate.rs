@@ -42,6 +42,9 @@ pub enum CheckKind {
     /// Where the two bodies' contact forces act, over the coarser spacing.
     #[serde(rename = "force centre")]
     ForceCentre,
+    /// The stick zone's width in spacings, against the minimum (Coulomb pairs in partial slip).
+    #[serde(rename = "stick zone resolution")]
+    StickResolution,
     /// The contact force against the other primary's.
     #[serde(rename = "primary agreement")]
     PrimaryAgreement,
@@ -64,6 +67,7 @@ impl CheckKind {
             Self::SecondarySag => "secondary sag",
             Self::Resolution => "resolution",
             Self::ForceCentre => "force centre",
+            Self::StickResolution => "stick zone resolution",
             Self::PrimaryAgreement => "primary agreement",
             Self::TransferAgreement => "transfer agreement",
         }
@@ -96,6 +100,7 @@ impl CheckKind {
                 " of the coarser spacing (between the two bodies' centres of normal force)"
             }
             Self::Resolution => " (spacing over the contact zone's width, over the minimum's, rim)",
+            Self::StickResolution => " (spacing over the stick zone's width, over the minimum's)",
             Self::PrimaryAgreement | Self::TransferAgreement | Self::Equilibrium => " of the force",
         }
     }
@@ -222,6 +227,17 @@ impl Certificate {
                 affects: "contact zone, peak pressure",
                 estimated_by: present(&[Resolution]),
                 not_estimated: None,
+            },
+            ErrorCoverage {
+                error: "stick zone resolution",
+                affects: "stick and slip zones, tangential traction profile",
+                estimated_by: present(&[StickResolution]),
+                not_estimated: (has(FrictionCone) && !has(StickResolution)).then_some(
+                    "no stick zone (every node in contact slips, or none sticks across more \
+                     than one node): the tangential force is mu times the normal force node by \
+                     node; the other primary's tangential force is compared with \
+                     check_other_primary = true (the whole force vector)",
+                ),
             },
             ErrorCoverage {
                 error: "bulk discretization",

@@ -39,6 +39,9 @@
 //!   a zone of three nodes is of the order of the force's (an explicit stiff primary on a
 //!   compliant secondary three nodes across: 1.3% off dolfinx's rigid flat).
 //! - **Force centre.** The two bodies' contact forces act at the same place ([`ForceCentres`]).
+//! - **Stick zone resolution** (Coulomb pairs in partial slip, [`friction`], which also measures
+//!   the Coulomb law's two residuals, the friction cone and the slip rule): the stick zone
+//!   at least `min_zone_width` spacings wide.
 //! - **Primary agreement** (only for a primary named in the case file and at least twice
 //!   stiffer than the other body, a choice `primary = "auto"` avoids):
 //!   the contact force must agree with the one found with the other body as primary, within
@@ -202,6 +205,11 @@ fn complementarity(
 /// - **Slip**: a sticking node's slip `|v|`, and a slipping node's slip along its own
 ///   friction traction `v . d` (it must slip against it), over its spacing, within
 ///   `penetration_tolerance` (the bound that holds the normal gap).
+///
+/// And, where some nodes stick and others slip, an accuracy indicator: the **stick zone's
+/// resolution**, the mean spacing of its nodes times `min_zone_width` over its width (the
+/// largest distance between two sticking nodes), at most 1: the rule the contact zone's
+/// resolution follows (its edge lies between a sticking and a slipping node, a spacing apart).
 pub fn friction(
     problem: &ContactProblem,
     mu: f64,
@@ -209,7 +217,7 @@ pub fn friction(
     pressure: &[f64],
     t_t: &[[f64; 3]],
     slip: &[[f64; 3]],
-) -> [CertificateCheck; 2] {
+) -> Vec<CertificateCheck> {
     let s1 = &problem.primary_surface;
     let settings = &problem.settings;
     let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -226,10 +234,41 @@ pub fn friction(
         };
         slipping.offer(along / s1.spacing[i], s1, i);
     }
-    [
+    let mut checks = vec![
         cone.check(CheckKind::FrictionCone, settings.tension_tolerance),
         slipping.check(CheckKind::Slip, settings.penetration_tolerance),
-    ]
+    ];
+    let sticking: Vec<usize> = (state.iter().enumerate())
+        .filter(|(_, s)| matches!(s, Some(Tangential::Stick)))
+        .map(|(i, _)| i)
+        .collect();
+    let slips = state
+        .iter()
+        .any(|s| matches!(s, Some(Tangential::Slip { .. })));
+    if slips && !sticking.is_empty() {
+        let mut width = 0.0_f64;
+        for (k, &i) in sticking.iter().enumerate() {
+            for &j in &sticking[k + 1..] {
+                let (a, b) = (s1.coords[i], s1.coords[j]);
+                width = width.max(norm(std::array::from_fn(|c| a[c] - b[c])));
+            }
+        }
+        let spacing = sticking.iter().map(|&i| s1.spacing[i]).sum::<f64>() / sticking.len() as f64;
+        let value = spacing * settings.min_zone_width / width;
+        checks.push(CertificateCheck {
+            name: CheckKind::StickResolution,
+            value,
+            tolerance: 1.0,
+            passed: value <= 1.0,
+            body: None,
+            node_tag: None,
+            note: Some(format!(
+                "{} sticking nodes across {width:.3e}",
+                sticking.len()
+            )),
+        });
+    }
+    checks
 }
 
 /// Equilibrium: `|F1 + F2| / |F1|`, the total contact forces on the two bodies.

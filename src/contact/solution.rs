@@ -187,8 +187,11 @@ pub struct FrictionFields {
     pub slip_increment: Vec<[f64; 3]>,
     /// The length of each node's tangential slip path over all load steps so far.
     pub accumulated_slip: Vec<f64>,
-    /// `sum A_i t_T,i` and `sum A_i p_i` over the primary's nodes: the tangential and the
-    /// normal contact force on the primary.
+    /// The total contact force on the primary split along the contact zone's mean normal
+    /// `N` (the nodes' contact normals weighted by their normal forces): the normal force
+    /// `P = -F . N` and the tangential force `Q = F + P N` (Johnson's P and Q). Each node's
+    /// `tangential_traction` is relative to its own contact normal instead (the normal of the
+    /// facet of the other surface it is held on).
     pub tangential_force: [f64; 3],
     pub normal_force: f64,
     pub stick_nodes: usize,

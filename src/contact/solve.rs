@@ -67,7 +67,7 @@
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::time::Instant;
 
-use super::active_set::{ActiveSet, FrictionHistory, Update};
+use super::active_set::{ActiveSet, FrictionHistory, SETTLED, Update};
 use super::checks::{self, certify, contact_status};
 use super::coupled_krylov::Tightness;
 use super::coupled_solver::{self, BodyFactors};
@@ -1066,6 +1066,7 @@ impl ContactSolver<'_> {
             state: vec![None; len],
             tangential_traction: vec![[0.0; 3]; len],
             pressure: vec![0.0; len],
+            normal: vec![[0.0; 3]; len],
             slip_increment: vec![[0.0; 3]; len],
             accumulated_slip: start.accumulated_slip.clone(),
             area: s1.nodal_area.clone(),
@@ -1077,6 +1078,7 @@ impl ContactSolver<'_> {
             answer.state[i] = Some(tangential[i]);
             answer.tangential_traction[i] = coulomb::tangential_part(t, n);
             answer.pressure[i] = -(0..3).map(|c| t[c] * n[c]).sum::<f64>();
+            answer.normal[i] = n;
             answer.slip_increment[i] = slip;
             answer.accumulated_slip[i] += coulomb::norm(slip);
         }
@@ -1153,8 +1155,19 @@ impl ContactSolver<'_> {
                 None => (Tangential::Stick, -c * gaps[i], [0.0; 3], normals[i]),
             };
             let v = coulomb::tangential_part(increment, n);
-            let node = coulomb::update(state, p_i, t_t, v, mu, c, slack);
-            update.max_direction_change = update.max_direction_change.max(node.direction_change);
+            // A slipping node sticks again only if it slips along its own traction by more
+            // than the loop's settled gap tolerance, 0.01 penetration_tolerance h.
+            let settled = SETTLED * problem.settings.penetration_tolerance * s1.spacing[i];
+            let node = coulomb::update(state, p_i, t_t, v, mu, c, slack, settled);
+            // A direction error turns the node's friction traction mu p_i d by as much: weighed
+            // by p_i / p_max, the change is the traction's error over mu p_max.
+            let weight = if p_max > 0.0 {
+                (p_i / p_max).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            update.max_direction_change =
+                (update.max_direction_change).max(weight * node.direction_change);
             let slips = |s: Tangential| matches!(s, Tangential::Slip { .. });
             if active.contains_key(&i) && slips(state) != slips(node.next) && p_max > 0.0 {
                 update.switching.push((i, node.margin / (mu * p_max)));
@@ -1170,8 +1183,9 @@ impl ContactSolver<'_> {
     /// coupled solve; the gaps of every primary candidate of each pair, geometric (the search)
     /// and linearized at the iterate (into `rows`), and how far each pair's active nodes have
     /// slid; the primal-dual active set update. On the Krylov path the solve is first loose
-    /// ([`Tightness::Loose`]) and solved again tightly when its update would keep the active
-    /// set or return to one seen before: no answer, status or check rests on a loose solve.
+    /// ([`Tightness::Loose`]) and solved again tightly when its update would keep the node
+    /// states (and no slipping direction still turns) or return to states seen before: no
+    /// answer, status or check rests on a loose solve.
     /// The time of each phase is added to `seconds`.
     fn iterate(
         &mut self,
@@ -1255,7 +1269,14 @@ impl ContactSolver<'_> {
                 slid.push(pair_slid);
             }
             let update = Update::merge(updates);
-            if loose && (update.next == *active || safeguard.seen.contains(&update.next)) {
+            // An iterate that keeps the node states while slipping nodes' directions still turn
+            // (3D Coulomb) only turns them further: the loop goes on from it, and a loose solve
+            // serves while they turn by more than a hundred times the settled change (a loose
+            // solve's own error turned them by about 1e-6 on the 3D sphere, the settled change
+            // itself, and held the loop there to its cap).
+            let turning = update.max_direction_change > 100.0 * coulomb::DIRECTION_SETTLED;
+            let keeps = update.next == *active && !turning;
+            if loose && (keeps || safeguard.seen.contains(&update.next)) {
                 loose = false;
                 continue;
             }
@@ -1430,6 +1451,9 @@ struct PairFriction {
     state: Vec<Option<Tangential>>,
     tangential_traction: Vec<[f64; 3]>,
     pressure: Vec<f64>,
+    /// The normal each node's pressure and tangential traction are measured against (zero
+    /// where open).
+    normal: Vec<[f64; 3]>,
     slip_increment: Vec<[f64; 3]>,
     accumulated_slip: Vec<f64>,
     area: Vec<f64>,
@@ -1437,12 +1461,26 @@ struct PairFriction {
 
 impl PairFriction {
     fn into_solution(self) -> FrictionFields {
-        let mut tangential_force = [0.0; 3];
-        let mut normal_force = 0.0;
-        for (i, t) in self.tangential_traction.iter().enumerate() {
-            (0..3).for_each(|c| tangential_force[c] += self.area[i] * t[c]);
-            normal_force += self.area[i] * self.pressure[i];
+        // The total contact force on the primary, split along the zone's mean normal (the
+        // nodes' normals weighted by their normal forces): Johnson's P and Q. Node by node the
+        // split depends on which facet a node on a vertex of the other surface is held on (its
+        // normal turns by the kink, h / R on a P1 circle), the total does not.
+        let (mut force, mut mean_normal) = ([0.0; 3], [0.0; 3]);
+        for i in 0..self.area.len() {
+            let (t, p, n, a) = (
+                self.tangential_traction[i],
+                self.pressure[i],
+                self.normal[i],
+                self.area[i],
+            );
+            (0..3).for_each(|c| force[c] += a * (t[c] - p * n[c]));
+            (0..3).for_each(|c| mean_normal[c] += a * p * n[c]);
         }
+        let length = coulomb::norm(mean_normal);
+        let mean_normal = mean_normal.map(|v| if length > 0.0 { v / length } else { 0.0 });
+        let normal_force = -(0..3).map(|c| force[c] * mean_normal[c]).sum::<f64>();
+        let tangential_force: [f64; 3] =
+            std::array::from_fn(|c| force[c] + normal_force * mean_normal[c]);
         let count = |slips: bool| {
             (self.state.iter())
                 .filter(|s| matches!(s, Some(Tangential::Slip { .. })) == slips && s.is_some())

@@ -31,8 +31,12 @@
 
 use super::{Multiplier, Reads, Restates, Tangential};
 
-/// A slipping node's direction has settled when it changes by less than this (the norm of
-/// the difference of the two unit vectors) from one iteration to the next.
+/// The slipping nodes' directions have settled when each changes by less than this from one
+/// iteration to the next (the norm of the difference of the two unit vectors), weighed by the
+/// node's pressure over the largest: the change of its friction traction over `mu p_max`. A
+/// node at the rim of the zone, where the pressure vanishes, carries a friction traction whose
+/// direction hardly matters, and on the 99k-DOF sphere its direction was still turning by 6%
+/// after 50 iterations when unweighed.
 pub const DIRECTION_SETTLED: f64 = 1e-6;
 
 /// A unit tangent basis at the unit normal `n`: one tangent in 2D (`n` rotated by +90
@@ -94,7 +98,12 @@ pub struct NodeUpdate {
 /// The tangential update of the module doc at an active node with pressure `p`, tangential
 /// traction `t_t` and slip increment `v` (tangential, over the step), in state `state`;
 /// `c_t = E* / h`. `slack` (a traction) keeps round-off at the cone's edge from switching a
-/// node back and forth.
+/// sticking node to slip, and `settled` (a length) a slipping node from sticking again: it
+/// sticks only if it also slips along its own traction by more than `settled`. Without it, a
+/// node at the stick zone's edge on the 99k-DOF sphere switched at every iteration (its slip
+/// along its traction 1e-6 of a spacing, far inside what the slip check accepts) and the loop
+/// ended `cycling`.
+#[allow(clippy::too_many_arguments)]
 pub fn update(
     state: Tangential,
     p: f64,
@@ -103,13 +112,17 @@ pub fn update(
     mu: f64,
     c_t: f64,
     slack: f64,
+    settled: f64,
 ) -> NodeUpdate {
     let xi: [f64; 3] = std::array::from_fn(|k| t_t[k] - c_t * v[k]);
     let size = norm(xi);
     let bound = mu * p.max(0.0);
     let stick = match state {
         Tangential::Stick => size <= bound + slack,
-        Tangential::Slip { .. } => size < bound - slack,
+        Tangential::Slip { direction } => {
+            let along: f64 = (0..3).map(|k| v[k] * direction[k]).sum();
+            size < bound - slack && along > settled
+        }
     };
     let margin = (size - bound).abs();
     if stick || size == 0.0 {
@@ -188,6 +201,7 @@ mod tests {
             0.3,
             1.0,
             0.0,
+            0.0,
         );
         assert_eq!(inside.next, Tangential::Stick);
         let outside = update(
@@ -197,6 +211,7 @@ mod tests {
             [0.0; 3],
             0.3,
             1.0,
+            0.0,
             0.0,
         );
         assert_eq!(
@@ -221,6 +236,7 @@ mod tests {
             0.3,
             10.0,
             0.0,
+            0.0,
         );
         assert_eq!(on.next, state);
         assert_eq!(on.direction_change, 0.0);
@@ -232,6 +248,7 @@ mod tests {
             [1e-3, 0.0, 0.0],
             0.3,
             10.0,
+            0.0,
             0.0,
         );
         assert_eq!(back.next, Tangential::Stick);
