@@ -109,7 +109,7 @@ fn krylov_and_schur_solves_agree() {
     // `K^-1 f`) and a slide (the operators paired again).
     //
     // GMRES stops early on the iterations that change the active set (`LOOSE_RTOL` in
-    // src/contact/coupled_krylov.rs), so the next iteration's gaps are linearized at a slightly
+    // src/contact/coupled/coupled_krylov.rs), so the next iteration's gaps are linearized at a slightly
     // different point. Where the active set is right from the first solve (the patch tests,
     // the 2D cases here) the two paths solve the same systems and agree to round-off. On the
     // 3D hemisphere they reach the same active sets and each final iterate holds its active

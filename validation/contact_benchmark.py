@@ -957,7 +957,7 @@ DIRECT_BOUND = (
     "The sparse Cholesky factorization grows faster than GAMG (factor work ~ n^2 in 3D with nested dissection, "
     "GAMG's ~ n): once it alone exceeds twice dolfinx's solve, the aim is out of reach for this path whatever "
     "the loop costs. The compliance solves are one forward + backward solve with each body's factor per "
-    "multiplier (per active primary node, src/contact/compliance.rs); the second iteration pays most of them, "
+    "multiplier (per active primary node, src/contact/coupled/compliance.rs); the second iteration pays most of them, "
     "because the unconstrained first iteration makes every geometrically overlapping node active at once, so "
     "columns are computed for more nodes than end in contact. The other iteration work (the dense Schur "
     "complement from the cached responses, its LU, the solves for z and the back-substitution, the interface "

@@ -1,12 +1,12 @@
-//! The active set of the loop (`super::solve`): where it starts, and its primal-dual update
-//! from an iterate's pressures and gaps.
+//! The active set of the loop (`crate::contact::iteration::solve`): where it starts, and its
+//! primal-dual update from an iterate's pressures and gaps.
 
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 
-use super::law::NodeStates;
+use crate::contact::law::NodeStates;
 
-use super::ContactProblem;
-use super::gap::GapRow;
+use crate::contact::geometry::gap::GapRow;
+use crate::contact::problem::ContactProblem;
 
 /// The active nodes count as lying on the other surface when their geometric gaps are within
 /// this fraction of the penetration tolerance. The gap corrections contract by about ten per
@@ -17,8 +17,9 @@ pub(super) const SETTLED: f64 = 0.01;
 
 /// Where an active-set loop starts: the active primary candidates (surface indices) and the
 /// linearization point of their constraints: the gap rows of every primary candidate
-/// (frictionless and Coulomb, `super::gap`) or the gap corrections `e` (tied,
-/// `super::interface`); for a Coulomb pair, the history the next load step starts from.
+/// (frictionless and Coulomb, `crate::contact::geometry::gap`) or the gap corrections `e` (tied,
+/// `crate::contact::coupled::interface`); for a Coulomb pair, the history the next load step starts
+/// from.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ActiveSet {
     pub nodes: BTreeSet<usize>,
@@ -41,12 +42,13 @@ pub struct FrictionHistory {
     pub accumulated_slip: Vec<f64>,
 }
 
-/// The active-set update of one iteration (step 4 of the loop, `super::solve`), in surface indices.
+/// The active-set update of one iteration (step 4 of the loop, `crate::contact::iteration::solve`),
+/// in surface indices.
 pub(super) struct Update {
     pub(super) next: NodeStates,
     /// Coulomb pairs: the direction of each node slipping next (loop indices), and the
     /// largest change of a slipping node's direction weighed by its pressure over the largest
-    /// ([`super::law::coulomb::DIRECTION_SETTLED`]).
+    /// ([`crate::contact::law::coulomb::DIRECTION_SETTLED`]).
     pub(super) directions: BTreeMap<usize, [f64; 3]>,
     pub(super) max_direction_change: f64,
     /// Coulomb pairs: the nodes in contact whose tangential state changes (stick to slip or
@@ -130,8 +132,8 @@ impl Update {
     }
 
     /// The update of the loop's whole active set from each pair's `(offset, update)`: the
-    /// pairs' nodes shifted by their offsets ([`super::ContactSolver`]); settled (within the
-    /// tolerance) when every pair is, with the largest gap error.
+    /// pairs' nodes shifted by their offsets ([`crate::contact::ContactSolver`]); settled (within
+    /// the tolerance) when every pair is, with the largest gap error.
     pub(super) fn merge(parts: Vec<(usize, Update)>) -> Self {
         let shift = |v: &[(usize, f64)], offset: usize| -> Vec<(usize, f64)> {
             v.iter().map(|&(i, x)| (offset + i, x)).collect()

@@ -1,7 +1,8 @@
 //! The certificate of a contact answer: its checks, each a figure against a tolerance with the
 //! place of its worst value. The residual checks say whether the discrete problem is solved
 //! (they decide the status); the accuracy indicators say whether its answer can be trusted
-//! (a report, never the status). `super::checks` measures them and says why each is what it is.
+//! (a report, never the status). `crate::contact::verify::checks` measures them and says why each
+//! is what it is.
 
 use serde::Serialize;
 
@@ -129,8 +130,8 @@ pub struct CertificateCheck {
 }
 
 impl Certificate {
-    /// Adds a check made outside `super::checks::certify` (e.g. an agreement between two
-    /// discretizations).
+    /// Adds a check made outside `crate::contact::verify::checks::certify` (e.g. an agreement
+    /// between two discretizations).
     pub fn push(&mut self, check: CertificateCheck) {
         self.checks.push(check);
     }

@@ -29,12 +29,14 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::certificate::CheckKind;
-use super::checks::agreement;
-use super::{
-    ActiveSet, CertificateCheck, ContactError, ContactProblem, ContactSolution, ContactSolver,
-    ContactStatus, ForcedDisplacement, OtherPrimary, Transfer,
-};
+use crate::contact::ContactError;
+use crate::contact::active_set::ActiveSet;
+use crate::contact::certificate::{CertificateCheck, CheckKind};
+use crate::contact::iteration::solve::ContactSolver;
+use crate::contact::problem::{ContactProblem, OtherPrimary};
+use crate::contact::settings::Transfer;
+use crate::contact::solution::{ContactSolution, ContactStatus, ForcedDisplacement};
+use crate::contact::verify::checks::agreement;
 use crate::elastic::{SolverSettings, StepFactors};
 
 /// How one load step ended.
@@ -68,7 +70,7 @@ pub struct StepRecord {
     pub friction: Option<StepFriction>,
 }
 
-/// A Coulomb pair's tangential answer at a load step ([`super::FrictionFields`]).
+/// A Coulomb pair's tangential answer at a load step ([`crate::contact::FrictionFields`]).
 #[derive(Debug, Clone, Serialize)]
 pub struct StepFriction {
     /// The tangential and the normal contact force on the primary (`dim` components).

@@ -1,31 +1,31 @@
 //! Elastic bodies in contact, coupled by INTERNODES: one or several pairs, decided together.
 //!
 //! In each pair, body 1 (primary) carries the multiplier `lambda`, the contact traction on it;
-//! body 2 (secondary) receives `-R21 lambda`. The files in the order of one solve; each imports only
-//! files listed before it (`tests/architecture.rs` checks that the imports have no cycle):
-//! - the geometry: `projection.rs` (closest points on a P1 surface), `boundary.rs`, `rbf.rs`
-//!   (rescaled Wendland C2 interpolation), `surface.rs` (a candidate surface: nodes, facets,
-//!   spacings, lumped interface mass), `gap.rs` (the geometric gap, and the gap linearized at
-//!   an iterate);
+//! body 2 (secondary) receives `-R21 lambda`. The parts of a solve, folders and files, in the
+//! order of one solve; each folder's `mod.rs` lists its files in order, and each file imports
+//! only files listed before it (`tests/architecture.rs` checks that the imports have no cycle):
+//! - `geometry/`: the contact surfaces and the interpolation between them, with no method and
+//!   no law: closest points on a P1 surface, a body's closed boundary, the rescaled Wendland C2
+//!   interpolation, a candidate surface (nodes, facets, spacings, lumped interface mass), the
+//!   geometric gap and the gap linearized at an iterate;
 //! - `settings.rs` (every setting, its default and range) and `problem.rs` (the two bodies,
 //!   their surfaces, which one is primary, which transfer);
 //! - the contact law, `law/` (frictionless, tied, Coulomb): each active node's multipliers
 //!   (column and row), the tangential state of a Coulomb node (stick, slip) and its update, and
 //!   the loop's per-node state; the only place that tells the laws apart;
-//! - the linear algebra of an iteration, for any number of bodies and pairs: `compliance.rs` (the bodies' responses to unit tractions),
-//!   `system.rs` (the coupled system of an active set), `interface.rs` (the
-//!   interface operators, built once over all candidates: the interpolation evaluated at each
-//!   node's closest point on the other surface, the contact normal), `half_space.rs` (the
-//!   interface Schur complement approximated by two elastic half-spaces), `coupled_krylov.rs`
-//!   (the whole coupled system by one preconditioned GMRES), `coupled_solver.rs` (which
-//!   solver, behind one call);
+//! - `coupled/`: the linear algebra of an iteration, for any number of bodies and pairs: the
+//!   bodies' responses to unit tractions, the coupled system of an active set, the INTERNODES
+//!   interface operators (built once over all candidates: the interpolation evaluated at each
+//!   node's closest point on the other surface, the contact normal), the half-space
+//!   approximation of the interface Schur complement, and the system's solvers (one
+//!   preconditioned GMRES on the whole system, or the dense Schur complement) behind one call;
 //! - what a solve returns: `certificate.rs` (the checks of an answer), `active_set.rs` (where
-//!   the loop starts, and its primal-dual update), `solution.rs`; `checks.rs` measures the
-//!   certificate independently of the loop's operators (the residuals that decide the status,
-//!   the accuracy report), `hertz.rs` fits a Hertz profile, `post.rs` makes the fields and
-//!   forces of the last iterate;
-//! - the loop: `safeguard.rs` (when it stops) and `solve.rs` (the active-set loop over every
-//!   pair);
+//!   the loop starts, and its primal-dual update: a solution carries the active set the next
+//!   load step starts from, so it comes before the loop), `solution.rs`;
+//! - `verify/`: the last iterate measured without the loop's operators (the residuals that
+//!   decide the status, the accuracy report), a Hertz fit, and the fields and forces of the
+//!   last iterate;
+//! - `iteration/`: the active-set loop over every pair, and when it stops;
 //! - `driver.rs`: [`solve_contact`], the solve a caller asks for: the load steps, and for a
 //!   single pair a second solve with the other body as primary, or auto's transfer, when a
 //!   choice made may be the wrong one.
@@ -33,33 +33,25 @@
 //! Method, signs and the reasons behind each rule: `docs/method.md`.
 
 mod active_set;
-mod boundary;
 mod certificate;
-mod checks;
-mod compliance;
-mod coupled_krylov;
-mod coupled_solver;
+mod coupled;
 mod driver;
-mod gap;
-mod half_space;
-mod hertz;
-mod interface;
+mod geometry;
+mod iteration;
 pub mod law;
-mod post;
 mod problem;
-pub mod projection;
-pub mod rbf;
-mod safeguard;
 mod settings;
 mod solution;
-mod solve;
-mod surface;
-pub mod system;
+mod verify;
 
 pub use active_set::ActiveSet;
 pub use certificate::{Certificate, CertificateCheck, CheckKind, ErrorCoverage};
-pub use coupled_krylov::{KrylovError, KrylovFailure};
+pub use coupled::coupled_krylov::{KrylovError, KrylovFailure};
+pub use coupled::system;
 pub use driver::{ContactRun, StepFriction, StepRecord, solve_contact, solve_contact_steps};
+pub use geometry::surface::{ContactSurface, SurfaceError};
+pub use geometry::{projection, rbf};
+pub use iteration::solve::ContactSolver;
 pub use problem::{
     ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,
 };
@@ -68,8 +60,6 @@ pub use solution::{
     ContactSolution, ContactStatus, ForcedDisplacement, FrictionFields, FrictionState, HertzFit,
     IterationRecord, LinearSolvers, PhaseSeconds, SurfaceFields,
 };
-pub use solve::ContactSolver;
-pub use surface::{ContactSurface, SurfaceError};
 
 use thiserror::Error;
 
@@ -150,7 +140,7 @@ pub enum ContactError {
     )]
     Inaccurate { residual: f64, tolerance: f64 },
     #[error(transparent)]
-    Krylov(#[from] coupled_krylov::KrylovError),
+    Krylov(#[from] coupled::coupled_krylov::KrylovError),
     /// The solve's [`crate::cancel::Cancel`] token was cancelled.
     #[error(transparent)]
     Cancelled(#[from] crate::cancel::Cancelled),

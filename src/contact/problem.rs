@@ -1,15 +1,16 @@
 //! What to solve: two elastic bodies, their candidate surfaces, which one carries the
-//! multiplier, and the settings of the active-set loop (`super::settings`).
+//! multiplier, and the settings of the active-set loop (`crate::contact::settings`).
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::settings::{ContactSettings, Transfer};
-use super::{ContactError, ContactSurface};
+use crate::contact::ContactError;
+use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::settings::{ContactSettings, Transfer};
 use crate::elastic::{ElasticProblem, StepFactors};
 
 /// A secondary body whose share of the two bodies' compliance (`1 / E'`) is below this is
-/// nearly rigid: the contact zone need not be resolved on it (`super::checks`), and its load
-/// is best transferred conservatively ([`ContactProblem::transfer`]).
+/// nearly rigid: the contact zone need not be resolved on it (`crate::contact::verify::checks`),
+/// and its load is best transferred conservatively ([`ContactProblem::transfer`]).
 pub(super) const COMPLIANT_SHARE: f64 = 0.1;
 
 /// Which body carries the multiplier: `"auto"` (default) or a body's name.
@@ -53,7 +54,7 @@ pub struct PrimaryReport {
     pub other_primary: OtherPrimary,
 }
 
-/// What a solve does with the other body as primary (`super::driver`), decided with the
+/// What a solve does with the other body as primary (`crate::contact::driver`), decided with the
 /// primary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum OtherPrimary {
@@ -80,7 +81,7 @@ pub const SIMILAR_STIFFNESS: f64 = 2.0;
 /// are graded towards the contact, so the finest spacing of a surface is one close pair of
 /// nodes somewhere there, too noisy to compare two surfaces meshed alike.
 pub fn contact_zone_spacing(surface: &ContactSurface, other: &ContactSurface) -> f64 {
-    let gaps = super::gap::geometric_gaps(surface, other, None, None);
+    let gaps = crate::contact::geometry::gap::geometric_gaps(surface, other, None, None);
     let mut order: Vec<usize> = (0..surface.len()).collect();
     order.sort_by(|&a, &b| gaps[a].abs().total_cmp(&gaps[b].abs()));
     let count = (surface.len() / 10).max(10).min(surface.len());
@@ -143,7 +144,7 @@ impl<'m> ContactProblem<'m> {
     }
 
     /// Whether the case names a transfer that `auto` would not choose: the answer is then
-    /// checked against the one with auto's (`super::driver`). Conservative onto a finer
+    /// checked against the one with auto's (`crate::contact::driver`). Conservative onto a finer
     /// secondary leaves its nodes between the primary's projections unevenly loaded; two flat
     /// blocks on rollers, the coarser primary, were 2.3% softer with it than with the
     /// interpolation and passed every other check.
@@ -212,7 +213,7 @@ impl<'m> ContactProblem<'m> {
 
     /// The contact moduli `E / (1 - nu^2)` of the primary and secondary bodies, normalized to
     /// sum to one: the weights of their normals in the contact normal
-    /// (`super::interface::contact_normal`).
+    /// (`crate::contact::coupled::interface::contact_normal`).
     pub fn normal_weights(&self) -> [f64; 2] {
         let modulus = |p: &ElasticProblem| {
             p.material.youngs_modulus() / (1.0 - p.material.poisson_ratio().powi(2))
@@ -236,9 +237,9 @@ impl<'m> ContactProblem<'m> {
     /// interpolated response `R12 K2^-1 (transfer)`, of rank at most the secondary's node count;
     /// on a nearly rigid primary, multiplier modes are left that nothing controls (the
     /// half-disc at R/500 on a block 1e4 times stiffer, the block primary:
-    /// [`super::ContactStatus::Unstable`]), and a curved secondary sags between the constrained
-    /// nodes of a coarse flat primary (the certificate's sag check). On the compliant body
-    /// `K1^-1` controls every mode.
+    /// [`crate::contact::ContactStatus::Unstable`]), and a curved secondary sags between the
+    /// constrained nodes of a coarse flat primary (the certificate's sag check). On the compliant
+    /// body `K1^-1` controls every mode.
     ///
     /// Why the coarser surface between similar bodies: a multiplier mesh coarser than the mesh
     /// it constrains is the classical inf-sup-stable choice, and the finer secondary receives
@@ -247,7 +248,7 @@ impl<'m> ContactProblem<'m> {
     /// coarser one) measured worse on two equal hemispheres meshed 1.5 times apart (`docs/method.md`
     /// 3.6). The price is the sag of a curved secondary between the
     /// nodes of a coarse flat primary, which the certificate measures; the retry with the
-    /// other primary (`super::driver`) answers it.
+    /// other primary (`crate::contact::driver`) answers it.
     pub fn new(
         sides: [ContactSide<'m>; 2],
         choice: &PrimaryChoice,

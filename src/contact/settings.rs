@@ -15,7 +15,7 @@ pub enum Formulation {
     Tied,
     /// Coulomb friction with the pair's `friction_coefficient`: each active node sticks
     /// (its tangential slip over the load step is zero) or slips (its tangential traction is
-    /// `mu` times its pressure, against its slip) (`super::law::coulomb`).
+    /// `mu` times its pressure, against its slip) (`crate::contact::law::coulomb`).
     Coulomb,
 }
 
@@ -42,11 +42,12 @@ impl Formulation {
 ///   transfer). The rows of `R12` sum to one, so the forces on the two bodies balance exactly.
 ///   For tied contact the coupling is then the transpose of the constraint (the Lagrange
 ///   multiplier form of `u1 - R12 u2 = d`); frictionless rows are node to segment
-///   (`super::gap`), and the system stays unsymmetric. Onto a secondary finer than the primary it leaves the
-///   secondary nodes between the projections of primary nodes unloaded, which is why
-///   INTERNODES interpolates there.
+///   (`crate::contact::geometry::gap`), and the system stays unsymmetric. Onto a secondary finer
+///   than the primary it leaves the secondary nodes between the projections of primary nodes
+///   unloaded, which is why INTERNODES interpolates there.
 /// - `Auto` (default): conservative when the secondary's contact surface is coarser than the
-///   primary's near the other body (`super::problem::contact_zone_spacing`), interpolation otherwise.
+///   primary's near the other body (`crate::contact::problem::contact_zone_spacing`), interpolation
+///   otherwise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Transfer {
@@ -65,13 +66,13 @@ pub struct SettingsError {
     pub value: f64,
 }
 
-/// How each iteration's coupled system is solved (`super::coupled_solver` says how each works
-/// and why `auto` is the default).
+/// How each iteration's coupled system is solved (`crate::contact::coupled::coupled_solver` says
+/// how each works and why `auto` is the default).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum CoupledSolver {
     /// The default: [`Self::Krylov`], and [`Self::Schur`] from the first iteration whose GMRES
-    /// solve fails (`super::coupled_solver`).
+    /// solve fails (`crate::contact::coupled::coupled_solver`).
     #[default]
     Auto,
     /// Each body's solver set up once, dense Schur complement on the multipliers per
@@ -119,7 +120,7 @@ pub struct ContactSettings {
     pub transfer: Transfer,
     /// How each iteration's linear system is solved (default: `auto`, the interface Schur
     /// system by GMRES on the bodies' solvers set up once, the dense Schur complement if
-    /// GMRES fails; `super::coupled_solver`).
+    /// GMRES fails; `crate::contact::coupled::coupled_solver`).
     pub solver: CoupledSolver,
     /// Cap on active-set iterations (default 50); reaching it is a status, not an error.
     pub max_iterations: usize,
@@ -146,9 +147,9 @@ pub struct ContactSettings {
     pub secondary_penetration_tolerance: f64,
     /// The accuracy report's bound on the relative error of the contact force, for each
     /// indicator that estimates it (default 0.01): the secondary's sag, and the agreement with
-    /// the other primary or with the automatic transfer when one was named (`super::checks`).
-    /// One tolerance, because each of them answers the same question: how far the force the
-    /// user reads may be from the one of a better discretization.
+    /// the other primary or with the automatic transfer when one was named
+    /// (`crate::contact::verify::checks`). One tolerance, because each of them answers the same
+    /// question: how far the force the user reads may be from the one of a better discretization.
     pub accuracy_tolerance: f64,
     /// The certificate's bound on the tensile normal force any surface node receives over its
     /// area (along the node's own outward normal), relative to the largest pressure (default
@@ -158,21 +159,23 @@ pub struct ContactSettings {
     /// of the order of the peak pressure.
     pub certificate_tension_tolerance: f64,
     /// The certificate's lower bound on the contact zone's width, in primary spacings
-    /// (`super::checks`; default 1.5: three nodes across a 2D zone, about seven in 3D).
+    /// (`crate::contact::verify::checks`; default 1.5: three nodes across a 2D zone, about seven in
+    /// 3D).
     pub min_zone_width: f64,
     /// The same bound in secondary spacings, unless the secondary is nearly rigid (default
     /// 2.5: four nodes across a 2D zone).
     pub secondary_min_zone_width: f64,
     /// The certificate's bound on the distance between the centres of the normal contact
     /// forces on the two bodies, over the coarser surface's spacing where they are loaded
-    /// (`super::checks`; default 1): equal and opposite forces must also act at the same place.
+    /// (`crate::contact::verify::checks`; default 1): equal and opposite forces must also act at
+    /// the same place.
     pub force_centre_tolerance: f64,
     /// The certificate's bound on `|F1 + F2| / |F1|` (default 0.01): the reported contact force
     /// is known to this fraction.
     pub imbalance_tolerance: f64,
     /// Support radius of each node's RBF in the transfer operators, in units of the distance
     /// to its nearest node (default 2, the radius Algorithm 1 of `docs/method.md` starts from; see
-    /// [`crate::contact::rbf::interpolation_radii`] for the measurements behind it).
+    /// [`crate::contact::geometry::rbf::interpolation_radii`] for the measurements behind it).
     pub rbf_radius: f64,
     /// Solve every load step again with the other body as primary and check that the two
     /// contact forces agree within `accuracy_tolerance` (`primary agreement`), whatever the
@@ -239,7 +242,8 @@ impl ContactSettings {
             _ => {}
         }
         // The loop ends by itself within a few iterations of a repeat or a stall
-        // (`super::solve`); a cap beyond this only postpones a status that is already due.
+        // (`crate::contact::iteration::solve`); a cap beyond this only postpones a status that is
+        // already due.
         if !(1..=MAX_ITERATIONS_CAP).contains(&self.max_iterations) {
             return error(
                 "max_iterations",

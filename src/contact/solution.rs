@@ -4,9 +4,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::Formulation;
-use super::active_set::ActiveSet;
-use super::certificate::Certificate;
+use crate::contact::active_set::ActiveSet;
+use crate::contact::certificate::Certificate;
+use crate::contact::settings::Formulation;
 use crate::elastic::ElasticSolution;
 
 /// How the active-set loop ended. Only `Converged` is a contact solution; the others carry the
@@ -18,7 +18,7 @@ pub enum ContactStatus {
     /// measured independently of the loop, is within its tolerance: no node of either surface
     /// penetrates the other body or receives a tensile force, every active node lies on the
     /// other surface, and the contact forces balance. Whether the answer is accurate is the
-    /// accuracy report's question ([`super::Certificate::accurate`]), not the status's.
+    /// accuracy report's question ([`crate::contact::Certificate::accurate`]), not the status's.
     Converged,
     /// The active set settled but a residual check failed (it says which, where, and by how
     /// much): the discrete problem is not solved.
@@ -145,8 +145,9 @@ pub struct SurfaceFields {
     /// Contact pressure `p = -traction . n` (positive in compression), `n` the node's outward
     /// normal.
     pub pressure: Vec<f64>,
-    /// Normal contact force of each node over its area ([`super::ContactSurface::mean_pressure`]);
-    /// with the lumped interface mass, equal to `pressure` on the primary surface.
+    /// Normal contact force of each node over its area
+    /// ([`crate::contact::ContactSurface::mean_pressure`]); with the lumped interface mass, equal
+    /// to `pressure` on the primary surface.
     pub mean_pressure: Vec<f64>,
     /// Geometric gap to the other body's surface in the deformed configuration: signed distance
     /// to its closest point, negative inside the other body (defined at any distance).
@@ -176,8 +177,8 @@ impl FrictionState {
     }
 }
 
-/// A Coulomb pair's tangential answer on its primary surface (`super::law::coulomb`), every
-/// candidate node in the order of [`SurfaceFields::nodes`].
+/// A Coulomb pair's tangential answer on its primary surface (`crate::contact::law::coulomb`),
+/// every candidate node in the order of [`SurfaceFields::nodes`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrictionFields {
     pub state: Vec<FrictionState>,
@@ -205,7 +206,8 @@ pub struct HertzFit {
     /// Contact radius (3D) or half-width (2D).
     pub a: f64,
     pub p0: f64,
-    /// Centre of the contact zone: the vertex of the fitted profile (`super::hertz`).
+    /// Centre of the contact zone: the vertex of the fitted profile
+    /// (`crate::contact::verify::hertz`).
     pub center: [f64; 3],
 }
 
@@ -358,8 +360,8 @@ impl ContactSolution {
     }
 
     /// Adds an accuracy indicator computed after the loop (e.g.
-    /// `super::checks::agreement`) to the report.
-    pub fn certify_further(&mut self, check: super::CertificateCheck) {
+    /// `crate::contact::verify::checks::agreement`) to the report.
+    pub fn certify_further(&mut self, check: crate::contact::certificate::CertificateCheck) {
         debug_assert!(!check.name.is_residual());
         self.certificate.push(check);
     }

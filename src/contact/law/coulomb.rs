@@ -11,7 +11,7 @@
 //! `lambda_n (n - mu d)` with the normal row: its friction traction `mu p d` (`p = -lambda_n`)
 //! rides on its pressure, in the direction `d` the last update chose. Its column is not its
 //! row: the coupled system is unsymmetric (the coupled GMRES and its half-space preconditioner,
-//! `super::super::half_space`, take rows and columns apart).
+//! `crate::contact::coupled::half_space`, take rows and columns apart).
 //!
 //! **The update** is the primal-dual active set (semismooth Newton) step of the complementarity
 //! function of Hüeber, Stadler and Wohlmuth (2008), node by node, for the tangential part:

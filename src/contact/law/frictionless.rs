@@ -1,6 +1,6 @@
 //! Frictionless contact: one scalar multiplier per active node, the pressure along the normal,
-//! and only the normal gap held (node to segment, `super::super::gap`). The surfaces slide
-//! freely: no tangential traction.
+//! and only the normal gap held (node to segment, `crate::contact::geometry::gap`). The surfaces
+//! slide freely: no tangential traction.
 
 use super::{Multiplier, Reads, Restates};
 

@@ -1,22 +1,26 @@
 //! The contact law of a pair: what holds at each of its active primary nodes, and how the
 //! loop decides each node's state. Everything the loop, the coupled system and the checks need
-//! to know about the law is asked here; nothing else matches on the formulation.
+//! to know about the law is asked here; nothing else matches on the formulation. Its files, in
+//! order, after this one (the law, [`ContactLaw`], and what a multiplier is): `state.rs` (the
+//! loop's per-node state), `frictionless.rs`, `tied.rs`, `coulomb.rs` (each law's multipliers;
+//! for Coulomb, the tangential state of a node and its update).
 //!
 //! Every law shares the normal part: a node is open (no multiplier) or in contact (its gap
 //! held at zero, its pressure `p = -lambda . n >= 0`), decided by the primal-dual active-set
-//! update of the active-set loop (`super::solve`). The laws differ in the tangential part:
+//! update of the active-set loop (`crate::contact::iteration::solve`). The laws differ in the
+//! tangential part:
 //!
 //! | law          | node state          | multipliers per node          | constraint rows |
 //! |--------------|---------------------|-------------------------------|-----------------|
-//! | frictionless | contact             | 1: `lambda_n n`               | the normal gap, node to segment (`super::gap`) |
-//! | tied         | contact             | `dim`: the traction's components | `u1 - R12 u2 = (d + e) n` (`super::interface`) |
+//! | frictionless | contact             | 1: `lambda_n n`               | the normal gap, node to segment (`crate::contact::geometry::gap`) |
+//! | tied         | contact             | `dim`: the traction's components | `u1 - R12 u2 = (d + e) n` (`crate::contact::coupled::interface`) |
 //! | Coulomb      | stick               | `dim`: `lambda_n n + sum lambda_a t_a` | the normal gap; `t_a . (u1 - R12 u2)` unchanged over the step |
 //! | Coulomb      | slip along `d`      | 1: `lambda_n (n - mu d)`      | the normal gap  |
 //!
 //! A multiplier ([`Multiplier`]) is a column (the traction one unit of it exerts on the
 //! primary) and a row (a direction of the constraint, read at a point of the secondary): the
-//! coupled system (`super::system`) assembles any such list, and only a slipping node's
-//! column differs from its row, which makes the system unsymmetric.
+//! coupled system (`crate::contact::coupled::system`) assembles any such list, and only a slipping
+//! node's column differs from its row, which makes the system unsymmetric.
 
 pub mod coulomb;
 mod frictionless;
@@ -25,11 +29,12 @@ mod tied;
 
 pub use state::NodeStates;
 
-use super::settings::{ContactSettings, Formulation};
+use crate::contact::settings::{ContactSettings, Formulation};
 
 /// Which point of the secondary surface a constraint row reads: the P1 corners of the facet
-/// the node projects onto (the geometric gap linearized, `super::gap`), or the row of the
-/// interpolation `R12` at the node's paired point (`super::interface`).
+/// the node projects onto (the geometric gap linearized, `crate::contact::geometry::gap`), or the
+/// row of the interpolation `R12` at the node's paired point
+/// (`crate::contact::coupled::interface`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reads {
     Geometric,
@@ -37,7 +42,7 @@ pub enum Reads {
 }
 
 /// When a multiplier only restates Dirichlet conditions of the primary (and is dropped from
-/// the system: its column would be empty, `super::system`).
+/// the system: its column would be empty, `crate::contact::coupled::system`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Restates {
     /// When every component of its node is prescribed.
@@ -104,8 +109,8 @@ impl ContactLaw {
     }
 
     /// Whether the normal gap of an active node is held node to segment (the geometric gap
-    /// linearized at the iterate, `super::gap`); otherwise (tied) through `R12` with the gap
-    /// correction `e` of the last iterate (`super::interface`).
+    /// linearized at the iterate, `crate::contact::geometry::gap`); otherwise (tied) through `R12`
+    /// with the gap correction `e` of the last iterate (`crate::contact::coupled::interface`).
     pub fn holds_geometric_gap(&self) -> bool {
         !matches!(self, Self::Tied)
     }
@@ -117,8 +122,8 @@ impl ContactLaw {
     }
 
     /// The directions an active node in state `tangential` holds its body along, against the
-    /// body's rigid motions (`super::solve`, `check_held`): the normal alone, or every
-    /// direction (tied, and a sticking node).
+    /// body's rigid motions (`crate::contact::iteration::solve`, `check_held`): the normal alone,
+    /// or every direction (tied, and a sticking node).
     pub fn holds_every_direction(&self, tangential: Tangential) -> bool {
         match self {
             Self::Frictionless => false,
@@ -128,8 +133,8 @@ impl ContactLaw {
     }
 
     /// Whether the first iteration may start from the half-space model's prediction of the
-    /// contact zone (`super::half_space::predicted_set`): a model of frictionless contact
-    /// between half-spaces, which a tied or frictional zone's normal part follows only for
+    /// contact zone (`crate::contact::coupled::half_space::predicted_set`): a model of frictionless
+    /// contact between half-spaces, which a tied or frictional zone's normal part follows only for
     /// equal materials.
     pub fn predicts_zone(&self) -> bool {
         matches!(self, Self::Frictionless)

@@ -1,6 +1,6 @@
 //! The state of every primary candidate of the loop, all pairs numbered one after another
-//! (`super::super::solve`: pair `p`'s node `i` is `offsets[p] + i`): open, in contact, and
-//! for Coulomb pairs, slipping (a node in contact and not slipping sticks). The partition is
+//! (`crate::contact::iteration::solve`: pair `p`'s node `i` is `offsets[p] + i`): open, in contact,
+//! and for Coulomb pairs, slipping (a node in contact and not slipping sticks). The partition is
 //! what the loop's safeguard remembers and compares; the slipping nodes' directions are carried
 //! beside it, as the gap linearization is.
 

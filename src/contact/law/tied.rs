@@ -1,7 +1,7 @@
 //! Tied contact (the original INTERNODES contact system): one multiplier per component of the
 //! traction, and the vector constraint `u1_i - (R12 u2)_i = (d_i + e_i) n_i` through the
-//! interpolation, `e` the gap correction of the last iterate (`super::super::interface`). The
-//! active surfaces are glued together.
+//! interpolation, `e` the gap correction of the last iterate
+//! (`crate::contact::coupled::interface`). The active surfaces are glued together.
 
 use super::{Multiplier, Reads, Restates};
 

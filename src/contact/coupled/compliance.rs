@@ -7,11 +7,11 @@
 //! An active-set iteration needs `K^-1 B` only where the constraint rows `C` read it, and the
 //! columns of `C` (the interface displacements) are candidate-surface dofs, so the Schur
 //! complement is `D - s C Y` with `Y = [Y_k]` restricted to those dofs. While the operators
-//! stay as built (`super::interface`), `b_(i,c)` depends only on the node and the component:
-//! it is computed (one solve with the body's solver per component) the first time
+//! stay as built (`crate::contact::coupled::interface`), `b_(i,c)` depends only on the node and the
+//! component: it is computed (one solve with the body's solver per component) the first time
 //! the node is active, and kept for every later iteration and load step, until the operators
 //! are paired again. Per component, not per multiplier: the frictionless traction acts along
-//! the normal of the secondary facet the node is held on (`super::gap`), which
+//! the normal of the secondary facet the node is held on (`crate::contact::geometry::gap`), which
 //! turns with the displacement from one iteration to the next; the price is `dim` solves per
 //! node instead of one.
 //!
@@ -26,11 +26,12 @@
 
 use std::collections::HashMap;
 
-use super::ContactError;
+use crate::contact::ContactError;
 use crate::linalg::BodySolver;
 
-/// Identifies a unit load across iterations (`super::system::CoupledSystem::columns` combines
-/// them into the columns of the multiplier block).
+/// Identifies a unit load across iterations
+/// (`crate::contact::coupled::system::CoupledSystem::columns` combines them into the columns of the
+/// multiplier block).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MultiplierKey {
     /// A unit traction of `component` at the primary body node `node` of contact pair `pair`.

@@ -32,14 +32,14 @@
 //! complementarity problem of the gap the certificate measures, and converges quadratically
 //! while the active set and the facets stay put (one or two iterations on a flat, where `g` is
 //! linear in `u`). The INTERNODES interpolation still carries the traction to the secondary
-//! (`R21` or `R12^T`, [`super::Transfer`]), and at the answer every active node is on the
+//! (`R21` or `R12^T`, [`crate::contact::Transfer`]), and at the answer every active node is on the
 //! secondary's P1 surface, as before; only the path there changed. The earlier constraint used
 //! the rows of `R12` with a correction `e = g - g_lin` from the last iterate: a fixed-point
 //! iteration on `e` that contracts only where `R12` reproduces the P1 surface, and diverged
 //! (error doubling each iteration) where it extrapolates, at the ends of two clamped blocks.
 
-use super::ContactSurface;
-use super::projection::{Projection, SurfaceIndex};
+use crate::contact::geometry::projection::{Projection, SurfaceIndex};
+use crate::contact::geometry::surface::ContactSurface;
 
 /// Within what distance of a contact surface a node is judged by the plane of the facet it
 /// faces, in units of that facet's longest edge. Two faces meant to end flush (equal blocks
@@ -64,16 +64,16 @@ pub const BEYOND_RIM: f64 = 1e-3;
 /// The geometric gap of every node of `own` to the `other` body, each displaced by its body's
 /// displacement (`None`: reference geometry), the one gap measure of the loop's penetration
 /// test, the checks and the `normal_gap` output. The node's closest point `q` on the other
-/// candidate surface's P1 facets ([`super::projection`], on the facet that faces the node's own
-/// normal where several share it, as its linearization does, [`gap_rows`]) and that
+/// candidate surface's P1 facets ([`crate::contact::geometry::projection`], on the facet that faces
+/// the node's own normal where several share it, as its linearization does, [`gap_rows`]) and that
 /// facet's outward normal `m` give:
 /// - for a node **beside the surface**, whose closest point is on the other surface's rim
 ///   (its free edges or end points) and which lies beyond the rim, along the facet's plane, by
 ///   more than [`BEYOND_RIM`] of its spacing, both in the reference configuration and now:
 ///   the distance `|x - q|`, negative only when the node is inside the other body (decided on
-///   that body's closed boundary, [`super::boundary`]). Such a node faces no facet: the plane
-///   of the rim's facet extends the surface where there is no surface, and a node of a block
-///   bulging up beside a punch would read as penetrating the punch it does not touch
+///   that body's closed boundary, [`crate::contact::geometry::boundary`]). Such a node faces no
+///   facet: the plane of the rim's facet extends the surface where there is no surface, and a node
+///   of a block bulging up beside a punch would read as penetrating the punch it does not touch
 ///   (`docs/method.md` 3.1). The reference configuration decides too because whether a node
 ///   faces a surface is a property of the two meshes: two blocks meant to end flush end a hair
 ///   apart once deformed, and a node whose side flips with that hair makes the loop cycle;

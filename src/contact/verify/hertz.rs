@@ -16,8 +16,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::ContactSurface;
-use super::solution::{HertzFit, SurfaceFields};
+use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::solution::{HertzFit, SurfaceFields};
 
 /// The fit over the active nodes of `surface` with positive mean pressure; `None` with fewer
 /// nodes than unknowns (plus one), a profile that does not decrease outward, or a fitted radius

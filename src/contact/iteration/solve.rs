@@ -1,7 +1,7 @@
 //! The INTERNODES active-set loop: a primal-dual active set method (a semismooth Newton method
 //! on the nodal complementarity conditions; Hüeber and Wohlmuth 2005) over interface operators
-//! built once (`super::interface`), with its answer checked by independent measures
-//! ([`super::checks`]).
+//! built once (`crate::contact::coupled::interface`), with its answer checked by independent
+//! measures ([`crate::contact::verify::checks`]).
 //!
 //! ```text
 //! A <- primary candidates that touch or penetrate in the reference configuration
@@ -24,7 +24,7 @@
 //! ```
 //!
 //! **Why it converges.** On a fixed active set, step 3 linearizes the very gap step 4 and the
-//! checks measure (`super::gap`): steps 1-3 are Newton's method on `g_A(u) = 0`,
+//! checks measure (`crate::contact::geometry::gap`): steps 1-3 are Newton's method on `g_A(u) = 0`,
 //! exact in one step where the secondary surface is flat and quadratic where it is smooth; on
 //! a P1 surface the gap is piecewise linear, and a node on an edge can hold the error at the
 //! size of the kink, which the stall test accepts within the tolerance. Over active sets,
@@ -47,8 +47,8 @@
 //! What differs from earlier INTERNODES contact loops: the operators do not change with A
 //! (rebuilding them for every active set moves the discrete problem from one iteration to the
 //! next), the pressure `p_i = -lambda_i . n_i` tested is the unknown of the system (lumped
-//! interface mass, `super::surface`), and the gap is the geometric one, for the loop and the
-//! checks alike.
+//! interface mass, `crate::contact::geometry::surface`), and the gap is the geometric one, for the
+//! loop and the checks alike.
 //!
 //! An update that would return to an active set seen before first keeps active (pins, for the
 //! rest of the solve) the nodes it removes for tension that had been removed before and came
@@ -67,23 +67,25 @@
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::time::Instant;
 
-use super::active_set::{ActiveSet, FrictionHistory, SETTLED, Update};
-use super::checks::{self, certify, contact_status};
-use super::coupled_krylov::Tightness;
-use super::coupled_solver::{self, BodyFactors};
-use super::gap::{GapRow, gap_rows, geometric_gaps};
-use super::half_space::{compliance_factor, force_controlled_set, predicted_set};
-use super::interface::{Constraint, InterfaceOperators};
-use super::law::{ContactLaw, NodeStates, Tangential, coulomb};
-use super::post::{self, LastIterate};
-use super::safeguard::{Safeguard, Step};
-use super::settings::CoupledSolver;
-use super::solution::{
+use crate::contact::ContactError;
+use crate::contact::active_set::{ActiveSet, FrictionHistory, SETTLED, Update};
+use crate::contact::coupled::coupled_krylov::Tightness;
+use crate::contact::coupled::coupled_solver::{self, BodyFactors};
+use crate::contact::coupled::half_space::{compliance_factor, force_controlled_set, predicted_set};
+use crate::contact::coupled::interface::{Constraint, InterfaceOperators};
+use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
+use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
+use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::iteration::safeguard::{Safeguard, Step};
+use crate::contact::law::{ContactLaw, NodeStates, Tangential, coulomb};
+use crate::contact::problem::ContactProblem;
+use crate::contact::settings::{ContactSettings, CoupledSolver, Transfer};
+use crate::contact::solution::{
     ContactSolution, ContactStatus, FrictionFields, FrictionState, IterationRecord, LinearSolvers,
     PhaseSeconds,
 };
-use super::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
-use super::{ContactError, ContactProblem, ContactSettings, ContactSurface, Transfer};
+use crate::contact::verify::checks::{self, certify, contact_status};
+use crate::contact::verify::post::{self, LastIterate};
 use crate::elastic::{
     AssembledBody, ElasticProblem, SolveStats, SolverSettings, StepFactors, assemble,
 };
@@ -303,7 +305,8 @@ impl<'a> ContactSolver<'a> {
                 .collect()
         };
         // A distributed run hands each body's matrix to PETSc and releases ours before the
-        // multigrid hierarchies are built (`coupled_solver::distributed_solvers`).
+        // multigrid hierarchies are built
+        // (`crate::contact::coupled::coupled_solver::distributed_solvers`).
         let start = Instant::now();
         let ready = match settings.solver {
             CoupledSolver::MonolithicLu => None,
@@ -709,9 +712,9 @@ impl ContactSolver<'_> {
     /// system is singular (the force would move it without bound), and from the nodes that
     /// merely touch (a sphere's pole) the first iterate would carry the whole force on them.
     /// Each pair of such a body starts on the half-space model's zone for the resultant of
-    /// its bodies' loads and forces (`super::half_space::force_controlled_set`); where the
-    /// model finds none (no force: a floating block between two others), on the nodes that
-    /// touch already, or the closest node. If the loop lets go of every contact of such a
+    /// its bodies' loads and forces (`crate::contact::coupled::half_space::force_controlled_set`);
+    /// where the model finds none (no force: a floating block between two others), on the nodes
+    /// that touch already, or the closest node. If the loop lets go of every contact of such a
     /// body after that, its loads pull it off: an error that names it.
     fn first_contact(
         &self,
@@ -929,10 +932,11 @@ impl ContactSolver<'_> {
         [constraint, own]
     }
 
-    /// The active set the half-space model predicts (`super::half_space::predicted_set`) for
-    /// each frictionless pair from the iterate `solution` on the active `nodes` with their
-    /// `couplings`, over the nodes the update keeps or adds (`next`) and those it removes;
-    /// `next`'s nodes of a pair where the model predicts no contact.
+    /// The active set the half-space model predicts
+    /// (`crate::contact::coupled::half_space::predicted_set`) for each frictionless pair from the
+    /// iterate `solution` on the active `nodes` with their `couplings`, over the nodes the update
+    /// keeps or adds (`next`) and those it removes; `next`'s nodes of a pair where the model
+    /// predicts no contact.
     fn predicted(
         &self,
         next: &NodeStates,
@@ -1106,7 +1110,7 @@ impl ContactSolver<'_> {
         }
     }
 
-    /// The tangential part of the update (`super::law::coulomb`) of Coulomb pair `p`'s
+    /// The tangential part of the update (`crate::contact::law::coulomb`) of Coulomb pair `p`'s
     /// active `nodes` at the iterate whose jumps are `jumps`, gap-row normals `normals` and
     /// geometric gaps `gaps`, added to the pair's `update`: which nodes in contact next slip,
     /// and along which direction. A node the update adds (it penetrates by `-g`) has no
@@ -1292,8 +1296,8 @@ impl ContactSolver<'_> {
     }
 
     /// The answers of a loop that ended `loop_end` in `state`, one per pair: each certified
-    /// without the loop's operators (`super::checks`), which decides its status, with the
-    /// fields and forces of `super::post`.
+    /// without the loop's operators (`crate::contact::verify::checks`), which decides its status,
+    /// with the fields and forces of `crate::contact::verify::post`.
     fn finish(
         &self,
         factors: &StepFactors,

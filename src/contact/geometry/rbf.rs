@@ -19,7 +19,7 @@
 //!   ([`interpolation_radii`]), for the accuracy reason given there. An iterative search for
 //!   interface nodes (keeping only the nodes within reach of the other side) is not needed: the
 //!   operators interpolate at each node's projection onto the source surface, which every
-//!   support covers (`super::interface`).
+//!   support covers (`crate::contact::coupled::interface`).
 //!
 //! Points are `[f64; 3]`; 2D problems pass `z = 0` (points on a curve), 3D problems points on a
 //! surface. Nothing here depends on the dimension.

@@ -2,7 +2,7 @@
 //! solve (`docs/method.md` 2.6):
 //!
 //! ```text
-//! A = [ K  B ]   x = [u; lambda / s],   A x = [f; g]      (super::system)
+//! A = [ K  B ]   x = [u; lambda / s],   A x = [f; g]      (crate::contact::coupled::system)
 //!     [ C  D ]
 //! ```
 //!
@@ -16,9 +16,9 @@
 //!
 //! with `K~^-1` one application of each body's solver (`BodySolver::precondition`: one AMG
 //! V-cycle, or the exact solve of a Cholesky factor) and `S~` the half-space approximation of the
-//! Schur complement `S = D - C K^-1 B` (`super::half_space`). With exact blocks, `A P^-1 =
-//! [I 0; C K^-1  S S~^-1]`: its eigenvalues are 1 and those of `S S~^-1`, so GMRES needs about
-//! as many iterations as on the interface problem alone; with V-cycles, about as many as CG
+//! Schur complement `S = D - C K^-1 B` (`crate::contact::coupled::half_space`). With exact blocks,
+//! `A P^-1 = [I 0; C K^-1  S S~^-1]`: its eigenvalues are 1 and those of `S S~^-1`, so GMRES needs
+//! about as many iterations as on the interface problem alone; with V-cycles, about as many as CG
 //! with the same V-cycle needs on one body, since the interface and the bulk are preconditioned
 //! by blocks of their own scale. Nothing is solved exactly inside the iteration: a product is
 //! one sparse matrix-vector product, and a preconditioner application one V-cycle per body, a
@@ -33,9 +33,9 @@
 //! that is new starts at 0). A solve stops when the true relative residual `|[f; g] - A x| /
 //! |[f; g]|` is at most [`Tightness::relative`]: [`TIGHT_RTOL`] for an answer that may be
 //! judged, [`LOOSE_RTOL`] for an iteration whose active set is about to change
-//! (`super::solve` decides). A solve that does not get there ends in a [`KrylovError`] naming
-//! why: the iteration cap, a restart cycle that did not reduce the true residual, or a
-//! non-finite value.
+//! (`crate::contact::iteration::solve` decides). A solve that does not get there ends in a
+//! [`KrylovError`] naming why: the iteration cap, a restart cycle that did not reduce the true
+//! residual, or a non-finite value.
 
 use std::collections::HashMap;
 use std::fmt;
@@ -43,11 +43,11 @@ use std::fmt;
 use rayon::prelude::*;
 use thiserror::Error;
 
-use super::ContactError;
-use super::compliance::MultiplierKey;
-use super::half_space::HalfSpace;
-use super::system::{CoupledSystem, Pair, stiffness_product};
 use crate::cancel::Cancel;
+use crate::contact::ContactError;
+use crate::contact::coupled::compliance::MultiplierKey;
+use crate::contact::coupled::half_space::HalfSpace;
+use crate::contact::coupled::system::{CoupledSystem, Pair, stiffness_product};
 use crate::elastic::{AssembledBody, StepFactors};
 use crate::linalg::BodySolver;
 use crate::linalg::gmres::{self, GmresFailure, GmresSettings, GmresStats, Operators};
@@ -200,7 +200,8 @@ pub struct KrylovProblem<'a> {
     pub bodies: &'a [&'a AssembledBody],
     /// Each body's solver, applied once per iteration as its block of the preconditioner.
     pub solvers: &'a [BodySolver],
-    /// Each pair's half-space compliance factor (`super::half_space::compliance_factor`).
+    /// Each pair's half-space compliance factor
+    /// (`crate::contact::coupled::half_space::compliance_factor`).
     pub compliance: &'a [f64],
     pub dim: usize,
 }

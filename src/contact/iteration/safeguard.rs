@@ -1,13 +1,13 @@
-//! When the active-set loop (`super::solve`) stops, and how it avoids repeating itself: the
-//! sets seen, the nodes kept active for good, the single switch, and the tests of the gap
-//! error on one active set (converged, stalled, unstable).
+//! When the active-set loop (`crate::contact::iteration::solve`) stops, and how it avoids repeating
+//! itself: the sets seen, the nodes kept active for good, the single switch, and the tests of the
+//! gap error on one active set (converged, stalled, unstable).
 
 use std::collections::HashSet;
 
-use super::active_set::Update;
-use super::law::NodeStates;
-use super::law::coulomb::DIRECTION_SETTLED;
-use super::solution::ContactStatus;
+use crate::contact::active_set::Update;
+use crate::contact::law::NodeStates;
+use crate::contact::law::coulomb::DIRECTION_SETTLED;
+use crate::contact::solution::ContactStatus;
 
 /// An active node this many spacings off the other surface after two solves in a row, the second
 /// not closer by [`CONTRACTION`], means the constraint no longer controls the geometry
@@ -67,8 +67,8 @@ const NO_PROGRESS_AFTER: usize = 10;
 /// error (`Update::max_gap_error_over_h`) to at most this factor of the smallest error seen on
 /// that set (not of the last one: an error alternating between two values, 9.6e-5 h and
 /// 2.9e-5 h on a 3D block held by a narrower one, halves every other iteration): Newton's
-/// method on the gap ([`super::gap`]) does far better (quadratic, exact in one step
-/// on a flat), the tied fixed-point correction by about ten. An iteration that does not is
+/// method on the gap ([`crate::contact::geometry::gap`]) does far better (quadratic, exact in one
+/// step on a flat), the tied fixed-point correction by about ten. An iteration that does not is
 /// outside the regime where the iteration converges for a reason: [`STALLED_AFTER`] such
 /// iterations in a row end the loop, converged if the error is within the penetration
 /// tolerance (the complementarity residual the certificate checks), as
@@ -111,7 +111,7 @@ impl Safeguard {
         }
         if update.next == *active {
             // A slipping node's direction (3D Coulomb) is a fixed point of its own: the loop
-            // goes on with the same states until it stops moving (`super::law::coulomb`).
+            // goes on with the same states until it stops moving (`crate::contact::law::coulomb`).
             let directions_settled = update.max_direction_change <= DIRECTION_SETTLED;
             if update.settled && directions_settled {
                 return Step::Stop(ContactStatus::Converged);

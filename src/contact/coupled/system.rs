@@ -18,9 +18,9 @@
 //!
 //! `K_k`, `f_k` are Dirichlet-constrained (rows and columns of prescribed dofs hold only their
 //! diagonal, and carry no coupling). `M_a`, `M_b` are the lumped interface mass matrices
-//! (`super::surface`). Tied: one vector multiplier per node and the vector constraint `u_a -
-//! R_ab u_b = d`. Frictionless: `lambda = lambda_n n_a`, one scalar per node, and only the
-//! normal constraint `n_a . (u_a - R_ab u_b) = n_a . d`.
+//! (`crate::contact::geometry::surface`). Tied: one vector multiplier per node and the vector
+//! constraint `u_a - R_ab u_b = d`. Frictionless: `lambda = lambda_n n_a`, one scalar per node, and
+//! only the normal constraint `n_a . (u_a - R_ab u_b) = n_a . d`.
 //!
 //! A multiplier whose constraint only restates a Dirichlet condition of its primary body (tied:
 //! its dof is prescribed; frictionless: every dof of its node is) is dropped: its row becomes
@@ -52,24 +52,25 @@ use std::ops::Range;
 
 use faer::sparse::{SparseColMat, Triplet};
 
-use super::ContactError;
-use super::compliance::MultiplierKey;
-use super::law::{Multiplier, Reads, Restates};
+use crate::contact::ContactError;
+use crate::contact::coupled::compliance::MultiplierKey;
+use crate::contact::law::{Multiplier, Reads, Restates};
 use rayon::prelude::*;
 
 use crate::elastic::{AssembledBody, StepFactors};
 use crate::linalg::{BodySolver, mat_vec};
 
 /// The interface operators of one pair in one iteration, on its active primary nodes I (built
-/// by `super::interface::InterfaceOperators::coupling`, each node's multipliers laid out by the
-/// pair's contact law, `super::law`).
+/// by `crate::contact::coupled::interface::InterfaceOperators::coupling`, each node's multipliers
+/// laid out by the pair's contact law, `crate::contact::law`).
 pub struct Coupling {
     /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
     /// Normal at each active node (pointing out of the primary), along which its pressure
     /// `p = -lambda . n` is measured. Frictionless and Coulomb: the normal of the secondary
     /// facet the node is held on, the direction of its normal constraint row (the gradient of
-    /// its gap, `super::gap`). Tied: the contact normal along which the gap is held.
+    /// its gap, `crate::contact::geometry::gap`). Tied: the contact normal along which the gap is
+    /// held.
     pub normals: Vec<[f64; 3]>,
     /// Lumped interface mass of each active node: its area `A_i`.
     pub areas1: Vec<f64>,
@@ -233,8 +234,8 @@ pub struct CoupledSystem {
     /// The column of `B` of each multiplier over `s`, as a combination of the unit forces of
     /// [`Self::unit_loads`]: for tied contact the force of one component at one primary node,
     /// for frictionless contact the sum of the components weighted by the node's normal
-    /// (`super::compliance` keeps the bodies' responses to the unit forces, which depend on
-    /// nothing else).
+    /// (`crate::contact::coupled::compliance` keeps the bodies' responses to the unit forces, which
+    /// depend on nothing else).
     pub columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// The force that a unit traction of one component at one active primary node puts on
     /// the bodies, with the multiplier it belongs to: `B` itself, kept once
@@ -248,8 +249,9 @@ pub struct CoupledSystem {
     /// Entries `(multiplier, column < offsets[N], value)` of C.
     pub c: Vec<(usize, usize, f64)>,
     /// The direction of each pair multiplier's constraint row (zero for a force-controlled
-    /// component): the half-space preconditioner (`super::half_space`) pairs it with the
-    /// columns' directions, which differ from it at a slipping node (`super::law::coulomb`).
+    /// component): the half-space preconditioner (`crate::contact::coupled::half_space`) pairs it
+    /// with the columns' directions, which differ from it at a slipping node
+    /// (`crate::contact::law::coulomb`).
     pub rows: Vec<[f64; 3]>,
     /// Diagonal of D.
     pub d: Vec<f64>,

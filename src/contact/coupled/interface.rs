@@ -4,7 +4,7 @@
 //!
 //! **Interpolation along the surfaces.** Every primary candidate `x_i` is projected onto the
 //! secondary surface along the contact normal below (point `p_i`, reference geometry,
-//! [`super::projection`]), and `R12`
+//! [`crate::contact::geometry::projection`]), and `R12`
 //! is the rescaled Wendland interpolation (`docs/method.md` 2.2) from all secondary candidates to
 //! the points `p_i`; likewise `R21` from all primary candidates to the projections of the
 //! secondary candidates onto the primary surface. The targets lie on the source surface, so
@@ -27,20 +27,21 @@
 //! geometric gap of the last iterate ([`geometric_gaps`]) and its linearized gap, so that an
 //! active node ends ON the other body's discrete surface, not on the RBF reconstruction of it.
 //! Frictionless contact constrains the geometric gap itself, linearized node to segment
-//! ([`super::gap`]); `R12` then only measures how far the pairing has slid.
+//! ([`crate::contact::geometry::gap`]); `R12` then only measures how far the pairing has slid.
 //!
 //! **Lumped interface mass.** Node `s` stands for its area `A_s` ([`ContactSurface`]): the
 //! multiplier `lambda_i` exerts `-A_i lambda_i` on body 1 and, on body 2, either
 //! `+A2_j (R21 lambda)_j` (interpolation, which balances to the interpolation's accuracy) or
-//! `+(R12^T A1 lambda)_j` (conservative, which balances exactly; [`super::Transfer`]).
+//! `+(R12^T A1 lambda)_j` (conservative, which balances exactly; [`crate::contact::Transfer`]).
 
 use std::collections::HashMap;
 
-use super::gap::GapRow;
-use super::law::{ContactLaw, Tangential, coulomb};
-use super::rbf::{Interpolation, interpolation_radii};
-use super::system::Coupling;
-use super::{ContactError, ContactSurface};
+use crate::contact::ContactError;
+use crate::contact::coupled::system::Coupling;
+use crate::contact::geometry::gap::GapRow;
+use crate::contact::geometry::rbf::{Interpolation, interpolation_radii};
+use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::law::{ContactLaw, Tangential, coulomb};
 
 /// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
 /// rows and columns of the transfers computed so far (an explicit cache: callers hold it `mut`).
@@ -182,7 +183,7 @@ impl InterfaceOperators {
             .iter()
             .map(|&i| {
                 if self.r21.is_none() {
-                    // The conservative transfer, `-R12^T M1 lambda` ([`super::Transfer`]):
+                    // The conservative transfer, `-R12^T M1 lambda` ([`crate::contact::Transfer`]):
                     // row i of R12 times A1_i is column i of R12^T M1.
                     to_body2(&self.rows12[&i], &|_, w| primary.nodal_area[i] * w)
                 } else {
@@ -311,9 +312,10 @@ pub enum Constraint<'a> {
     /// correction `e` of the last iterate (module doc).
     Interpolated { corrections: &'a [f64] },
     /// Frictionless and Coulomb contact: the geometric gap linearized at the last iterate, one
-    /// row per primary candidate ([`super::gap`]); for Coulomb, the tangential state of every
-    /// primary candidate and its jump at the start of the load step ([`Self::jumps`]), which a
-    /// sticking node's tangential rows hold (`super::law::coulomb`).
+    /// row per primary candidate ([`crate::contact::geometry::gap`]); for Coulomb, the tangential
+    /// state of every primary candidate and its jump at the start of the load step
+    /// ([`Self::jumps`]), which a sticking node's tangential rows hold
+    /// (`crate::contact::law::coulomb`).
     Geometric {
         rows: &'a [GapRow],
         start_jumps: Option<&'a [[f64; 3]]>,
@@ -323,9 +325,9 @@ pub enum Constraint<'a> {
 
 /// The contact normal at a node: `(w_own n_own - w_other n_other) / |...|`, its outward normal
 /// and the other surface's outward normal there weighted by their bodies' contact moduli
-/// `w = E / (1 - nu^2)` ([`super::ContactProblem::normal_weights`]); `n_own` if they cancel, which
-/// facing surfaces cannot do. The deformed interface lies between the two undeformed surfaces,
-/// nearer to the stiffer one: on a rigid flat it is the flat, between equal bodies the
+/// `w = E / (1 - nu^2)` ([`crate::contact::ContactProblem::normal_weights`]); `n_own` if they
+/// cancel, which facing surfaces cannot do. The deformed interface lies between the two undeformed
+/// surfaces, nearer to the stiffer one: on a rigid flat it is the flat, between equal bodies the
 /// bisector (the symmetry plane between two equal spheres).
 pub fn contact_normal(own: &[f64; 3], other: &[f64], weights: [f64; 2]) -> [f64; 3] {
     let [w_own, w_other] = weights;

@@ -1,14 +1,17 @@
 //! Post-processing of the last iterate: each body's solution (reactions, cell strains and
 //! stresses), the interface fields of both surfaces, total forces and the Hertz fit.
 
-use super::active_set::ActiveSet;
-use super::certificate::{Certificate, CheckKind};
-use super::solution::{
+use crate::contact::ContactError;
+use crate::contact::active_set::ActiveSet;
+use crate::contact::certificate::{Certificate, CheckKind};
+use crate::contact::coupled::system::{CoupledSolution, Coupling};
+use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::problem::ContactProblem;
+use crate::contact::solution::{
     ContactSolution, ContactStatus, ForcedDisplacement, FrictionFields, IterationRecord,
     LinearSolvers, SurfaceFields,
 };
-use super::system::{CoupledSolution, Coupling};
-use super::{ContactError, ContactProblem, ContactSurface, hertz};
+use crate::contact::verify::hertz;
 use crate::elastic::{
     AssembledBody, ElasticProblem, ElasticSolution, SolveStats, StepFactors, reactions,
 };
@@ -16,7 +19,7 @@ use crate::fem::stress::cell_fields;
 
 /// What an active-set loop hands over: the problem with its assembled bodies, and how the loop
 /// ended with its last iterate and that iterate's certificate.
-pub(super) struct LastIterate<'a> {
+pub(in crate::contact) struct LastIterate<'a> {
     pub problem: &'a ContactProblem<'a>,
     /// The primary's and the secondary's assembly, with its statistics.
     pub bodies: [(&'a AssembledBody, &'a SolveStats); 2],
@@ -39,7 +42,7 @@ pub(super) struct LastIterate<'a> {
 }
 
 /// The solution of the last iterate, with surface fields, forces and the Hertz fit.
-pub(super) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError> {
+pub(in crate::contact) fn finish(last: LastIterate) -> Result<ContactSolution, ContactError> {
     let LastIterate {
         problem,
         bodies: [(body1, stats1), (body2, stats2)],

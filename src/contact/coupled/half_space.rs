@@ -1,5 +1,5 @@
 //! The interface Schur complement approximated by two elastic half-spaces: the multiplier block
-//! of the coupled Krylov solve's preconditioner (`super::coupled_krylov`).
+//! of the coupled Krylov solve's preconditioner (`crate::contact::coupled::coupled_krylov`).
 //!
 //! The Schur complement `S = D - C K^-1 B` of the coupled system maps the (scaled) multipliers to
 //! the (scaled) gaps they open: `(S lambda)_k = t s sum_l (r_k . e_l) c(x_k, x_l) A_l lambda_l`,
@@ -7,11 +7,12 @@
 //! direction `r_k` of multiplier `k`, under a unit force at `x_l` along the column direction
 //! `e_l` of multiplier `l` (the facet normal for frictionless contact, an axis for tied, the
 //! local normal and tangents at a sticking node; at a slipping node `e = n - mu d` and `r = n`,
-//! `super::law::coulomb`); `t`, `s` the system's scalings (`super::system`). Its spectrum
-//! spans the ratio of the contact zone to the spacing (the compliance operator is of order -1), so
-//! a diagonal approximation leaves iteration counts growing under refinement. The approximation
-//! is the same operator for two elastic half-spaces in contact (Boussinesq; Johnson, *Contact
-//! Mechanics*, 1985, 3.2 and 2.2), on the active nodes' reference positions:
+//! `crate::contact::law::coulomb`); `t`, `s` the system's scalings
+//! (`crate::contact::coupled::system`). Its spectrum spans the ratio of the contact zone to the
+//! spacing (the compliance operator is of order -1), so a diagonal approximation leaves iteration
+//! counts growing under refinement. The approximation is the same operator for two elastic
+//! half-spaces in contact (Boussinesq; Johnson, *Contact Mechanics*, 1985, 3.2 and 2.2), on the
+//! active nodes' reference positions:
 //!
 //! ```text
 //! S~_kl = t s c0 (r_k . e_l) G_kl A_l,        1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
@@ -45,9 +46,9 @@ use std::collections::HashMap;
 use faer::Mat;
 use faer::prelude::*;
 
-use super::ContactSurface;
-use super::compliance::MultiplierKey;
-use super::system::{CoupledSystem, Coupling};
+use crate::contact::coupled::compliance::MultiplierKey;
+use crate::contact::coupled::system::{CoupledSystem, Coupling};
+use crate::contact::geometry::surface::ContactSurface;
 use crate::fem::Material;
 
 /// The half-space approximation of the Schur complement, LU-factored.

@@ -6,15 +6,16 @@
 //!
 //! - [`CoupledSolver::Krylov`]: one restarted GMRES on the whole system, block-preconditioned
 //!   by one application of each body's solver and a half-space approximation of the interface
-//!   Schur complement ([`super::coupled_krylov`]), warm-started from the last solve.
+//!   Schur complement ([`crate::contact::coupled::coupled_krylov`]), warm-started from the last
+//!   solve.
 //! - [`CoupledSolver::Schur`]: the exact reference by elimination, `z = K^-1 f`,
 //!   `(D - C K^-1 B) lambda = g - C z`, `u = z - K^-1 (B lambda)`, with `C K^-1 B = s C Y`
 //!   formed densely from each body's responses `Y_k` to the multipliers
-//!   ([`super::compliance`]), computed once per multiplier (`dim` solves per primary node) and
-//!   reused by every later iteration and load step; the Schur complement is factored by dense
-//!   LU with partial pivoting (interfaces have hundreds to a few thousand multipliers). With
-//!   CG + AMG bodies each of those columns would be a whole CG solve: `schur` then runs the
-//!   Krylov path.
+//!   ([`crate::contact::coupled::compliance`]), computed once per multiplier (`dim` solves per
+//!   primary node) and reused by every later iteration and load step; the Schur complement is
+//!   factored by dense LU with partial pivoting (interfaces have hundreds to a few thousand
+//!   multipliers). With CG + AMG bodies each of those columns would be a whole CG solve: `schur`
+//!   then runs the Krylov path.
 //! - [`CoupledSolver::Auto`]: Krylov, and Schur after a GMRES failure (below).
 //! - [`CoupledSolver::MonolithicLu`]: a sparse LU of the whole unsymmetric matrix, refactored
 //!   every iteration; the reference the Schur path is tested against.
@@ -37,11 +38,11 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use super::ContactError;
-use super::compliance::SurfaceResponse;
-use super::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
-use super::settings::{ContactSettings, CoupledSolver};
-use super::system::{CoupledSystem, Pair, assembled};
+use crate::contact::ContactError;
+use crate::contact::coupled::compliance::SurfaceResponse;
+use crate::contact::coupled::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
+use crate::contact::coupled::system::{CoupledSystem, Pair, assembled};
+use crate::contact::settings::{ContactSettings, CoupledSolver};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
 use crate::linalg::{
@@ -53,7 +54,8 @@ use crate::linalg::{
 /// multipliers computed so far (dense Schur), or the warm start (Krylov).
 pub struct BodyFactors {
     solvers: Vec<BodySolver>,
-    /// The half-space compliance factor of each pair's two materials (`super::half_space`).
+    /// The half-space compliance factor of each pair's two materials
+    /// (`crate::contact::coupled::half_space`).
     compliance: Vec<f64>,
     interface: Interface,
     /// The candidate nodes of each body, for the dense Schur path `auto` falls back to.
@@ -92,8 +94,9 @@ impl BodyFactors {
     /// Sets up every body's solver (`kind`: Cholesky or CG + AMG, resolved by the caller) for
     /// the coupled solve `contact.solver`. `candidates` are each body's candidate nodes (over
     /// all its pairs), which the response caches of the dense path cover; `compliance` each
-    /// pair's half-space compliance factor (`super::half_space::compliance_factor`), for the
-    /// Krylov path's preconditioner.
+    /// pair's half-space compliance factor
+    /// (`crate::contact::coupled::half_space::compliance_factor`), for the Krylov path's
+    /// preconditioner.
     ///
     /// `ready`: solvers already set up for the bodies (those of
     /// [`distributed_solvers`]); otherwise they are set up here.
@@ -433,7 +436,8 @@ fn solve_bodies(
         .map_err(body_solve_error)
 }
 
-/// Each body's responses to the unit forces of `system` not seen before (`super::compliance`).
+/// Each body's responses to the unit forces of `system` not seen before
+/// (`crate::contact::coupled::compliance`).
 fn extend_responses(
     system: &CoupledSystem,
     solvers: &[BodySolver],
@@ -520,9 +524,9 @@ mod tests {
     use std::collections::BTreeMap;
 
     use super::*;
-    use crate::contact::half_space::compliance_factor;
+    use crate::contact::coupled::half_space::compliance_factor;
+    use crate::contact::coupled::system::Coupling;
     use crate::contact::law::{ContactLaw, Tangential};
-    use crate::contact::system::Coupling;
     use crate::elastic::{
         DirichletCondition, ElasticProblem, SolveStats, StepFactors, assemble, solve,
     };

@@ -111,8 +111,8 @@ impl SurfaceIndex {
     /// [`Self::project`], on the facet that faces `towards` the most when several share the
     /// closest point (an edge or a vertex of the surface): the one whose outward normal is the
     /// most opposed to `towards`. The gap's linearization holds the node on that facet's plane
-    /// (`super::gap`): a block's node under a punch's corner is held on the punch's
-    /// face, not on its side.
+    /// (`crate::contact::geometry::gap`): a block's node under a punch's corner is held on the
+    /// punch's face, not on its side.
     pub fn project_facing(&self, x: &[f64; 3], towards: Option<&[f64; 3]>) -> Option<Projection> {
         let mut nearest = self.tree.nearest_neighbor_iter_with_distance_2(x);
         let (first, d2) = nearest.next()?;

@@ -1,6 +1,6 @@
 //! The whole boundary of a body (every cell facet that no other cell shares), oriented
 //! outward: a closed surface, on which the sign of the distance to the closest point tells
-//! inside from outside wherever the point is ([`super::projection`]).
+//! inside from outside wherever the point is ([`crate::contact::geometry::projection`]).
 //!
 //! A candidate contact surface alone is an open patch: a point behind it (the top face of a
 //! block seen from its base, two units away) has a negative distance along the patch's normal
@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 
-use super::projection::SurfaceIndex;
+use crate::contact::geometry::projection::SurfaceIndex;
 use crate::fem::kernels::facet_measure_and_normal;
 use crate::mesh::BodyMesh;
 

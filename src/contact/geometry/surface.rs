@@ -1,5 +1,5 @@
 //! A body's contact candidate surface: its nodes, their outward normals, spacing and areas, and
-//! its facets for the geometric gap ([`super::projection`]).
+//! its facets for the geometric gap ([`crate::contact::geometry::projection`]).
 //!
 //! Nodal normals are area-weighted averages of the normals of ALL candidate facets touching a
 //! node (not only active ones, so rim nodes have well-defined normals), each facet oriented out
@@ -16,9 +16,9 @@ use std::collections::HashMap;
 
 use thiserror::Error;
 
-use super::boundary::BodyBoundary;
-use super::projection::SurfaceIndex;
-use super::rbf::nearest_distances;
+use crate::contact::geometry::boundary::BodyBoundary;
+use crate::contact::geometry::projection::SurfaceIndex;
+use crate::contact::geometry::rbf::nearest_distances;
 use crate::fem::kernels::facet_measure_and_normal;
 use crate::mesh::BodyMesh;
 
@@ -159,13 +159,13 @@ impl ContactSurface {
     }
 
     /// The corners of facet `facet` (surface node indices), in the order of the barycentric
-    /// coordinates of a [`super::projection::Projection`] onto it.
+    /// coordinates of a [`crate::contact::geometry::projection::Projection`] onto it.
     pub fn facet_nodes(&self, facet: usize) -> &[usize] {
         &self.facets[self.dim * facet..self.dim * (facet + 1)]
     }
 
     /// Whether the point with `barycentric` coordinates on facet `facet` (a closest point,
-    /// [`super::projection::Projection`]) lies on the surface's rim ([`Rim`]).
+    /// [`crate::contact::geometry::projection::Projection`]) lies on the surface's rim ([`Rim`]).
     pub fn on_rim(&self, facet: usize, barycentric: &[f64; 3]) -> bool {
         self.rim
             .contains(self.facet_nodes(facet), facet, barycentric)
@@ -196,7 +196,7 @@ impl ContactSurface {
 /// Where a candidate surface ends: its free edges (3D: the edges of one facet only) and their
 /// nodes, or its end points (2D: the nodes of one facet only). A closed candidate surface has
 /// none. A point beyond the rim faces no facet, so the plane of the facet it is closest to
-/// says nothing about it (`super::gap`).
+/// says nothing about it (`crate::contact::geometry::gap`).
 #[derive(Debug, Clone)]
 struct Rim {
     /// Surface nodes on the rim.

@@ -22,7 +22,8 @@
 //!   holds, measured again at the answer, within `penetration_tolerance` of its spacing.
 //! - **Equilibrium.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
 //!   exceed `imbalance_tolerance`: the interpolation transfer `R21` conserves force only to its
-//!   accuracy; the conservative transfer (`R12^T`, [`super::Transfer`]) balances to round-off.
+//!   accuracy; the conservative transfer (`R12^T`, [`crate::contact::Transfer`]) balances to
+//!   round-off.
 //!
 //! **Can the answer be trusted?** The accuracy indicators, each an error measure of what users
 //! read (the contact force and zone); they never change the status:
@@ -45,8 +46,8 @@
 //! - **Primary agreement** (only for a primary named in the case file and at least twice
 //!   stiffer than the other body, a choice `primary = "auto"` avoids):
 //!   the contact force must agree with the one found with the other body as primary, within
-//!   `accuracy_tolerance` ([`agreement`], solved by `super::driver`). Another multiplier space
-//!   is an independent discretization of the same problem; a stiff block primary twice finer
+//!   `accuracy_tolerance` ([`agreement`], solved by `crate::contact::driver`). Another multiplier
+//!   space is an independent discretization of the same problem; a stiff block primary twice finer
 //!   than a hemisphere passed every other check with a force 3% off, and the hemisphere as
 //!   primary told it apart.
 //! - **Transfer agreement** (only for a transfer named in the case file that `auto` would not
@@ -56,12 +57,13 @@
 
 use std::collections::HashSet;
 
-use super::certificate::{Certificate, CertificateCheck, CheckKind};
-use super::gap::{gap_rows, geometric_gaps};
-use super::law::{ContactLaw, Tangential};
-use super::solution::ContactStatus;
-use super::system::CoupledSolution;
-use super::{ContactProblem, ContactSurface};
+use crate::contact::certificate::{Certificate, CertificateCheck, CheckKind};
+use crate::contact::coupled::system::CoupledSolution;
+use crate::contact::geometry::gap::{gap_rows, geometric_gaps};
+use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::law::{ContactLaw, Tangential};
+use crate::contact::problem::ContactProblem;
+use crate::contact::solution::ContactStatus;
 
 /// How the loop's ending and the residual checks make the status: the one place that decides
 /// it. A loop that stopped converged has solved the discrete problem only if every residual,
@@ -172,9 +174,9 @@ fn tension(problem: &ContactProblem, sides: &[Side; 2], mean: &[Vec<f64>]) -> Ce
 }
 
 /// Complementarity: the gap each active node's constraint holds, measured again at the
-/// answer (frictionless: the gap of its linearization, `super::gap`, which is the geometric
-/// gap wherever the node faces the inside of a secondary facet; tied: the geometric gap
-/// `gaps1`), over the node's spacing.
+/// answer (frictionless: the gap of its linearization, `crate::contact::geometry::gap`, which is
+/// the geometric gap wherever the node faces the inside of a secondary facet; tied: the geometric
+/// gap `gaps1`), over the node's spacing.
 fn complementarity(
     problem: &ContactProblem,
     solution: &CoupledSolution,
@@ -199,7 +201,7 @@ fn complementarity(
 
 /// The residuals of the Coulomb law at the answer of a Coulomb pair with coefficient `mu`,
 /// on every primary candidate in `state` (`None`: open) with its `pressure`, tangential
-/// traction `t_t` and slip increment `slip` over the step (`super::law::coulomb`):
+/// traction `t_t` and slip increment `slip` over the step (`crate::contact::law::coulomb`):
 /// - **Friction cone** (dual feasibility): `(|t_T| - mu p) / (mu p_max)` at every node in
 ///   contact, within `tension_tolerance` (the slack of the update);
 /// - **Slip**: a sticking node's slip `|v|`, and a slipping node's slip along its own
@@ -516,7 +518,7 @@ fn secondary_sag(
     gaps: &[f64],
     pressure: &[f64],
     indentation: f64,
-    settings: &super::ContactSettings,
+    settings: &crate::contact::settings::ContactSettings,
 ) -> CertificateCheck {
     let mut deepest = Worst::default();
     let (mut weighted, mut total) = (0.0, 0.0);

@@ -1,0 +1,16 @@
+//! The linear algebra of an active-set iteration, for any number of bodies and pairs: the
+//! coupled system of an active set, the INTERNODES interface operators that couple the bodies
+//! in it, and the ways to solve it. Its files, in order:
+//! `compliance.rs` (the bodies' responses to unit tractions), `system.rs` (the coupled system
+//! of an active set), `interface.rs` (the interface operators, built once over all candidates:
+//! the interpolation evaluated at each node's closest point on the other surface, the contact
+//! normal), `half_space.rs` (the interface Schur complement approximated by two elastic
+//! half-spaces), `coupled_krylov.rs` (the whole coupled system by one preconditioned GMRES),
+//! `coupled_solver.rs` (which solver, behind one call).
+
+pub mod compliance;
+pub mod coupled_krylov;
+pub mod coupled_solver;
+pub mod half_space;
+pub mod interface;
+pub mod system;
