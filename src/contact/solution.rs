@@ -189,7 +189,7 @@ pub struct FrictionFields {
     /// The length of each node's tangential slip path over all load steps so far.
     pub accumulated_slip: Vec<f64>,
     /// The total contact force on the primary split along the contact zone's mean normal
-    /// `N` (the nodes' contact normals weighted by their normal forces): the normal force
+    /// `N` (the primary's own outward normals weighted by the nodes' normal forces): the normal force
     /// `P = -F . N` and the tangential force `Q = F + P N` (Johnson's P and Q). Each node's
     /// `tangential_traction` is relative to its own contact normal instead (the normal of the
     /// facet of the other surface it is held on).

@@ -1071,6 +1071,7 @@ impl ContactSolver<'_> {
             tangential_traction: vec![[0.0; 3]; len],
             pressure: vec![0.0; len],
             normal: vec![[0.0; 3]; len],
+            own_normal: s1.normals.clone(),
             slip_increment: vec![[0.0; 3]; len],
             accumulated_slip: start.accumulated_slip.clone(),
             area: s1.nodal_area.clone(),
@@ -1458,6 +1459,9 @@ struct PairFriction {
     /// The normal each node's pressure and tangential traction are measured against (zero
     /// where open).
     normal: Vec<[f64; 3]>,
+    /// Each node's own outward normal (of the primary's surface): what the zone's mean normal
+    /// averages.
+    own_normal: Vec<[f64; 3]>,
     slip_increment: Vec<[f64; 3]>,
     accumulated_slip: Vec<f64>,
     area: Vec<f64>,
@@ -1466,19 +1470,17 @@ struct PairFriction {
 impl PairFriction {
     fn into_solution(self) -> FrictionFields {
         // The total contact force on the primary, split along the zone's mean normal (the
-        // nodes' normals weighted by their normal forces): Johnson's P and Q. Node by node the
-        // split depends on which facet a node on a vertex of the other surface is held on (its
-        // normal turns by the kink, h / R on a P1 circle), the total does not.
+        // primary's own outward normals weighted by the nodes' normal forces): Johnson's P and
+        // Q. Not along each node's contact normal, the normal of the facet of the other surface
+        // it is held on: at a node on a vertex of the other surface that facet is either of two
+        // whose normals differ by the kink (h / 2R on a P1 circle), and a Q split so differed by
+        // 2% between two codes that agree on every force (the dolfinx frictional reference).
         let (mut force, mut mean_normal) = ([0.0; 3], [0.0; 3]);
         for i in 0..self.area.len() {
-            let (t, p, n, a) = (
-                self.tangential_traction[i],
-                self.pressure[i],
-                self.normal[i],
-                self.area[i],
-            );
+            let (t, p, a) = (self.tangential_traction[i], self.pressure[i], self.area[i]);
+            let (n, own) = (self.normal[i], self.own_normal[i]);
             (0..3).for_each(|c| force[c] += a * (t[c] - p * n[c]));
-            (0..3).for_each(|c| mean_normal[c] += a * p * n[c]);
+            (0..3).for_each(|c| mean_normal[c] += a * p * own[c]);
         }
         let length = coulomb::norm(mean_normal);
         let mean_normal = mean_normal.map(|v| if length > 0.0 { v / length } else { 0.0 });
