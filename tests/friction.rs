@@ -72,8 +72,11 @@ fn one(case: CaseFile) -> ContactSolution {
     along_path(&[case]).0.remove(0)
 }
 
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
 fn relative(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     norm(std::array::from_fn(|k| a[k] - b[k])) / norm(b)
 }
 
@@ -203,16 +206,35 @@ fn a_block_dragged_in_full_slip_carries_mu_times_its_normal_force() {
         assert_eq!(answer.status, ContactStatus::Converged, "drag {drag}");
         let friction = answer.primary_fields.friction.as_ref().unwrap();
         assert_eq!(friction.stick_nodes, 0, "drag {drag}: full slip");
-        // Every node carries mu times its pressure along its own tangent, the tangent of the
-        // deformed lower surface where it is held: those tilt by up to 0.012 rad at the lower
-        // block's edge (measured at a drag of 0.05), so the sum of the nodes' tangential forces
-        // is shorter than mu P by at most 1 - cos(0.012) = 7e-5 of it.
+        // Every node carries mu times its pressure along its contact normal (the deformed lower
+        // surface's where it is held), read from the output fields: the traction on the primary
+        // is lambda = t_T - p n, so p = |lambda - t_T|.
+        let fields = &answer.primary_fields;
+        let (mut worst, mut p_max) = (0.0_f64, 0.0_f64);
+        for (i, state) in friction.state.iter().enumerate() {
+            if *state == FrictionState::Open {
+                continue;
+            }
+            let (t, lambda) = (friction.tangential_traction[i], fields.traction[i]);
+            let p = norm(std::array::from_fn(|k| lambda[k] - t[k]));
+            worst = worst.max((norm(t) - MU * p).abs());
+            p_max = p_max.max(p);
+        }
+        assert!(
+            worst <= 1e-9 * MU * p_max,
+            "drag {drag}: |t_T| - mu p up to {worst:.3e}"
+        );
+        // The summary's Q and P split the total force along the primary's own (flat, undeformed)
+        // normal instead: the lower surface's deformed facets tilt under the drag (shear strains
+        // of a few percent at these drags), so |Q| / P is below mu by about the tilt over mu
+        // (3.3% at a drag of 0.05): a small-deformation model with the gap measured on the
+        // deformed surfaces.
         let q = friction.tangential_force;
         let p = friction.normal_force;
-        let length = (q[0] * q[0] + q[1] * q[1]).sqrt();
         assert!(
-            length <= MU * p * (1.0 + 1e-12) && length >= MU * p * (1.0 - 1e-4),
-            "drag {drag}: |Q| = {length:.9e} against mu P = {:.9e}",
+            q[0].abs() < MU * p,
+            "drag {drag}: Q {:.6e}, mu P {:.6e}",
+            q[0],
             MU * p
         );
         let q = q[0];
