@@ -1308,6 +1308,8 @@ impl ContactSolver<'_> {
         let (couplings, solution) = state.last.expect("max_iterations >= 1 is validated");
         let dim = self.pairs[0].primary_surface.dim;
         let mut answers = Vec::with_capacity(self.pairs.len());
+        // Each Coulomb pair's tangential states the last iterate was solved with.
+        let tangential = self.tangential_states(&state.solved, &state.directions);
         for (p, problem) in self.pairs.iter().enumerate() {
             let [a, b] = self.pair_bodies[p];
             let nodes = self.pair_nodes(&state.active.contact, p);
@@ -1325,7 +1327,6 @@ impl ContactSolver<'_> {
                         friction_coefficient,
                     },
                 ) => {
-                    let tangential = self.tangential_states(&state.solved, &state.directions);
                     let fields = self.friction_fields(
                         p,
                         &nodes,

@@ -61,6 +61,7 @@ use crate::contact::certificate::{Certificate, CertificateCheck, CheckKind};
 use crate::contact::coupled::system::CoupledSolution;
 use crate::contact::geometry::gap::{gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::law::coulomb::norm;
 use crate::contact::law::{ContactLaw, Tangential};
 use crate::contact::problem::ContactProblem;
 use crate::contact::solution::ContactStatus;
@@ -222,7 +223,6 @@ pub fn friction(
 ) -> Vec<CertificateCheck> {
     let s1 = &problem.primary_surface;
     let settings = &problem.settings;
-    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let p_max = pressure.iter().copied().fold(0.0, f64::max);
     let (mut cone, mut slipping) = (Worst::default(), Worst::default());
     for (i, state) in state.iter().enumerate() {
