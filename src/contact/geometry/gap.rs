@@ -40,6 +40,7 @@
 
 use crate::contact::geometry::projection::{Projection, SurfaceIndex};
 use crate::contact::geometry::surface::ContactSurface;
+use crate::fem::kernels::facet_measure_and_normal;
 
 /// Within what distance of a contact surface a node is judged by the plane of the facet it
 /// faces, in units of that facet's longest edge. Two faces meant to end flush (equal blocks
@@ -60,6 +61,25 @@ pub const NEAR_SURFACE: f64 = 0.1;
 /// scale of `penetration_tolerance` (1e-3), so that a node on the rim to the precision the
 /// checks judge a gap is held on the facet's plane as before.
 pub const BEYOND_RIM: f64 = 1e-3;
+
+/// The direction a node's gap row holds it along ([`gap_rows`]), where the node faces a facet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowNormal {
+    /// The facet's own outward normal `m`: the gradient of the gap, so that the loop is Newton's
+    /// method on it (module doc). It jumps from facet to facet.
+    Facet,
+    /// The displaced secondary's nodal normals (each the area-weighted mean of its facets'
+    /// normals) interpolated at the closest point, `m = sum_k b_k N_k / |sum_k b_k N_k|`:
+    /// continuous across the facets' edges, so that a node held on an edge reads the same
+    /// direction from either facet (the smoothed normal of node-to-surface contact). The row
+    /// `m . (x - q)` vanishes where the gap does, so the contact it holds is the same; only the
+    /// direction of the force changes, by at most half the angle between two facets. Used where
+    /// the answer is a fixed point in that direction (the slip directions of 3D Coulomb
+    /// friction, `crate::contact::law::coulomb`): with facet normals, a node near an edge of the
+    /// indented block was held along one facet's normal, slipped onto the other's side, was held
+    /// along that one's, slipped back, and the loop never settled.
+    Averaged,
+}
 
 /// The geometric gap of every node of `own` to the `other` body, each displaced by its body's
 /// displacement (`None`: reference geometry), the one gap measure of the loop's penetration
@@ -88,7 +108,7 @@ pub fn geometric_gaps(
     u_own: Option<&[f64]>,
     u_other: Option<&[f64]>,
 ) -> Vec<f64> {
-    let measure = Measure::new(own, other, u_own, u_other);
+    let measure = Measure::new(own, other, u_own, u_other, RowNormal::Facet);
     (0..own.len())
         .map(|s| {
             let gap = measure.at(s);
@@ -128,6 +148,8 @@ struct Measure<'a> {
     other: &'a ContactSurface,
     u_own: Option<&'a [f64]>,
     surface: SurfaceIndex,
+    /// The other surface's displaced nodal normals, for [`RowNormal::Averaged`].
+    nodal_normals: Option<Vec<[f64; 3]>>,
     boundary: SurfaceIndex,
     beside_in_reference: Vec<bool>,
 }
@@ -138,6 +160,7 @@ impl<'a> Measure<'a> {
         other: &'a ContactSurface,
         u_own: Option<&'a [f64]>,
         u_other: Option<&'a [f64]>,
+        row_normal: RowNormal,
     ) -> Self {
         let surface = other.index(u_other);
         let reference = u_other.map(|_| other.index(None));
@@ -147,12 +170,15 @@ impl<'a> Measure<'a> {
                 beside_rim(own, other, index, &own.coords[s], s).is_some()
             })
             .collect();
+        let nodal_normals =
+            (row_normal == RowNormal::Averaged).then(|| nodal_normals(other, u_other));
         Self {
             own,
             other,
             u_own,
             boundary: other.boundary.index(u_other),
             surface,
+            nodal_normals,
             beside_in_reference,
         }
     }
@@ -175,7 +201,19 @@ impl<'a> Measure<'a> {
                 let sign = if self.inside(&x) { -1.0 } else { 1.0 };
                 offset.map(|v| sign * v / distance)
             }
-            None => self.surface.normal(closest.facet),
+            None => match &self.nodal_normals {
+                Some(normals) => {
+                    let corners = self.other.facet_nodes(closest.facet);
+                    let sum: [f64; 3] = std::array::from_fn(|k| {
+                        (corners.iter().zip(closest.barycentric))
+                            .map(|(&s, b)| b * normals[s][k])
+                            .sum()
+                    });
+                    let length = (0..3).map(|k| sum[k] * sum[k]).sum::<f64>().sqrt();
+                    sum.map(|v| v / length)
+                }
+                None => self.surface.normal(closest.facet),
+            },
         };
         NodeGap {
             position: x,
@@ -191,6 +229,30 @@ impl<'a> Measure<'a> {
     fn inside(&self, x: &[f64; 3]) -> bool {
         (self.boundary.project(x)).is_some_and(|p| p.signed_distance < 0.0)
     }
+}
+
+/// The outward unit normal at each node of `surface` displaced by `u` (`None`: as it is): the
+/// mean of its facets' normals weighted by their areas (2D: lengths).
+fn nodal_normals(surface: &ContactSurface, u: Option<&[f64]>) -> Vec<[f64; 3]> {
+    let position = |s: usize| u.map_or(surface.coords[s], |u| surface.deformed(u, s));
+    let mut normals = vec![[0.0; 3]; surface.len()];
+    for facet in 0..surface.facet_count() {
+        let nodes = surface.facet_nodes(facet);
+        let corners: Vec<[f64; 3]> = nodes.iter().map(|&s| position(s)).collect();
+        let (area, normal) = facet_measure_and_normal(&corners, surface.dim);
+        for &s in nodes {
+            for k in 0..3 {
+                normals[s][k] += area * normal[k];
+            }
+        }
+    }
+    for normal in &mut normals {
+        let length = (0..3).map(|k| normal[k] * normal[k]).sum::<f64>().sqrt();
+        if length > 0.0 {
+            *normal = normal.map(|v| v / length);
+        }
+    }
+    normals
 }
 
 /// The closest point of `x` (node `s` of `own`) on `other`'s surface `index`, if it is on the
@@ -232,14 +294,16 @@ pub struct GapRow {
 }
 
 /// The gap rows of every primary candidate at the displacements `u1`, `u2` (body dofs; `None`:
-/// the reference configuration).
+/// the reference configuration), each along the `row_normal` the pair's law asks for
+/// (`crate::contact::law::ContactLaw::row_normal`).
 pub fn gap_rows(
     primary: &ContactSurface,
     secondary: &ContactSurface,
     u1: Option<&[f64]>,
     u2: Option<&[f64]>,
+    row_normal: RowNormal,
 ) -> Vec<GapRow> {
-    let measure = Measure::new(primary, secondary, u1, u2);
+    let measure = Measure::new(primary, secondary, u1, u2, row_normal);
     let dim = primary.dim;
     let displacement = |surface: &ContactSurface, u: Option<&[f64]>, s: usize| -> [f64; 3] {
         let node = surface.nodes[s];

@@ -160,6 +160,10 @@ impl ContactSurface {
 
     /// The corners of facet `facet` (surface node indices), in the order of the barycentric
     /// coordinates of a [`crate::contact::geometry::projection::Projection`] onto it.
+    pub fn facet_count(&self) -> usize {
+        self.facets.len() / self.dim
+    }
+
     pub fn facet_nodes(&self, facet: usize) -> &[usize] {
         &self.facets[self.dim * facet..self.dim * (facet + 1)]
     }

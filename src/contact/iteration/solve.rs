@@ -76,6 +76,7 @@ use crate::contact::coupled::interface::{Constraint, InterfaceOperators};
 use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::iteration::anderson::DirectionAcceleration;
 use crate::contact::iteration::safeguard::{Safeguard, Step};
 use crate::contact::law::{ContactLaw, NodeStates, Tangential, coulomb};
 use crate::contact::problem::ContactProblem;
@@ -455,8 +456,8 @@ impl<'a> ContactSolver<'a> {
     /// Each pair's primary candidates that touch or penetrate in the reference configuration,
     /// with their constraints linearized there.
     pub fn initial_active_set(&self) -> Vec<ActiveSet> {
-        (self.pairs.iter())
-            .map(|problem| {
+        (self.pairs.iter().zip(&self.laws))
+            .map(|(problem, law)| {
                 let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
                 let tol = problem.settings.penetration_tolerance;
                 let gaps = geometric_gaps(s1, s2, None, None);
@@ -464,7 +465,7 @@ impl<'a> ContactSolver<'a> {
                     nodes: (0..s1.len())
                         .filter(|&i| gaps[i] < tol * s1.spacing[i])
                         .collect(),
-                    rows: gap_rows(s1, s2, None, None),
+                    rows: gap_rows(s1, s2, None, None, law.row_normal(s1.dim)),
                     corrections: vec![0.0; s1.len()],
                     slip: BTreeMap::new(),
                     history: None,
@@ -514,6 +515,7 @@ impl<'a> ContactSolver<'a> {
             solved: active.clone(),
             active,
             directions,
+            acceleration: DirectionAcceleration::default(),
             friction,
             rows,
             corrections,
@@ -558,6 +560,8 @@ struct LoopState {
     /// The direction of the friction traction of each slipping node (and of nodes that
     /// slipped before: only those in `active.slip` are read).
     directions: BTreeMap<usize, [f64; 3]>,
+    /// The history of the slip directions' iteration (3D Coulomb).
+    acceleration: DirectionAcceleration,
     /// Each Coulomb pair's start of the load step.
     friction: Vec<Option<StepStart>>,
     /// Each pair's gap rows and tied corrections.
@@ -577,6 +581,22 @@ struct LoopState {
 }
 
 impl LoopState {
+    /// Moves on to the directions `update` finds for the nodes that slip next: in 3D, where a
+    /// slipping node's direction is a fixed point, accelerated by [`DirectionAcceleration`] from
+    /// the directions just solved with; in 2D, where it is one of two tangents (a choice, as
+    /// the normal state is), as they are.
+    fn turn_directions(&mut self, update: &BTreeMap<usize, [f64; 3]>, accelerate: bool) {
+        let next = if accelerate {
+            let solved: BTreeMap<usize, [f64; 3]> = (self.active.slip.iter())
+                .filter_map(|&i| Some((i, *self.directions.get(&i)?)))
+                .collect();
+            self.acceleration.next(&solved, update)
+        } else {
+            update.clone()
+        };
+        self.directions.extend(next);
+    }
+
     /// Keeps an iteration's `record` and `last` iterate, and moves on to its `step`: the status
     /// the loop ends with, or `None` to go on with the next active set.
     fn advance(
@@ -653,9 +673,8 @@ impl ContactSolver<'_> {
                     .collect();
             }
         }
-        state
-            .directions
-            .extend(update.directions.iter().map(|(&i, &d)| (i, d)));
+        let accelerate = self.pairs[0].primary_surface.dim == 3;
+        state.turn_directions(&update.directions, accelerate);
         // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
         //    settled on a pairing the surfaces have slid away from is paired again where
         //    they touch, and solved again.
@@ -1223,10 +1242,11 @@ impl ContactSolver<'_> {
                 let (u1, u2) = (&solution.u[a][..], &solution.u[b][..]);
                 let nodes = self.pair_nodes(&active.contact, p);
                 let operators = &self.operators[p];
+                let row_normal = self.laws[p].row_normal(s1.dim);
                 let rows = &mut state.rows[p];
                 let (pair_gaps, jumps, pair_slid) = timed(&mut seconds.search, || {
                     let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                    *rows = gap_rows(s1, s2, Some(u1), Some(u2));
+                    *rows = gap_rows(s1, s2, Some(u1), Some(u2), row_normal);
                     let jumps = operators.jumps(s1, s2, u1, u2);
                     let slid = operators.slide(s1, &jumps, &nodes);
                     (gaps, jumps, slid)

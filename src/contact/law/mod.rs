@@ -29,6 +29,7 @@ mod tied;
 
 pub use state::NodeStates;
 
+use crate::contact::geometry::gap::RowNormal;
 use crate::contact::settings::{ContactSettings, Formulation};
 
 /// Which point of the secondary surface a constraint row reads: the P1 corners of the facet
@@ -113,6 +114,17 @@ impl ContactLaw {
     /// with the gap correction `e` of the last iterate (`crate::contact::coupled::interface`).
     pub fn holds_geometric_gap(&self) -> bool {
         !matches!(self, Self::Tied)
+    }
+
+    /// The direction a node's gap row holds it along
+    /// (`crate::contact::geometry::gap::RowNormal`): the facet's normal, the gradient of the gap,
+    /// except for 3D Coulomb pairs, whose slip directions are a fixed point that a normal
+    /// jumping between facets keeps from settling.
+    pub fn row_normal(&self, dim: usize) -> RowNormal {
+        match self {
+            ContactLaw::Coulomb { .. } if dim == 3 => RowNormal::Averaged,
+            _ => RowNormal::Facet,
+        }
     }
 
     /// Whether the tangential slip of an active node is constrained through `R12` and the
