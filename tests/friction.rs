@@ -454,3 +454,66 @@ fn a_load_path_in_one_run_is_the_chain_of_its_steps_with_each_steps_friction_in_
         assert!(xdmf.contains(&format!("Name=\"{field}\"")), "{field}");
     }
 }
+
+#[test]
+fn a_sphere_sheared_back_and_forth_follows_the_hysteresis_loop_of_mindlin_and_deresiewicz() {
+    // The sphere of the test above, pressed, sheared by its top's shift to d* in three steps
+    // (d*/4, d*/2, d*), then back to -d* (d*/2, 0, -d*). Mindlin and Deresiewicz (1953;
+    // Johnson 1985, 7.3): where shear does not change the pressure (one material), the
+    // unloading from the turning point (d*, Q*) is the loading curve doubled,
+    //
+    //     Q_unload(d* - 2s) = Q* - 2 Q_load(s),
+    //
+    // since the change from the turning point solves the loading problem with the friction
+    // bound 2 mu p. The discrete law node by node obeys the same superposition: what departs
+    // from it is the shear's effect on the pressure of these finite bodies, and the stick zone's
+    // edge, known to a node. The check reads only forces, against a property of the exact
+    // solution, not against the solver's own quantities.
+    let d = 0.0012;
+    let sphere = |shift: f64| {
+        hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
+            .with_body("sphere", |_| {
+                Body::new("sphere", 1000.0, 0.3)
+                    .dirichlet(Dirichlet::on("sphere_top").ux(shift).uy(0.0).uz(-0.01))
+            })
+            .contact_setting("formulation", "coulomb")
+            .contact_setting("friction_coefficient", MU)
+    };
+    let shifts = [0.0, d / 4.0, d / 2.0, d, d / 2.0, 0.0, -d];
+    let cases: Vec<CaseFile> = shifts.iter().map(|&s| sphere(s)).collect();
+    let (answers, _) = along_path(&cases);
+    let forces: Vec<(f64, f64)> = answers
+        .iter()
+        .map(|answer| {
+            assert_eq!(answer.status, ContactStatus::Converged);
+            let friction = answer.primary_fields.friction.as_ref().unwrap();
+            (friction.tangential_force[0], friction.normal_force)
+        })
+        .collect();
+    let (q, p): (Vec<f64>, Vec<f64>) = forces.into_iter().unzip();
+    let mu_p = MU * p[0];
+    eprintln!("shifts {shifts:?}\nQ/(mu P) {:?}", q.iter().map(|q| q / mu_p).collect::<Vec<_>>());
+    let turning = q[3].abs() / mu_p;
+    assert!(turning > 0.3 && turning < 0.6, "partial slip at the turning point: {turning}");
+    // (loading step s, unloading step at d* - 2 s)
+    for (load, unload) in [(1, 4), (2, 5), (3, 6)] {
+        let masing = q[3] - 2.0 * q[load];
+        let off = (q[unload] - masing).abs() / mu_p;
+        eprintln!(
+            "shift {}: Q/(mu P) = {:.4}, Mindlin-Deresiewicz {:.4}, off by {off:.2e} mu P",
+            shifts[unload],
+            q[unload] / mu_p,
+            masing / mu_p
+        );
+        // The bound: each force is known to the stick zone's edge, a node (about 560 in
+        // contact: one node's share of mu P is 0.2%), and the relation combines four of them
+        // (one doubled): 4 x 0.2%, rounded up to 1%. The press alone makes a tangential force
+        // of 0.1% of mu P (zero on half-spaces). Measured: 0.3%, 0.5%, 0.6% of mu P.
+        assert!(off < 0.01, "shift {}: off by {off:.3e} of mu P", shifts[unload]);
+    }
+    // The pressure hardly moves with the shear (the premise of the closed form).
+    let p_change = p.iter().map(|x| (x - p[0]).abs()).fold(0.0, f64::max) / p[0];
+    eprintln!("normal force changed by {p_change:.2e} of P; the press alone made Q = {:.2e} mu P", q[0].abs() / mu_p);
+    assert!(p_change < 1e-2, "normal force changed by {p_change:.2e}");
+    assert!(q[0].abs() < 1e-3 * mu_p);
+}
