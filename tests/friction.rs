@@ -492,9 +492,15 @@ fn a_sphere_sheared_back_and_forth_follows_the_hysteresis_loop_of_mindlin_and_de
         .collect();
     let (q, p): (Vec<f64>, Vec<f64>) = forces.into_iter().unzip();
     let mu_p = MU * p[0];
-    eprintln!("shifts {shifts:?}\nQ/(mu P) {:?}", q.iter().map(|q| q / mu_p).collect::<Vec<_>>());
+    eprintln!(
+        "shifts {shifts:?}\nQ/(mu P) {:?}",
+        q.iter().map(|q| q / mu_p).collect::<Vec<_>>()
+    );
     let turning = q[3].abs() / mu_p;
-    assert!(turning > 0.3 && turning < 0.6, "partial slip at the turning point: {turning}");
+    assert!(
+        turning > 0.3 && turning < 0.6,
+        "partial slip at the turning point: {turning}"
+    );
     // (loading step s, unloading step at d* - 2 s)
     for (load, unload) in [(1, 4), (2, 5), (3, 6)] {
         let masing = q[3] - 2.0 * q[load];
@@ -509,11 +515,18 @@ fn a_sphere_sheared_back_and_forth_follows_the_hysteresis_loop_of_mindlin_and_de
         // contact: one node's share of mu P is 0.2%), and the relation combines four of them
         // (one doubled): 4 x 0.2%, rounded up to 1%. The press alone makes a tangential force
         // of 0.1% of mu P (zero on half-spaces). Measured: 0.3%, 0.5%, 0.6% of mu P.
-        assert!(off < 0.01, "shift {}: off by {off:.3e} of mu P", shifts[unload]);
+        assert!(
+            off < 0.01,
+            "shift {}: off by {off:.3e} of mu P",
+            shifts[unload]
+        );
     }
     // The pressure hardly moves with the shear (the premise of the closed form).
     let p_change = p.iter().map(|x| (x - p[0]).abs()).fold(0.0, f64::max) / p[0];
-    eprintln!("normal force changed by {p_change:.2e} of P; the press alone made Q = {:.2e} mu P", q[0].abs() / mu_p);
+    eprintln!(
+        "normal force changed by {p_change:.2e} of P; the press alone made Q = {:.2e} mu P",
+        q[0].abs() / mu_p
+    );
     assert!(p_change < 1e-2, "normal force changed by {p_change:.2e}");
     assert!(q[0].abs() < 1e-3 * mu_p);
 }

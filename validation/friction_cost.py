@@ -11,13 +11,18 @@ slip, Q / (mu P) about 0.4). The figure is the second step's wall time (the "con
 timing of ``summary.json``) of the frictional run over the frictionless run's, with each run's
 active-set iterations and GMRES iterations of that step (from the log). The aim: at most 1.5.
 
+Writes ``validation/FRICTION_COST.md`` (date, machine, commit, the table) beside the contact
+benchmark's report; refuses to write it from a tree with uncommitted changes to ``src/``.
+
 Usage:  /usr/bin/python3 validation/friction_cost.py [--binary PATH] [--level L]
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
+import platform
 import re
 import subprocess
 import sys
@@ -33,6 +38,7 @@ APPROACH = 0.01
 SHEAR = 0.0012
 MU = 0.3
 AIM = 1.5
+REPORT = VALIDATION / "FRICTION_COST.md"
 
 
 def mesh(level: float) -> Path:
@@ -128,18 +134,45 @@ def main() -> int:
     ratio = coulomb["steps"][1] / frictionless["steps"][1]
     commit = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip()
-    print(f"friction cost at {commit}: {frictionless['dofs']} DOFs (level {args.level}), shear {SHEAR} after {APPROACH}")
+    dirty = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--", "src", "Cargo.toml", "Cargo.lock"],
+                           capture_output=True, text=True).stdout.strip()
+    lines = [f"{frictionless['dofs']} DOFs (level {args.level}), step 1 presses by {APPROACH}, step 2 shears by "
+             f"{SHEAR} at that approach, mu = {MU}", "",
+             "| run | statuses | step 1 (s) | step 2 (s) | step 2: active-set iterations | step 2: GMRES iterations "
+             "| wall (s) |", "|---|---|---|---|---|---|---|"]
     for name, r in runs.items():
-        print(f"  {name:12s} statuses {r['statuses']}, step seconds {', '.join(f'{s:.2f}' for s in r['steps'])}, "
-              f"step 2: {r['iterations']} active-set iterations, {r['gmres']} GMRES iterations; wall {r['wall']:.1f} s")
+        lines.append(f"| {name} | {', '.join(r['statuses'])} | {r['steps'][0]:.1f} | {r['steps'][1]:.1f} "
+                     f"| {r['iterations']} | {r['gmres']} | {r['wall']:.1f} |")
     friction = coulomb["friction"] or {}
     if friction:
         q = (sum(v * v for v in friction["tangential_force"])) ** 0.5
-        print(f"  coulomb step 2: Q/(mu P) = {q / (MU * friction['normal_force']):.3f}, "
-              f"{friction['stick_nodes']} sticking and {friction['slip_nodes']} slipping nodes")
+        lines += ["", f"Coulomb step 2: Q/(mu P) = {q / (MU * friction['normal_force']):.3f}, "
+                      f"{friction['stick_nodes']} sticking and {friction['slip_nodes']} slipping nodes."]
     verdict = "met" if ratio <= AIM else "missed"
-    print(f"frictional step over frictionless step: {ratio:.2f} (aim <= {AIM}: {verdict})")
+    lines += ["", f"**Frictional step over frictionless step: {ratio:.2f}** (aim <= {AIM}: {verdict})."]
+    print(f"friction cost at {commit}:")
+    print("\n".join(lines))
+    if dirty:
+        print(f"not writing {REPORT.name}: uncommitted changes under src/ ({dirty.splitlines()[0]} ...)")
+        return 0
+    cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                if line.startswith("model name")), platform.processor())
+    header = ["# Friction cost: a frictional load step against a frictionless one", "",
+              "Written by `validation/friction_cost.py`; do not edit by hand. Regenerate with", "",
+              "```sh", "/usr/bin/python3 validation/friction_cost.py", "```", "",
+              f"Run {datetime.datetime.now(datetime.timezone.utc).isoformat(timespec='seconds')} at commit {commit} "
+              f"on {cpu}, {os_cpu_count()} cores; one run of each, the figures of that run (the machine is "
+              f"noisy: compare ratios within one run only). The case is the contact benchmark's 99k-DOF hemisphere "
+              f"on a block (`validation/CONTACT_BENCHMARK.md`), both runs with the binary's default solvers.", ""]
+    REPORT.write_text("\n".join(header + lines) + "\n")
+    print(f"wrote {REPORT}")
     return 0
+
+
+def os_cpu_count() -> int:
+    import os
+
+    return os.cpu_count() or 0
 
 
 if __name__ == "__main__":

@@ -40,7 +40,6 @@
 
 use crate::contact::geometry::projection::{Projection, SurfaceIndex};
 use crate::contact::geometry::surface::ContactSurface;
-use crate::fem::kernels::facet_measure_and_normal;
 
 /// Within what distance of a contact surface a node is judged by the plane of the facet it
 /// faces, in units of that facet's longest edge. Two faces meant to end flush (equal blocks
@@ -170,8 +169,10 @@ impl<'a> Measure<'a> {
                 beside_rim(own, other, index, &own.coords[s], s).is_some()
             })
             .collect();
-        let nodal_normals =
-            (row_normal == RowNormal::Averaged).then(|| nodal_normals(other, u_other));
+        let nodal_normals = (row_normal == RowNormal::Averaged).then(|| match u_other {
+            Some(u) => other.displaced_normals(u),
+            None => other.normals.clone(),
+        });
         Self {
             own,
             other,
@@ -229,30 +230,6 @@ impl<'a> Measure<'a> {
     fn inside(&self, x: &[f64; 3]) -> bool {
         (self.boundary.project(x)).is_some_and(|p| p.signed_distance < 0.0)
     }
-}
-
-/// The outward unit normal at each node of `surface` displaced by `u` (`None`: as it is): the
-/// mean of its facets' normals weighted by their areas (2D: lengths).
-fn nodal_normals(surface: &ContactSurface, u: Option<&[f64]>) -> Vec<[f64; 3]> {
-    let position = |s: usize| u.map_or(surface.coords[s], |u| surface.deformed(u, s));
-    let mut normals = vec![[0.0; 3]; surface.len()];
-    for facet in 0..surface.facet_count() {
-        let nodes = surface.facet_nodes(facet);
-        let corners: Vec<[f64; 3]> = nodes.iter().map(|&s| position(s)).collect();
-        let (area, normal) = facet_measure_and_normal(&corners, surface.dim);
-        for &s in nodes {
-            for k in 0..3 {
-                normals[s][k] += area * normal[k];
-            }
-        }
-    }
-    for normal in &mut normals {
-        let length = (0..3).map(|k| normal[k] * normal[k]).sum::<f64>().sqrt();
-        if length > 0.0 {
-            *normal = normal.map(|v| v / length);
-        }
-    }
-    normals
 }
 
 /// The closest point of `x` (node `s` of `own`) on `other`'s surface `index`, if it is on the

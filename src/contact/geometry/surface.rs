@@ -85,26 +85,19 @@ impl ContactSurface {
         }
         let index: HashMap<usize, usize> = nodes.iter().enumerate().map(|(s, &n)| (n, s)).collect();
         let coords: Vec<[f64; 3]> = nodes.iter().map(|&n| body.coords[n]).collect();
-        let mut normals = vec![[0.0; 3]; nodes.len()];
         let mut facets = Vec::with_capacity(group.facets.len());
         let mut nodal_area = vec![0.0; nodes.len()];
         for f in 0..group.num_facets(dim) {
             let facet = group.facet(f, dim);
             let x: Vec<[f64; 3]> = facet.iter().map(|&n| body.coords[n]).collect();
-            let (measure, normal) = facet_measure_and_normal(&x, dim);
+            let (measure, _) = facet_measure_and_normal(&x, dim);
             for &n in facet {
                 let s = index[&n];
                 facets.push(s);
                 nodal_area[s] += measure / dim as f64;
-                for k in 0..3 {
-                    normals[s][k] += measure * normal[k];
-                }
             }
         }
-        for n in &mut normals {
-            let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            n.iter_mut().for_each(|v| *v /= norm);
-        }
+        let normals = area_weighted_normals(&facets, dim, &coords);
         let spacing = nearest_distances(&coords).map_err(|e| SurfaceError::Spacing {
             body: body.name.clone(),
             group: group_name.to_string(),
@@ -160,8 +153,11 @@ impl ContactSurface {
 
     /// The corners of facet `facet` (surface node indices), in the order of the barycentric
     /// coordinates of a [`crate::contact::geometry::projection::Projection`] onto it.
-    pub fn facet_count(&self) -> usize {
-        self.facets.len() / self.dim
+    /// The outward unit normal at each node of the surface displaced by `u` (body dofs), as
+    /// [`Self::normals`] are in the reference configuration.
+    pub fn displaced_normals(&self, u: &[f64]) -> Vec<[f64; 3]> {
+        let positions: Vec<[f64; 3]> = (0..self.len()).map(|s| self.deformed(u, s)).collect();
+        area_weighted_normals(&self.facets, self.dim, &positions)
     }
 
     pub fn facet_nodes(&self, facet: usize) -> &[usize] {
@@ -195,6 +191,26 @@ impl ContactSurface {
         };
         SurfaceIndex::new(&self.facets, self.dim, &positions)
     }
+}
+
+/// The mean of the facets' outward normals at each node, weighted by the facets' areas (2D:
+/// lengths), of unit length; `facets` lists `dim` node indices into `positions` per facet.
+fn area_weighted_normals(facets: &[usize], dim: usize, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let mut normals = vec![[0.0; 3]; positions.len()];
+    for facet in facets.chunks_exact(dim) {
+        let x: Vec<[f64; 3]> = facet.iter().map(|&s| positions[s]).collect();
+        let (measure, normal) = facet_measure_and_normal(&x, dim);
+        for &s in facet {
+            for k in 0..3 {
+                normals[s][k] += measure * normal[k];
+            }
+        }
+    }
+    for n in &mut normals {
+        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        n.iter_mut().for_each(|v| *v /= norm);
+    }
+    normals
 }
 
 /// Where a candidate surface ends: its free edges (3D: the edges of one facet only) and their
