@@ -77,7 +77,22 @@ fn main() -> ExitCode {
     // solves guarantee it themselves; faer's sparse LUs (RBF interpolation, the monolithic
     // reference solver) take faer's global setting, whose default splits work by thread count.
     faer::set_global_parallelism(faer::Par::Seq);
-    let cli = Cli::parse();
+    // A usage error (an unknown flag, a missing argument, a bad `--parameter` value) is an
+    // error like bad input: exit 1 with clap's message. clap's own exit status for it, 2, is the
+    // one that says "contact not solved" here. `--help` and `--version` print and exit 0.
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let usage = e.use_stderr();
+            // Nothing useful is left to do if the terminal is gone.
+            let _ = e.print();
+            return if usage {
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     // Under an MPI launcher (`mpirun -n N internodes solve CASE`): join the run. Every rank
     // solves; rank 0 alone prints and writes.
     let ranks = match parallel::start() {

@@ -347,3 +347,22 @@ fn without_the_output_key_or_flag_the_error_names_both() {
         "{message}"
     );
 }
+
+#[test]
+fn usage_errors_exit_1_with_the_message_of_the_command_line_parser_and_help_exits_0() {
+    // Exit 2 says "contact not solved"; a command line the parser refuses is an error (1).
+    for args in [
+        &["solve", "--bogus", "case.toml"][..],
+        &["solve"][..],
+        &["study", "case.toml", "--parameter", "level"][..],
+        &["frobnicate"][..],
+    ] {
+        let output = Command::new(BINARY).args(args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.starts_with("error:"), "{args:?}: {stderr}");
+    }
+    let help = Command::new(BINARY).arg("--help").output().unwrap();
+    assert_eq!(help.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&help.stdout).contains("solve"));
+}

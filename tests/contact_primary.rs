@@ -369,3 +369,33 @@ fn a_retry_is_checked_against_the_first_answer_where_that_one_settled() {
         "the first answer's imbalance widens the bound: {check}"
     );
 }
+
+#[test]
+fn a_named_primary_says_whether_auto_would_choose_it() {
+    // Two bodies of one material: auto takes the coarser surface, and either primary is
+    // stable. The reason of each named primary must tell the truth about auto's choice.
+    let problems = |primary: &str| {
+        let (_dir, path) = common::half_disc_on_block("half_disc_on_block.msh")
+            .primary(primary)
+            .write();
+        let case = Case::load(&path).unwrap();
+        let mesh = read_msh(&case.mesh).unwrap();
+        let problems = case.contact_problems(&mesh).unwrap();
+        let primary = problems[0].primary.body.name.clone();
+        (primary, problems[0].primary_report.reason.clone())
+    };
+    let (auto, _) = problems("auto");
+    for named in ["disc", "block"] {
+        let (primary, reason) = problems(named);
+        assert_eq!(primary, named);
+        if named == auto {
+            assert!(reason.contains("as \"auto\" would"), "{named}: {reason}");
+        } else {
+            assert!(!reason.contains("as \"auto\" would"), "{named}: {reason}");
+            assert!(
+                reason.contains(&format!("would choose '{auto}'")),
+                "{named}: {reason}"
+            );
+        }
+    }
+}

@@ -232,8 +232,8 @@ fn a_component_both_prescribed_and_force_controlled_is_refused() {
         &case,
         &[
             "body 'disc'",
-            "force-controlled by group 'disc_top'",
-            "Dirichlet",
+            "'s uy is force-controlled (fy) by group 'disc_top'",
+            "by the Dirichlet condition on group 'disc_top'",
         ],
     );
 }

@@ -310,6 +310,36 @@ fn cases_the_pairs_cannot_solve_are_refused_with_what_to_do() {
     assert_names(&refusal(&same_name, ""), &["both named 'interface'"]);
     let slash = pairs("").replacen("[[contact]]", "[[contact]]\nname = \"a/b\"", 1);
     assert_names(&refusal(&slash, ""), &["'a/b'", "file names"]);
+    // Names that would break force_displacement.csv's columns.
+    for bad in ["a,b", "a\\nb", "a\\\"b"] {
+        let named = pairs("").replacen("[[contact]]", &format!("[[contact]]\nname = \"{bad}\""), 1);
+        assert_names(
+            &refusal(&named, ""),
+            &["force_displacement.csv", "letters, digits"],
+        );
+    }
+    // A pair listed twice (the same two surfaces, in either order, under any names) would
+    // share its force with its copy: refused, naming both.
+    let upper = "[[contact]]\nbodies = [\"upper\", \"middle\"]\nsurfaces = [\"upper_contact\", \"middle_top\"]\n";
+    let reversed = "[[contact]]\nname = \"again\"\nbodies = [\"middle\", \"upper\"]\nsurfaces = [\"middle_top\", \"upper_contact\"]\n";
+    let copy = "[[contact]]\nname = \"copy\"\nbodies = [\"upper\", \"middle\"]\nsurfaces = [\"upper_contact\", \"middle_top\"]\n";
+    for twice in [reversed, copy] {
+        let text = format!("{}\n{twice}", pairs(""));
+        let message = refusal(&text, "");
+        assert_names(
+            &message,
+            &[
+                "pairs 1 ('upper-middle')",
+                "and 3",
+                "same two surfaces",
+                "once",
+            ],
+        );
+    }
+    assert_names(
+        &refusal(&format!("{upper}\n{copy}"), ""),
+        &["pairs 1", "and 2", "'copy'"],
+    );
     let steps_in_pair = pairs("load_steps = [0.5, 1.0]");
     assert_names(
         &refusal(&steps_in_pair, ""),

@@ -368,14 +368,46 @@ impl Case {
                     ),
                 ));
             }
-            if pair.name.is_empty() || pair.name.contains(['/', '\\']) {
+            let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.');
+            if pair.name.is_empty() || !pair.name.chars().all(allowed) {
                 return Err(self.invalid(
                     format!("{context} name"),
                     format!(
                         "'{}': a pair's name goes into the file names \
-                         force_displacement_<name>.csv and .png, so it must be non-empty and \
-                         hold no '/' or '\\'",
-                        pair.name
+                         force_displacement_<name>.png and the column names \
+                         <name>.<column> of force_displacement.csv, so it must be made of \
+                         letters, digits, '_', '-' and '.' (without a `name` key it is \
+                         BODY1-BODY2: give the pair a `name` if a body's name has other \
+                         characters)",
+                        pair.name.escape_debug()
+                    ),
+                ));
+            }
+            fn sides(spec: &ContactSpec) -> [(&str, &str); 2] {
+                let mut sides = [
+                    (spec.bodies[0].as_str(), spec.surfaces[0].as_str()),
+                    (spec.bodies[1].as_str(), spec.surfaces[1].as_str()),
+                ];
+                sides.sort();
+                sides
+            }
+            if let Some(q) =
+                (self.contacts[..p].iter()).position(|other| sides(other) == sides(pair))
+            {
+                return Err(self.invalid(
+                    context,
+                    format!(
+                        "pairs {} ('{}') and {} ('{}') are the same two surfaces ('{}' of '{}' \
+                         and '{}' of '{}'); list each pair once (two copies would share its \
+                         force between them)",
+                        q + 1,
+                        self.contacts[q].name,
+                        p + 1,
+                        pair.name,
+                        pair.surfaces[0],
+                        pair.bodies[0],
+                        pair.surfaces[1],
+                        pair.bodies[1]
                     ),
                 ));
             }

@@ -339,16 +339,22 @@ fn choose_primary(
     // Between bodies of similar stiffness either choice is stable (the coarser one is auto's
     // for accuracy), and the other one's answer may be the one that fails; a stiff primary is
     // the unstable choice.
-    let (other_primary, reason) = if first != auto_first && !similar {
-        let auto = name(&sides[auto_first]);
+    let auto = name(&sides[auto_first]);
+    let (other_primary, reason) = if first == auto_first {
+        let reason = format!("named in the case file (as \"auto\" would: {auto_reason})");
+        (OtherPrimary::Unused, reason)
+    } else if similar {
+        let reason = format!(
+            "named in the case file; \"auto\" would choose '{auto}' ({auto_reason}); between \
+             bodies of similar stiffness either primary is stable"
+        );
+        (OtherPrimary::Unused, reason)
+    } else {
         let reason = format!(
             "named in the case file; \"auto\" would choose '{auto}' ({auto_reason}), so the \
              answer is checked against the one with '{auto}' as primary"
         );
         (OtherPrimary::CheckAgreement, reason)
-    } else {
-        let reason = format!("named in the case file (as \"auto\" would: {auto_reason})");
-        (OtherPrimary::Unused, reason)
     };
     let report = PrimaryReport {
         mode: "explicit",

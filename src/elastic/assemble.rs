@@ -29,6 +29,8 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
     // follows one path (a 0 is 0 on every path).
     let with_paths = problem.dirichlet.iter().any(|d| d.path.is_some());
     let mut path_of: HashMap<usize, (Option<&str>, &str)> = HashMap::new();
+    // The group that prescribes each dof, for a force on it to name.
+    let mut prescribed_by: HashMap<usize, &str> = HashMap::new();
     for condition in &problem.dirichlet {
         let nodes = body
             .group_nodes(&condition.group)
@@ -47,6 +49,7 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
                             second: value,
                         }
                     })?;
+                    prescribed_by.entry(dof).or_insert(condition.group.as_str());
                     let path = condition.path.as_deref();
                     if with_paths && value != 0.0 {
                         let on = (path, condition.group.as_str());
@@ -77,9 +80,12 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
     for forced in forced_components(problem) {
         for &dof in &forced.dofs {
             if let Some(value) = constraints.value(dof) {
-                let other = match forced_by.get(&dof) {
-                    Some(group) => format!("by group '{group}'"),
-                    None => format!("prescribed {value} by a Dirichlet condition"),
+                let other = match (forced_by.get(&dof), prescribed_by.get(&dof)) {
+                    (Some(group), _) => format!("by group '{group}'"),
+                    (None, Some(group)) => {
+                        format!("prescribed {value} by the Dirichlet condition on group '{group}'")
+                    }
+                    (None, None) => format!("prescribed {value}"),
                 };
                 return Err(ProblemError::ForcedTwice {
                     body: body.name.clone(),

@@ -54,6 +54,9 @@ pub struct ElasticProblem<'m> {
     pub body_force: Option<[f64; 3]>,
 }
 
+/// The letter of a component in the case file's keys (`ux`, `fx`): components are named by it.
+const AXES: [char; 3] = ['x', 'y', 'z'];
+
 #[derive(Debug, Error, PartialEq)]
 pub enum ProblemError {
     #[error("body '{body}' has no group '{group}' (groups on this body: {})", .on_body.join(", "))]
@@ -71,7 +74,8 @@ pub enum ProblemError {
     )]
     ComponentOutOfRange { body: String, group: String },
     #[error(
-        "body '{body}': node {node_tag} component {component} is prescribed {first} by one Dirichlet group and {second} by '{group}'"
+        "body '{body}': node {node_tag}'s u{} is prescribed {first} by one Dirichlet group and {second} by '{group}'",
+        AXES[*.component]
     )]
     ConflictingDirichlet {
         body: String,
@@ -90,9 +94,10 @@ pub enum ProblemError {
     )]
     FreeRigidModes { body: String, count: usize },
     #[error(
-        "body '{body}': node {node_tag} component {component} is force-controlled by group \
+        "body '{body}': node {node_tag}'s u{axis} is force-controlled (f{axis}) by group \
          '{group}' and also {other}; a component of a node is either prescribed or \
-         force-controlled, by one group"
+         force-controlled, by one group",
+        axis = AXES[*.component]
     )]
     ForcedTwice {
         body: String,
@@ -108,9 +113,10 @@ pub enum ProblemError {
     #[error("body '{body}': {what} is not finite")]
     NotFinite { body: String, what: String },
     #[error(
-        "body '{body}': node {node_tag} component {component} is prescribed {value} by Dirichlet \
+        "body '{body}': node {node_tag}'s u{} is prescribed {value} by Dirichlet \
          conditions that follow {paths}; a prescribed value follows one load path (conditions \
-         that prescribe 0 may share a dof)"
+         that prescribe 0 may share a dof)",
+        AXES[*.component]
     )]
     ConflictingPath {
         body: String,
