@@ -132,8 +132,26 @@ fn a_vanishing_coefficient_is_frictionless_and_a_large_one_sticks_like_tied_cont
         small.primary_fields.active,
         frictionless.primary_fields.active
     );
+    // Coulomb pairs hold a node along the block's averaged nodal normal, frictionless ones
+    // along its facet's normal (method.md 1.4): the two differ by up to half the kink between
+    // neighbouring facets of the indented block, h / R times the block's share of the
+    // curvature (E*_disc / (E*_disc + E*_block) = 1/21 here), and each node's force turns by
+    // as much. The force may differ by that angle; the law itself adds mu = 1e-9. Measured:
+    // 2.2e-5 (2026-12-02), against 3e-4.
+    let (_, coords) = along_path(&[dissimilar("frictionless", None)]);
+    let mut x: Vec<f64> = coords
+        .iter()
+        .map(|c| c[0])
+        .filter(|x| x.abs() < 0.1)
+        .collect();
+    x.sort_by(f64::total_cmp);
+    let h = x.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    let half_kink = 0.5 * h / 1.0 / 21.0;
     let off = relative(small.force_primary, frictionless.force_primary);
-    assert!(off < 1e-6, "mu = 1e-9 against frictionless: {off:.2e}");
+    assert!(
+        off < half_kink,
+        "mu = 1e-9 against frictionless: {off:.2e} (half the kink: {half_kink:.2e})"
+    );
 
     let large = one(dissimilar("coulomb", Some(100.0)));
     assert_eq!(large.status, ContactStatus::Converged);

@@ -26,13 +26,15 @@ no history), a path of its own. The block's base is clamped throughout.
 References. ``friction_reference.py`` (dolfinx stiffness matrices, node to segment from the disc's
 nodes onto the block's top, Coulomb by a primal-dual active set method on the nodes, every step's
 discrete KKT conditions certified), along the same path on the same mesh, with the pairing on the
-deformed surfaces (``normal = "deformed"``: the gap, contact normal and tangent of the deformed block
-facet, as internodes measures the gap, docs/method.md 3.1): the one compared. Two more are solved
-for information: the linear pairing (``"reference"``, Johnson's small-deformation theory; its
-difference from the deformed pairing is the geometric effect, up to 0.57 mu p0 at a node and 1% in
-Q), and the deformed pairing with smoothed (nodal) normals (``"smoothed"``; its difference is what
-the answer owes to the discrete contact normal). Johnson (Contact Mechanics 7.1): for equal
-materials, c = a sqrt(1 - Q / (mu P)) and the closed-form q(x), with a, p0 Hertz's for P.
+deformed surfaces and smoothed (nodal) normals (``normal = "smoothed"``: the gap of the deformed
+block facet, held along the block's averaged nodal normal, as internodes' Coulomb rows hold it,
+docs/method.md 1.4): the one compared. Two more are solved for information: the linear pairing
+(``"reference"``, Johnson's small-deformation theory; its difference from the deformed pairing is
+the geometric effect, up to 0.57 mu p0 at a node and 1% in Q), and the deformed pairing with the
+facet's own normal (``"deformed"``, as internodes' frictionless rows measure the gap; its
+difference is what the answer owes to the discrete contact normal). Johnson (Contact Mechanics
+7.1): for equal materials, c = a sqrt(1 - Q / (mu P)) and the closed-form q(x), with a, p0
+Hertz's for P.
 
 Figures (each from the run's own summary.json and solution.h5; forces and tractions on the disc, so
 a block primary's are turned round):
@@ -126,6 +128,9 @@ BUILD = VALIDATION / "build" / "friction_suite"
 MU = 0.3
 APPROACH = 0.02
 SHEAR = (0.002, 0.004, 0.006)
+# The reference compared: the deformed pairing with smoothed normals, internodes' Coulomb rows'
+# own (module doc).
+COMPARED = "smoothed"
 # The press in four equal steps (module doc: why not one).
 PRESS_STEPS = 4
 DISC = (1000.0, 0.3)
@@ -322,9 +327,9 @@ def profile_difference(ours: dict, record: dict, scale: float) -> tuple[float, f
 
 
 def compare_step(case: FrictionCase, path: str, ours_step: dict, fields: dict | None, record: dict,
-                 smoothed: dict) -> dict:
+                 facet: dict) -> dict:
     """Figures of one step of one run against the reference (and Johnson); against the reference
-    with smoothed normals for information (``*_smoothed``)."""
+    with facet normals for information (``*_facet``)."""
     e_star = record["e_star"]
     # internodes splits the total force along the zone's mean normal of its primary's own
     # normals; the reference's split is the disc's. With the block primary, whose own normal is
@@ -340,11 +345,11 @@ def compare_step(case: FrictionCase, path: str, ours_step: dict, fields: dict | 
                "status": ours_step["status"], "stick_nodes": ours_step["stick_nodes"],
                "slip_nodes": ours_step["slip_nodes"], "stick_nodes_ref": record["stick_nodes"],
                "slip_nodes_ref": record["slip_nodes"]}
-    q_smoothed = smoothed["tangential_force"][0] if ours_step["own_normal"] == "disc" else smoothed["force_on_disc"][0]
-    figures |= {"P_smoothed": smoothed["P"], "Q_smoothed": q_smoothed}
+    q_facet = facet["tangential_force"][0] if ours_step["own_normal"] == "disc" else facet["force_on_disc"][0]
+    figures |= {"P_facet": facet["P"], "Q_facet": q_facet}
     if abs(q_ref) > 1e-2 * MU * p_ref:  # a shear step
-        figures |= {"Q_error": abs(ours_step["Q"] / q_ref - 1), "Q_error_smoothed": abs(ours_step["Q"] / q_smoothed - 1),
-                    "Q_normal_choice": abs(q_smoothed / q_ref - 1), "Fx": ours_step["Fx"],
+        figures |= {"Q_error": abs(ours_step["Q"] / q_ref - 1), "Q_error_facet": abs(ours_step["Q"] / q_facet - 1),
+                    "Q_normal_choice": abs(q_facet / q_ref - 1), "Fx": ours_step["Fx"],
                     "Fx_ref": record["force_on_disc"][0], "Fx_error": abs(ours_step["Fx"] / record["force_on_disc"][0] - 1)}
     if fields is None:
         return figures
@@ -356,9 +361,9 @@ def compare_step(case: FrictionCase, path: str, ours_step: dict, fields: dict | 
                 "c_vs_ref": abs(zone["c"] - zone_ref["c"]) / max(h_ours, h_ref)}
     profile, where = profile_difference(fields, record, MU * hertz["p0"])
     figures |= {"profile": profile, "profile_at": where,
-                "profile_smoothed": profile_difference(fields, smoothed, MU * hertz["p0"])[0],
+                "profile_facet": profile_difference(fields, facet, MU * hertz["p0"])[0],
                 "profile_normal_choice": profile_difference(
-                    {"x": np.array(smoothed["nodes"]["x"]), "traction_x": np.array(smoothed["nodes"]["traction_x"])},
+                    {"x": np.array(facet["nodes"]["x"]), "traction_x": np.array(facet["nodes"]["traction_x"])},
                     record, MU * hertz["p0"])[0]}
     if case.equal and path == "cattaneo-mindlin" and "Q_error" in figures:
         j = fr.johnson(ours_step["P"], ours_step["Q"], e_star, MU)
@@ -388,7 +393,7 @@ def figure_note(steps: list[dict], key: str) -> str:
             continue
         if key == "Q_error":
             parts.append(f"step {k}: {s['Q']:.5g} / {s['Q_ref']:.5g} ({s[key]:.2%}; against the reference with "
-                         f"smoothed normals {s['Q_error_smoothed']:.2%}, which differs from it by "
+                         f"facet normals {s['Q_error_facet']:.2%}, which differs from it by "
                          f"{s['Q_normal_choice']:.2%})")
         elif key == "P_error":
             parts.append(f"step {k}: {s['P']:.5g} / {s['P_ref']:.5g} ({s[key]:.2%})")
@@ -399,8 +404,8 @@ def figure_note(steps: list[dict], key: str) -> str:
         elif key == "c_vs_johnson":
             parts.append(f"step {k}: c {s['c']:.4f} / Johnson {s['c_johnson']:.4f} ({s[key]:.2f} h)")
         else:
-            parts.append(f"step {k}: {s[key]:.3f} at x = {s['profile_at']:+.4f} (against the smoothed-normal "
-                         f"reference {s['profile_smoothed']:.3f}; the two references differ by "
+            parts.append(f"step {k}: {s[key]:.3f} at x = {s['profile_at']:+.4f} (against the facet-normal "
+                         f"reference {s['profile_facet']:.3f}; the two references differ by "
                          f"{s['profile_normal_choice']:.3f})")
     return "; ".join(parts)
 
@@ -434,8 +439,8 @@ def run_primary(binary: Path, case: FrictionCase, msh: Path, primary: str, path:
     """The runs of one primary on one path, their figures and rows (``references``: pairing -> path ->
     the reference's records)."""
     label = f"{case.name} {path} [{primary}]"
-    records = references["deformed"][path]
-    smoothed = references["smoothed"][path]
+    records = references[COMPARED][path]
+    facet = references["deformed"][path]
     n = len(records)
     runs = {k: solve(binary, case, msh, primary, path, k) for k in range(1, n + 1)}
     full = runs[n]
@@ -465,7 +470,7 @@ def run_primary(binary: Path, case: FrictionCase, msh: Path, primary: str, path:
                         record["prefix_difference"] = max(record["prefix_difference"],
                                                           abs(prefix["P"] - here["P"]) / here["P"],
                                                           abs(prefix["Q"] - here["Q"]) / max(abs(here["Q"]), 1e-300))
-                steps.append(compare_step(case, path, step_figures(contact, k, sign), fields, records[k], smoothed[k]))
+                steps.append(compare_step(case, path, step_figures(contact, k, sign), fields, records[k], facet[k]))
         except (OSError, KeyError, ValueError, TypeError, json.JSONDecodeError) as error:
             full["tail"] = f"{type(error).__name__}: {error}"
             contact = None
@@ -559,7 +564,7 @@ def plot_profiles(case: FrictionCase, msh: Path, records: dict, path: Path) -> b
     """q(x) / (mu p0) of ours (each primary), the reference (both pairings) and Johnson (equal
     materials) at each shear step of the Cattaneo-Mindlin path."""
     plt = fr._pyplot()
-    refs = reference(case, msh, "cattaneo-mindlin", "deformed")
+    refs = reference(case, msh, "cattaneo-mindlin", COMPARED)
     linear = reference(case, msh, "cattaneo-mindlin", "reference")
     fig, axes = plt.subplots(1, len(SHEAR), figsize=(5.0 * len(SHEAR), 4.8), squeeze=False)
     drawn = False
@@ -572,7 +577,7 @@ def plot_profiles(case: FrictionCase, msh: Path, records: dict, path: Path) -> b
         x = np.array(r["nodes"]["x"])
         keep = np.abs(x) <= 1.4 * a
         ax.plot(x[keep] / a, np.array(r["nodes"]["traction_x"])[keep] / scale * np.sign(r["tangential_force"][0]),
-                "k.-", lw=0.8, ms=5, label="dolfinx reference (deformed pairing)")
+                "k.-", lw=0.8, ms=5, label="dolfinx reference (deformed pairing, smoothed normals)")
         xl = np.array(linear[step]["nodes"]["x"])
         ax.plot(xl[keep] / a, np.array(linear[step]["nodes"]["traction_x"])[keep] / scale
                 * np.sign(r["tangential_force"][0]), ":", color="0.5", lw=1, label="reference, linear pairing")
@@ -643,8 +648,8 @@ def report_text(cases: list[FrictionCase], checks: list[Check], records: dict, q
     lines = [f"{'Quick subset' if quick else 'Friction suite'}: {len(cases)} cases, {sum(tally.values())} runs "
              f"(each of a path's steps), {len(checks)} checks, {sum(not c.passed for c in checks)} failed; wall time "
              f"{seconds:.0f} s. Runs: " + ", ".join(f"{v} {k}" for k, v in tally.items()) + ".", "",
-             "**Reference** (dolfinx; the deformed pairing, the one compared; in brackets the linear pairing, in "
-             "braces the deformed pairing with smoothed normals), Cattaneo-Mindlin path:", "",
+             "**Reference** (dolfinx; the deformed pairing with facet normals; in brackets the linear pairing, in "
+             "braces the deformed pairing with smoothed normals, the one compared), Cattaneo-Mindlin path:", "",
              "| case | step | P | Q | Q/(mu P) | c | Johnson c | stick / slip |", "|---|---|---|---|---|---|---|---|"]
     for case in cases:
         ref = records[case.name].get("reference", {}).get("cattaneo-mindlin")
@@ -660,7 +665,7 @@ def report_text(cases: list[FrictionCase], checks: list[Check], records: dict, q
     lines += ["", "**Runs** (ours / reference; c in spacings of the larger spacing; profile: largest difference of "
               "the traction's x-component over mu p0):", "",
               "| case | path | primary | solved with | class | step | status | P (ours / ref) | Q (ours / ref) "
-              "| Q diff (smoothed ref.) | Fx diff | c (ours / ref / Johnson) | c diff (h) | profile (smoothed ref.) "
+              "| Q diff (facet-normal ref.) | Fx diff | c (ours / ref / Johnson) | c diff (h) | profile (facet-normal ref.) "
               "| stick / slip (ours; ref) |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for case in cases:
@@ -675,8 +680,8 @@ def report_text(cases: list[FrictionCase], checks: list[Check], records: dict, q
                              f"{run['why']} |" + " |" * 10)
             for k, s in enumerate(run["steps"]):
                 q = f"{s['Q']:+.4g} / {s['Q_ref']:+.4g}" if "Q_error" in s else ""
-                qd = f"{s['Q_error']:.2%} ({s['Q_error_smoothed']:.2%})" if "Q_error" in s else ""
-                pr = f"{s['profile']:.3f} ({s['profile_smoothed']:.3f})" if "profile" in s else ""
+                qd = f"{s['Q_error']:.2%} ({s['Q_error_facet']:.2%})" if "Q_error" in s else ""
+                pr = f"{s['profile']:.3f} ({s['profile_facet']:.3f})" if "profile" in s else ""
                 fx = f"{s['Fx_error']:.2%}" if "Fx_error" in s else ""
                 c = (f"{s['c']:.4f} / {s['c_ref']:.4f}" + (f" / {s['c_johnson']:.4f}" if "c_johnson" in s else "")
                      if "c" in s else "")

@@ -72,11 +72,12 @@ pub enum RowNormal {
     /// continuous across the facets' edges, so that a node held on an edge reads the same
     /// direction from either facet (the smoothed normal of node-to-surface contact). The row
     /// `m . (x - q)` vanishes where the gap does, so the contact it holds is the same; only the
-    /// direction of the force changes, by at most half the angle between two facets. Used where
-    /// the answer is a fixed point in that direction (the slip directions of 3D Coulomb
-    /// friction, `crate::contact::law::coulomb`): with facet normals, a node near an edge of the
-    /// indented block was held along one facet's normal, slipped onto the other's side, was held
-    /// along that one's, slipped back, and the loop never settled.
+    /// direction of the force changes, by at most half the angle between two facets. Used by
+    /// Coulomb friction (`crate::contact::law::coulomb`), whose answer is a fixed point in that
+    /// direction: with facet normals, a node near an edge of the indented 3D block was held
+    /// along one facet's normal, slipped onto the other's side, was held along that one's,
+    /// slipped back, and the loop never settled; in 2D a node at the stick zone's rim
+    /// alternated between stick and slip.
     Averaged,
 }
 

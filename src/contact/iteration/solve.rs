@@ -465,7 +465,7 @@ impl<'a> ContactSolver<'a> {
                     nodes: (0..s1.len())
                         .filter(|&i| gaps[i] < tol * s1.spacing[i])
                         .collect(),
-                    rows: gap_rows(s1, s2, None, None, law.row_normal(s1.dim)),
+                    rows: gap_rows(s1, s2, None, None, law.row_normal()),
                     corrections: vec![0.0; s1.len()],
                     slip: BTreeMap::new(),
                     history: None,
@@ -1242,7 +1242,7 @@ impl ContactSolver<'_> {
                 let (u1, u2) = (&solution.u[a][..], &solution.u[b][..]);
                 let nodes = self.pair_nodes(&active.contact, p);
                 let operators = &self.operators[p];
-                let row_normal = self.laws[p].row_normal(s1.dim);
+                let row_normal = self.laws[p].row_normal();
                 let rows = &mut state.rows[p];
                 let (pair_gaps, jumps, pair_slid) = timed(&mut seconds.search, || {
                     let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));

@@ -118,11 +118,11 @@ impl ContactLaw {
 
     /// The direction a node's gap row holds it along
     /// (`crate::contact::geometry::gap::RowNormal`): the facet's normal, the gradient of the gap,
-    /// except for 3D Coulomb pairs, whose slip directions are a fixed point that a normal
-    /// jumping between facets keeps from settling.
-    pub fn row_normal(&self, dim: usize) -> RowNormal {
+    /// except for Coulomb pairs, whose answer (a slip direction in 3D, a node's state at the
+    /// stick zone's edge in 2D) has no fixed point when the normal jumps between facets.
+    pub fn row_normal(&self) -> RowNormal {
         match self {
-            ContactLaw::Coulomb { .. } if dim == 3 => RowNormal::Averaged,
+            ContactLaw::Coulomb { .. } => RowNormal::Averaged,
             _ => RowNormal::Facet,
         }
     }

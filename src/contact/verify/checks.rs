@@ -188,7 +188,7 @@ fn complementarity(
     let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
     let law = ContactLaw::of(&problem.settings);
     let held: Vec<f64> = match law.holds_geometric_gap() {
-        true => (gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal(s1.dim)).into_iter())
+        true => (gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal()).into_iter())
             .map(|row| row.gap)
             .collect(),
         false => gaps1.to_vec(),
