@@ -296,20 +296,23 @@ fn a_friction_coefficient_is_refused_without_coulomb_and_required_with_it() {
     }
 }
 
+/// The hemisphere (R = 1, the contact zone meshed at R/67) pressed 0.01 into the block of the
+/// same material, its top shifted by `shift` along x.
+fn sphere(shift: f64) -> CaseFile {
+    hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
+        .with_body("sphere", |_| {
+            Body::new("sphere", 1000.0, 0.3)
+                .dirichlet(Dirichlet::on("sphere_top").ux(shift).uy(0.0).uz(-0.01))
+        })
+        .contact_setting("formulation", "coulomb")
+        .contact_setting("friction_coefficient", MU)
+}
+
 #[test]
 fn a_sphere_pressed_then_sheared_has_the_stick_zone_of_mindlin() {
     // 3D: the hemisphere (R = 1, the contact zone meshed at R/67) pressed 0.01 into the block
     // of the same material, then sheared along x at the same approach:
     // c = a (1 - Q / (mu P))^(1/3) (Mindlin 1949; Johnson 1985, 7.2).
-    let sphere = |shift: f64| {
-        hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
-            .with_body("sphere", |_| {
-                Body::new("sphere", 1000.0, 0.3)
-                    .dirichlet(Dirichlet::on("sphere_top").ux(shift).uy(0.0).uz(-0.01))
-            })
-            .contact_setting("formulation", "coulomb")
-            .contact_setting("friction_coefficient", MU)
-    };
     let shifts = [0.0, 0.0012];
     let cases: Vec<CaseFile> = shifts.iter().map(|&s| sphere(s)).collect();
     let (answers, coords) = along_path(&cases);
@@ -488,15 +491,6 @@ fn a_sphere_sheared_back_and_forth_follows_the_hysteresis_loop_of_mindlin_and_de
     // edge, known to a node. The check reads only forces, against a property of the exact
     // solution, not against the solver's own quantities.
     let d = 0.0012;
-    let sphere = |shift: f64| {
-        hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0)
-            .with_body("sphere", |_| {
-                Body::new("sphere", 1000.0, 0.3)
-                    .dirichlet(Dirichlet::on("sphere_top").ux(shift).uy(0.0).uz(-0.01))
-            })
-            .contact_setting("formulation", "coulomb")
-            .contact_setting("friction_coefficient", MU)
-    };
     let shifts = [0.0, d / 4.0, d / 2.0, d, d / 2.0, 0.0, -d];
     let cases: Vec<CaseFile> = shifts.iter().map(|&s| sphere(s)).collect();
     let (answers, _) = along_path(&cases);
