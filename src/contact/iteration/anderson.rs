@@ -20,11 +20,15 @@
 //!
 //! For a linear `F` it is GMRES on `(I - J) x = F(0)` (Walker and Ni, theorem 2.2): it settles
 //! whatever the size of `J`'s eigenvalues, as long as `I - J` is regular, which is why it is
-//! used here rather than a relaxation factor tuned to one case. The history is only valid
-//! while the same nodes slip (the unknowns are their directions): it restarts whenever the
-//! set of slipping nodes changes, and after `m` steps the oldest pair is dropped. Each node's
-//! accelerated direction is normalized again; a node where the combination points away from
-//! its plain update (a slip that reverses) takes the plain update.
+//! used here rather than a relaxation factor tuned to one case. The unknowns are the directions
+//! of the nodes that slip, and a node or two may start or stop slipping from one iteration to
+//! the next while the others turn (the 99k-DOF sphere sheared twice as far: 326 to 328 slipping
+//! nodes for several iterations). Restarting the history at each such change left the plain
+//! iteration, which grew there; so the combination is taken over the nodes that slipped in
+//! every kept iterate and slip now, and the others take the plain update. After `m` steps the
+//! oldest iterate is dropped. Each node's accelerated direction is normalized again; a node
+//! where the combination points away from its plain update (a slip that reverses) takes the
+//! plain update.
 
 use std::collections::{BTreeMap, VecDeque};
 
@@ -34,77 +38,91 @@ use nalgebra::{DMatrix, DVector};
 /// adds little where each iterate is a coupled solve and the slipping set settles in tens.
 const DEPTH: usize = 5;
 
-/// The history of the direction iteration since the slipping set last changed.
+/// The history of the direction iteration: for each kept iterate, `(F(x_i), f_i)` of each node
+/// that slipped in it, oldest first.
 #[derive(Debug, Default)]
 pub struct DirectionAcceleration {
-    /// The slipping nodes the history is about, in order.
-    nodes: Vec<usize>,
-    /// `(F(x_j), f_j)` of the last iterates, oldest first, each stacked node by node.
-    history: VecDeque<(DVector<f64>, DVector<f64>)>,
+    history: VecDeque<BTreeMap<usize, ([f64; 3], [f64; 3])>>,
 }
 
 impl DirectionAcceleration {
-    /// The next directions of the slipping nodes, from the directions `solved` the iterate was
-    /// solved with and the plain update `update` it gives, both keyed by node: the plain update
-    /// where the history is empty (a new slipping set), the accelerated one otherwise. Nodes in
-    /// `update` but not in `solved` start slipping: the history restarts with them.
+    /// The next directions of the nodes in `update` (the plain update the iterate gives), from
+    /// the directions `solved` the iterate was solved with: accelerated on the nodes that slip
+    /// in every kept iterate and in both of these, plain elsewhere (a node that starts
+    /// slipping, or the first iterate).
     pub fn next(
         &mut self,
         solved: &BTreeMap<usize, [f64; 3]>,
         update: &BTreeMap<usize, [f64; 3]>,
     ) -> BTreeMap<usize, [f64; 3]> {
-        let nodes: Vec<usize> = update.keys().copied().collect();
-        if nodes != self.nodes {
-            self.nodes = nodes;
-            self.history.clear();
-        }
-        if self.nodes.is_empty() || self.nodes.iter().any(|i| !solved.contains_key(i)) {
-            self.history.clear();
-            return update.clone();
-        }
-        let stack = |map: &BTreeMap<usize, [f64; 3]>| {
-            DVector::from_iterator(3 * self.nodes.len(), self.nodes.iter().flat_map(|i| map[i]))
-        };
-        let (x, g) = (stack(solved), stack(update));
-        let f = &g - &x;
-        if self.history.is_empty() {
-            self.history.push_back((g, f));
-            return update.clone();
-        }
-        let mut next = g.clone();
-        {
-            // The differences between successive iterates' residuals and updates.
-            let mut pairs: Vec<(&DVector<f64>, &DVector<f64>)> =
-                self.history.iter().map(|(g, f)| (g, f)).collect();
-            pairs.push((&g, &f));
-            let columns = pairs.len() - 1;
-            let delta_f =
-                DMatrix::from_fn(f.len(), columns, |r, c| pairs[c + 1].1[r] - pairs[c].1[r]);
-            let delta_g =
-                DMatrix::from_fn(g.len(), columns, |r, c| pairs[c + 1].0[r] - pairs[c].0[r]);
-            // A least-squares solve that ignores directions the residual differences do not
-            // span (two iterates with the same residual): the combination then reverts to the
-            // plain update along them.
-            if let Ok(gamma) = delta_f
-                .clone()
-                .svd(true, true)
-                .solve(&f, 1e-12 * f.norm().max(1e-300))
-            {
-                next = &g - delta_g * gamma;
+        let current: BTreeMap<usize, ([f64; 3], [f64; 3])> = (update.iter())
+            .filter_map(|(&i, &g)| {
+                let x = solved.get(&i)?;
+                Some((i, (g, std::array::from_fn(|c| g[c] - x[c]))))
+            })
+            .collect();
+        let common: Vec<usize> = (current.keys().copied())
+            .filter(|i| self.history.iter().all(|kept| kept.contains_key(i)))
+            .collect();
+        let mut next = update.clone();
+        if !self.history.is_empty() && !common.is_empty() {
+            for (i, direction) in self.combination(&current, &common) {
+                next.insert(i, direction);
             }
         }
-        self.history.push_back((g.clone(), f));
+        self.history.push_back(current);
         if self.history.len() > DEPTH {
             self.history.pop_front();
         }
-        (self.nodes.iter().enumerate())
+        next
+    }
+
+    /// Anderson's combination (module doc) over the `common` nodes of the kept iterates and
+    /// `current`, each node's direction normalized again (the plain update where it points away
+    /// from it).
+    fn combination(
+        &self,
+        current: &BTreeMap<usize, ([f64; 3], [f64; 3])>,
+        common: &[usize],
+    ) -> Vec<(usize, [f64; 3])> {
+        let stack = |iterate: &BTreeMap<usize, ([f64; 3], [f64; 3])>, part: usize| {
+            DVector::from_iterator(
+                3 * common.len(),
+                common.iter().flat_map(|i| match part {
+                    0 => iterate[i].0,
+                    _ => iterate[i].1,
+                }),
+            )
+        };
+        let iterates: Vec<&BTreeMap<usize, ([f64; 3], [f64; 3])>> = self
+            .history
+            .iter()
+            .chain(std::iter::once(current))
+            .collect();
+        let g: Vec<DVector<f64>> = iterates.iter().map(|it| stack(it, 0)).collect();
+        let f: Vec<DVector<f64>> = iterates.iter().map(|it| stack(it, 1)).collect();
+        let (rows, columns) = (3 * common.len(), iterates.len() - 1);
+        let delta_f = DMatrix::from_fn(rows, columns, |r, c| f[c + 1][r] - f[c][r]);
+        let delta_g = DMatrix::from_fn(rows, columns, |r, c| g[c + 1][r] - g[c][r]);
+        let (g_k, f_k) = (&g[columns], &f[columns]);
+        // A least-squares solve that ignores directions the residual differences do not span
+        // (two iterates with the same residual): the combination reverts to the plain update
+        // along them.
+        let accelerated = match delta_f
+            .svd(true, true)
+            .solve(f_k, 1e-12 * f_k.norm().max(1e-300))
+        {
+            Ok(gamma) => g_k - delta_g * gamma,
+            Err(_) => g_k.clone(),
+        };
+        (common.iter().enumerate())
             .map(|(k, &i)| {
-                let plain = update[&i];
-                let accelerated: [f64; 3] = std::array::from_fn(|c| next[3 * k + c]);
-                let length = norm(accelerated);
-                let along: f64 = (0..3).map(|c| accelerated[c] * plain[c]).sum();
+                let plain = current[&i].0;
+                let direction: [f64; 3] = std::array::from_fn(|c| accelerated[3 * k + c]);
+                let length = norm(direction);
+                let along: f64 = (0..3).map(|c| direction[c] * plain[c]).sum();
                 let direction = if length > 0.0 && along > 0.0 {
-                    accelerated.map(|v| v / length)
+                    direction.map(|v| v / length)
                 } else {
                     plain
                 };
@@ -158,15 +176,24 @@ mod tests {
     }
 
     #[test]
-    fn a_new_slipping_set_restarts_with_the_plain_update() {
-        let mut acceleration = DirectionAcceleration::default();
-        let x = directions([0.3, 0.0]);
-        let first = acceleration.next(&x, &directions([0.1, 0.1]));
-        assert_eq!(first, directions([0.1, 0.1]));
-        let mut update = directions([0.15, 0.05]);
+    fn a_node_that_starts_slipping_takes_the_plain_update_while_the_others_are_accelerated() {
+        let mut with_newcomer = DirectionAcceleration::default();
+        let mut without = DirectionAcceleration::default();
+        let mut x = directions([0.25, -0.12]);
+        // The first iterate: the plain update.
+        let first = directions(map(angles(&x)));
+        assert_eq!(with_newcomer.next(&x, &first), first);
+        assert_eq!(without.next(&x, &first), first);
+        x = first;
+        // Node 9 starts slipping: its direction as the update gives it; nodes 3 and 7 as
+        // without it.
+        let mut update = directions(map(angles(&x)));
+        let plain = update.clone();
         update.insert(9, [0.0, 1.0, 0.0]);
-        let mut solved = first.clone();
-        solved.insert(9, [0.0, 1.0, 0.0]);
-        assert_eq!(acceleration.next(&solved, &update), update);
+        let next = with_newcomer.next(&x, &update);
+        let alone = without.next(&x, &plain);
+        assert_eq!(next[&9], [0.0, 1.0, 0.0]);
+        assert_eq!((next[&3], next[&7]), (alone[&3], alone[&7]));
+        assert_ne!(alone, plain, "the combination is not the plain update");
     }
 }
