@@ -18,7 +18,7 @@ use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_patter
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::{Constraints, NodeColumns, NodeGraph};
 use crate::linalg::{Distribution, LinalgError, RankRows};
-use crate::parallel::Ranks;
+use crate::parallel::ranks::Ranks;
 
 /// The prescribed dofs and values of a problem; conflicting values on shared nodes are errors.
 pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, ProblemError> {

@@ -18,7 +18,7 @@
 use super::LinalgError;
 use super::ordering::partition;
 use crate::fem::{NodeColumns, NodeGraph};
-use crate::parallel::Ranks;
+use crate::parallel::ranks::Ranks;
 
 #[derive(Debug)]
 pub struct Distribution {

@@ -38,11 +38,14 @@ use nalgebra::{DMatrix, DVector};
 /// adds little where each iterate is a coupled solve and the slipping set settles in tens.
 const DEPTH: usize = 5;
 
+/// One iterate of the direction iteration: `(F(x_i), f_i)` of each node that slipped in it.
+type Iterate = BTreeMap<usize, ([f64; 3], [f64; 3])>;
+
 /// The history of the direction iteration: for each kept iterate, `(F(x_i), f_i)` of each node
 /// that slipped in it, oldest first.
 #[derive(Debug, Default)]
 pub struct DirectionAcceleration {
-    history: VecDeque<BTreeMap<usize, ([f64; 3], [f64; 3])>>,
+    history: VecDeque<Iterate>,
 }
 
 impl DirectionAcceleration {
@@ -55,7 +58,7 @@ impl DirectionAcceleration {
         solved: &BTreeMap<usize, [f64; 3]>,
         update: &BTreeMap<usize, [f64; 3]>,
     ) -> BTreeMap<usize, [f64; 3]> {
-        let current: BTreeMap<usize, ([f64; 3], [f64; 3])> = (update.iter())
+        let current: Iterate = (update.iter())
             .filter_map(|(&i, &g)| {
                 let x = solved.get(&i)?;
                 Some((i, (g, std::array::from_fn(|c| g[c] - x[c]))))
@@ -82,10 +85,10 @@ impl DirectionAcceleration {
     /// from it).
     fn combination(
         &self,
-        current: &BTreeMap<usize, ([f64; 3], [f64; 3])>,
+        current: &Iterate,
         common: &[usize],
     ) -> Vec<(usize, [f64; 3])> {
-        let stack = |iterate: &BTreeMap<usize, ([f64; 3], [f64; 3])>, part: usize| {
+        let stack = |iterate: &Iterate, part: usize| {
             DVector::from_iterator(
                 3 * common.len(),
                 common.iter().flat_map(|i| match part {
@@ -94,7 +97,7 @@ impl DirectionAcceleration {
                 }),
             )
         };
-        let iterates: Vec<&BTreeMap<usize, ([f64; 3], [f64; 3])>> = self
+        let iterates: Vec<&Iterate> = self
             .history
             .iter()
             .chain(std::iter::once(current))

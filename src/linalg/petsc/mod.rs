@@ -63,17 +63,21 @@
 //!   such an object is collective: a distributed run has one thread per rank, so every rank
 //!   makes them in the same order, and V-cycles never overlap.
 
-use std::ffi::{CStr, c_char, c_int};
+mod mpi;
+mod runtime;
+
+use std::ffi::{c_char, c_int};
 use std::ptr::NonNull;
-use std::sync::{Mutex, OnceLock, PoisonError, RwLock, RwLockWriteGuard};
+use std::sync::{Mutex, PoisonError};
 
 use faer::sparse::SparseColMat;
 
-use super::{Distribution, LinalgError, RankRows};
-use crate::parallel::Ranks;
-
-/// MPI's Fortran communicator handle (`MPI_Fint`, an `int` in Open MPI and MPICH alike).
-type MpiFint = c_int;
+pub use mpi::{abort_world, broadcast_bytes, finalize, gather_values, world_ranks};
+pub use runtime::concurrent_v_cycles;
+use runtime::{MpiFint, PETSC, petsc, petsc_error, text};
+use super::distribution::{Distribution, RankRows};
+use super::LinalgError;
+use crate::parallel::ranks::Ranks;
 
 #[repr(C)]
 struct RawCgAmg {
@@ -81,28 +85,8 @@ struct RawCgAmg {
 }
 
 unsafe extern "C" {
-    fn internodes_petsc_initialize(step: *mut *const c_char) -> c_int;
-    fn internodes_petsc_options_are_ours(ours: *mut c_int, step: *mut *const c_char) -> c_int;
     fn internodes_petsc_comm_self() -> MpiFint;
     fn internodes_petsc_comm_world() -> MpiFint;
-    fn internodes_mpi_rank_size(
-        rank: *mut c_int,
-        size: *mut c_int,
-        step: *mut *const c_char,
-    ) -> c_int;
-    fn internodes_mpi_allgather(
-        local: *const f64,
-        count: c_int,
-        global: *mut f64,
-        counts: *const c_int,
-        displs: *const c_int,
-        step: *mut *const c_char,
-    ) -> c_int;
-    fn internodes_mpi_broadcast_length(len: *mut i64, step: *mut *const c_char) -> c_int;
-    fn internodes_mpi_broadcast(data: *mut u8, len: i64, step: *mut *const c_char) -> c_int;
-    fn internodes_mpi_abort(code: c_int);
-    fn internodes_petsc_finalize(step: *mut *const c_char) -> c_int;
-    fn internodes_petsc_error_text(code: c_int) -> *const c_char;
     fn internodes_ksp_reason_name(reason: c_int) -> *const c_char;
     fn internodes_cgamg_create(
         comm: MpiFint,
@@ -143,68 +127,6 @@ unsafe extern "C" {
     fn internodes_cgamg_destroy(solver: *mut RawCgAmg);
 }
 
-/// Orders every PETSc call of the process: V-cycles ([`CgAmg::precondition`]) take it shared,
-/// every other call exclusively (see the module's doc).
-static PETSC: RwLock<()> = RwLock::new(());
-/// The outcome of PETSc's initialization (made once, under [`PETSC`] held exclusively): on
-/// success, whether V-cycles of distinct objects may run at once (no option in PETSc's
-/// database but ours).
-static INITIALIZED: OnceLock<Result<bool, (String, i32)>> = OnceLock::new();
-
-/// Whether V-cycles ([`CgAmg::precondition`]) of distinct objects run at the same time: PETSc
-/// is initialized and its options database holds no option but ours (see the module's doc).
-pub fn concurrent_v_cycles() -> bool {
-    matches!(INITIALIZED.get(), Some(Ok(true)))
-}
-
-/// A C string from the shim (static storage) as Rust text.
-fn text(s: *const c_char) -> String {
-    if s.is_null() {
-        return String::from("?");
-    }
-    // SAFETY: the shim returns null or pointers to static NUL-terminated strings.
-    unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned()
-}
-
-fn petsc_error(step: *const c_char, code: c_int) -> LinalgError {
-    LinalgError::Petsc {
-        step: text(step),
-        code,
-        // SAFETY: plain lookup of a static string.
-        message: text(unsafe { internodes_petsc_error_text(code) }),
-    }
-}
-
-/// The PETSc lock held exclusively, with PETSc initialized. A poisoned lock is taken anyway:
-/// a panic cannot happen inside a PETSc call (they return codes), so PETSc's state is whole.
-fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
-    let guard = PETSC.write().unwrap_or_else(PoisonError::into_inner);
-    let outcome = INITIALIZED.get_or_init(|| {
-        let mut step = std::ptr::null();
-        // SAFETY: called once per process, under the exclusive lock.
-        let code = unsafe { internodes_petsc_initialize(&mut step) };
-        if code != 0 {
-            return Err((text(step), code));
-        }
-        let mut ours = 0;
-        // SAFETY: PETSc is initialized; the exclusive lock is held.
-        let code = unsafe { internodes_petsc_options_are_ours(&mut ours, &mut step) };
-        if code == 0 {
-            Ok(ours != 0)
-        } else {
-            Err((text(step), code))
-        }
-    });
-    match outcome {
-        Ok(_) => Ok(guard),
-        Err((step, code)) => Err(LinalgError::Petsc {
-            step: format!("initializing PETSc: {step}"),
-            code: *code,
-            message: text(unsafe { internodes_petsc_error_text(*code) }),
-        }),
-    }
-}
-
 /// The communicator PETSc objects are created on, with this process's place in it.
 #[derive(Debug, Clone, Copy)]
 struct Communicator {
@@ -232,103 +154,6 @@ impl Communicator {
             handle: unsafe { internodes_petsc_comm_world() },
             ranks,
         })
-    }
-}
-
-/// This process's rank and the number of ranks of `PETSC_COMM_WORLD` (initializes PETSc, and
-/// MPI, if needed: collective the first time).
-pub fn world_ranks() -> Result<Ranks, LinalgError> {
-    let _lock = petsc()?;
-    let (mut rank, mut size) = (0, 0);
-    let mut step = std::ptr::null();
-    // SAFETY: PETSc is initialized, the lock is held.
-    let code = unsafe { internodes_mpi_rank_size(&mut rank, &mut size, &mut step) };
-    if code != 0 {
-        return Err(petsc_error(step, code));
-    }
-    Ok(Ranks {
-        rank: rank as usize,
-        size: size as usize,
-    })
-}
-
-/// An MPI count: the counts of our vectors fit in an `int` as long as PETSc's 32-bit indices do.
-fn mpi_count(n: usize) -> Result<c_int, LinalgError> {
-    c_int::try_from(n).map_err(|_| LinalgError::Sizes(format!("{n} values in one MPI message")))
-}
-
-/// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
-/// order, on every rank (collective over `PETSC_COMM_WORLD`).
-pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
-    let total = counts.iter().sum();
-    let mut displs = Vec::with_capacity(counts.len());
-    let mut at = 0;
-    for &count in counts {
-        displs.push(mpi_count(at)?);
-        at += count;
-    }
-    let counts = counts
-        .iter()
-        .map(|&c| mpi_count(c))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut global = vec![0.0; total];
-    let mut step = std::ptr::null();
-    let _lock = petsc()?;
-    // SAFETY: `global` holds the sum of `counts`, `counts` and `displs` one value per rank,
-    // `local` this rank's count; the lock is held.
-    let code = unsafe {
-        internodes_mpi_allgather(
-            local.as_ptr(),
-            mpi_count(local.len())?,
-            global.as_mut_ptr(),
-            counts.as_ptr(),
-            displs.as_ptr(),
-            &mut step,
-        )
-    };
-    match code {
-        0 => Ok(global),
-        _ => Err(petsc_error(step, code)),
-    }
-}
-
-/// Rank 0's `bytes` on every rank (collective over `PETSC_COMM_WORLD`; the other ranks'
-/// `bytes` are not read).
-pub fn broadcast_bytes(bytes: Vec<u8>) -> Result<Vec<u8>, LinalgError> {
-    let mut len = bytes.len() as i64;
-    let mut step = std::ptr::null();
-    let _lock = petsc()?;
-    // SAFETY: the lock is held; `len` is one value.
-    let code = unsafe { internodes_mpi_broadcast_length(&mut len, &mut step) };
-    if code != 0 {
-        return Err(petsc_error(step, code));
-    }
-    let mut data = bytes;
-    data.resize(len.max(0) as usize, 0);
-    // SAFETY: `data` holds `len` bytes on every rank; the lock is held.
-    let code = unsafe { internodes_mpi_broadcast(data.as_mut_ptr(), len, &mut step) };
-    match code {
-        0 => Ok(data),
-        _ => Err(petsc_error(step, code)),
-    }
-}
-
-/// Ends every rank of the run with `code` (`MPI_Abort`).
-pub fn abort_world(code: i32) -> ! {
-    // No lock: the thread that holds it may be the one waiting for the other ranks.
-    // SAFETY: PETSc (MPI) is initialized in a distributed run; MPI_Abort does not return.
-    unsafe { internodes_mpi_abort(code) };
-    std::process::exit(code)
-}
-
-/// `PetscFinalize` (and MPI's): the last PETSc call of the process.
-pub fn finalize() -> Result<(), LinalgError> {
-    let _lock = petsc()?;
-    let mut step = std::ptr::null();
-    // SAFETY: the lock is held; the caller has dropped every PETSc object.
-    match unsafe { internodes_petsc_finalize(&mut step) } {
-        0 => Ok(()),
-        code => Err(petsc_error(step, code)),
     }
 }
 

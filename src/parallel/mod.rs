@@ -14,24 +14,11 @@
 //! Without the cargo feature `petsc` a run is always one rank; launched by `mpirun` on more,
 //! [`start`] refuses.
 
-use std::sync::OnceLock;
+pub mod ranks;
 
-use serde::Serialize;
 use thiserror::Error;
 
-/// This process's place in the run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct Ranks {
-    /// 0 to `size - 1`.
-    pub rank: usize,
-    /// The number of processes of the run.
-    pub size: usize,
-}
-
-impl Ranks {
-    /// A run of one process.
-    pub const ONE: Self = Self { rank: 0, size: 1 };
-}
+pub use ranks::{Ranks, distributed, is_root, ranks};
 
 #[derive(Debug, Error)]
 pub enum ParallelError {
@@ -45,8 +32,6 @@ pub enum ParallelError {
     #[error("the rayon thread pool of a rank: {0}")]
     Threads(String),
 }
-
-static RUN: OnceLock<Ranks> = OnceLock::new();
 
 /// The number of ranks the environment of an MPI launcher announces (Open MPI's `mpirun`,
 /// and the PMI of MPICH, Intel MPI and Slurm's `srun`), if it names one.
@@ -63,16 +48,16 @@ fn announced_size() -> Option<usize> {
 /// always a serial run).
 pub fn start() -> Result<Ranks, ParallelError> {
     let Some(announced) = announced_size() else {
-        return Ok(*RUN.get_or_init(|| Ranks::ONE));
+        return Ok(ranks::settle(Ranks::ONE));
     };
-    let ranks = join_world(announced)?;
-    if ranks.size > 1 {
+    let world = join_world(announced)?;
+    if world.size > 1 {
         rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build_global()
             .map_err(|e| ParallelError::Threads(e.to_string()))?;
     }
-    Ok(*RUN.get_or_init(|| ranks))
+    Ok(ranks::settle(world))
 }
 
 #[cfg(feature = "petsc")]
@@ -86,21 +71,6 @@ fn join_world(announced: usize) -> Result<Ranks, ParallelError> {
         0 | 1 => Ok(Ranks::ONE),
         size => Err(ParallelError::NoPetsc(size)),
     }
-}
-
-/// This process's place in the run (one rank unless [`start`] joined more).
-pub fn ranks() -> Ranks {
-    RUN.get().copied().unwrap_or(Ranks::ONE)
-}
-
-/// Whether the run has more than one rank.
-pub fn distributed() -> bool {
-    ranks().size > 1
-}
-
-/// Whether this rank writes the results and prints (rank 0).
-pub fn is_root() -> bool {
-    ranks().rank == 0
 }
 
 /// Rank 0's `bytes` on every rank (`bytes` is read on rank 0 only). Serial: `bytes` itself.

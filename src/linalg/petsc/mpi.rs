@@ -1,0 +1,127 @@
+//! The MPI calls of a distributed run, through PETSc's initialization of MPI: this process's
+//! place among the ranks, gathering values, broadcasting bytes, aborting and finalizing
+//! (`crate::parallel` puts them behind calls that also work without PETSc).
+
+use std::ffi::{c_char, c_int};
+
+use super::runtime::{petsc, petsc_error};
+use crate::linalg::LinalgError;
+use crate::parallel::ranks::Ranks;
+
+unsafe extern "C" {
+    fn internodes_mpi_rank_size(
+        rank: *mut c_int,
+        size: *mut c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_allgather(
+        local: *const f64,
+        count: c_int,
+        global: *mut f64,
+        counts: *const c_int,
+        displs: *const c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_broadcast_length(len: *mut i64, step: *mut *const c_char) -> c_int;
+    fn internodes_mpi_broadcast(data: *mut u8, len: i64, step: *mut *const c_char) -> c_int;
+    fn internodes_mpi_abort(code: c_int);
+    fn internodes_petsc_finalize(step: *mut *const c_char) -> c_int;
+}
+
+/// This process's rank and the number of ranks of `PETSC_COMM_WORLD` (initializes PETSc, and
+/// MPI, if needed: collective the first time).
+pub fn world_ranks() -> Result<Ranks, LinalgError> {
+    let _lock = petsc()?;
+    let (mut rank, mut size) = (0, 0);
+    let mut step = std::ptr::null();
+    // SAFETY: PETSc is initialized, the lock is held.
+    let code = unsafe { internodes_mpi_rank_size(&mut rank, &mut size, &mut step) };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    Ok(Ranks {
+        rank: rank as usize,
+        size: size as usize,
+    })
+}
+
+/// An MPI count: the counts of our vectors fit in an `int` as long as PETSc's 32-bit indices do.
+fn mpi_count(n: usize) -> Result<c_int, LinalgError> {
+    c_int::try_from(n).map_err(|_| LinalgError::Sizes(format!("{n} values in one MPI message")))
+}
+
+/// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
+/// order, on every rank (collective over `PETSC_COMM_WORLD`).
+pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
+    let total = counts.iter().sum();
+    let mut displs = Vec::with_capacity(counts.len());
+    let mut at = 0;
+    for &count in counts {
+        displs.push(mpi_count(at)?);
+        at += count;
+    }
+    let counts = counts
+        .iter()
+        .map(|&c| mpi_count(c))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut global = vec![0.0; total];
+    let mut step = std::ptr::null();
+    let _lock = petsc()?;
+    // SAFETY: `global` holds the sum of `counts`, `counts` and `displs` one value per rank,
+    // `local` this rank's count; the lock is held.
+    let code = unsafe {
+        internodes_mpi_allgather(
+            local.as_ptr(),
+            mpi_count(local.len())?,
+            global.as_mut_ptr(),
+            counts.as_ptr(),
+            displs.as_ptr(),
+            &mut step,
+        )
+    };
+    match code {
+        0 => Ok(global),
+        _ => Err(petsc_error(step, code)),
+    }
+}
+
+/// Rank 0's `bytes` on every rank (collective over `PETSC_COMM_WORLD`; the other ranks'
+/// `bytes` are not read).
+pub fn broadcast_bytes(bytes: Vec<u8>) -> Result<Vec<u8>, LinalgError> {
+    let mut len = bytes.len() as i64;
+    let mut step = std::ptr::null();
+    let _lock = petsc()?;
+    // SAFETY: the lock is held; `len` is one value.
+    let code = unsafe { internodes_mpi_broadcast_length(&mut len, &mut step) };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    let mut data = bytes;
+    data.resize(len.max(0) as usize, 0);
+    // SAFETY: `data` holds `len` bytes on every rank; the lock is held.
+    let code = unsafe { internodes_mpi_broadcast(data.as_mut_ptr(), len, &mut step) };
+    match code {
+        0 => Ok(data),
+        _ => Err(petsc_error(step, code)),
+    }
+}
+
+/// Ends every rank of the run with `code` (`MPI_Abort`).
+pub fn abort_world(code: i32) -> ! {
+    // No lock: the thread that holds it may be the one waiting for the other ranks.
+    // SAFETY: PETSc (MPI) is initialized in a distributed run; MPI_Abort does not return.
+    unsafe { internodes_mpi_abort(code) };
+    std::process::exit(code)
+}
+
+/// `PetscFinalize` (and MPI's): the last PETSc call of the process.
+pub fn finalize() -> Result<(), LinalgError> {
+    let _lock = petsc()?;
+    let mut step = std::ptr::null();
+    // SAFETY: the lock is held; the caller has dropped every PETSc object.
+    match unsafe { internodes_petsc_finalize(&mut step) } {
+        0 => Ok(()),
+        code => Err(petsc_error(step, code)),
+    }
+}
+
