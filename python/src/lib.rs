@@ -297,10 +297,7 @@ impl CaseSource {
     /// every case "case file NAME", which for a dict's case names a file that does not exist.
     fn relabel(&self, text: String) -> String {
         match self.from_dict {
-            true => text.replace(
-                &format!("case file {}", self.name),
-                &dict_label(&self.name),
-            ),
+            true => text.replace(&format!("case file {}", self.name), &dict_label(&self.name)),
             false => text,
         }
     }
@@ -314,7 +311,8 @@ fn dict_label(name: &str) -> String {
 impl Case {
     /// How messages name this case: its file, or the dict's name.
     fn label(&self) -> String {
-        self.source.relabel(format!("case file {}", self.file.path.display()))
+        self.source
+            .relabel(format!("case file {}", self.file.path.display()))
     }
 
     /// `error` (an exception of this module, whose argument is its message) with the case

@@ -170,7 +170,8 @@ fn solve_contact_pairs(
     } = run;
     timings.phases.extend(contact_timings);
     let mut contacts = Vec::new();
-    for (p, ((problem, solution), steps)) in problems.iter().zip(&solutions).zip(steps).enumerate() {
+    for (p, ((problem, solution), steps)) in problems.iter().zip(&solutions).zip(steps).enumerate()
+    {
         let name = case.contacts[p].name.clone();
         contacts.push(SolvedContact {
             summary: summarize_contact(name.clone(), problem, solution, steps),
@@ -186,7 +187,11 @@ fn solve_contact_pairs(
     let earlier = (earlier_solutions.into_iter())
         .map(|step| bodies_in_contact(case, &problems, step))
         .collect();
-    Ok((contacts, bodies_in_contact(case, &problems, solutions), earlier))
+    Ok((
+        contacts,
+        bodies_in_contact(case, &problems, solutions),
+        earlier,
+    ))
 }
 
 /// Each body of the pairs `problems` with its solution in `solutions` (one per pair) and its
