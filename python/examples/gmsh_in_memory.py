@@ -70,7 +70,8 @@ def main(output):
     disc = result.bodies["disc"]
     print(f"largest pressure {disc.surface.pressure.max():.4e} on {disc.surface.active.sum()} "
           f"active nodes; largest von Mises stress in the disc {disc.von_mises.max():.4e}")
-    result.write(output)
+    # The example's own folder: a second run replaces the first one's results.
+    result.write(output, overwrite=True)
 
 
 if __name__ == "__main__":

@@ -78,8 +78,10 @@ class Case:
         table: Mapping[str, Any], name: str = "case", folder: Optional[_StrPath] = None
     ) -> Case:
         """A case from a dict with the case file's keys ("contact": a dict, or a list of dicts
-        for several pairs); `mesh` may be left out when a Mesh is passed to solve(). Relative
-        paths are relative to `folder` (default: the current one)."""
+        for several pairs); `mesh` may be left out when a Mesh is passed to solve(). Messages
+        name it "case 'NAME' (from a dict)". Numbers may be NumPy values, Fractions or Decimals
+        (the nearest float); NaN and infinities are refused, naming the key. Relative paths are
+        relative to `folder` (default: the current one)."""
     @property
     def path(self) -> Path:
         """The case file, or the name given to from_dict."""
@@ -155,7 +157,8 @@ class SurfaceResult:
 
 @final
 class BodyResult:
-    """One body's fields: n nodes in the body's local numbering, m cells."""
+    """One body's fields: n nodes in the body's local numbering, m cells. The arrays are
+    read-only."""
 
     name: str
     coordinates: npt.NDArray[np.float64]
@@ -283,9 +286,13 @@ class Result:
         contact pairs it raises ValueError: use contacts[name].steps."""
     @property
     def bodies(self) -> dict[str, BodyResult]:
-        """Each body's fields by name."""
-    def write(self, folder: _StrPath) -> Path:
-        """Writes the command line's result files into `folder` and returns it."""
+        """Each body's fields at the last load step by name."""
+    def step_bodies(self, k: int) -> dict[str, BodyResult]:
+        """Each body's fields at load step k + 1 (that of steps[k]; negative k counts from the
+        last) by name; IndexError beyond the steps solved."""
+    def write(self, folder: _StrPath, *, overwrite: bool = False) -> Path:
+        """Writes the command line's result files into `folder` and returns it; a folder that
+        holds results already raises FileExistsError unless overwrite=True."""
 
 def solve(
     case: Case,
@@ -343,6 +350,8 @@ def study(
     extrapolation, GCI), writing the files of `internodes study` into `output`."""
 
 # What pickles of cases and meshes are read back with (not for direct use).
-def _restore_case(text: str, name: str, folder: _StrPath, names_mesh: bool) -> Case: ...
+def _restore_case(
+    text: str, name: str, folder: _StrPath, names_mesh: bool, from_dict: bool
+) -> Case: ...
 def _restore_generated_mesh(geo: _StrPath, bytes: bytes) -> Mesh: ...
 def _restore_model_mesh(arrays: Mapping[str, Any]) -> Mesh: ...

@@ -13,7 +13,10 @@ use std::sync::Arc;
 
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyException, PyFileExistsError, PyIndexError, PyKeyboardInterrupt, PyOSError, PyRuntimeError,
+    PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyList};
@@ -25,7 +28,8 @@ use internodes::mesh::{
     read_msh, read_msh_bytes,
 };
 use internodes::output::{
-    CaseSummary, ContactSummary, GENERATED_MESH, OutputError, ResultFolder, Verdict, unsaid_causes,
+    CaseSummary, ContactSummary, FAILURE_MARK, GENERATED_MESH, OutputError, RESULT_FILES,
+    ResultFolder, Verdict, unsaid_causes,
 };
 use internodes::run::{CaseSolution, RunError, Timings, solve_case_on, write_results};
 use internodes::study::{Study as StudyRun, StudyError, StudyOptions, StudySpec, run_study};
@@ -129,14 +133,17 @@ impl Case {
                 text,
                 name: path.to_string_lossy().into_owned(),
                 folder: path.parent().unwrap_or(Path::new("")).to_owned(),
+                from_dict: false,
             },
         })
     }
 
     /// A case from a dict with the case file's keys (`{"mesh": ..., "body": [...], "contact":
-    /// {...}}`; `"contact"` a list of such dicts for several pairs). `mesh` may be left out when a `Mesh` is passed to `solve`. `name` stands for
-    /// the case file in messages and the plot title; relative paths are relative to `folder`
-    /// (default: the current directory).
+    /// {...}}`; `"contact"` a list of such dicts for several pairs). `mesh` may be left out when
+    /// a `Mesh` is passed to `solve`. `name` names the case in messages (`case 'NAME' (from a
+    /// dict)`) and the plot title; relative paths are relative to `folder` (default: the
+    /// current directory). Numbers may be NumPy scalars or arrays, `Fraction`s or `Decimal`s
+    /// (taken as the nearest float); NaN and infinities are refused, naming the key.
     #[staticmethod]
     #[pyo3(signature = (table, name = "case", folder = None))]
     fn from_dict(
@@ -145,30 +152,27 @@ impl Case {
         name: &str,
         folder: Option<PathBuf>,
     ) -> PyResult<Self> {
-        // The dict goes through JSON (its values may be path objects, NumPy scalars or arrays:
-        // `internodes._values.json_value` turns them into strings, numbers and lists), then into
-        // the same schema as a file.
-        let kwargs = PyDict::new(py);
-        kwargs.set_item(
-            "default",
-            py.import("internodes._values")?.getattr("json_value")?,
-        )?;
+        let label = dict_label(name);
+        // The dict goes through JSON, then into the same schema as a file. Its values are made
+        // JSON's first (`internodes._values.plain`: path objects, NumPy values, fractions and
+        // decimals become strings, numbers and lists), where a value JSON cannot hold (NaN, an
+        // infinity, an object) is refused naming its key: `json.dumps` would name none.
+        let plain = (py.import("internodes._values")?)
+            .call_method1("plain", (table,))
+            .map_err(|e| InputError::new_err(format!("{label}: {}", e.value(py))))?;
         let text: String = (py.import("json")?)
-            .call_method("dumps", (table,), Some(&kwargs))
-            .map_err(|e| InputError::new_err(format!("case '{name}': {e}")))?
+            .call_method1("dumps", (plain,))?
             .extract()?;
         let json: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| InputError::new_err(e.to_string()))?;
         if let Some(key) = first_none(&json, String::new()) {
             return Err(InputError::new_err(format!(
-                "case '{name}': {key} is None: a case file has no null; leave the key out to \
-                 take its default"
+                "{label}: {key} is None: a case file has no null; leave the key out to take its \
+                 default"
             )));
         }
         let mut value: toml::Table = serde_json::from_value(json).map_err(|e| {
-            InputError::new_err(format!(
-                "case '{name}': expected a dict of case-file keys ({e})"
-            ))
+            InputError::new_err(format!("{label}: expected a dict of case-file keys ({e})"))
         })?;
         let names_mesh = value.contains_key("mesh");
         if !names_mesh {
@@ -176,16 +180,18 @@ impl Case {
         }
         let folder = folder.unwrap_or_default();
         let text = toml::to_string(&value).map_err(|e| InputError::new_err(e.to_string()))?;
-        let file = CaseFile::from_table(value, name, &folder)
-            .map_err(|e| InputError::new_err(message(&e)))?;
+        let source = CaseSource {
+            text,
+            name: name.to_string(),
+            folder,
+            from_dict: true,
+        };
+        let file = CaseFile::from_table(value, name, &source.folder)
+            .map_err(|e| InputError::new_err(source.relabel(message(&e))))?;
         Ok(Case {
             file,
             names_mesh,
-            source: CaseSource {
-                text,
-                name: name.to_string(),
-                folder,
-            },
+            source,
         })
     }
 
@@ -234,8 +240,13 @@ impl Case {
         let restore = py
             .import("internodes._internodes")?
             .getattr("_restore_case")?;
-        let CaseSource { text, name, folder } = &self.source;
-        let arguments = (text, name, folder, self.names_mesh).into_pyobject(py)?;
+        let CaseSource {
+            text,
+            name,
+            folder,
+            from_dict,
+        } = &self.source;
+        let arguments = (text, name, folder, self.names_mesh, from_dict).into_pyobject(py)?;
         Ok((restore, arguments.into_any()))
     }
 
@@ -270,28 +281,91 @@ fn first_none(value: &serde_json::Value, at: String) -> Option<String> {
     }
 }
 
-/// What a `Case` was made from: its keys as TOML text, the name that stands for its file, and
-/// the folder its relative paths are relative to. A pickled case is this, read again by
-/// [`restore_case`] with the same checks; it holds no solver state.
+/// What a `Case` was made from: its keys as TOML text, the name that stands for its file, the
+/// folder its relative paths are relative to, and whether it was a dict. A pickled case is
+/// this, read again by [`restore_case`] with the same checks; it holds no solver state.
 #[derive(Clone)]
 struct CaseSource {
     text: String,
     name: String,
     folder: PathBuf,
+    from_dict: bool,
+}
+
+impl CaseSource {
+    /// A message of the library about this case as the user knows the case: the library names
+    /// every case "case file NAME", which for a dict's case names a file that does not exist.
+    fn relabel(&self, text: String) -> String {
+        match self.from_dict {
+            true => text.replace(&format!("case file {}", self.name), &dict_label(&self.name)),
+            false => text,
+        }
+    }
+}
+
+/// How messages name a case made from a dict: `case 'NAME' (from a dict)`.
+fn dict_label(name: &str) -> String {
+    format!("case '{name}' (from a dict)")
+}
+
+impl Case {
+    /// How messages name this case: its file, or the dict's name.
+    fn label(&self) -> String {
+        self.source
+            .relabel(format!("case file {}", self.file.path.display()))
+    }
+
+    /// `error` (an exception of this module, whose argument is its message) with the case
+    /// named as the user knows it ([`CaseSource::relabel`]).
+    fn relabel(&self, py: Python<'_>, error: PyErr) -> PyErr {
+        let value = error.value(py);
+        let ours = [
+            py.get_type::<InputError>(),
+            py.get_type::<SolveError>(),
+            py.get_type::<WriteError>(),
+            py.get_type::<Cancelled>(),
+        ];
+        let Some(kind) = ours.into_iter().find(|t| value.get_type().is(t)) else {
+            return error;
+        };
+        let Ok(text) = value.str().map(|t| t.to_string()) else {
+            return error;
+        };
+        let relabeled = self.source.relabel(text.clone());
+        if relabeled == text {
+            return error;
+        }
+        match kind.call1((relabeled,)) {
+            Ok(new) => PyErr::from_value(new),
+            Err(e) => e,
+        }
+    }
 }
 
 /// The `Case` of a pickle ([`Case::__reduce__`]).
 #[pyfunction]
 #[pyo3(name = "_restore_case")]
-fn restore_case(text: String, name: String, folder: PathBuf, names_mesh: bool) -> PyResult<Case> {
+fn restore_case(
+    text: String,
+    name: String,
+    folder: PathBuf,
+    names_mesh: bool,
+    from_dict: bool,
+) -> PyResult<Case> {
     let table: toml::Table =
         toml::from_str(&text).map_err(|e| InputError::new_err(e.to_string()))?;
-    let file = CaseFile::from_table(table, &name, &folder)
-        .map_err(|e| InputError::new_err(message(&e)))?;
+    let source = CaseSource {
+        text,
+        name,
+        folder,
+        from_dict,
+    };
+    let file = CaseFile::from_table(table, &source.name, &source.folder)
+        .map_err(|e| InputError::new_err(source.relabel(message(&e))))?;
     Ok(Case {
         file,
         names_mesh,
-        source: CaseSource { text, name, folder },
+        source,
     })
 }
 
@@ -581,6 +655,17 @@ fn solve(
     cancel: Option<PyRef<'_, Cancel>>,
     threads: Option<usize>,
 ) -> PyResult<Result> {
+    solve_named(py, case, mesh, cancel, threads).map_err(|e| case.relabel(py, e))
+}
+
+/// [`solve`], its errors naming a dict's case as the library names a case file.
+fn solve_named(
+    py: Python<'_>,
+    case: &Case,
+    mesh: Option<PyRef<'_, Mesh>>,
+    cancel: Option<PyRef<'_, Cancel>>,
+    threads: Option<usize>,
+) -> PyResult<Result> {
     if threads == Some(0) {
         return Err(PyValueError::new_err(
             "threads must be at least 1 (leave it out for the default)",
@@ -590,8 +675,8 @@ fn solve(
         Some(mesh) => mesh.clone(),
         None if !case.names_mesh => {
             return Err(InputError::new_err(format!(
-                "case '{}' names no mesh: give it the `mesh` key, or pass mesh= to solve()",
-                case.file.path.display()
+                "{} names no mesh: give it the `mesh` key, or pass mesh= to solve()",
+                case.label()
             )));
         }
         None if case.file.generates_mesh() => {
@@ -612,6 +697,8 @@ fn solve(
     let mut file = case.file.clone();
     file.solver.verbose = true;
     file.solver.progress_line = false;
+    // Every load step's fields are the result's (`Result.step_bodies`).
+    file.solver.keep_step_fields = true;
     file.solver.cancel = cancel.map(|c| c.token.clone()).unwrap_or_default();
     let solution = interruptible(py, &file.solver.cancel, || {
         in_own_pool(threads, || {
@@ -921,7 +1008,8 @@ impl Result {
         }
     }
 
-    /// Each body's fields by name (a `dict` of `BodyResult`), built on first access.
+    /// Each body's fields at the last load step by name (a `dict` of `BodyResult`), built on
+    /// first access.
     #[getter]
     fn bodies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let bodies = self
@@ -937,11 +1025,56 @@ impl Result {
         Ok(bodies.bind(py).clone())
     }
 
+    /// Each body's fields at load step `k + 1` (the step of `steps[k]`; negative `k` counts
+    /// from the last, `step_bodies(-1)` holds the fields of `bodies`), by name. A body in no
+    /// contact pair is solved once, at its full load: its fields are the same at every step.
+    /// Without contact there is one step.
+    fn step_bodies<'py>(&self, py: Python<'py>, k: isize) -> PyResult<Bound<'py, PyDict>> {
+        let count = self.solution.earlier_steps.len() + 1;
+        let index = if k < 0 { k + count as isize } else { k };
+        if index < 0 || index >= count as isize {
+            return Err(PyIndexError::new_err(format!(
+                "load step index {k} out of range: the result has {count} load step{}",
+                if count == 1 { "" } else { "s" }
+            )));
+        }
+        let index = index as usize;
+        if index + 1 == count {
+            return self.bodies(py);
+        }
+        let earlier = &self.solution.earlier_steps[index];
+        let dict = PyDict::new(py);
+        for last in &self.solution.bodies {
+            let solved = earlier.iter().find(|b| b.name == last.name).unwrap_or(last);
+            let body = BodyResult::new(py, &self.mesh.mesh, solved)?;
+            dict.set_item(&last.name, Py::new(py, body)?)?;
+        }
+        Ok(dict)
+    }
+
     /// Writes the command line's result files into `folder` (`solution.xdmf` and `.h5`,
     /// `summary.json`, `force_displacement.csv` and `.png`, `matrices/` when the case exports
-    /// them, and `mesh.msh` when the mesh was made from a `.geo`), replacing earlier results
-    /// there, and returns the folder.
-    fn write(&self, py: Python<'_>, folder: PathBuf) -> PyResult<PathBuf> {
+    /// them, and `mesh.msh` when the mesh was made from a `.geo`), and returns the folder. A
+    /// folder that holds result files already (or a failed run's `FAILED.txt`) is refused with
+    /// `FileExistsError` naming them, unless `overwrite=True`: then those are replaced, as the
+    /// command line replaces the results in its output folder. Other files are never touched.
+    #[pyo3(signature = (folder, *, overwrite = false))]
+    fn write(&self, py: Python<'_>, folder: PathBuf, overwrite: bool) -> PyResult<PathBuf> {
+        if !overwrite {
+            let generated = self.mesh.generated.is_some().then_some(GENERATED_MESH);
+            let earlier: Vec<&str> = (RESULT_FILES.iter().copied())
+                .chain([FAILURE_MARK])
+                .chain(generated)
+                .filter(|name| folder.join(name).exists())
+                .collect();
+            if !earlier.is_empty() {
+                return Err(PyFileExistsError::new_err(format!(
+                    "{} holds results already ({}): pass overwrite=True to replace them",
+                    folder.display(),
+                    earlier.join(", ")
+                )));
+            }
+        }
         py.detach(|| guarded("writing the results", || self.write_into(&folder)))?;
         Ok(folder)
     }
@@ -1020,8 +1153,8 @@ fn study(
 ) -> PyResult<Study> {
     if !case.names_mesh {
         return Err(InputError::new_err(format!(
-            "case '{}' names no mesh: a study needs the `mesh` key naming a .geo",
-            case.file.path.display()
+            "{} names no mesh: a study needs the `mesh` key naming a .geo",
+            case.label()
         )));
     }
     let spec = StudySpec { parameter, values };
@@ -1031,11 +1164,13 @@ fn study(
         output,
         quiet: false,
     };
-    let study = py.detach(|| {
-        guarded("the study", || {
-            run_study(&file, &spec, &options).map_err(study_error)
+    let study = py
+        .detach(|| {
+            guarded("the study", || {
+                run_study(&file, &spec, &options).map_err(study_error)
+            })
         })
-    })?;
+        .map_err(|e| case.relabel(py, e))?;
     Ok(Study { study })
 }
 
@@ -1400,12 +1535,15 @@ impl SurfaceResult {
     }
 }
 
-/// A flat vector as a NumPy array of shape `shape`.
+/// A flat vector as a read-only NumPy array of shape `shape`. Read-only because a result is
+/// the solver's answer: an array edited in place would change what `to_meshio` exports but not
+/// what `Result.write` writes (which reads the solver's own copy).
 fn array<T: numpy::Element>(py: Python<'_>, data: Vec<T>, shape: &[usize]) -> PyResult<Py<PyAny>> {
-    Ok(PyArray1::from_vec(py, data)
-        .reshape(shape)?
-        .into_any()
-        .unbind())
+    let array = PyArray1::from_vec(py, data).reshape(shape)?.into_any();
+    let kwargs = PyDict::new(py);
+    kwargs.set_item("write", false)?;
+    array.call_method("setflags", (), Some(&kwargs))?;
+    Ok(array.unbind())
 }
 
 impl BodyResult {

@@ -1,6 +1,10 @@
 """Bad input raises an exception with the command line's message; nothing crashes the
 interpreter."""
 
+import math
+from decimal import Decimal
+from fractions import Fraction
+
 import pytest
 
 import internodes
@@ -52,7 +56,8 @@ def test_a_missing_case_file_names_it():
       "contact": {"bodies": ["disc", "block"], "surfaces": ["a", "b"], "load_steps": []}},
      "load_steps"),
     ({"body": [{"name": "disc", "youngs_modulus": 1.0, "poisson_ratio": 0.3}], "mesh": object()},
-     "not JSON serializable|expected str"),
+     r"case 'study' \(from a dict\): mesh: a value of type object \(<object object at .*>\) is "
+     "not a case value"),
 ], ids=["no body", "null modulus", "rtol", "empty load steps", "an object for a path"])
 def test_a_bad_dict_raises_input_error(table, match):
     with pytest.raises(internodes.InputError, match=match):
@@ -172,8 +177,74 @@ def test_numpy_scalars_and_arrays_are_numbers():
 ], ids=["E = 0", "E < 0", "nu = 0.5", "nu = -1"])
 def test_a_bad_material_is_refused_by_from_dict(material, match):
     np = pytest.importorskip("numpy")
-    with pytest.raises(internodes.InputError, match=f"case file study: body 'disc': {match}"):
+    with pytest.raises(internodes.InputError,
+                       match=f"case 'study' \\(from a dict\\): body 'disc': {match}"):
         internodes.Case.from_dict(disc_dict(**material), name="study")
     # NumPy values are checked alike.
     with pytest.raises(internodes.InputError, match=match):
         internodes.Case.from_dict(disc_dict(**{k: np.float64(v) for k, v in material.items()}))
+
+
+@pytest.mark.parametrize("value, says", [
+    (math.nan, "NaN"), (math.inf, "inf"), (-math.inf, "-inf"), (Decimal("NaN"), "NaN"),
+    (Decimal("Infinity"), "Decimal\\('Infinity'\\)"), (Fraction(10**400), "Fraction"),
+], ids=["nan", "inf", "-inf", "Decimal nan", "Decimal inf", "a Fraction beyond floats"])
+def test_nan_and_inf_in_a_dict_name_the_key(value, says):
+    table = disc_dict(uy=value)
+    with pytest.raises(internodes.InputError,
+                       match=rf"^case 'study' \(from a dict\): body\[0\]\.dirichlet\[0\]\.uy: "
+                             rf"{says}.* is not a number a case can hold"):
+        internodes.Case.from_dict(table, name="study")
+    table = disc_dict()
+    table["contact"]["friction_coefficient"] = value
+    with pytest.raises(internodes.InputError, match=r"contact\.friction_coefficient: "):
+        internodes.Case.from_dict(table)
+    np = pytest.importorskip("numpy")
+    with pytest.raises(internodes.InputError, match=r"contact\.load_steps\[1\]: NaN"):
+        internodes.Case.from_dict(disc_dict(load_steps=np.array([0.5, np.nan])))
+
+
+@pytest.mark.parametrize("fault, match", [
+    ("friction_coefficient = nan", r"\[contact\]: friction_coefficient must be a finite number > 0, got NaN"),
+    ("load_steps = [0.5, inf]", "load_steps"),
+], ids=["nan", "inf"])
+def test_nan_and_inf_in_a_case_file_name_the_key(tmp_path, fault, match):
+    case_file = hertz_2d_case(tmp_path, MESH, formulation="coulomb")
+    text = case_file.read_text().replace("[contact]\n", f"[contact]\n{fault}\n")
+    if "friction" not in fault:
+        text = text.replace('formulation = "coulomb"\n', "")
+    case_file.write_text(text)
+    # Refused when the case is read or, for the pair's keys, when its contact is set up.
+    with pytest.raises(internodes.InputError, match=f"case file {case_file}: .*{match}"):
+        internodes.solve(internodes.Case.from_toml(case_file))
+
+
+def test_fractions_and_decimals_are_the_nearest_floats():
+    mesh = internodes.Mesh.from_msh(MESH)
+    floats = internodes.solve(internodes.Case.from_dict(disc_dict(load_steps=[0.5, 1.0])), mesh=mesh)
+    exact = internodes.Case.from_dict(disc_dict(youngs_modulus=Decimal("1000"),
+                                                poisson_ratio=Fraction(3, 10),
+                                                uy=Decimal("-0.02"),
+                                                load_steps=[Fraction(1, 2), Decimal(1)]))
+    assert exact.load_steps == [0.5, 1.0]
+    assert (internodes.solve(exact, mesh=mesh).summary["contact"]["force_primary"]
+            == floats.summary["contact"]["force_primary"])
+
+
+def test_a_case_from_a_dict_is_not_called_a_case_file():
+    pickle = pytest.importorskip("pickle")
+    bad = {"body": [{"name": "ball", "youngs_modulus": 1.0, "poisson_ratio": 0.3}]}
+    with pytest.raises(internodes.InputError) as raised:
+        internodes.solve(internodes.Case.from_dict(bad, name="sweep"),
+                         mesh=internodes.Mesh.from_msh(MESH))
+    message = str(raised.value)
+    assert message.startswith("case 'sweep' (from a dict): ") and "case file" not in message
+    # A pickled case is still a dict's.
+    case = pickle.loads(pickle.dumps(internodes.Case.from_dict(bad, name="sweep")))
+    with pytest.raises(internodes.InputError, match=r"^case 'sweep' \(from a dict\): body 'ball'"):
+        internodes.solve(case, mesh=internodes.Mesh.from_msh(MESH))
+    with pytest.raises(internodes.InputError, match=r"^case 'case' \(from a dict\): body 'disc': Young's modulus"):
+        internodes.Case.from_dict(disc_dict(youngs_modulus=-1.0))
+    # A case file keeps its name.
+    with pytest.raises(internodes.InputError, match="^cannot read case file"):
+        internodes.Case.from_toml("nowhere.toml")

@@ -1,5 +1,7 @@
 """The module runs the library's solve: its results equal the command line's, bit for bit."""
 
+import re
+
 import h5py
 import numpy as np
 import pytest
@@ -51,6 +53,23 @@ def test_the_arrays_are_the_files_fields(tmp_path):
     case = internodes.Case.from_toml(REPO / "geo" / "half_disc_on_block.toml")
     result = internodes.solve(case)
     result.write(tmp_path)
+    # Earlier results are replaced only on request, the folder named; other files stay.
+    (tmp_path / "notes.txt").write_text("mine")
+    written = (tmp_path / "summary.json").stat().st_mtime_ns
+    with pytest.raises(FileExistsError,
+                       match=rf"^{re.escape(str(tmp_path))} holds results already \(solution.xdmf, solution.h5, "
+                             r"summary.json, force_displacement.csv, force_displacement.png, "
+                             r"mesh.msh\): pass overwrite=True to replace them$"):
+        result.write(tmp_path)
+    assert (tmp_path / "summary.json").stat().st_mtime_ns == written
+    assert result.write(tmp_path, overwrite=True) == tmp_path
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+    # A folder of other files only is written into.
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    result.write(other)
+    assert (other / "summary.json").is_file() and (other / "notes.txt").read_text() == "mine"
     files = datasets(tmp_path / "solution.h5")
     disc, block = result.bodies["disc"], result.bodies["block"]
     n = disc.displacement.shape[0]

@@ -122,6 +122,10 @@ pub struct ContactRun<'m> {
     pub solutions: Vec<ContactSolution>,
     /// Each pair's records, one per load step.
     pub steps: Vec<Vec<StepRecord>>,
+    /// Each load step's answers before the last one (indexed by step, then pair), with
+    /// `SolverSettings::keep_step_fields`; empty without it. Their status and certificate are
+    /// the loop's: the checks made after the loop are in the step records only.
+    pub earlier_solutions: Vec<Vec<ContactSolution>>,
     /// Seconds of each set-up and load step, named in order (the checking solves prefixed).
     pub timings: Vec<(String, f64)>,
 }
@@ -182,11 +186,14 @@ pub fn solve_contact_steps<'m>(
         timings: Vec::new(),
     };
     // 1. The chosen primaries.
-    let (solutions, steps) = solve_load_steps(&problems, solver, load_path, "", &mut log)?;
+    let keep = solver.keep_step_fields;
+    let (solutions, steps, earlier) =
+        solve_load_steps(&problems, solver, load_path, keep, "", &mut log)?;
     let mut run = Answer {
         problems,
         solutions,
         steps,
+        earlier,
     };
     // 2. The other primary of each pair where auto's choice between similar bodies did not
     //    settle.
@@ -237,15 +244,18 @@ pub fn solve_contact_steps<'m>(
         problems: run.problems,
         solutions: run.solutions,
         steps: run.steps,
+        earlier_solutions: run.earlier,
         timings: log.timings,
     })
 }
 
-/// The pairs, their answers at the last load step and their step records, of one solve.
+/// The pairs, their answers at the last load step and their step records, of one solve, and
+/// the answers of the steps before the last when they are kept ([`ContactRun::earlier_solutions`]).
 struct Answer<'m> {
     problems: Vec<ContactProblem<'m>>,
     solutions: Vec<ContactSolution>,
     steps: Vec<Vec<StepRecord>>,
+    earlier: Vec<Vec<ContactSolution>>,
 }
 
 /// Says which errors the accuracy report of `solution` could not estimate, and why.
@@ -284,8 +294,9 @@ fn retry_with_other_primary<'m>(
         ));
         others[p] = other;
     }
-    let retry = solve_load_steps(&others, solver, load_path, "other primary: ", log);
-    let retry = retry.map(|(solutions, steps)| {
+    let keep = solver.keep_step_fields;
+    let retry = solve_load_steps(&others, solver, load_path, keep, "other primary: ", log);
+    let retry = retry.map(|(solutions, steps, earlier)| {
         let solutions: Vec<ContactSolution> = (solutions.into_iter().enumerate())
             .map(|(p, second)| match retried.contains(&p) {
                 true => {
@@ -295,16 +306,16 @@ fn retry_with_other_primary<'m>(
                 false => second,
             })
             .collect();
-        (solutions, steps)
+        (solutions, steps, earlier)
     });
-    let keep_second = retry.as_ref().is_ok_and(|(second, _)| {
+    let keep_second = retry.as_ref().is_ok_and(|(second, _, _)| {
         (0..second.len()).all(|p| match retried.contains(&p) {
             true => second[p].is_trusted(),
             false => !first.solutions[p].is_trusted() || second[p].is_trusted(),
         })
     });
     match retry {
-        Ok((solutions, steps)) if keep_second => {
+        Ok((solutions, steps, earlier)) if keep_second => {
             for &p in retried {
                 let (first_name, other_name) = (
                     &first.problems[p].primary.body.name,
@@ -321,13 +332,14 @@ fn retry_with_other_primary<'m>(
                 problems: others,
                 solutions,
                 steps,
+                earlier,
             }
         }
         retry => {
             let mut problems = first.problems.clone();
             for &p in retried {
                 let second_ended = match &retry {
-                    Ok((second, _)) => second[p].ending(),
+                    Ok((second, _, _)) => second[p].ending(),
                     Err(e) => format!("with an error ({e})"),
                 };
                 let reason = format!(
@@ -418,7 +430,8 @@ fn check_against(
         [with] => format!("check with {with}: "),
         _ => "check with the other discretizations: ".to_string(),
     };
-    let solved = solve_load_steps(&other.problems, solver, load_path, &label, log);
+    // A check's answers are compared, not kept: its earlier steps' fields are not either.
+    let solved = solve_load_steps(&other.problems, solver, load_path, false, &label, log);
     for (k, &p) in due.iter().enumerate() {
         let problem = &run.problems[p];
         let reference_is_better = match alternative {
@@ -433,7 +446,7 @@ fn check_against(
         };
         let tolerance = problem.settings.accuracy_tolerance / per_distance;
         let (reference, other_steps) = match &solved {
-            Ok((checks, other_steps))
+            Ok((checks, other_steps, _))
                 if checks[p].status == ContactStatus::Converged && checks[p].is_trusted() =>
             {
                 let check = &checks[p];
@@ -442,7 +455,7 @@ fn check_against(
                     &other_steps[p][..],
                 )
             }
-            Ok((checks, other_steps)) => (Err(checks[p].ending()), &other_steps[p][..]),
+            Ok((checks, other_steps, _)) => (Err(checks[p].ending()), &other_steps[p][..]),
             Err(e) => (Err(format!("with an error ({e})")), &[][..]),
         };
         let with = &other.with[k];
@@ -554,15 +567,24 @@ impl<'m> OtherSolve<'m> {
 /// The set-up (assembly, factorizations, interpolation) once, then one active-set loop per
 /// load step, each starting from the previous active sets; stops at the first step whose loop
 /// does not settle (`not-solved` steps go on). `label` prefixes the timing names. Each pair's
-/// answer at the last step, and its records.
+/// answer at the last step, and its records; with `keep`, the answers of the steps before the
+/// last (by step, then pair), else nothing.
 #[allow(clippy::type_complexity)]
 fn solve_load_steps(
     problems: &[ContactProblem],
     solver: &SolverSettings,
     load_path: &[StepFactors],
+    keep: bool,
     label: &str,
     log: &mut Log,
-) -> Result<(Vec<ContactSolution>, Vec<Vec<StepRecord>>), ContactError> {
+) -> Result<
+    (
+        Vec<ContactSolution>,
+        Vec<Vec<StepRecord>>,
+        Vec<Vec<ContactSolution>>,
+    ),
+    ContactError,
+> {
     let dim = problems[0].primary_surface.dim;
     let phase = Instant::now();
     let mut contact_solver = ContactSolver::new(problems, solver)?;
@@ -578,6 +600,7 @@ fn solve_load_steps(
     }
     let mut steps = vec![Vec::new(); problems.len()];
     let mut last: Option<Vec<ContactSolution>> = None;
+    let mut earlier = Vec::new();
     for (k, factors) in load_path.iter().enumerate() {
         solver.cancel.check()?;
         if load_path.len() > 1 {
@@ -643,13 +666,19 @@ fn solve_load_steps(
         // is not.
         let stop = (solutions.iter())
             .any(|s| !s.status.is_solution() && s.status != ContactStatus::NotSolved);
-        last = Some(solutions);
+        // The step before is moved, not copied: keeping it costs its memory only.
+        if let Some(before) = last.replace(solutions)
+            && keep
+        {
+            earlier.push(before);
+        }
         if stop {
             log.say("stopping the load steps: this step's active set did not settle");
             break;
         }
     }
-    Ok((last.expect("solve_contact checks the load factors"), steps))
+    let last = last.expect("solve_contact checks the load factors");
+    Ok((last, steps, earlier))
 }
 
 /// A step record's force (`dim` components) as a 3-vector.

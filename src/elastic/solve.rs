@@ -51,6 +51,12 @@ pub struct SolverSettings {
     /// cancels; the Python module sets it on Ctrl-C).
     #[serde(skip)]
     pub cancel: Cancel,
+    /// Keep every load step's answer, not only the last one's
+    /// (`crate::contact::ContactRun::earlier_solutions`): each step's fields then cost the
+    /// memory of the last step's (default: false; the command line writes the last step's
+    /// fields only, the Python module keeps every step's).
+    #[serde(skip)]
+    pub keep_step_fields: bool,
 }
 
 impl SolverSettings {
@@ -76,6 +82,7 @@ impl Default for SolverSettings {
             verbose: true,
             progress_line: true,
             cancel: Cancel::default(),
+            keep_step_fields: false,
         }
     }
 }

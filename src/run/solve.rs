@@ -56,6 +56,10 @@ pub struct CaseSolution {
     pub bodies: Vec<SolvedBody>,
     /// Each contact pair's outcome, in the case file's order (empty without contact).
     pub contacts: Vec<SolvedContact>,
+    /// With `case.solver.keep_step_fields`, the bodies in contact at each load step before the
+    /// last (`bodies` holds the last step's, and the bodies in no contact, which are solved
+    /// once at their full load); empty without it.
+    pub earlier_steps: Vec<Vec<SolvedBody>>,
     pub timings: Timings,
     /// Every rank's peak memory (MB) in a distributed run, in rank order (empty otherwise).
     pub rank_peak_memory_mb: Vec<f64>,
@@ -100,11 +104,13 @@ pub fn solve_case_on(
     }
     let mut bodies = Vec::new();
     let mut contacts = Vec::new();
+    let mut earlier_steps = Vec::new();
     let problems = case.contact_problems(mesh)?;
     if !problems.is_empty() {
-        let (solved, in_contact) = solve_contact_pairs(case, problems, &mut timings)?;
+        let (solved, in_contact, earlier) = solve_contact_pairs(case, problems, &mut timings)?;
         contacts = solved;
         bodies.extend(in_contact);
+        earlier_steps = earlier;
     }
     for spec in &case.bodies {
         if !bodies.iter().any(|s| s.name == spec.name) {
@@ -115,19 +121,21 @@ pub fn solve_case_on(
     Ok(CaseSolution {
         bodies,
         contacts,
+        earlier_steps,
         timings,
         rank_peak_memory_mb: Vec::new(),
     })
 }
 
 /// The contact solve of the case's pairs ([`solve_contact_steps`]: its load steps, and for a single
-/// pair the other primary's solve when the first choice may be wrong), and the solution of
-/// each body in contact.
+/// pair the other primary's solve when the first choice may be wrong), the solution of each
+/// body in contact, and with `keep_step_fields` those of the steps before the last.
+#[allow(clippy::type_complexity)]
 fn solve_contact_pairs(
     case: &Case,
     problems: Vec<ContactProblem>,
     timings: &mut Timings,
-) -> Result<(Vec<SolvedContact>, Vec<SolvedBody>), RunError> {
+) -> Result<(Vec<SolvedContact>, Vec<SolvedBody>, Vec<Vec<SolvedBody>>), RunError> {
     for problem in &problems {
         log::info!(
             "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
@@ -157,15 +165,16 @@ fn solve_contact_pairs(
         problems,
         solutions,
         steps,
+        earlier_solutions,
         timings: contact_timings,
     } = run;
     timings.phases.extend(contact_timings);
     let mut contacts = Vec::new();
-    let mut bodies: Vec<SolvedBody> = Vec::new();
-    for (p, ((problem, solution), steps)) in problems.iter().zip(solutions).zip(steps).enumerate() {
+    for (p, ((problem, solution), steps)) in problems.iter().zip(&solutions).zip(steps).enumerate()
+    {
         let name = case.contacts[p].name.clone();
         contacts.push(SolvedContact {
-            summary: summarize_contact(name.clone(), problem, &solution, steps),
+            summary: summarize_contact(name.clone(), problem, solution, steps),
             plot_title: format!(
                 "{}: contact of '{}' (primary) and '{}'",
                 case_name(case),
@@ -174,6 +183,27 @@ fn solve_contact_pairs(
             ),
             imposed_approach: imposed_approach(problem),
         });
+    }
+    let earlier = (earlier_solutions.into_iter())
+        .map(|step| bodies_in_contact(case, &problems, step))
+        .collect();
+    Ok((
+        contacts,
+        bodies_in_contact(case, &problems, solutions),
+        earlier,
+    ))
+}
+
+/// Each body of the pairs `problems` with its solution in `solutions` (one per pair) and its
+/// contact surface in each pair.
+fn bodies_in_contact(
+    case: &Case,
+    problems: &[ContactProblem],
+    solutions: Vec<ContactSolution>,
+) -> Vec<SolvedBody> {
+    let mut bodies: Vec<SolvedBody> = Vec::new();
+    for (p, (problem, solution)) in problems.iter().zip(solutions).enumerate() {
+        let name = &case.contacts[p].name;
         let sides = [
             (&problem.primary, solution.primary, solution.primary_fields),
             (
@@ -198,7 +228,7 @@ fn solve_contact_pairs(
             }
         }
     }
-    Ok((contacts, bodies))
+    bodies
 }
 
 /// One body that is in no contact, solved alone.
