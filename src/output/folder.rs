@@ -6,6 +6,9 @@
 //! folder, and moves them into place only when every body has been solved and every file
 //! written ([`ResultFolder::commit`]). A run that fails removes its staging folder and writes
 //! [`FAILURE_MARK`] with the error ([`ResultFolder::fail`]); the next successful run removes it.
+//! A [`ResultFolder`] dropped uncommitted removes its staging folder whatever the way out (an
+//! error passed up with `?`, a panic, a cancelled run), so only a process killed outright leaves
+//! one behind.
 //! The staging folder's name carries the process id and a counter, so concurrent runs never
 //! write into each other's files, and a lock file makes each commit (or failure mark) whole:
 //! the run that finishes last owns the folder, with all of its files.
@@ -399,6 +402,15 @@ fn not_found_is_fine(path: &Path, result: std::io::Result<()>) -> Result<(), Out
     }
 }
 
+/// The staging folder goes with the [`ResultFolder`]: committed or failed, it is gone already;
+/// on any other way out it would be left holding a partial result set that nothing removes.
+/// Best effort: a drop has no one to report to.
+impl Drop for ResultFolder {
+    fn drop(&mut self) {
+        let _ = remove_staging(&self.staging);
+    }
+}
+
 /// The commit lock of an output folder, released when dropped.
 #[derive(Debug)]
 struct CommitLock(PathBuf);
@@ -469,7 +481,18 @@ impl Drop for CommitLock {
 
 #[cfg(test)]
 mod tests {
-    use super::{CommitLock, Duration, OutputError, utc};
+    use super::{CommitLock, Duration, OutputError, ResultFolder, utc};
+
+    #[test]
+    fn a_result_folder_dropped_uncommitted_removes_its_staging_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let results = ResultFolder::create(dir.path(), "a test", &[], false).unwrap();
+        let staging = results.staging().to_owned();
+        std::fs::write(staging.join("summary.json"), "{}").unwrap();
+        drop(results);
+        assert!(!staging.exists());
+        assert!(!dir.path().join("summary.json").exists());
+    }
 
     #[test]
     fn a_lock_held_past_the_wait_is_an_error_naming_it_and_its_removal() {

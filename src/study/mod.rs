@@ -93,6 +93,8 @@ pub struct StudyOptions {
     pub output: Option<PathBuf>,
     /// Progress messages off (errors and warnings only).
     pub quiet: bool,
+    /// Stops the level being solved, and with it the study ([`RunOptions::cancel`]).
+    pub cancel: crate::cancel::Cancel,
 }
 
 #[derive(Debug, Error)]
@@ -233,6 +235,7 @@ fn solve_level(
         output: Some(folder.join(&name)),
         export_matrices: false,
         quiet: options.quiet,
+        cancel: options.cancel.clone(),
     };
     let command = format!(
         "internodes study {} ({} = {value})",
