@@ -199,6 +199,35 @@ pub fn mark_failed_folder(
     }
 }
 
+/// Whether everything in `dir` is what runs write into an output folder: the result files
+/// (`matrices/` with `.mtx` files only), the generated mesh, the failure mark, staging folders
+/// and the commit lock. Such a folder holds nothing of the user's, and can go whole.
+pub fn holds_only_run_outputs(dir: &Path) -> std::io::Result<bool> {
+    let paths = |dir: &Path| -> std::io::Result<Vec<PathBuf>> {
+        std::fs::read_dir(dir)?
+            .map(|e| e.map(|e| e.path()))
+            .collect()
+    };
+    for entry in paths(dir)? {
+        let name = entry.file_name().unwrap_or_default().to_string_lossy();
+        let ours = if name.starts_with(STAGING_PREFIX) {
+            true
+        } else if entry.is_dir() {
+            name == MATRICES
+                && (paths(&entry)?.iter())
+                    .all(|f| f.extension().is_some_and(|e| e == "mtx") && f.is_file())
+        } else {
+            name != MATRICES
+                && (RESULT_FILES.contains(&name.as_ref())
+                    || [GENERATED_MESH, FAILURE_MARK, COMMIT_LOCK].contains(&name.as_ref()))
+        };
+        if !ours {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
 /// Refuses an output folder `dir` that holds one of the run's `inputs` under a name the run
 /// removes or replaces: a result file, the failure mark, an `.mtx` file in `matrices/`, or
 /// `mesh.msh` when the run generates the mesh. Paths are compared after resolving symbolic

@@ -1,10 +1,57 @@
 //! The study's files: `study.json` (everything), `study.csv` (one row per level), `study.md`
 //! (the two tables a publication reports) and `study.png` ([`super::plot`]).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::gci::{Estimate, Flag, SAFETY_FACTOR};
 use super::{QUANTITIES, Study, StudyError};
+use crate::output::holds_only_run_outputs;
+
+/// The files a study writes into its folder, beside its levels' folders.
+const STUDY_FILES: [&str; 4] = ["study.json", "study.csv", "study.md", "study.png"];
+
+/// Removes what an earlier study left in `dir` before a new one starts, as `internodes solve`
+/// removes the results of earlier runs from its output folder: the study's files, and every
+/// level folder, a folder named `NAME_VALUE` (a level's name for any parameter, as an earlier
+/// study may have varied another) that holds nothing but what a run writes. Without this a
+/// study of fewer levels, or of another parameter, left the earlier levels beside its own, and
+/// a study that failed left the earlier `study.json` describing them. A folder holding anything
+/// else is the user's and stays. Returns the level folders removed, for the caller to say so.
+pub fn remove_earlier_study(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    let io = |path: &Path| {
+        let path = path.to_owned();
+        move |source| StudyError::Io { path, source }
+    };
+    if !dir.is_dir() {
+        return Ok(Vec::new());
+    }
+    for name in STUDY_FILES {
+        let path = dir.join(name);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound && !path.is_dir() => {
+                return Err(io(&path)(e));
+            }
+            _ => {}
+        }
+    }
+    let mut removed = Vec::new();
+    let entries = std::fs::read_dir(dir).map_err(io(dir))?;
+    for entry in entries {
+        let path = entry.map_err(io(dir))?.path();
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let level_name = name.rsplit_once('_').is_some_and(|(parameter, value)| {
+            !parameter.is_empty() && value.parse::<f64>().is_ok()
+        });
+        let ours =
+            level_name && path.is_dir() && holds_only_run_outputs(&path).map_err(io(&path))?;
+        if ours {
+            std::fs::remove_dir_all(&path).map_err(io(&path))?;
+            removed.push(path);
+        }
+    }
+    removed.sort();
+    Ok(removed)
+}
 
 /// Writes the four files into the study's folder. The plot only pictures the tables: a plot
 /// that cannot be drawn (no font) is a warning.

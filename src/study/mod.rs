@@ -171,7 +171,8 @@ pub struct Study {
 
 /// Solves `case` at every value of `spec` into `<output>/<parameter>_<value>/`, estimates each
 /// quantity's discretization error and writes the study's files into the output folder.
-/// Every value's case is checked before anything is solved.
+/// Every value's case is checked before anything is solved, and what an earlier study left in
+/// the folder removed ([`files::remove_earlier_study`]).
 pub fn run_study(
     case: &Case,
     spec: &StudySpec,
@@ -207,6 +208,12 @@ pub fn run_study(
                     .to_string(),
             )
         })?;
+    for removed in files::remove_earlier_study(&folder)? {
+        log::info!(
+            "study: removed {}, a level of an earlier study (only results of a run in it)",
+            removed.display()
+        );
+    }
     let mut levels = Vec::new();
     for (level_case, &value) in cases.into_iter().zip(&spec.values) {
         levels.push(solve_level(level_case, spec, value, &folder, options)?);
