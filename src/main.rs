@@ -5,8 +5,11 @@ use std::error::Error;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicI32, Ordering};
 
 use clap::{Parser, Subcommand};
+use internodes::cancel::Cancel;
 use internodes::case::Case;
 use internodes::mesh::{MeshSummary, read_msh};
 use internodes::output::{Verdict, unsaid_causes};
@@ -112,6 +115,12 @@ fn main() -> ExitCode {
     } else {
         log::LevelFilter::Info
     });
+    // Under MPI the ranks would stop at different safe points and wait for each other: the
+    // launcher ends them as it ends any program.
+    let cancel = match ranks.size {
+        1 => cancel_on_interrupt(),
+        _ => Cancel::new(),
+    };
     let result: Result<u8, Box<dyn Error>> = match cli.command {
         Command::Solve {
             case,
@@ -124,6 +133,7 @@ fn main() -> ExitCode {
                 output,
                 export_matrices,
                 quiet: quiet || ranks.rank != 0,
+                cancel,
             },
         )
         .map_err(Into::into)
@@ -151,7 +161,15 @@ fn main() -> ExitCode {
             parameter,
             output,
             quiet,
-        } => study(&case, &parameter, &StudyOptions { output, quiet }),
+        } => study(
+            &case,
+            &parameter,
+            &StudyOptions {
+                output,
+                quiet,
+                cancel,
+            },
+        ),
         Command::Info { mesh } => read_msh(&mesh)
             .map_err(Into::into)
             .and_then(|m| match ranks.rank {
@@ -191,8 +209,50 @@ fn main() -> ExitCode {
             }
             // A launcher's single rank finalizes MPI all the same.
             let _ = parallel::finish();
-            ExitCode::FAILURE
+            // Stopped by a signal: the shell's status for a process it ended (130 for Ctrl-C).
+            match INTERRUPTED_BY.load(Ordering::Relaxed) {
+                0 => ExitCode::FAILURE,
+                signal => ExitCode::from(128 + signal as u8),
+            }
         }
+    }
+}
+
+/// The token [`on_interrupt`] cancels.
+static INTERRUPT_TOKEN: OnceLock<Cancel> = OnceLock::new();
+
+/// The signal that cancelled the run, 0 before one came.
+static INTERRUPTED_BY: AtomicI32 = AtomicI32::new(0);
+
+/// A token that the first SIGINT (Ctrl-C) or SIGTERM cancels. The run then stops at its next
+/// safe point and fails as an error does, so its output folder keeps no staging folder and
+/// says it failed; being killed outright would leave the staging folder behind. A second
+/// signal ends the process at once, for a run that takes long to reach a safe point.
+fn cancel_on_interrupt() -> Cancel {
+    let token = INTERRUPT_TOKEN.get_or_init(Cancel::new).clone();
+    #[cfg(unix)]
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: the handler only stores to atomics and calls `signal`, which is
+        // async-signal-safe.
+        unsafe {
+            libc::signal(
+                signal,
+                on_interrupt as extern "C" fn(libc::c_int) as libc::sighandler_t,
+            );
+        }
+    }
+    token
+}
+
+#[cfg(unix)]
+extern "C" fn on_interrupt(signal: libc::c_int) {
+    INTERRUPTED_BY.store(signal, Ordering::Relaxed);
+    if let Some(token) = INTERRUPT_TOKEN.get() {
+        token.cancel();
+    }
+    // SAFETY: `signal` is async-signal-safe; the default disposition ends the process.
+    unsafe {
+        libc::signal(signal, libc::SIG_DFL);
     }
 }
 

@@ -29,6 +29,32 @@ fn bodies_pulled_apart_end_with_no_contact() {
 }
 
 #[test]
+fn bodies_apart_agree_with_the_other_primary_and_exit_0() {
+    // No contact is the single run's right answer here (exit 0); the other primary finding no
+    // contact either is agreement, not a missing answer to compare with.
+    let case = two_blocks(2, "frictionless")
+        .with_support("upper", "upper_top", |d| d.uy(0.01).ux(0.0))
+        .with_support("lower", "lower_base", |d| d.ux(0.0))
+        .contact_setting("check_other_primary", true);
+    let (dir, path) = case.write();
+    let output = run_solve(&path);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let contact = &summary["contact"];
+    assert_eq!(contact["status"], "no-contact");
+    let indicators = contact["accuracy"]["indicators"].as_array().unwrap();
+    let agreement = (indicators.iter())
+        .find(|c| c["name"] == "primary agreement")
+        .expect("the other primary was solved");
+    assert_eq!(agreement["passed"], true, "{agreement}");
+    assert_eq!(agreement["value"], 0.0, "{agreement}");
+}
+
+#[test]
 fn surfaces_that_do_not_face_each_other_end_with_no_contact() {
     // The base of the lower block and the top of the upper one are two units apart.
     let case =

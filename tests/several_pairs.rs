@@ -399,6 +399,37 @@ fn a_floating_block_its_flat_contacts_cannot_hold_sideways_is_refused_by_name() 
 }
 
 #[test]
+fn the_open_pair_of_a_loop_of_three_agrees_with_its_other_primary() {
+    // A third pair closes the loop, the upper block on the lower one across the middle block:
+    // open, as a single run answers it (no contact). Every pair asks for the other primary;
+    // the open pair's other primary finds no contact either, which is agreement: exit 0.
+    let third = "[[contact]]\nbodies = [\"upper\", \"lower\"]\nsurfaces = [\"upper_contact\", \
+                 \"lower_contact\"]\ncheck_other_primary = true\n";
+    let looped = format!("{}\n{third}", pairs("check_other_primary = true"));
+    let (dir, path) = write_case(&pushed(&looped));
+    let output = run_solve(&path);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let pairs = summary["contacts"].as_array().unwrap();
+    let statuses: Vec<&str> = pairs
+        .iter()
+        .map(|c| c["status"].as_str().unwrap())
+        .collect();
+    assert_eq!(statuses, ["converged", "converged", "no-contact"]);
+    for (p, contact) in pairs.iter().enumerate() {
+        let indicators = contact["accuracy"]["indicators"].as_array().unwrap();
+        let agreement = (indicators.iter())
+            .find(|c| c["name"] == "primary agreement")
+            .unwrap_or_else(|| panic!("pair {p}: no primary agreement"));
+        assert_eq!(agreement["passed"], true, "pair {p}: {agreement}");
+    }
+}
+
+#[test]
 fn a_named_stiff_primary_and_check_other_primary_are_checked_in_their_own_pairs() {
     // Pair 1 names the stiffer middle block primary (auto would not): its force is checked
     // against the answer with the upper block as primary. Pair 2 asks for the same check.

@@ -116,6 +116,42 @@ fn two_levels_give_the_difference_and_say_there_is_no_order() {
 }
 
 #[test]
+fn a_study_over_an_earlier_one_removes_its_levels_and_nothing_of_the_users() {
+    let (dir, case) = coarse_half_disc().write();
+    let out = dir.path().join("study");
+    // An earlier study's level this one does not solve, killed while it wrote its results.
+    let stale = out.join("level_3");
+    std::fs::create_dir_all(stale.join(".internodes-partial-1-0")).unwrap();
+    for name in ["summary.json", "solution.h5", "mesh.msh"] {
+        std::fs::write(stale.join(name), "earlier").unwrap();
+    }
+    // A level folder holding a file of the user's, and a folder of the user's.
+    let annotated = out.join("level_4");
+    std::fs::create_dir_all(&annotated).unwrap();
+    std::fs::write(annotated.join("summary.json"), "earlier").unwrap();
+    std::fs::write(annotated.join("notes.txt"), "mine").unwrap();
+    std::fs::create_dir_all(out.join("notes")).unwrap();
+    std::fs::write(out.join("notes/level_5.txt"), "mine").unwrap();
+    std::fs::write(out.join("study.json"), "earlier").unwrap();
+
+    let run = study(&case, "level=-1,0", &out);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(!stale.exists(), "{stderr}");
+    assert!(
+        stderr.contains(&format!("removed {}", stale.display())),
+        "{stderr}"
+    );
+    assert!(annotated.join("notes.txt").is_file() && annotated.join("summary.json").is_file());
+    assert!(out.join("notes/level_5.txt").is_file());
+    let json = read_json(&out.join("study.json"));
+    let folders: Vec<&str> = (json["levels"].as_array().unwrap().iter())
+        .map(|l| l["folder"].as_str().unwrap())
+        .collect();
+    assert_eq!(folders, ["level_-1", "level_0"]);
+}
+
+#[test]
 fn a_parameter_the_geo_does_not_use_is_refused_with_its_parameters() {
     let (dir, case) = coarse_half_disc().write();
     let out = dir.path().join("typo");

@@ -89,6 +89,7 @@ fn run_error(error: RunError) -> PyErr {
             SolveError::new_err(text)
         }
         RunError::Output(_) => WriteError::new_err(text),
+        RunError::Cancelled(_) => Cancelled::new_err(text),
     }
 }
 
@@ -1163,6 +1164,7 @@ fn study(
     let options = StudyOptions {
         output,
         quiet: false,
+        cancel: Default::default(),
     };
     let study = py
         .detach(|| {
@@ -1188,6 +1190,7 @@ fn study_error(error: StudyError) -> PyErr {
                 RunError::Solve { .. } | RunError::Contact { .. } | RunError::Parallel(_) => {
                     SolveError::new_err(text)
                 }
+                RunError::Cancelled(_) => Cancelled::new_err(text),
                 RunError::Output(_) => WriteError::new_err(text),
             }
         }

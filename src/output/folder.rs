@@ -6,6 +6,9 @@
 //! folder, and moves them into place only when every body has been solved and every file
 //! written ([`ResultFolder::commit`]). A run that fails removes its staging folder and writes
 //! [`FAILURE_MARK`] with the error ([`ResultFolder::fail`]); the next successful run removes it.
+//! A [`ResultFolder`] dropped uncommitted removes its staging folder whatever the way out (an
+//! error passed up with `?`, a panic, a cancelled run), so only a process killed outright leaves
+//! one behind.
 //! The staging folder's name carries the process id and a counter, so concurrent runs never
 //! write into each other's files, and a lock file makes each commit (or failure mark) whole:
 //! the run that finishes last owns the folder, with all of its files.
@@ -194,6 +197,35 @@ pub fn mark_failed_folder(
     if let Err(e) = marked {
         log::warn!("{e}");
     }
+}
+
+/// Whether everything in `dir` is what runs write into an output folder: the result files
+/// (`matrices/` with `.mtx` files only), the generated mesh, the failure mark, staging folders
+/// and the commit lock. Such a folder holds nothing of the user's, and can go whole.
+pub fn holds_only_run_outputs(dir: &Path) -> std::io::Result<bool> {
+    let paths = |dir: &Path| -> std::io::Result<Vec<PathBuf>> {
+        std::fs::read_dir(dir)?
+            .map(|e| e.map(|e| e.path()))
+            .collect()
+    };
+    for entry in paths(dir)? {
+        let name = entry.file_name().unwrap_or_default().to_string_lossy();
+        let ours = if name.starts_with(STAGING_PREFIX) {
+            true
+        } else if entry.is_dir() {
+            name == MATRICES
+                && (paths(&entry)?.iter())
+                    .all(|f| f.extension().is_some_and(|e| e == "mtx") && f.is_file())
+        } else {
+            name != MATRICES
+                && (RESULT_FILES.contains(&name.as_ref())
+                    || [GENERATED_MESH, FAILURE_MARK, COMMIT_LOCK].contains(&name.as_ref()))
+        };
+        if !ours {
+            return Ok(false);
+        }
+    }
+    Ok(true)
 }
 
 /// Refuses an output folder `dir` that holds one of the run's `inputs` under a name the run
@@ -399,6 +431,15 @@ fn not_found_is_fine(path: &Path, result: std::io::Result<()>) -> Result<(), Out
     }
 }
 
+/// The staging folder goes with the [`ResultFolder`]: committed or failed, it is gone already;
+/// on any other way out it would be left holding a partial result set that nothing removes.
+/// Best effort: a drop has no one to report to.
+impl Drop for ResultFolder {
+    fn drop(&mut self) {
+        let _ = remove_staging(&self.staging);
+    }
+}
+
 /// The commit lock of an output folder, released when dropped.
 #[derive(Debug)]
 struct CommitLock(PathBuf);
@@ -469,7 +510,18 @@ impl Drop for CommitLock {
 
 #[cfg(test)]
 mod tests {
-    use super::{CommitLock, Duration, OutputError, utc};
+    use super::{CommitLock, Duration, OutputError, ResultFolder, utc};
+
+    #[test]
+    fn a_result_folder_dropped_uncommitted_removes_its_staging_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let results = ResultFolder::create(dir.path(), "a test", &[], false).unwrap();
+        let staging = results.staging().to_owned();
+        std::fs::write(staging.join("summary.json"), "{}").unwrap();
+        drop(results);
+        assert!(!staging.exists());
+        assert!(!dir.path().join("summary.json").exists());
+    }
 
     #[test]
     fn a_lock_held_past_the_wait_is_an_error_naming_it_and_its_removal() {

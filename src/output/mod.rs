@@ -8,7 +8,8 @@ mod summary;
 mod xdmf;
 
 pub use folder::{
-    FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, mark_failed_folder, unsaid_causes,
+    FAILURE_MARK, GENERATED_MESH, RESULT_FILES, ResultFolder, holds_only_run_outputs,
+    mark_failed_folder, unsaid_causes,
 };
 pub use matrix_market::write_matrix_market;
 pub use plot::{PLOT_SIZE, PlotError, write_force_displacement_png};

@@ -17,6 +17,7 @@ use std::time::Instant;
 
 use thiserror::Error;
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::case::{Case, CaseError};
 use crate::contact::ContactError;
 use crate::contact::CoupledSolver;
@@ -28,12 +29,16 @@ use crate::output::{
 };
 use crate::parallel::{self, ParallelError};
 
-/// Command-line overrides of the case file.
+/// Command-line overrides of the case file, and the run's cancellation token.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
     pub output: Option<PathBuf>,
     pub export_matrices: bool,
     pub quiet: bool,
+    /// Stops the run (the command line cancels it on Ctrl-C): the solve at its next safe
+    /// point, and the run before it moves its results into place. The run then fails like any
+    /// other, its staging folder removed and the output folder marked.
+    pub cancel: Cancel,
 }
 
 #[derive(Debug, Error)]
@@ -48,6 +53,10 @@ pub enum RunError {
     Output(#[from] OutputError),
     #[error(transparent)]
     Parallel(ParallelError),
+    /// Cancelled between the solve and the commit (a solve cancelled in its contact loop is a
+    /// [`RunError::Contact`]).
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
 }
 
 impl RunError {
@@ -55,10 +64,11 @@ impl RunError {
     pub fn is_cancelled(&self) -> bool {
         matches!(
             self,
-            RunError::Contact {
-                source: ContactError::Cancelled(_),
-                ..
-            }
+            RunError::Cancelled(_)
+                | RunError::Contact {
+                    source: ContactError::Cancelled(_),
+                    ..
+                }
         )
     }
 }
@@ -140,6 +150,8 @@ pub fn solve_loaded_case(
         case.generates_mesh(),
     )?;
     let outcome = solve_into(case, options, &results).and_then(|run| {
+        // Results written after a Ctrl-C are not the ones asked for any more.
+        options.cancel.check()?;
         results.commit()?;
         Ok(run)
     });
@@ -245,6 +257,7 @@ fn solve_into(
 ) -> Result<(CaseSummary, Mesh, CaseSolution), RunError> {
     let mut timings = Timings::start();
     case.export_matrices |= options.export_matrices;
+    case.solver.cancel = options.cancel.clone();
     // The live progress line of long interface solves, on a terminal.
     case.solver.verbose = !options.quiet;
 

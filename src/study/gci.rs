@@ -4,9 +4,9 @@
 //! reporting of uncertainty due to discretization in CFD applications", J. Fluids Eng. 130,
 //! 078001, which allows refinement ratios that differ from one pair of meshes to the next.
 //!
-//! The meshes are numbered from the finest: `h1 < h2 < h3` are their spacings and `phi1`,
-//! `phi2`, `phi3` the quantity on them (only the three finest of a longer sequence are used).
-//! With
+//! The meshes are numbered from the finest: `h1 < h2 < h3 < ...` are their spacings and `phi1`,
+//! `phi2`, ... the quantity on them. Every triplet of consecutive meshes (`1-2-3`, `2-3-4`, ...)
+//! gives an estimate of its own; for the finest three, with
 //!
 //! ```text
 //! r21 = h2 / h1,   r32 = h3 / h2,   eps21 = phi2 - phi1,   eps32 = phi3 - phi2,
@@ -26,13 +26,13 @@
 //! e_a21      = |(phi1 - phi2) / phi1|                      approximate relative error
 //! e_ext21    = |(phi_ext - phi1) / phi_ext|                extrapolated relative error
 //! GCI_fine21 = Fs e_a21 / (r21^p - 1),   Fs = 1.25         fine-grid convergence index
-//! GCI_32     = Fs e_a32 / (r32^p - 1),   e_a32 = |(phi2 - phi3) / phi2|
 //! ```
 //!
-//! `GCI_fine21` is a relative uncertainty of `phi1`: the band `phi1 (1 +- GCI_fine21)` is meant to
-//! hold the exact value with about 95% confidence when the sequence is in its asymptotic range
-//! (Roache's safety factor 1.25 for three or more meshes, as ASME V&V 20 uses it). Whether it is
-//! in that range is judged by [`Flag`]s:
+//! and the same with the indices shifted for each coarser triplet. The finest triplet's is the
+//! estimate reported. `GCI_fine21` is a relative uncertainty of `phi1`: the band
+//! `phi1 (1 +- GCI_fine21)` is meant to hold the exact value with about 95% confidence when the
+//! sequence is in its asymptotic range (Roache's safety factor 1.25 for three or more meshes, as
+//! ASME V&V 20 uses it). Whether it is in that range is judged on every triplet by [`Flag`]s:
 //!
 //! - the sign `s`: `s < 0` is oscillatory convergence (the differences change sign);
 //! - divergence: `ln|eps32 / eps21| + q(p) < 0`, i.e. the order equation holds only with the
@@ -40,8 +40,13 @@
 //!   usual `|R| >= 1` on the convergence ratio `R = eps21 / eps32` (reported too), which alone
 //!   would misjudge unequal ratios: `phi = 2 + 0.7 h^1.7` on `h = 0.1, 0.23, 0.31` has `R = 1.15`;
 //! - `p` within [`ORDER_RANGE`];
-//! - Roache's ratio `GCI_32 / (r21^p GCI_fine21)` within [`GCI_RATIO_RANGE`] of 1: on a sequence
-//!   `phi = phi0 + C h^p` it is exactly `|phi1 / phi2|`.
+//!
+//! and across them: the triplets' orders within a factor [`ORDER_AGREEMENT`] of each other. A
+//! quantity is asymptotic only when no triplet is flagged and the orders agree: one triplet
+//! always yields some order, and only a second one can show that the same leading term governs
+//! the sequence. (Roache's ratio `GCI_32 / (r21^p GCI_fine21)` was checked here once; it equals
+//! `|phi1 / phi2|` on every triplet whose differences keep their sign, whatever the ratios, so
+//! it tested nothing about the range.)
 //!
 //! With two meshes only no order can be observed: the difference `phi1 - phi2` and `e_a21` are
 //! reported, with the flag [`Flag::TwoLevels`], and nothing else.
@@ -57,9 +62,14 @@ pub const SAFETY_FACTOR: f64 = 1.25;
 /// dominated by the leading error term.
 pub const ORDER_RANGE: (f64, f64) = (0.5, 3.0);
 
-/// Roache's asymptotic-range ratio `GCI_32 / (r21^p GCI_fine21)` outside this range flags the
-/// sequence.
-pub const GCI_RATIO_RANGE: (f64, f64) = (0.9, 1.1);
+/// The largest ratio between the orders of two triplets of one sequence that still agree. In
+/// the asymptotic range every triplet observes the same leading order, the higher terms'
+/// share shrinking with h. P1's two formal orders, 1 and 2, are a factor 2 apart: orders
+/// further apart than half of that on a log scale, `sqrt(2)`, could be one of each, and then no
+/// one leading term governs the sequence (an order 1.60 on the coarse triplet and 3.88 on the
+/// fine one is no order at all). Within it the triplets of the validation cases' force
+/// sequences agree.
+pub const ORDER_AGREEMENT: f64 = std::f64::consts::SQRT_2;
 
 /// Differences below this fraction of `|phi1|` are round-off: no order is computed from them.
 pub const ROUND_OFF: f64 = 1e-12;
@@ -86,8 +96,9 @@ pub enum Flag {
     NoOrder,
     /// `p` outside [`ORDER_RANGE`].
     OrderOutOfRange,
-    /// `GCI_32 / (r21^p GCI_fine21)` outside [`GCI_RATIO_RANGE`].
-    GciRatio,
+    /// The triplets' orders are more than [`ORDER_AGREEMENT`] apart (a quantity's flag, never
+    /// one triplet's).
+    OrdersDisagree,
 }
 
 impl Flag {
@@ -101,37 +112,56 @@ impl Flag {
             Flag::OscillatoryDivergence => "oscillatory divergence",
             Flag::NoOrder => "the iteration for p did not converge",
             Flag::OrderOutOfRange => "p outside [0.5, 3]",
-            Flag::GciRatio => "GCI ratio outside [0.9, 1.1]",
+            Flag::OrdersDisagree => "the triplets' orders differ by more than a factor 1.41",
         }
     }
 }
 
-/// One quantity's estimate from the finest two or three meshes (numbered from the finest).
+/// The estimate of three consecutive meshes, numbered from the finest of them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Triplet {
+    /// Their spacings `h1 < h2 < h3` (as in [`Estimate::h`]).
+    pub h: [f64; 3],
+    /// `R = eps21 / eps32`.
+    pub convergence_ratio: Option<f64>,
+    /// The observed order `p` and the iterations it took.
+    pub order: Option<f64>,
+    pub iterations: Option<usize>,
+    /// `phi_ext`, `e_ext21` and `GCI_fine21`.
+    pub extrapolated: Option<f64>,
+    pub extrapolated_error: Option<f64>,
+    pub gci_fine: Option<f64>,
+    /// Empty when the triplet passed every test of the asymptotic range.
+    pub flags: Vec<Flag>,
+}
+
+/// One quantity's estimate from its values on every mesh (numbered from the finest).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Estimate {
-    /// `phi1`, `phi2`, and `phi3` with three or more meshes.
+    /// `phi1`, `phi2`, ... of every mesh.
     pub phi: Vec<f64>,
-    /// `h1`, `h2`, and `h3` with three or more meshes.
+    /// `h1 < h2 < ...`.
     pub h: Vec<f64>,
-    /// `r21`, and `r32` with three or more meshes.
+    /// `r21`, `r32`, ...
     pub ratios: Vec<f64>,
     /// `phi1 - phi2`.
     pub difference: f64,
     /// `e_a21 = |(phi1 - phi2) / phi1|`.
     pub relative_difference: f64,
-    /// `R = eps21 / eps32` (three meshes).
+    /// The finest triplet's `R`, `p`, its iterations, `phi_ext`, `e_ext21` and `GCI_fine21`:
+    /// the estimate reported (also `triplets[0]`).
     pub convergence_ratio: Option<f64>,
-    /// The observed order `p` and the iterations it took.
     pub order: Option<f64>,
     pub iterations: Option<usize>,
-    /// `phi_ext`, `e_ext21`, `GCI_fine21`, `GCI_32` and `GCI_32 / (r21^p GCI_fine21)`.
     pub extrapolated: Option<f64>,
     pub extrapolated_error: Option<f64>,
     pub gci_fine: Option<f64>,
-    pub gci_coarse: Option<f64>,
-    pub gci_ratio: Option<f64>,
-    /// Empty when the sequence passed every test of the asymptotic range.
+    /// Every triplet of consecutive meshes, the finest first (none with two meshes).
+    pub triplets: Vec<Triplet>,
+    /// Every flag of a triplet (each once) and [`Flag::OrdersDisagree`].
     pub flags: Vec<Flag>,
+    /// No flag: every triplet is in its asymptotic range and their orders agree.
+    pub asymptotic: bool,
 }
 
 /// Why no estimate can be made.
@@ -165,77 +195,92 @@ pub fn estimate(levels: &[(f64, f64)]) -> Result<Estimate, GciError> {
     if let Some(pair) = sorted.windows(2).find(|w| w[0].0 == w[1].0) {
         return Err(GciError::SameSpacing(pair[0].0));
     }
-    sorted.truncate(3);
     let (h, phi): (Vec<f64>, Vec<f64>) = sorted.into_iter().unzip();
     let ratios: Vec<f64> = h.windows(2).map(|w| w[1] / w[0]).collect();
-    let mut estimate = Estimate {
+    let triplets: Vec<Triplet> = (0..h.len().saturating_sub(2))
+        .map(|k| triplet([h[k], h[k + 1], h[k + 2]], [phi[k], phi[k + 1], phi[k + 2]]))
+        .collect();
+    let mut flags = Vec::new();
+    if triplets.is_empty() {
+        flags.push(Flag::TwoLevels);
+    }
+    for flag in triplets.iter().flat_map(|t| &t.flags) {
+        if !flags.contains(flag) {
+            flags.push(*flag);
+        }
+    }
+    let orders: Vec<f64> = triplets.iter().filter_map(|t| t.order).collect();
+    let (lowest, highest) = (orders.iter()).fold((f64::INFINITY, 0.0_f64), |(lo, hi), &p| {
+        (lo.min(p), hi.max(p))
+    });
+    if orders.len() > 1 && highest > ORDER_AGREEMENT * lowest {
+        flags.push(Flag::OrdersDisagree);
+    }
+    let finest = triplets.first();
+    let of_finest = |field: fn(&Triplet) -> Option<f64>| finest.and_then(field);
+    Ok(Estimate {
         difference: phi[0] - phi[1],
         relative_difference: ((phi[0] - phi[1]) / phi[0]).abs(),
+        convergence_ratio: of_finest(|t| t.convergence_ratio),
+        order: of_finest(|t| t.order),
+        iterations: finest.and_then(|t| t.iterations),
+        extrapolated: of_finest(|t| t.extrapolated),
+        extrapolated_error: of_finest(|t| t.extrapolated_error),
+        gci_fine: of_finest(|t| t.gci_fine),
+        asymptotic: flags.is_empty(),
         phi,
         h,
         ratios,
+        triplets,
+        flags,
+    })
+}
+
+/// The order, extrapolation, GCI and flags of three meshes, the finest first.
+fn triplet(h: [f64; 3], [phi1, phi2, phi3]: [f64; 3]) -> Triplet {
+    let mut t = Triplet {
+        h,
         convergence_ratio: None,
         order: None,
         iterations: None,
         extrapolated: None,
         extrapolated_error: None,
         gci_fine: None,
-        gci_coarse: None,
-        gci_ratio: None,
         flags: Vec::new(),
     };
-    if estimate.phi.len() == 2 {
-        estimate.flags.push(Flag::TwoLevels);
-    } else {
-        three_meshes(&mut estimate);
-    }
-    Ok(estimate)
-}
-
-/// The order, extrapolation, GCIs and flags of a sequence of three meshes.
-fn three_meshes(e: &mut Estimate) {
-    let [phi1, phi2, phi3] = [e.phi[0], e.phi[1], e.phi[2]];
-    let [r21, r32] = [e.ratios[0], e.ratios[1]];
+    let [r21, r32] = [h[1] / h[0], h[2] / h[1]];
     let (eps21, eps32) = (phi2 - phi1, phi3 - phi2);
     let round_off = ROUND_OFF * phi1.abs().max(f64::MIN_POSITIVE);
     if eps21.abs() <= round_off || eps32.abs() <= round_off {
-        e.flags.push(Flag::NoDifference);
-        return;
+        t.flags.push(Flag::NoDifference);
+        return t;
     }
-    let ratio = eps21 / eps32;
-    e.convergence_ratio = Some(ratio);
+    t.convergence_ratio = Some(eps21 / eps32);
     let sign = (eps32 / eps21).signum();
     let Some((p, iterations)) = observed_order(r21, r32, eps21, eps32) else {
-        e.flags.push(Flag::NoOrder);
-        return;
+        t.flags.push(Flag::NoOrder);
+        return t;
     };
     // The order solves |ln|eps32/eps21| + q(p)| = p ln r21; where the expression inside the
     // bars is negative the errors grow with refinement (with r21 = r32: |R| > 1).
     let growing = (eps32 / eps21).abs().ln() + q(p, r21, r32, sign) < 0.0;
-    e.flags.extend(match (growing, sign > 0.0) {
+    t.flags.extend(match (growing, sign > 0.0) {
         (false, true) => None,
         (false, false) => Some(Flag::OscillatoryConvergence),
         (true, true) => Some(Flag::MonotonicDivergence),
         (true, false) => Some(Flag::OscillatoryDivergence),
     });
-    e.order = Some(p);
-    e.iterations = Some(iterations);
+    t.order = Some(p);
+    t.iterations = Some(iterations);
     if !(ORDER_RANGE.0..=ORDER_RANGE.1).contains(&p) {
-        e.flags.push(Flag::OrderOutOfRange);
+        t.flags.push(Flag::OrderOutOfRange);
     }
-    let (r21p, r32p) = (r21.powf(p), r32.powf(p));
+    let r21p = r21.powf(p);
     let extrapolated = (r21p * phi1 - phi2) / (r21p - 1.0);
-    let gci_fine = SAFETY_FACTOR * e.relative_difference / (r21p - 1.0);
-    let gci_coarse = SAFETY_FACTOR * ((phi2 - phi3) / phi2).abs() / (r32p - 1.0);
-    let gci_ratio = gci_coarse / (r21p * gci_fine);
-    if !(GCI_RATIO_RANGE.0..=GCI_RATIO_RANGE.1).contains(&gci_ratio) {
-        e.flags.push(Flag::GciRatio);
-    }
-    e.extrapolated = Some(extrapolated);
-    e.extrapolated_error = Some(((extrapolated - phi1) / extrapolated).abs());
-    e.gci_fine = Some(gci_fine);
-    e.gci_coarse = Some(gci_coarse);
-    e.gci_ratio = Some(gci_ratio);
+    t.extrapolated = Some(extrapolated);
+    t.extrapolated_error = Some(((extrapolated - phi1) / extrapolated).abs());
+    t.gci_fine = Some(SAFETY_FACTOR * ((phi1 - phi2) / phi1).abs() / (r21p - 1.0));
+    t
 }
 
 /// The observed order `p` of the differences `eps21 = phi2 - phi1` and `eps32 = phi3 - phi2`
@@ -300,26 +345,84 @@ mod tests {
     }
 
     /// `phi = phi0 + C h^p` on non-constant ratios gives back p and phi0 to round-off, in any
-    /// order of the levels, and is in its asymptotic range (GCI ratio `|phi1 / phi2|`).
+    /// order of the levels, on both triplets of its four levels, and is in its asymptotic range.
     #[test]
     fn manufactured_sequence_gives_its_order_and_limit() {
         for (phi0, c, p) in [(2.0, 0.7, 1.7), (5.0, -3.0, 1.0), (-1.0, 0.2, 2.5)] {
             let hs: [f64; 4] = [0.5, 0.23, 0.1, 0.31];
             let levels: Vec<(f64, f64)> = hs.iter().map(|&h| (h, phi0 + c * h.powf(p))).collect();
             let e = estimate(&levels).unwrap();
-            assert_eq!(e.h, vec![0.1, 0.23, 0.31]);
-            assert!((e.order.unwrap() - p).abs() < 1e-8, "{e:?}");
-            assert!(
-                (e.extrapolated.unwrap() - phi0).abs() < 1e-9 * phi0.abs(),
-                "{e:?}"
-            );
-            let ratio = (e.phi[0] / e.phi[1]).abs();
-            assert!((e.gci_ratio.unwrap() - ratio).abs() < 1e-9, "{e:?}");
-            assert!(e.flags.is_empty(), "{e:?}");
+            assert_eq!(e.h, vec![0.1, 0.23, 0.31, 0.5]);
+            assert_eq!(e.triplets.len(), 2);
+            assert_eq!(e.triplets[0].h, [0.1, 0.23, 0.31]);
+            for t in &e.triplets {
+                assert!((t.order.unwrap() - p).abs() < 1e-8, "{e:?}");
+                assert!(
+                    (t.extrapolated.unwrap() - phi0).abs() < 1e-9 * phi0.abs(),
+                    "{e:?}"
+                );
+            }
+            assert_eq!(e.order, e.triplets[0].order);
+            assert!(e.flags.is_empty() && e.asymptotic, "{e:?}");
             // The exact value lies in the GCI band of the finest mesh.
             let band = e.gci_fine.unwrap() * e.phi[0].abs();
             assert!((e.phi[0] - phi0).abs() <= band);
         }
+    }
+
+    /// `phi` on `h = 1, 2, 4, 8` whose finest triplet has the order `fine` and the coarser one
+    /// `coarse` (constant ratio 2: each order is `log2` of the ratio of its two differences);
+    /// `sign` is that of the finest difference against the others'.
+    fn two_triplets(fine: f64, coarse: f64, sign: f64) -> Vec<(f64, f64)> {
+        let d1 = 0.01 * sign;
+        let d2 = 0.01 * 2f64.powf(fine);
+        let d3 = d2 * 2f64.powf(coarse);
+        vec![
+            (1.0, 1.0),
+            (2.0, 1.0 + d1),
+            (4.0, 1.0 + d1 + d2),
+            (8.0, 1.0 + d1 + d2 + d3),
+        ]
+    }
+
+    #[test]
+    fn order_2_on_four_levels_is_asymptotic() {
+        let levels: Vec<(f64, f64)> = [0.1f64, 0.2, 0.4, 0.8]
+            .iter()
+            .map(|&h| (h, 1.0 + 0.3 * h * h))
+            .collect();
+        let e = estimate(&levels).unwrap();
+        let orders: Vec<f64> = e.triplets.iter().map(|t| t.order.unwrap()).collect();
+        assert!(orders.iter().all(|p| (p - 2.0).abs() < 1e-8), "{orders:?}");
+        assert!(e.asymptotic && e.flags.is_empty(), "{e:?}");
+    }
+
+    #[test]
+    fn a_finest_triplet_that_oscillates_is_not_asymptotic() {
+        let e = estimate(&two_triplets(2.0, 2.0, -1.0)).unwrap();
+        assert_eq!(e.triplets[0].flags, vec![Flag::OscillatoryConvergence]);
+        assert!(e.triplets[1].flags.is_empty(), "{e:?}");
+        assert!((e.triplets[1].order.unwrap() - 2.0).abs() < 1e-8);
+        assert_eq!(e.flags, vec![Flag::OscillatoryConvergence]);
+        assert!(!e.asymptotic);
+    }
+
+    #[test]
+    fn triplets_whose_orders_disagree_are_flagged() {
+        // The force of a half-disc study: 1.60 on levels 0-1-2, 3.88 on 1-2-3.
+        let e = estimate(&two_triplets(3.88, 1.60, 1.0)).unwrap();
+        let orders: Vec<f64> = e.triplets.iter().map(|t| t.order.unwrap()).collect();
+        assert!((orders[0] - 3.88).abs() < 1e-8 && (orders[1] - 1.60).abs() < 1e-8);
+        assert_eq!(e.flags, vec![Flag::OrderOutOfRange, Flag::OrdersDisagree]);
+        assert!(!e.asymptotic);
+        // Each order in range and each triplet clean: only their disagreement flags them.
+        let e = estimate(&two_triplets(2.0, 1.0, 1.0)).unwrap();
+        assert!(e.triplets.iter().all(|t| t.flags.is_empty()), "{e:?}");
+        assert_eq!(e.flags, vec![Flag::OrdersDisagree]);
+        assert!(!e.asymptotic);
+        // Within a factor sqrt(2) they agree.
+        let e = estimate(&two_triplets(1.7, 1.4, 1.0)).unwrap();
+        assert!(e.asymptotic, "{e:?}");
     }
 
     #[test]
@@ -358,6 +461,7 @@ mod tests {
         assert_eq!((e.difference, e.relative_difference), (1.0, 0.2));
         assert_eq!((e.order, e.gci_fine, e.extrapolated), (None, None, None));
         assert_eq!(e.flags, vec![Flag::TwoLevels]);
+        assert!(e.triplets.is_empty() && !e.asymptotic);
     }
 
     #[test]

@@ -3,9 +3,9 @@
 //! (each solve as `internodes solve` runs it, into its own folder), the contact quantities of
 //! every level are read from its summary ([`quantities`]), the spacing of every level is measured
 //! on its mesh ([`measure`]), and each quantity's discretization error is estimated from the
-//! finest levels by the grid convergence index of Celik et al. (2008) ([`gci`]). The results go
-//! into `study.json`, `study.csv`, `study.md` and `study.png` ([`files`], [`plot`]);
-//! `docs/study.md` is the user's page.
+//! levels by the grid convergence index of Celik et al. (2008), on every triplet of consecutive
+//! levels ([`gci`]). The results go into `study.json`, `study.csv`, `study.md` and `study.png`
+//! ([`files`], [`plot`]); `docs/study.md` is the user's page.
 
 pub mod files;
 pub mod gci;
@@ -93,6 +93,8 @@ pub struct StudyOptions {
     pub output: Option<PathBuf>,
     /// Progress messages off (errors and warnings only).
     pub quiet: bool,
+    /// Stops the level being solved, and with it the study ([`RunOptions::cancel`]).
+    pub cancel: crate::cancel::Cancel,
 }
 
 #[derive(Debug, Error)]
@@ -169,7 +171,8 @@ pub struct Study {
 
 /// Solves `case` at every value of `spec` into `<output>/<parameter>_<value>/`, estimates each
 /// quantity's discretization error and writes the study's files into the output folder.
-/// Every value's case is checked before anything is solved.
+/// Every value's case is checked before anything is solved, and what an earlier study left in
+/// the folder removed ([`files::remove_earlier_study`]).
 pub fn run_study(
     case: &Case,
     spec: &StudySpec,
@@ -205,6 +208,12 @@ pub fn run_study(
                     .to_string(),
             )
         })?;
+    for removed in files::remove_earlier_study(&folder)? {
+        log::info!(
+            "study: removed {}, a level of an earlier study (only results of a run in it)",
+            removed.display()
+        );
+    }
     let mut levels = Vec::new();
     for (level_case, &value) in cases.into_iter().zip(&spec.values) {
         levels.push(solve_level(level_case, spec, value, &folder, options)?);
@@ -233,6 +242,7 @@ fn solve_level(
         output: Some(folder.join(&name)),
         export_matrices: false,
         quiet: options.quiet,
+        cancel: options.cancel.clone(),
     };
     let command = format!(
         "internodes study {} ({} = {value})",
