@@ -584,7 +584,7 @@ fn solve_load_steps(
 ) -> Result<(Vec<ContactSolution>, Vec<Vec<StepRecord>>), ContactError> {
     let dim = problems[0].primary_surface.dim;
     let phase = Instant::now();
-    let set_up = Heartbeat::start(log.verbose, format!("{label}contact set-up"));
+    let set_up = Heartbeat::start(log.verbose, format!("  {label}contact set-up"));
     let mut contact_solver = ContactSolver::new(problems, solver)?;
     drop(set_up);
     log.time(format!("{label}contact set-up"), phase);
