@@ -87,22 +87,26 @@ impl Heartbeat {
         });
         let what = what.into();
         let beat = Arc::clone(&shared);
+        let start = Instant::now();
         let thread = std::thread::spawn(move || {
-            let start = Instant::now();
+            let lock = || beat.done.lock().unwrap_or_else(|e| e.into_inner());
             let mut next = cadence.first;
-            let mut done = beat.done.lock().unwrap_or_else(|e| e.into_inner());
             loop {
-                let wait = next.saturating_sub(start.elapsed());
-                done = (beat.ended.wait_timeout(done, wait))
-                    .unwrap_or_else(|e| e.into_inner())
-                    .0;
+                // `done` is read under the lock the wait releases: an end signalled before
+                // the wait began (a phase shorter than the thread's start) is not missed.
+                let mut done = lock();
+                while !*done && start.elapsed() < next {
+                    let wait = next.saturating_sub(start.elapsed());
+                    done = (beat.ended.wait_timeout(done, wait))
+                        .unwrap_or_else(|e| e.into_inner())
+                        .0;
+                }
                 if *done {
                     return;
                 }
+                // Not logged under the lock: the phase's end does not wait for a logger.
+                drop(done);
                 let elapsed = start.elapsed();
-                if elapsed < next {
-                    continue; // woken early, not ended
-                }
                 let note = (beat.note.lock().unwrap_or_else(|e| e.into_inner()))
                     .as_ref()
                     .map_or(String::new(), |n| format!(" ({n})"));

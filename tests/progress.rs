@@ -48,6 +48,23 @@ fn a_long_phase_says_how_long_it_runs_a_short_one_nothing() {
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(taken(), Vec::<String>::new());
 
+    // A phase ends when it ends, even before its heartbeat's thread has begun to wait (an
+    // end signalled then once went unseen, and each active-set iteration of a small case
+    // took the 5 s of the first beat).
+    let patient = Cadence {
+        first: Duration::from_secs(60),
+        ..CADENCE
+    };
+    let clock = std::time::Instant::now();
+    for _ in 0..50 {
+        drop(Heartbeat::with_cadence(true, "instant", patient));
+    }
+    assert!(
+        clock.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        clock.elapsed()
+    );
+
     // A phase of five beats and a bit, with a note after the second.
     let beat = Heartbeat::with_cadence(true, "  long", CADENCE);
     std::thread::sleep(Duration::from_millis(500));
