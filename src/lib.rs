@@ -29,6 +29,7 @@
 //! - [`output`]: XDMF/HDF5, JSON summary, Matrix Market;
 //! - [`cancel`]: the token that stops a solve from outside it;
 //! - [`parallel`]: the MPI ranks of a distributed run (`mpirun -n N internodes solve`);
+//! - [`progress`]: progress lines of long phases;
 //! - [`run`]: `internodes solve CASE`, from the case file to the result files;
 //! - [`study`]: `internodes study CASE`, a mesh refinement study with the grid convergence index.
 
@@ -41,5 +42,6 @@ pub mod linalg;
 pub mod mesh;
 pub mod output;
 pub mod parallel;
+pub mod progress;
 pub mod run;
 pub mod study;

@@ -2,11 +2,11 @@
 //! `info MESH`.
 
 use std::error::Error;
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicI32, Ordering};
+use std::sync::{Mutex, OnceLock};
 
 use clap::{Parser, Subcommand};
 use internodes::cancel::Cancel;
@@ -37,8 +37,11 @@ enum Command {
         #[arg(long)]
         export_matrices: bool,
         /// Print nothing but errors.
-        #[arg(long, short)]
+        #[arg(long, short, conflicts_with = "verbose")]
         quiet: bool,
+        /// More detail: -v each active-set iteration and the checks, -vv the Krylov solves.
+        #[arg(long, short, action = clap::ArgAction::Count)]
+        verbose: u8,
     },
     /// Refinement study: solve a .geo case on a sequence of meshes and estimate its error (GCI).
     ///
@@ -57,8 +60,11 @@ enum Command {
         #[arg(long, short)]
         output: Option<PathBuf>,
         /// Print nothing but errors.
-        #[arg(long, short)]
+        #[arg(long, short, conflicts_with = "verbose")]
         quiet: bool,
+        /// More detail: -v each active-set iteration and the checks, -vv the Krylov solves.
+        #[arg(long, short, action = clap::ArgAction::Count)]
+        verbose: u8,
     },
     /// Print the physical groups, element counts and bounding boxes of a gmsh mesh.
     Info {
@@ -105,16 +111,20 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let quiet = ranks.rank != 0
-        || matches!(
-            cli.command,
-            Command::Solve { quiet: true, .. } | Command::Study { quiet: true, .. }
-        );
-    StderrLogger::install(if quiet {
-        log::LevelFilter::Warn
-    } else {
-        log::LevelFilter::Info
-    });
+    // The levels of docs/output.md ("The log"): info by default, debug with -v, trace with -vv.
+    let level = match cli.command {
+        _ if ranks.rank != 0 => log::LevelFilter::Warn,
+        Command::Solve { quiet: true, .. } | Command::Study { quiet: true, .. } => {
+            log::LevelFilter::Warn
+        }
+        Command::Solve { verbose, .. } | Command::Study { verbose, .. } => match verbose {
+            0 => log::LevelFilter::Info,
+            1 => log::LevelFilter::Debug,
+            _ => log::LevelFilter::Trace,
+        },
+        Command::Info { .. } => log::LevelFilter::Info,
+    };
+    StderrLogger::install(level);
     // Under MPI the ranks would stop at different safe points and wait for each other: the
     // launcher ends them as it ends any program.
     let cancel = match ranks.size {
@@ -127,6 +137,7 @@ fn main() -> ExitCode {
             output,
             export_matrices,
             quiet,
+            ..
         } => solve_case(
             &case,
             &RunOptions {
@@ -138,6 +149,7 @@ fn main() -> ExitCode {
         )
         .map_err(Into::into)
         .map(|report| {
+            log::logger().flush();
             let folder = report.output_dir.display();
             let verdict = report.summary.verdict();
             match &verdict {
@@ -161,6 +173,7 @@ fn main() -> ExitCode {
             parameter,
             output,
             quiet,
+            ..
         } => study(
             &case,
             &parameter,
@@ -178,6 +191,7 @@ fn main() -> ExitCode {
             })
             .map(|()| 0),
     };
+    log::logger().flush();
     match result {
         Ok(code) => match parallel::finish() {
             Ok(()) => ExitCode::from(code),
@@ -261,6 +275,7 @@ extern "C" fn on_interrupt(signal: libc::c_int) {
 fn study(case: &Path, spec: &StudySpec, options: &StudyOptions) -> Result<u8, Box<dyn Error>> {
     let case = Case::load(case)?;
     let study = run_study(&case, spec, options)?;
+    log::logger().flush();
     if !options.quiet {
         print_stdout(&markdown(&study))?;
     }
@@ -274,16 +289,34 @@ fn study(case: &Path, spec: &StudySpec, options: &StudyOptions) -> Result<u8, Bo
     Ok(study.exit_status)
 }
 
-/// Prints the library's progress messages on stderr as they are, and its warnings prefixed
-/// with `warning: `. Hand-written: the `log` facade needs a logger, and the ones on crates.io
-/// add timestamps, levels and colours the CLI's output has never had.
-struct StderrLogger;
+/// Prints the library's messages on stderr, its warnings prefixed with `warning: `.
+/// Hand-written: the `log` facade needs a logger, and the ones on crates.io add timestamps,
+/// levels and colours the CLI's output has never had.
+///
+/// Two things make the default level read at a glance (docs/output.md, "The log"): an info
+/// message longer than [`WIDTH`] is wrapped at its spaces (a long name, path or reason stays
+/// on screen; debug and trace lines are left whole for scripts that parse them), and the
+/// progress lines of long phases ([`internodes::progress`]) rewrite one line in place on a
+/// terminal, the next message replacing it, but are plain lines elsewhere (a log file, a pipe),
+/// where a carriage return would garble the text.
+struct StderrLogger {
+    terminal: bool,
+    /// Whether a progress line is on screen, not ended by a newline.
+    progress_shown: Mutex<bool>,
+}
+
+/// The widest line of an info message.
+const WIDTH: usize = 120;
 
 impl StderrLogger {
     fn install(level: log::LevelFilter) {
-        static LOGGER: StderrLogger = StderrLogger;
+        static LOGGER: OnceLock<StderrLogger> = OnceLock::new();
+        let logger = LOGGER.get_or_init(|| StderrLogger {
+            terminal: std::io::stderr().is_terminal(),
+            progress_shown: Mutex::new(false),
+        });
         // Only fails when a logger is already installed, which nothing else in the CLI does.
-        let _ = log::set_logger(&LOGGER);
+        let _ = log::set_logger(logger);
         log::set_max_level(level);
     }
 }
@@ -294,15 +327,70 @@ impl log::Log for StderrLogger {
     }
 
     fn log(&self, record: &log::Record) {
-        if self.enabled(record.metadata()) {
-            match record.level() {
-                log::Level::Error | log::Level::Warn => eprintln!("warning: {}", record.args()),
-                _ => eprintln!("{}", record.args()),
-            }
+        if !self.enabled(record.metadata()) {
+            return;
+        }
+        // One lock for the whole write: a heartbeat's thread and the solve may log at once.
+        let mut shown = self
+            .progress_shown
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let clear = if *shown { "\r\x1b[2K" } else { "" };
+        let text = record.args().to_string();
+        let progress = record.target() == internodes::progress::TARGET;
+        *shown = progress && self.terminal;
+        match record.level() {
+            log::Level::Error | log::Level::Warn => eprintln!("{clear}warning: {text}"),
+            _ if progress && self.terminal => eprint!("{clear}{text}"),
+            log::Level::Info => eprintln!("{clear}{}", wrap(&text, WIDTH)),
+            _ => eprintln!("{clear}{text}"),
         }
     }
 
-    fn flush(&self) {}
+    /// Ends a progress line on screen, before a message not written through the logger (an
+    /// error) starts on a line of its own.
+    fn flush(&self) {
+        let mut shown = self
+            .progress_shown
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        if *shown {
+            eprint!("\r\x1b[2K");
+            *shown = false;
+        }
+    }
+}
+
+/// `text` with every line longer than `width` (in characters) broken at spaces; a continuation
+/// is indented four spaces past its line's own indentation. A word longer than the width (a long path)
+/// stays whole.
+fn wrap(text: &str, width: usize) -> String {
+    let mut lines = Vec::new();
+    let count = |s: &str| s.chars().count();
+    for line in text.lines() {
+        // A line that fits keeps its spacing (aligned columns).
+        if count(line) <= width {
+            lines.push(line.to_string());
+            continue;
+        }
+        let indent = line.len() - line.trim_start().len();
+        let mut current = line[..indent].to_string();
+        let mut empty = true;
+        for word in line.split_whitespace() {
+            if !empty && count(&current) + 1 + count(word) > width {
+                lines.push(std::mem::take(&mut current));
+                current = " ".repeat(indent + 4);
+                empty = true;
+            }
+            if !empty {
+                current.push(' ');
+            }
+            current.push_str(word);
+            empty = false;
+        }
+        lines.push(current);
+    }
+    lines.join("\n")
 }
 
 /// Writes `text` to stdout. A reader that stops early (`internodes info m.msh | head`) closes

@@ -54,7 +54,7 @@ fn text_failure(text: &str) -> (RunError, String) {
 fn solve_writes_xdmf_hdf5_and_summary() {
     let (dir, path) = block_3d_case().write();
     let output = Command::new(BINARY)
-        .args(["solve", path.to_str().unwrap(), "--export-matrices"])
+        .args(["solve", path.to_str().unwrap(), "--export-matrices", "-v"])
         .output()
         .unwrap();
     assert!(
@@ -64,8 +64,8 @@ fn solve_writes_xdmf_hdf5_and_summary() {
     );
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(
-        stderr.contains("numeric factorization"),
-        "phases are reported: {stderr}"
+        stderr.contains("body 'block': ") && stderr.contains("numeric factorization"),
+        "the body and, with -v, the phases of its solve are reported: {stderr}"
     );
 
     let out = dir.path().join("out");

@@ -60,7 +60,7 @@ fn along_path(cases: &[CaseFile]) -> (Vec<ContactSolution>, Vec<[f64; 3]>) {
         start = Some(solutions.iter().map(|s| s.active_set.clone()).collect());
         if std::env::var_os("FRICTION_HISTORY").is_some() {
             for record in &solutions[0].history {
-                eprintln!("{}", record.line());
+                eprintln!("{}", record.line(true));
             }
         }
         answers.push(solutions.remove(0));

@@ -406,12 +406,13 @@ def body_solves(iterations: list[dict]) -> int | None:
 
 
 def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
-    """One internodes contact solve (verbose: the log has every step's iterations)."""
+    """One internodes contact solve, with -vv: the log has every step's iterations, their phases and
+    their GMRES solves (``parse_log``)."""
     shutil.rmtree(output, ignore_errors=True)  # never read a stale summary
     log = output.with_suffix(".log")
     ranks = PATHS[path].get("ranks", 1)
     launcher = [MPIRUN, "-n", str(ranks)] if ranks > 1 else []
-    usage = measure([*launcher, binary, "solve", case, "--output", output], log,
+    usage = measure([*launcher, binary, "solve", case, "-vv", "--output", output], log,
                     env=MPI_ENV if ranks > 1 else None, max_seconds=MAX_SECONDS_OURS[path],
                     max_rss_gb=MAX_RSS_GB, check=False)
     summary_file = output / "summary.json"

@@ -10,7 +10,8 @@ as the command line ``internodes solve CASE``, with results as NumPy arrays.
     print(result.summary["contact"]["force_primary"])
 
 Progress goes to the ``logging`` logger ``internodes`` (silent unless configured, e.g.
-``logging.basicConfig(level=logging.INFO)``). See docs/python.md.
+``logging.basicConfig(level=logging.INFO)``), at the command line's levels: ``INFO`` its default
+log, ``DEBUG`` its ``-v``, ``internodes.TRACE`` its ``-vv``. See docs/python.md.
 """
 
 import logging
@@ -21,3 +22,7 @@ from .export import to_meshio
 
 # A library's logger stays silent until the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+#: The level of the coupled Krylov solves' lines, below ``logging.DEBUG``: the command line's
+#: ``-vv`` (``logging.basicConfig(level=internodes.TRACE)`` prints them).
+TRACE = 5

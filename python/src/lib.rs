@@ -697,7 +697,6 @@ fn solve_named(
     };
     let mut file = case.file.clone();
     file.solver.verbose = true;
-    file.solver.progress_line = false;
     // Every load step's fields are the result's (`Result.step_bodies`).
     file.solver.keep_step_fields = true;
     file.solver.cancel = cancel.map(|c| c.token.clone()).unwrap_or_default();
@@ -1159,8 +1158,7 @@ fn study(
         )));
     }
     let spec = StudySpec { parameter, values };
-    let mut file = case.file.clone();
-    file.solver.progress_line = false;
+    let file = case.file.clone();
     let options = StudyOptions {
         output,
         quiet: false,
@@ -1626,8 +1624,10 @@ fn _internodes(m: &Bound<'_, PyModule>) -> PyResult<()> {
     faer::set_global_parallelism(faer::Par::Seq);
     // The solver's messages go to Python's logging ([`LogBridge`]); a second import of the
     // module (a subinterpreter) keeps the first bridge.
+    // Every level reaches Python, whose logger levels choose (docs/python.md, "Logging"): the
+    // command line's default log is INFO, its -v DEBUG, its -vv level 5 (the Krylov solves).
     if log::set_boxed_logger(Box::new(LogBridge)).is_ok() {
-        log::set_max_level(log::LevelFilter::Debug);
+        log::set_max_level(log::LevelFilter::Trace);
     }
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Case>()?;

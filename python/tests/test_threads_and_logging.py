@@ -71,6 +71,23 @@ def test_progress_goes_to_logging(caplog):
     assert any(m.startswith("contact status: converged") for m in messages), messages
 
 
+def test_the_levels_are_the_command_line_s(caplog):
+    # INFO is the command line's default log, DEBUG its -v, internodes.TRACE its -vv.
+    with caplog.at_level(internodes.TRACE, logger="internodes"):
+        internodes.solve(internodes.Case.from_toml(REPO / "geo" / "half_disc_on_block.toml"))
+
+    def at(level):
+        return [r.getMessage() for r in caplog.records
+                if r.name.startswith("internodes.") and r.levelno == level]
+
+    info, debug, trace = at(logging.INFO), at(logging.DEBUG), at(internodes.TRACE)
+    assert any(m.startswith("contact status: converged") for m in info), info
+    assert not any("iteration " in m or "GMRES" in m for m in info), info
+    assert any(m.startswith("  iteration ") for m in debug), debug
+    assert any("\n  checks:\n" in m for m in debug), debug
+    assert any("coupled GMRES: " in m for m in trace), trace
+
+
 def test_the_module_is_silent_by_default():
     script = ("import internodes; r = internodes.solve(internodes.Case.from_toml(%r)); "
               "assert r.status == 'converged'" % str(REPO / "geo" / "half_disc_on_block.toml"))

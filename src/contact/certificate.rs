@@ -164,6 +164,14 @@ impl Certificate {
             .collect()
     }
 
+    /// The names of the failed checks, "secondary sag, resolution": the short form of
+    /// [`Self::failures`].
+    pub fn failed_names(&self) -> String {
+        (self.failed().iter().map(|k| k.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The failed checks in one line, e.g. for a status message.
     pub fn failures(&self) -> String {
         self.checks

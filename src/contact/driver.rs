@@ -38,6 +38,7 @@ use crate::contact::settings::Transfer;
 use crate::contact::solution::{ContactSolution, ContactStatus, ForcedDisplacement};
 use crate::contact::verify::checks::agreement;
 use crate::elastic::{SolverSettings, StepFactors};
+use crate::progress::Heartbeat;
 
 /// How one load step ended.
 #[derive(Debug, Clone, Serialize)]
@@ -133,7 +134,9 @@ pub struct ContactRun<'m> {
 /// Solves the contact `problems` (one or several pairs, decided together) at each of
 /// `load_factors` in turn (each step starting from the previous active sets), with the retry
 /// and the agreement checks of the module doc for each pair that needs them. Progress goes to
-/// the `log` crate (level info) when `solver.verbose`. Every load, force and prescribed
+/// the `log` crate when `solver.verbose`, at the levels of docs/output.md ("The log": info a
+/// line per phase and per load step, debug the iterations and checks, trace the Krylov
+/// solves). Every load, force and prescribed
 /// displacement is scaled by the step's factor: [`solve_contact_steps`] with no named load
 /// path.
 pub fn solve_contact<'m>(
@@ -231,8 +234,8 @@ pub fn solve_contact_steps<'m>(
             solver.cancel.check()?;
         }
     }
-    for (solution, steps) in run.solutions.iter().zip(&mut run.steps) {
-        report_coverage(solution, &log);
+    for (p, (solution, steps)) in run.solutions.iter().zip(&mut run.steps).enumerate() {
+        report_coverage(&pair_label(&run.problems, p), solution, &log);
         // The last step's record is the answer's, checks made after the loop included.
         if let Some(last) = steps.last_mut() {
             last.status = solution.status;
@@ -258,15 +261,30 @@ struct Answer<'m> {
     earlier: Vec<Vec<ContactSolution>>,
 }
 
-/// Says which errors the accuracy report of `solution` could not estimate, and why.
-fn report_coverage(solution: &ContactSolution, log: &Log) {
-    for error in solution.certificate.coverage() {
-        if let Some(how) = error.not_estimated {
-            log.say(format!(
-                "accuracy report: {} not estimated: {how}",
-                error.error
-            ));
-        }
+/// The accuracy report of `solution` (the last step's, after every check) in one line: its
+/// verdict and the errors it could not estimate, by name; with -v, why each was not and how to
+/// estimate it (a sentence each).
+fn report_coverage(pair: &str, solution: &ContactSolution, log: &Log) {
+    let coverage = solution.certificate.coverage();
+    let missing: Vec<_> = (coverage.iter())
+        .filter_map(|e| e.not_estimated.as_ref().map(|how| (e.error, how)))
+        .collect();
+    let verdict = match solution.certificate.accurate() {
+        true => "passed".to_string(),
+        false => format!("FAILED ({})", solution.certificate.failed_names()),
+    };
+    let not_estimated = match missing.is_empty() {
+        true => String::new(),
+        false => format!(
+            "; not estimated: {} (-v says why)",
+            (missing.iter().map(|(error, _)| *error))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    log.say(format!("{pair}accuracy report: {verdict}{not_estimated}"));
+    for (error, how) in missing {
+        log.detail(format!("  {error} not estimated: {how}"));
     }
 }
 
@@ -469,9 +487,10 @@ fn check_against(
         let pair = pair_label(&run.problems, p);
         log.say(format!("{pair}check with {with}: {}", check.describe()));
         solution.certify_further(check);
-        log.say(format!(
-            "{pair}contact status: {}",
-            solution.describe(problem.settings.formulation)
+        log.detail(format!(
+            "{pair}contact status: {}\n{}",
+            solution.summary(),
+            solution.details(problem.settings.formulation)
         ));
     }
 }
@@ -589,7 +608,9 @@ fn solve_load_steps(
 > {
     let dim = problems[0].primary_surface.dim;
     let phase = Instant::now();
+    let set_up = Heartbeat::start(log.verbose, format!("  {label}contact set-up"));
     let mut contact_solver = ContactSolver::new(problems, solver)?;
+    drop(set_up);
     log.time(format!("{label}contact set-up"), phase);
     for problem in problems {
         let transfer = problem.transfer();
@@ -605,17 +626,26 @@ fn solve_load_steps(
     let mut earlier = Vec::new();
     for (k, factors) in load_path.iter().enumerate() {
         solver.cancel.check()?;
-        if load_path.len() > 1 {
-            let paths: String = (factors.paths.iter())
-                .map(|(name, f)| format!(", path '{name}' {f}"))
-                .collect();
-            log.say(format!(
-                "load step {}/{}: factor {}{paths}",
-                k + 1,
-                load_path.len(),
-                factors.default
-            ));
-        }
+        // "load step 2/5 (factor 0.55)" heads the step's outcome; with -v it also opens the
+        // step's iterations, in the form validation/contact_benchmark.py parses.
+        let step = match load_path.len() {
+            1 => None,
+            n => {
+                let paths: String = (factors.paths.iter())
+                    .map(|(name, f)| format!(", path '{name}' {f}"))
+                    .collect();
+                log.detail(format!(
+                    "{label}load step {}/{n}: factor {}{paths}",
+                    k + 1,
+                    factors.default
+                ));
+                Some(format!(
+                    "load step {}/{n} (factor {}{paths})",
+                    k + 1,
+                    factors.default
+                ))
+            }
+        };
         let phase = Instant::now();
         let start: Option<Vec<ActiveSet>> = (last.as_ref())
             .map(|solutions| solutions.iter().map(|s| s.active_set.clone()).collect());
@@ -635,10 +665,12 @@ fn solve_load_steps(
                     problem.primary.body.name, problem.secondary.body.name
                 ),
             };
+            let head = step.as_deref().unwrap_or("contact status");
             log.say(format!(
-                "{pair}contact status: {}",
-                solution.describe(problem.settings.formulation)
+                "{label}{head}: {pair}{}; {seconds:.2} s",
+                solution.summary()
             ));
+            log.detail(solution.details(problem.settings.formulation));
             steps.push(StepRecord {
                 step: k + 1,
                 load_factor: factors.default,
@@ -695,9 +727,17 @@ struct Log {
 }
 
 impl Log {
+    /// A line of the default log: a phase, a load step's outcome.
     fn say(&self, message: impl AsRef<str>) {
         if self.verbose {
             log::info!("{}", message.as_ref());
+        }
+    }
+
+    /// A line of the `-v` log: what led to a phase's outcome.
+    fn detail(&self, message: impl AsRef<str>) {
+        if self.verbose {
+            log::debug!("{}", message.as_ref());
         }
     }
 

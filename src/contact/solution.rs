@@ -109,11 +109,19 @@ pub struct IterationRecord {
 }
 
 impl IterationRecord {
-    /// The progress line printed for this iteration.
-    pub fn line(&self) -> String {
+    /// The log line of this iteration; with `phases` (the `-vv` log) the seconds of its
+    /// phases too, which keeps the `-v` line near 120 characters.
+    pub fn line(&self, phases: bool) -> String {
         let t = &self.seconds;
+        let phases = match phases {
+            true => format!(
+                " (operators {:.3}, solve {:.3}, search {:.3})",
+                t.operators, t.solve, t.search
+            ),
+            false => String::new(),
+        };
         format!(
-            "  iteration {:>3}: active {:>5}, +{:<4} -{:<4} penetration {:.1e} h, tension {:.1e} p_max, active gap {:.1e} h, slid {:.1e} h; {:.3} s (operators {:.3}, solve {:.3}, search {:.3})",
+            "  iteration {:>3}: active {:>5}, +{:<4} -{:<4} penetration {:.1e} h, tension {:.1e} p_max, active gap {:.1e} h, slid {:.1e} h; {:.3} s{phases}",
             self.iteration,
             self.active,
             self.added,
@@ -123,9 +131,6 @@ impl IterationRecord {
             self.max_gap_error_over_h,
             self.pairing_drift_over_h,
             t.operators + t.solve + t.search + t.checks,
-            t.operators,
-            t.solve,
-            t.search
         ) + &self.slipping.map_or(String::new(), |slip| {
             format!(
                 "; slipping {slip}, direction change {:.1e}",
@@ -273,16 +278,39 @@ pub struct ForcedDisplacement {
 }
 
 impl ContactSolution {
-    /// How the solve ended, with its certificate (the progress output).
-    pub fn describe(&self, formulation: Formulation) -> String {
-        let iterations = self.history.len();
-        let certificate = (self.certificate.checks.iter())
-            .map(|c| c.describe())
-            .collect::<Vec<_>>()
-            .join("; ");
-        let outcome = match self.status {
-            ContactStatus::Converged => format!(
-                "converged in {iterations} iterations; contact force {:.6e}{}{}",
+    /// How the solve ended, in the one line of the default log: for an answer the iterations,
+    /// the force, the contact size and the accuracy report's failed indicators by name (the
+    /// checks themselves are [`Self::details`]); any other ending with its explanation, which
+    /// the error message (the status's name) does not give.
+    pub fn summary(&self) -> String {
+        if self.status != ContactStatus::Converged {
+            return self.outcome();
+        }
+        let nodes = self.primary_fields.active.iter().filter(|&&a| a).count();
+        let slipping = (self.primary_fields.friction.as_ref())
+            .map_or(String::new(), |f| format!(" ({} slipping)", f.slip_nodes));
+        let accuracy = match self.certificate.accurate() {
+            true => String::new(),
+            false => format!(
+                ", accuracy report failed ({})",
+                self.certificate.failed_names()
+            ),
+        };
+        format!(
+            "{}{accuracy}; force {:.4e}, {nodes} contact nodes{slipping}",
+            self.outcome(),
+            norm(&self.force_primary)
+        )
+    }
+
+    /// What [`Self::summary`] leaves out (the `-v` log): the force to seven digits and the
+    /// Hertz fit of an answer, then each check on a line of its own (one line of all of them
+    /// ran to 700 characters) and the accuracy report's verdict.
+    pub fn details(&self, formulation: Formulation) -> String {
+        let mut lines = Vec::new();
+        if self.status == ContactStatus::Converged {
+            lines.push(format!(
+                "  contact force {:.6e}{}{}",
                 norm(&self.force_primary),
                 self.hertz_primary.map_or(String::new(), |h| format!(
                     ", Hertz fit a = {:.6e}, p0 = {:.6e}",
@@ -296,7 +324,27 @@ impl ContactSolution {
                 } else {
                     String::new()
                 }
-            ),
+            ));
+        }
+        lines.push("  checks:".to_string());
+        lines.extend((self.certificate.checks.iter()).map(|c| format!("    {}", c.describe())));
+        lines.push(format!(
+            "  accuracy report: {}",
+            match self.certificate.accurate() {
+                true => "passed".to_string(),
+                false => format!("FAILED ({})", self.certificate.failed_names()),
+            }
+        ));
+        lines.join("\n")
+    }
+
+    /// The status in words, with the explanation of an ending that is not an answer.
+    fn outcome(&self) -> String {
+        let iterations = self.history.len();
+        match self.status {
+            ContactStatus::Converged => {
+                format!("converged in {iterations} iterations")
+            }
             ContactStatus::NoContact => {
                 "no contact: the bodies do not touch; each body was solved alone".to_string()
             }
@@ -322,21 +370,7 @@ impl ContactSolution {
                     .last()
                     .map_or(f64::NAN, |r| r.max_gap_error_over_h)
             ),
-        };
-        let accuracy = if self.certificate.accurate() {
-            "passed".to_string()
-        } else {
-            format!(
-                "FAILED: {}",
-                self.certificate
-                    .indicators()
-                    .filter(|c| !c.passed)
-                    .map(|c| c.describe())
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            )
-        };
-        format!("{outcome}\n  checks: {certificate}\n  accuracy report: {accuracy}")
+        }
     }
 
     /// How the solve ended, in a few words (for the primary choice's reason): the status, and

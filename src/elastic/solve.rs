@@ -14,6 +14,7 @@ use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
     relative_difference, relative_residual,
 };
+use crate::progress::Heartbeat;
 
 /// How to solve; every field has a documented default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -37,15 +38,10 @@ pub struct SolverSettings {
     pub ordering: Ordering,
     /// A solve whose relative residual exceeds this is reported as failed (default 1e-8).
     pub residual_tolerance: f64,
-    /// Report each phase and its time as `log` messages at level info (default: true; the
-    /// CLI's `--quiet` clears it).
+    /// Report the phases, their times and the progress of long ones as `log` messages, at the
+    /// levels of docs/output.md, "The log" (default: true; the CLI's `--quiet` clears it).
     #[serde(skip)]
     pub verbose: bool,
-    /// With `verbose`, rewrite a live progress line of long interface solves on stderr when it
-    /// is a terminal (default: true; the Python module clears it: its messages go to Python's
-    /// `logging`, never to the terminal).
-    #[serde(skip)]
-    pub progress_line: bool,
     /// Stops a contact solve at its next load step, active-set iteration or coupled GMRES
     /// iteration once cancelled, with `ContactError::Cancelled` (default: a token nobody
     /// cancels; the Python module sets it on Ctrl-C).
@@ -80,7 +76,6 @@ impl Default for SolverSettings {
             ordering: Ordering::default(),
             residual_tolerance: 1e-8,
             verbose: true,
-            progress_line: true,
             cancel: Cancel::default(),
             keep_step_fields: false,
         }
@@ -115,7 +110,8 @@ pub enum SolveError {
     },
 }
 
-/// Runs `f`, records its duration under `name`, and reports it when verbose.
+/// Runs `f`, records its duration under `name`, and when verbose reports it (in the `-v` log:
+/// one line per body solve is enough by default) and its progress if it runs long.
 pub(crate) fn timed<T>(
     stats: &mut SolveStats,
     verbose: bool,
@@ -123,10 +119,12 @@ pub(crate) fn timed<T>(
     f: impl FnOnce() -> T,
 ) -> T {
     let start = Instant::now();
+    let beat = Heartbeat::start(verbose, format!("    {name}"));
     let value = f();
+    drop(beat);
     let seconds = start.elapsed().as_secs_f64();
     if verbose {
-        log::info!("    {name:<28} {seconds:>8.3} s");
+        log::debug!("    {name:<28} {seconds:>8.3} s");
     }
     stats.timings.push((name.to_string(), seconds));
     value

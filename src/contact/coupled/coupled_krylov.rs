@@ -170,26 +170,19 @@ pub struct KrylovState {
     /// Applications of each body's block of the preconditioner so far (one V-cycle each with
     /// CG + AMG bodies).
     pub body_applications: Vec<usize>,
-    /// Whether a solve over [`PROGRESS_AFTER`] rewrites a progress line on the terminal.
-    pub progress: bool,
     /// Checked at each GMRES iteration.
     pub cancel: Cancel,
 }
 
 impl KrylovState {
-    /// Nothing kept yet; `progress` as [`KrylovState::progress`].
-    pub fn new(progress: bool, cancel: Cancel) -> Self {
+    /// Nothing kept yet.
+    pub fn new(cancel: Cancel) -> Self {
         Self {
-            progress,
             cancel,
             ..Self::default()
         }
     }
 }
-
-/// A GMRES solve running longer than this (seconds) shows its progress on one line, when
-/// [`KrylovState::progress`] is set.
-const PROGRESS_AFTER: f64 = 2.0;
 
 /// What one coupled Krylov solve works on.
 pub struct KrylovProblem<'a> {
@@ -234,8 +227,6 @@ pub fn solve(
         schur,
         rigid: RigidBlock::new(system),
         applications: vec![0; num_bodies],
-        started: std::time::Instant::now(),
-        progress: state.progress,
         tolerance,
         rhs_norm,
         cancel: &state.cancel,
@@ -330,8 +321,6 @@ struct Blocks<'a> {
     rigid: RigidBlock,
     /// Applications of each body's block.
     applications: Vec<usize>,
-    started: std::time::Instant,
-    progress: bool,
     tolerance: f64,
     rhs_norm: f64,
     cancel: &'a Cancel,
@@ -397,20 +386,19 @@ impl Operators for Blocks<'_> {
         Ok(())
     }
 
+    /// How far the solve is, for the progress line of a long active-set iteration.
     fn progress(&mut self, stats: &GmresStats, estimate: f64) -> Result<(), ContactError> {
-        let seconds = self.started.elapsed().as_secs_f64();
-        if self.progress && seconds > PROGRESS_AFTER {
+        crate::progress::note(|| {
             let estimate = if self.rhs_norm > 0.0 {
                 estimate / self.rhs_norm
             } else {
                 estimate
             };
-            eprint!(
-                "\r\x1b[2K    coupled GMRES: {} iterations, residual ~{estimate:.1e} (target \
-                 {:.1e}), {seconds:.1} s",
+            format!(
+                "coupled GMRES: {} iterations, residual ~{estimate:.1e}, target {:.1e}",
                 stats.iterations, self.tolerance
-            );
-        }
+            )
+        });
         Ok(())
     }
 }

@@ -31,8 +31,6 @@
 //! does). A failed GMRES solve costs at most its iteration cap, which is why the fallback is
 //! for the rest of the solve and not retried per iteration.
 
-use std::io::IsTerminal;
-
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use nalgebra::{DMatrix, DVector};
@@ -129,10 +127,8 @@ impl BodyFactors {
         let cg = kind == BodySolverKind::CgAmg;
         let krylov = cg || matches!(method, CoupledSolver::Krylov | CoupledSolver::Auto);
         let interface = if krylov {
-            let progress =
-                settings.verbose && settings.progress_line && std::io::stderr().is_terminal();
             Interface::Krylov {
-                state: KrylovState::new(progress, settings.cancel.clone()),
+                state: KrylovState::new(settings.cancel.clone()),
                 max_iterations: contact.krylov_max_iterations,
             }
         } else {
@@ -230,10 +226,8 @@ impl BodyFactors {
         let stats = state.last;
         self.last_krylov = Some(stats);
         if self.verbose {
-            // Over a progress line, if one was shown.
-            let clear = if state.progress { "\r\x1b[2K" } else { "" };
-            log::info!(
-                "{clear}    coupled GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
+            log::trace!(
+                "    coupled GMRES: {} iterations (+{} residuals), relative residual {:.1e} \
                  (start {:.1e}, target {:.1e})",
                 stats.iterations,
                 stats.residual_products,

@@ -92,6 +92,7 @@ use crate::elastic::{
 };
 use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::BodySolverKind;
+use crate::progress::Heartbeat;
 
 /// [`ContactSolver::check_held`]: a free motion is held when the Gram matrix's eigenvalue along
 /// it, per row, exceeds this. Measured (2026-11-28): a block resting flat, its rotation 0.15; a
@@ -528,6 +529,7 @@ impl<'a> ContactSolver<'a> {
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.loop_settings().max_iterations {
             self.solver.cancel.check()?;
+            let _beat = Heartbeat::start(self.solver.verbose, format!("  iteration {iteration}"));
             if let Some(end) = self.iteration(&mut state, iteration, factors)? {
                 status = end;
                 break;
@@ -720,7 +722,7 @@ impl ContactSolver<'_> {
             record.max_direction_change = Some(update.max_direction_change);
         }
         if self.solver.verbose {
-            log::info!("{}", record.line());
+            log::debug!("{}", record.line(log::log_enabled!(log::Level::Trace)));
         }
         Ok(state.advance(record, (couplings, solution), step))
     }
@@ -799,7 +801,7 @@ impl ContactSolver<'_> {
                 zone.extend(closest);
             }
             if self.solver.verbose {
-                log::info!(
+                log::debug!(
                     "  '{}' and '{}': a body only the contacts hold starts on {} nodes (the zone \
                      where two half-spaces carry the force {force:.6e}, or those that touch)",
                     problem.primary.body.name,
@@ -991,7 +993,7 @@ impl ContactSolver<'_> {
             let c0 = compliance_factor(materials, s1.dim);
             let predicted = predicted_set(s1, &candidates, &gaps[p], &pressure, c0);
             if self.solver.verbose {
-                log::info!(
+                log::debug!(
                     "  half-space prediction: {} nodes active next (the update's {})",
                     predicted.len(),
                     self.pair_nodes(next, p).len()
