@@ -12,144 +12,15 @@ use std::collections::HashMap;
 
 use faer::sparse::SparseColMat;
 
-use super::solve::timed;
-use super::{ElasticProblem, ProblemError, SolveError, SolveStats, StepFactors};
+use super::StepFactors;
+use super::error::SolveError;
+use super::problem::{ElasticProblem, ForcedComponent, constraints, forced_components};
+use super::solution::{SolveStats, timed};
 use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::{Constraints, NodeColumns, NodeGraph};
 use crate::linalg::{Distribution, LinalgError, RankRows};
 use crate::parallel::ranks::Ranks;
-
-/// The prescribed dofs and values of a problem; conflicting values on shared nodes are errors.
-pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, ProblemError> {
-    let body = problem.body;
-    let dim = body.dim;
-    let mut constraints = Constraints::new(body.num_dofs());
-    // The load path of each nonzero prescribed value, when some condition names one: a value
-    // follows one path (a 0 is 0 on every path).
-    let with_paths = problem.dirichlet.iter().any(|d| d.path.is_some());
-    let mut path_of: HashMap<usize, (Option<&str>, &str)> = HashMap::new();
-    // The group that prescribes each dof, for a force on it to name.
-    let mut prescribed_by: HashMap<usize, &str> = HashMap::new();
-    for condition in &problem.dirichlet {
-        let nodes = body
-            .group_nodes(&condition.group)
-            .expect("groups are checked first");
-        for node in nodes {
-            for (component, value) in condition.components.iter().enumerate().take(dim) {
-                if let Some(value) = *value {
-                    let dof = dim * node + component;
-                    constraints.prescribe(dof, value).map_err(|first| {
-                        ProblemError::ConflictingDirichlet {
-                            body: body.name.clone(),
-                            group: condition.group.clone(),
-                            node_tag: body.node_tags[node],
-                            component,
-                            first,
-                            second: value,
-                        }
-                    })?;
-                    prescribed_by.entry(dof).or_insert(condition.group.as_str());
-                    let path = condition.path.as_deref();
-                    if with_paths && value != 0.0 {
-                        let on = (path, condition.group.as_str());
-                        match path_of.insert(dof, on) {
-                            Some(first) if first.0 != path => {
-                                let name = |(path, group): (Option<&str>, &str)| match path {
-                                    None => format!("the default load path (on '{group}')"),
-                                    Some(name) => format!("load path '{name}' (on '{group}')"),
-                                };
-                                return Err(ProblemError::ConflictingPath {
-                                    body: body.name.clone(),
-                                    node_tag: body.node_tags[node],
-                                    component,
-                                    value,
-                                    paths: format!("{} and {}", name(first), name(on)),
-                                });
-                            }
-                            _ => {}
-                        }
-                    }
-                }
-            }
-        }
-    }
-    // A force-controlled dof is held at 0 in `K_c`: its displacement is the group's unknown,
-    // which enters through its column (`RigidColumn`).
-    let mut forced_by: HashMap<usize, String> = HashMap::new();
-    for forced in forced_components(problem) {
-        for &dof in &forced.dofs {
-            if let Some(value) = constraints.value(dof) {
-                let other = match (forced_by.get(&dof), prescribed_by.get(&dof)) {
-                    (Some(group), _) => format!("by group '{group}'"),
-                    (None, Some(group)) => {
-                        format!("prescribed {value} by the Dirichlet condition on group '{group}'")
-                    }
-                    (None, None) => format!("prescribed {value}"),
-                };
-                return Err(ProblemError::ForcedTwice {
-                    body: body.name.clone(),
-                    group: forced.group.clone(),
-                    node_tag: body.node_tags[dof / dim],
-                    component: forced.component,
-                    other,
-                });
-            }
-            constraints
-                .prescribe(dof, 0.0)
-                .expect("the dof was free: checked above");
-            forced_by.insert(dof, forced.group.clone());
-        }
-    }
-    Ok(constraints)
-}
-
-/// One force-controlled component of a group: its dofs (one per node of the group) and force;
-/// or a rigid-mode pin (`ElasticProblem::pins`), one dof with no force.
-pub(crate) struct ForcedComponent {
-    pub group: String,
-    pub component: usize,
-    pub force: f64,
-    pub dofs: Vec<usize>,
-    pub pin: bool,
-    /// The load path the force follows (`None`: the default one).
-    pub path: Option<String>,
-}
-
-/// The force-controlled components of `problem`, group after group, component after component.
-pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent> {
-    let body = problem.body;
-    let dim = body.dim;
-    let mut out = Vec::new();
-    for condition in &problem.forces {
-        let nodes = body
-            .group_nodes(&condition.group)
-            .expect("groups are checked first");
-        for (component, force) in condition.components.iter().enumerate().take(dim) {
-            if let Some(force) = *force {
-                out.push(ForcedComponent {
-                    group: condition.group.clone(),
-                    component,
-                    force,
-                    dofs: nodes.iter().map(|&node| dim * node + component).collect(),
-                    pin: false,
-                    path: condition.path.clone(),
-                });
-            }
-        }
-    }
-    for &(node, component) in &problem.pins {
-        out.push(ForcedComponent {
-            group: format!("rigid-mode pin at node {}", body.node_tags[node]),
-            component,
-            force: 0.0,
-            dofs: vec![dim * node + component],
-            pin: true,
-            path: None,
-        });
-    }
-    out
-}
 
 /// A body's assembled system: `f` as assembled, the Dirichlet-constrained `K_c` (on the
 /// pattern of `K`) and `f_c`, and what the reactions need of `K`.

@@ -1,9 +1,12 @@
 //! The result of one elastic solve.
 
+use std::time::Instant;
+
 use serde::Serialize;
 
 use crate::fem::stress::CellFields;
 use crate::linalg::BodySolverKind;
+use crate::progress::Heartbeat;
 
 /// Displacement, cell fields, reactions and solver statistics of one body.
 #[derive(Debug, Clone)]
@@ -40,4 +43,24 @@ pub struct SolveStats {
     pub relative_residual: f64,
     /// Seconds per phase, in order.
     pub timings: Vec<(String, f64)>,
+}
+
+/// Runs `f`, records its duration under `name`, and when verbose reports it (in the `-v` log:
+/// one line per body solve is enough by default) and its progress if it runs long.
+pub(crate) fn timed<T>(
+    stats: &mut SolveStats,
+    verbose: bool,
+    name: &str,
+    f: impl FnOnce() -> T,
+) -> T {
+    let start = Instant::now();
+    let beat = Heartbeat::start(verbose, format!("    {name}"));
+    let value = f();
+    drop(beat);
+    let seconds = start.elapsed().as_secs_f64();
+    if verbose {
+        log::debug!("    {name:<28} {seconds:>8.3} s");
+    }
+    stats.timings.push((name.to_string(), seconds));
+    value
 }

@@ -1,20 +1,18 @@
 //! One body, `K u = f`, solved by sparse Cholesky or by CG + AMG (`crate::linalg::BodySolver`).
 
-use std::time::Instant;
-
 use serde::{Deserialize, Serialize};
-use thiserror::Error;
 
-use super::{
-    AssembledBody, ElasticProblem, ElasticSolution, ProblemError, SolveStats, StepFactors, assemble,
-};
+use super::StepFactors;
+use super::assemble::{AssembledBody, assemble};
+use super::error::SolveError;
+use super::problem::ElasticProblem;
+use super::solution::{ElasticSolution, SolveStats, timed};
 use crate::cancel::Cancel;
 use crate::fem::stress::cell_fields;
 use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
     relative_difference, relative_residual,
 };
-use crate::progress::Heartbeat;
 
 /// How to solve; every field has a documented default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -80,54 +78,6 @@ impl Default for SolverSettings {
             keep_step_fields: false,
         }
     }
-}
-
-#[derive(Debug, Error)]
-pub enum SolveError {
-    #[error(transparent)]
-    Problem(#[from] ProblemError),
-    #[error("body '{body}': {source}")]
-    Linalg { body: String, source: LinalgError },
-    #[error(
-        "body '{body}': the linear solve is inaccurate (relative residual {residual:.2e} > [solver] \
-         residual_tolerance {tolerance:.0e}); the mesh may be badly graded or the material nearly \
-         incompressible"
-    )]
-    Inaccurate {
-        body: String,
-        residual: f64,
-        tolerance: f64,
-    },
-    #[error(
-        "body '{body}' is held along {component} by nothing but the force-controlled group \
-         '{group}': alone, nothing balances that force; prescribe a displacement along \
-         {component} somewhere, or put the body in contact"
-    )]
-    Unheld {
-        body: String,
-        group: String,
-        component: &'static str,
-    },
-}
-
-/// Runs `f`, records its duration under `name`, and when verbose reports it (in the `-v` log:
-/// one line per body solve is enough by default) and its progress if it runs long.
-pub(crate) fn timed<T>(
-    stats: &mut SolveStats,
-    verbose: bool,
-    name: &str,
-    f: impl FnOnce() -> T,
-) -> T {
-    let start = Instant::now();
-    let beat = Heartbeat::start(verbose, format!("    {name}"));
-    let value = f();
-    drop(beat);
-    let seconds = start.elapsed().as_secs_f64();
-    if verbose {
-        log::debug!("    {name:<28} {seconds:>8.3} s");
-    }
-    stats.timings.push((name.to_string(), seconds));
-    value
 }
 
 /// Reaction of each Dirichlet and force-controlled group: `sum (K u - f_s - f_other)` over its

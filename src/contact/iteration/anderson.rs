@@ -83,11 +83,7 @@ impl DirectionAcceleration {
     /// Anderson's combination (module doc) over the `common` nodes of the kept iterates and
     /// `current`, each node's direction normalized again (the plain update where it points away
     /// from it).
-    fn combination(
-        &self,
-        current: &Iterate,
-        common: &[usize],
-    ) -> Vec<(usize, [f64; 3])> {
+    fn combination(&self, current: &Iterate, common: &[usize]) -> Vec<(usize, [f64; 3])> {
         let stack = |iterate: &Iterate, part: usize| {
             DVector::from_iterator(
                 3 * common.len(),

@@ -72,12 +72,12 @@ use std::sync::{Mutex, PoisonError};
 
 use faer::sparse::SparseColMat;
 
+use super::LinalgError;
+use super::distribution::{Distribution, RankRows};
+use crate::parallel::ranks::Ranks;
 pub use mpi::{abort_world, broadcast_bytes, finalize, gather_values, world_ranks};
 pub use runtime::concurrent_v_cycles;
 use runtime::{MpiFint, PETSC, petsc, petsc_error, text};
-use super::distribution::{Distribution, RankRows};
-use super::LinalgError;
-use crate::parallel::ranks::Ranks;
 
 #[repr(C)]
 struct RawCgAmg {

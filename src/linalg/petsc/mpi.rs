@@ -124,4 +124,3 @@ pub fn finalize() -> Result<(), LinalgError> {
         code => Err(petsc_error(step, code)),
     }
 }
-

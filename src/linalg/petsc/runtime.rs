@@ -76,4 +76,3 @@ pub(super) fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
         }),
     }
 }
-
