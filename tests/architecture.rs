@@ -1,20 +1,24 @@
 //! The shape of `src/contact/`: its module docs list the parts of a solve in order (`mod.rs`
 //! its folders and files, each folder's `mod.rs` the folder's files), and each file imports only
 //! files listed before it. The imports then run one way (no cycle), and a newcomer can read the
-//! files in that order.
+//! files in that order. Across the whole crate, no files import each other, directly or through
+//! others.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 const CONTACT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/src/contact");
+/// How a file of `src/contact` names the others: `crate::contact::...` (or `super::`).
+const CONTACT_ROOT: &str = "crate::contact::";
+const SRC: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/src");
 
-/// Every `.rs` file under `src/contact`, by its path from there (`geometry/gap.rs`).
-fn contact_files(dir: &Path, under: &str, files: &mut BTreeMap<String, String>) {
+/// Every `.rs` file under `dir`, by its path from there (`geometry/gap.rs`).
+fn rust_files(dir: &Path, under: &str, files: &mut BTreeMap<String, String>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         let name = path.file_name().unwrap().to_str().unwrap().to_string();
         if path.is_dir() {
-            contact_files(&path, &format!("{under}{name}/"), files);
+            rust_files(&path, &format!("{under}{name}/"), files);
         } else if name.ends_with(".rs") {
             files.insert(
                 format!("{under}{name}"),
@@ -29,7 +33,7 @@ fn contact_files(dir: &Path, under: &str, files: &mut BTreeMap<String, String>) 
 fn module_of(file: &str) -> String {
     let path = file.strip_suffix(".rs").unwrap();
     let path = match path {
-        "mod" => "",
+        "mod" | "lib" => "",
         path => path.strip_suffix("/mod").unwrap_or(path),
     };
     path.replace('/', "::")
@@ -150,10 +154,10 @@ fn tree_paths(rest: &str, prefix: &str, paths: &mut Vec<String>) {
     paths.push(path);
 }
 
-/// The paths (from `contact`) a file's code names through `crate::contact::` or `super::`
-/// (comments and the unit tests left out); `module` is the file's module (a folder's `mod.rs`
-/// is the folder, whose `super` is the folder above).
-fn named_paths(source: &str, module: &str) -> Vec<String> {
+/// The paths (from the tree's root) a file's code names through `root` (`crate::contact::`, or
+/// `crate::` for the whole crate) or `super::` (comments and the unit tests left out); `module`
+/// is the file's module (a folder's `mod.rs` is the folder, whose `super` is the folder above).
+fn named_paths(source: &str, module: &str, root: &str) -> Vec<String> {
     let code: String = (source.split("#[cfg(test)]").next().unwrap().lines())
         .filter(|l| !l.trim_start().starts_with("//"))
         .collect::<Vec<_>>()
@@ -161,7 +165,7 @@ fn named_paths(source: &str, module: &str) -> Vec<String> {
     let mut paths = Vec::new();
     let mut at = 0;
     loop {
-        let next = (["crate::contact::", "super::"].into_iter())
+        let next = ([root, "super::"].into_iter())
             .filter_map(|prefix| code[at..].find(prefix).map(|i| (at + i, prefix)))
             .min();
         let Some((i, prefix)) = next else {
@@ -192,11 +196,13 @@ fn named_paths(source: &str, module: &str) -> Vec<String> {
     paths
 }
 
-/// What the `pub use` lines of the `mod.rs` files re-export: each name, by the module path it
-/// is reached through (`rbf` by `geometry::rbf`, `law::NodeStates` by `law::state::NodeStates`).
-fn reexports(files: &BTreeMap<String, String>) -> BTreeMap<String, String> {
+/// What the `pub use` lines of the `mod.rs` files (and `lib.rs`) re-export: each name, by the
+/// module path it is reached through (`rbf` by `geometry::rbf`, `law::NodeStates` by
+/// `law::state::NodeStates`); `root` as in [`named_paths`].
+fn reexports(files: &BTreeMap<String, String>, root: &str) -> BTreeMap<String, String> {
     let mut aliases = BTreeMap::new();
-    for (file, source) in files.iter().filter(|(f, _)| f.ends_with("mod.rs")) {
+    let roots = |f: &&String| f.ends_with("mod.rs") || *f == "lib.rs";
+    for (file, source) in files.iter().filter(|(f, _)| roots(f)) {
         let module = module_of(file);
         let prefix = if module.is_empty() {
             String::new()
@@ -216,7 +222,7 @@ fn reexports(files: &BTreeMap<String, String>) -> BTreeMap<String, String> {
                 continue;
             };
             let mut paths = Vec::new();
-            match tree.strip_prefix("crate::contact::") {
+            match tree.strip_prefix(root) {
                 Some(tree) => tree_paths(tree, "", &mut paths),
                 None => tree_paths(tree, &prefix, &mut paths),
             }
@@ -252,11 +258,12 @@ fn resolve(path: &str, modules: &[String], aliases: &BTreeMap<String, String>) -
 fn imports(
     source: &str,
     module: &str,
+    root: &str,
     modules: &[String],
     aliases: &BTreeMap<String, String>,
 ) -> Vec<String> {
     let mut found = Vec::new();
-    for path in named_paths(source, module) {
+    for path in named_paths(source, module, root) {
         if let Some(target) = resolve(&path, modules, aliases).filter(|t| !found.contains(t)) {
             found.push(target);
         }
@@ -268,7 +275,7 @@ fn imports(
 /// folder's `mod.rs` may use its own files: it declares them).
 fn check(files: &BTreeMap<String, String>) -> (Vec<String>, Vec<String>) {
     let order = documented_order(files);
-    let aliases = reexports(files);
+    let aliases = reexports(files, CONTACT_ROOT);
     let mut wrong = Vec::new();
     for (position, module) in order.iter().enumerate() {
         let file = file_of(module, files);
@@ -276,7 +283,7 @@ fn check(files: &BTreeMap<String, String>) -> (Vec<String>, Vec<String>) {
             continue;
         };
         let is_mod_rs = file.ends_with("mod.rs");
-        for import in imports(source, module, &order, &aliases) {
+        for import in imports(source, module, CONTACT_ROOT, &order, &aliases) {
             let at = order.iter().position(|o| *o == import).unwrap();
             let own = is_mod_rs && import.starts_with(&format!("{module}::"));
             if at > position && !own {
@@ -291,7 +298,7 @@ fn check(files: &BTreeMap<String, String>) -> (Vec<String>, Vec<String>) {
 #[test]
 fn contact_files_import_only_files_listed_before_them() {
     let mut files = BTreeMap::new();
-    contact_files(Path::new(CONTACT), "", &mut files);
+    rust_files(Path::new(CONTACT), "", &mut files);
     let (order, wrong) = check(&files);
 
     let mut listed = order.clone();
@@ -335,7 +342,7 @@ fn the_import_reader_sees_grouped_and_reexported_imports() {
                   fn f() { crate::contact::iteration::solve::run(); }\n#[cfg(test)]\n\
                   use crate::contact::nothing;";
     assert_eq!(
-        imports(source, "law::coulomb", &modules, &aliases),
+        imports(source, "law::coulomb", CONTACT_ROOT, &modules, &aliases),
         [
             "solution",
             "geometry::gap",
@@ -347,7 +354,13 @@ fn the_import_reader_sees_grouped_and_reexported_imports() {
     );
     // A folder's mod.rs is the folder: its `super` is the parent.
     assert_eq!(
-        imports("use super::solution::X;", "law", &modules, &aliases),
+        imports(
+            "use super::solution::X;",
+            "law",
+            CONTACT_ROOT,
+            &modules,
+            &aliases
+        ),
         ["solution"].map(String::from)
     );
 
@@ -393,5 +406,80 @@ fn the_import_reader_sees_grouped_and_reexported_imports() {
     assert_eq!(
         wrong,
         ["geometry/gap.rs imports solution.rs, listed after it"]
+    );
+}
+
+/// The import graph of the whole crate (`src/`, the command line's `main.rs` aside): each
+/// module with the modules it imports, re-exported items counted for the module that defines
+/// them, a `mod.rs` not importing its own files (it declares them).
+fn crate_imports() -> BTreeMap<String, Vec<String>> {
+    let mut files = BTreeMap::new();
+    rust_files(Path::new(SRC), "", &mut files);
+    files.remove("main.rs");
+    let modules: Vec<String> = files.keys().map(|f| module_of(f)).collect();
+    let aliases = reexports(&files, "crate::");
+    (files.iter())
+        .map(|(file, source)| {
+            let module = module_of(file);
+            let own = |import: &String| {
+                file.ends_with("mod.rs") && import.starts_with(&format!("{module}::"))
+            };
+            let imported = imports(source, &module, "crate::", &modules, &aliases);
+            let imported = (imported.into_iter())
+                .filter(|import| *import != module && !own(import))
+                .collect();
+            (module, imported)
+        })
+        .collect()
+}
+
+/// A cycle of `graph` (its modules in import order, the first repeated at the end), if any.
+fn a_cycle(graph: &BTreeMap<String, Vec<String>>) -> Option<Vec<String>> {
+    fn visit(
+        module: &str,
+        graph: &BTreeMap<String, Vec<String>>,
+        path: &mut Vec<String>,
+        done: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(at) = path.iter().position(|m| m == module) {
+            let mut cycle = path[at..].to_vec();
+            cycle.push(module.to_string());
+            return Some(cycle);
+        }
+        if done.iter().any(|m| m == module) {
+            return None;
+        }
+        path.push(module.to_string());
+        for next in graph.get(module).into_iter().flatten() {
+            if let Some(cycle) = visit(next, graph, path, done) {
+                return Some(cycle);
+            }
+        }
+        path.pop();
+        done.push(module.to_string());
+        None
+    }
+    let mut done = Vec::new();
+    (graph.keys()).find_map(|m| visit(m, graph, &mut Vec::new(), &mut done))
+}
+
+#[test]
+fn no_two_files_of_the_crate_import_each_other_even_through_others() {
+    let graph = crate_imports();
+    assert!(graph.len() > 50, "the reader found {} modules", graph.len());
+    // The reader must see the crate's imports: one known edge of each kind (a `crate::` path
+    // through a re-export, and a `super::` path).
+    assert!(graph["contact::iteration::solve"].contains(&"parallel::ranks".to_string()));
+    assert!(graph["elastic::solve"].contains(&"elastic::assemble".to_string()));
+    assert_eq!(a_cycle(&graph), None, "an import circle");
+    // And the search must be able to find one.
+    let circle = BTreeMap::from([
+        ("a".to_string(), vec!["b".to_string()]),
+        ("b".to_string(), vec!["c".to_string()]),
+        ("c".to_string(), vec!["a".to_string()]),
+    ]);
+    assert_eq!(
+        a_cycle(&circle),
+        Some(["a", "b", "c", "a"].map(String::from).to_vec())
     );
 }
