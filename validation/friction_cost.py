@@ -52,14 +52,17 @@ def mesh(level: float) -> Path:
     return path
 
 
-def case(msh: Path, formulation: str, output: Path) -> Path:
+def case(msh: Path, formulation: str, output: Path, press: tuple[float, ...] = (1.0, 1.0),
+         shear: tuple[float, ...] = (0.0, 1.0)) -> Path:
+    """The case file of one run, beside ``output``: the sphere's top pressed down by
+    ``APPROACH`` times the factors ``press`` and moved along x by ``SHEAR`` times ``shear``."""
     friction = f"\nfriction_coefficient = {MU}" if formulation == "coulomb" else ""
     text = f"""mesh = {json.dumps(str(msh))}
 output = {json.dumps(str(output))}
 
 [load_path]
-press = [1.0, 1.0]
-shear = [0.0, 1.0]
+press = [{", ".join(str(f) for f in press)}]
+shear = [{", ".join(str(f) for f in shear)}]
 
 [contact]
 bodies = ["sphere", "block"]
@@ -94,7 +97,8 @@ ux = 0.0
 uy = 0.0
 uz = 0.0
 """
-    path = BUILD / f"{formulation}.toml"
+    output.parent.mkdir(parents=True, exist_ok=True)
+    path = output.parent / f"{output.name}.toml"
     path.write_text(text)
     return path
 

@@ -44,14 +44,12 @@ VALIDATION = Path(__file__).resolve().parent
 REPO = VALIDATION.parent
 sys.path.insert(0, str(VALIDATION))
 
-from friction_cost import mesh  # noqa: E402  (the same geo parameters, meshes cached by level)
+from friction_cost import MU, SHEAR, case, mesh  # noqa: E402  (the same case, meshes cached by level)
 
 BUILD = VALIDATION / "build" / "mindlin_displacement"
 REPORT = VALIDATION / "report" / "mindlin_displacement.md"
-APPROACH = 0.01
-SHEAR = 0.0012
 SHEAR_FACTORS = [0.25, 0.5, 1.0]
-MU = 0.3
+# The materials of both bodies in friction_cost.case.
 E, NU = 1000.0, 0.3
 
 
@@ -64,54 +62,6 @@ def load_path(press_steps: int) -> tuple[list[float], list[float]]:
     press = [first + k * increment for k in range(press_steps)] + [1.0] * len(SHEAR_FACTORS)
     shear = [0.0] * press_steps + SHEAR_FACTORS
     return press, shear
-
-
-def case(msh: Path, formulation: str, output: Path, press_steps: int) -> Path:
-    friction = f"\nfriction_coefficient = {MU}" if formulation == "coulomb" else ""
-    press, shear = (", ".join(str(f) for f in factors) for factors in load_path(press_steps))
-    text = f"""mesh = {json.dumps(str(msh))}
-output = {json.dumps(str(output))}
-
-[load_path]
-press = [{press}]
-shear = [{shear}]
-
-[contact]
-bodies = ["sphere", "block"]
-surfaces = ["sphere_contact", "block_contact"]
-formulation = "{formulation}"{friction}
-
-[[body]]
-name = "sphere"
-youngs_modulus = {E}
-poisson_ratio = {NU}
-
-[[body.dirichlet]]
-group = "sphere_top"
-uz = {-APPROACH}
-path = "press"
-
-[[body.dirichlet]]
-group = "sphere_top"
-ux = {SHEAR}
-uy = 0.0
-path = "shear"
-
-[[body]]
-name = "block"
-youngs_modulus = {E}
-poisson_ratio = {NU}
-
-[[body.dirichlet]]
-group = "block_base"
-ux = 0.0
-uy = 0.0
-uz = 0.0
-"""
-    output.parent.mkdir(parents=True, exist_ok=True)
-    path = output.parent / f"{output.name}.toml"
-    path.write_text(text)
-    return path
 
 
 def solve(binary: Path, case_file: Path, output: Path) -> dict:
@@ -129,7 +79,8 @@ def measure(binary: Path, level: float, press_steps: int) -> dict:
     runs = {}
     for formulation in ("coulomb", "tied"):
         output = BUILD / f"level{level}-press{press_steps}" / formulation
-        runs[formulation] = solve(binary, case(msh, formulation, output, press_steps), output)
+        press, shear = load_path(press_steps)
+        runs[formulation] = solve(binary, case(msh, formulation, output, tuple(press), tuple(shear)), output)
     coulomb, tied = runs["coulomb"]["contact"], runs["tied"]["contact"]
     g = E / (2.0 * (1.0 + NU))
     g_star = 1.0 / (2.0 * (2.0 - NU) / g)
