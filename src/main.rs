@@ -124,7 +124,10 @@ fn main() -> ExitCode {
         },
         Command::Info { .. } => log::LevelFilter::Info,
     };
-    StderrLogger::install(level);
+    // A study's default log is one line per level: each level's own solve log needs -v.
+    let study_lines_only =
+        matches!(cli.command, Command::Study { .. }) && level == log::LevelFilter::Info;
+    StderrLogger::install(level, study_lines_only);
     // Under MPI the ranks would stop at different safe points and wait for each other: the
     // launcher ends them as it ends any program.
     let cancel = match ranks.size {
@@ -301,6 +304,9 @@ fn study(case: &Path, spec: &StudySpec, options: &StudyOptions) -> Result<u8, Bo
 /// where a carriage return would garble the text.
 struct StderrLogger {
     terminal: bool,
+    /// Whether the only info lines shown are the study's own ([`internodes::study::LOG_TARGET`])
+    /// and progress lines.
+    study_lines_only: bool,
     /// Whether a progress line is on screen, not ended by a newline.
     progress_shown: Mutex<bool>,
 }
@@ -309,10 +315,11 @@ struct StderrLogger {
 const WIDTH: usize = 120;
 
 impl StderrLogger {
-    fn install(level: log::LevelFilter) {
+    fn install(level: log::LevelFilter, study_lines_only: bool) {
         static LOGGER: OnceLock<StderrLogger> = OnceLock::new();
         let logger = LOGGER.get_or_init(|| StderrLogger {
             terminal: std::io::stderr().is_terminal(),
+            study_lines_only,
             progress_shown: Mutex::new(false),
         });
         // Only fails when a logger is already installed, which nothing else in the CLI does.
@@ -323,7 +330,13 @@ impl StderrLogger {
 
 impl log::Log for StderrLogger {
     fn enabled(&self, metadata: &log::Metadata) -> bool {
+        let shown = |target: &str| {
+            target == internodes::study::LOG_TARGET || target == internodes::progress::TARGET
+        };
         metadata.level() <= log::max_level()
+            && (!self.study_lines_only
+                || metadata.level() <= log::Level::Warn
+                || shown(metadata.target()))
     }
 
     fn log(&self, record: &log::Record) {

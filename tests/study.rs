@@ -191,3 +191,41 @@ fn bad_values_and_meshes_that_are_not_geo_are_refused() {
     assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("not a .geo"), "{stderr}");
 }
+
+#[test]
+fn the_default_log_is_one_line_per_level_and_v_adds_each_solve_log() {
+    let (dir, case) = coarse_half_disc().write();
+    let log_of = |flags: &[&str]| {
+        let run = Command::new(BINARY)
+            .args(["study", case.to_str().unwrap(), "--parameter", "level=-1,0"])
+            .arg("--output")
+            .arg(dir.path().join("log"))
+            .args(flags)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8(run.stderr).unwrap();
+        assert!(run.status.success(), "{flags:?}: {stderr}");
+        stderr
+    };
+    let default = log_of(&[]);
+    let lines: Vec<&str> = default.lines().collect();
+    assert_eq!(lines.len(), 2, "one line per level: {default}");
+    for (line, value) in lines.iter().zip(["-1", "0"]) {
+        assert!(
+            line.starts_with(&format!("study: level = {value}: converged (exit 0); h "))
+                && line.contains(" DOFs, force "),
+            "{line}"
+        );
+        assert!(line.chars().count() <= 120, "{line}");
+    }
+    // -v: each level's solve log as `solve -v` prints it (its iterations among them).
+    let verbose = log_of(&["-v"]);
+    let count = |start: &str| verbose.lines().filter(|l| l.starts_with(start)).count();
+    assert_eq!(count("contact status: converged"), 2, "{verbose}");
+    assert!(count("  iteration ") >= 2, "{verbose}");
+    assert_eq!(
+        count("study: level = "),
+        4,
+        "each level's start and end: {verbose}"
+    );
+}

@@ -233,7 +233,7 @@ fn solve_level(
 ) -> Result<Level, StudyError> {
     let started = Instant::now();
     let name = spec.folder_name(value);
-    log::info!(
+    log::debug!(
         "study: {} = {value} into {}",
         spec.parameter,
         folder.join(&name).display()
@@ -264,7 +264,7 @@ fn solve_level(
     let surfaces = contact.map(|c| (c.bodies, c.surfaces));
     let spacing = contact_zone_spacing(&run.mesh, &run.solution, &primary, surfaces.as_ref());
     let verdict = summary.verdict();
-    Ok(Level {
+    let level = Level {
         value,
         folder: name,
         spacing,
@@ -278,7 +278,27 @@ fn solve_level(
         quantities: (QUANTITIES.iter())
             .map(|q| (q.key.to_string(), (q.read)(summary)))
             .collect(),
-    })
+    };
+    log::info!(target: LOG_TARGET, "{}", level.line(&spec.parameter));
+    Ok(level)
+}
+
+/// The log target of the study's own lines: `internodes study` shows only these (and
+/// warnings and progress lines) at its default level, each level's solve log with `-v`.
+pub const LOG_TARGET: &str = "internodes::study";
+
+impl Level {
+    /// The level's line of the log: status, exit status, size, force and time.
+    fn line(&self, parameter: &str) -> String {
+        let force = (self.quantities.iter())
+            .find(|(key, _)| key == "force")
+            .and_then(|(_, value)| *value)
+            .map_or_else(|| "no force".to_string(), |f| format!("force {f:.4e}"));
+        format!(
+            "study: {parameter} = {}: {} (exit {}); h {:.3e}, {} DOFs, {force}; {:.1} s",
+            self.value, self.status, self.exit_status, self.spacing.h, self.num_dofs, self.seconds
+        )
+    }
 }
 
 /// The estimates of every quantity and the study's exit status.
