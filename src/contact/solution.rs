@@ -91,9 +91,10 @@ pub struct IterationRecord {
     /// Largest |geometric gap| of an active node over its h: how far the active nodes are
     /// from the other body's discrete surface.
     pub max_gap_error_over_h: f64,
-    /// How far the surfaces have slid over each other since the interface operators were
-    /// paired (the change of the active nodes' mean slide), over the smallest spacing of the
-    /// active primary nodes (they are paired again beyond 0.05).
+    /// How far the surfaces have slid over each other from where the interface operators were
+    /// paired (the active nodes' mean slide against the pairing's), over the smallest spacing
+    /// of the active primary nodes (the pairing follows the slide on a grid of 0.05 of the
+    /// smallest candidate spacing: `docs/method.md` 3.5).
     pub pairing_drift_over_h: f64,
     pub relative_residual: f64,
     /// GMRES iterations of the iteration's interface solves (a loose solve and, when its

@@ -75,7 +75,7 @@ const NO_PROGRESS_AFTER: usize = 10;
 /// [`ContactStatus::Stalled`] otherwise, instead of running to the iteration cap. (A node on
 /// an edge of the other P1 surface can hold the error at 1e-5 h, its closest facet changing
 /// every iteration: seen on the half-disc, whose block surface bends at each node.)
-const CONTRACTION: f64 = 0.5;
+pub(super) const CONTRACTION: f64 = 0.5;
 
 /// See [`CONTRACTION`].
 const STALLED_AFTER: usize = 2;

@@ -14,8 +14,9 @@
 //!   3. gaps of every candidate: geometric g (closest point, deformed); L <- linearized at u
 //!      (tied: e <- g - g_lin); the slide s of the surfaces over each other
 //!   4. A' <- {i in A : p_i >= -tol_t p_max}  +  {i not in A : g_i < -tol_p h_i}
-//!   5. if A' = A, settled, and s moved more than 0.05 h from the operators' pairing:
-//!      pair the operators again for s (each node moved by s), A' <- A
+//!   5. if A' = A, settled, and s rounded to the pairing grid (0.05 h) is not the operators'
+//!      pairing, nor one this solve left: pair the operators again for it (each node moved
+//!      by it), A' <- A
 //! until A' = A and every active node lies on the other surface (|g_i| <= 0.01 tol_p h_i),
 //!   or A' = A and |g_i| stopped shrinking (by half, twice): converged within tol_p h_i,
 //!   stalled beyond
@@ -77,7 +78,7 @@ use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, 
 use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::iteration::anderson::DirectionAcceleration;
-use crate::contact::iteration::safeguard::{Safeguard, Step};
+use crate::contact::iteration::safeguard::{CONTRACTION, Safeguard, Step};
 use crate::contact::law::{ContactLaw, NodeStates, Tangential, coulomb};
 use crate::contact::problem::ContactProblem;
 use crate::contact::settings::{ContactSettings, CoupledSolver, Transfer};
@@ -145,10 +146,27 @@ fn motions_left_free(coords: &[[f64; 3]], body: &AssembledBody) -> nalgebra::DMa
 /// ([`ContactSolver::check_held`]).
 type HeldRow = ([f64; 3], Vec<[f64; 3]>);
 
-/// When the surfaces have slid ([`InterfaceOperators::slide`]) this many spacings of the
-/// active nodes away from the pairing of the operators, they are paired again once the active
-/// set settles.
-const REPAIR_DRIFT_OVER_H: f64 = 0.05;
+/// The grid the pairing follows the slide on, in spacings of the pair's primary candidates
+/// (the smallest): [`pairing_slide`].
+const PAIRING_STEP_OVER_H: f64 = 0.05;
+
+/// The slide the interface operators of a pair whose surfaces have slid by `slide`
+/// ([`InterfaceOperators::slide`]) are paired for: each component rounded to a multiple of
+/// `PAIRING_STEP_OVER_H` times the smallest spacing of the primary's candidates. A function
+/// of the answer's slide alone, the same on every path to it (one solve or load steps, force
+/// or displacement control, another preconditioner), so that two paths to one answer solve
+/// the same discrete problem; within 0.043 spacings of the slide (half a step along each of
+/// three components). Following the slide itself (pairing again once it moved 0.05 spacings
+/// from the last pairing) left each path on a pairing made where it happened to settle.
+fn pairing_slide(slide: &[f64; 3], primary: &ContactSurface) -> [f64; 3] {
+    let h = (primary.spacing.iter()).fold(f64::INFINITY, |h, &s| h.min(s));
+    let step = PAIRING_STEP_OVER_H * h;
+    if step.is_finite() && step > 0.0 {
+        slide.map(|s| (s / step).round() * step)
+    } else {
+        [0.0; 3]
+    }
+}
 
 /// How far the slide `now` is from the operators' `slid`, over the smallest spacing of the
 /// `active` primary nodes.
@@ -525,6 +543,9 @@ impl<'a> ContactSolver<'a> {
             last: None,
             cold,
             first_contact: false,
+            pairings: vec![Vec::new(); self.pairs.len()],
+            slides: vec![None; self.pairs.len()],
+            slide_change: None,
         };
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.loop_settings().max_iterations {
@@ -580,6 +601,13 @@ struct LoopState {
     /// Whether the loop has chosen where the bodies that only their contacts hold touch first
     /// ([`ContactSolver::first_contact`]).
     first_contact: bool,
+    /// Each pair's pairings ([`pairing_slide`]) this solve has left, with the set it had
+    /// settled on there.
+    pairings: Vec<Vec<([f64; 3], NodeStates)>>,
+    /// Each pair's slide at the last iterate, and the largest change of a pair's slide over
+    /// the last iteration that the loop went on for (over the settling margin).
+    slides: Vec<Option<[f64; 3]>>,
+    slide_change: Option<f64>,
 }
 
 impl LoopState {
@@ -678,15 +706,44 @@ impl ContactSolver<'_> {
         let accelerate = self.pairs[0].primary_surface.dim == 3;
         state.turn_directions(&update.directions, accelerate);
         // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
-        //    settled on a pairing the surfaces have slid away from is paired again where
-        //    they touch, and solved again.
-        let drifted: Vec<usize> = (0..self.pairs.len())
-            .filter(|&p| drift[p] > REPAIR_DRIFT_OVER_H)
+        //    settled on a pairing its slide no longer rounds to is paired again where the
+        //    surfaces touch, and solved again. A pairing this solve has left on the same set
+        //    is not taken again: the slide lies at the edge of a step, within what the pairing
+        //    itself moves it, and going back would cycle.
+        let pairings: Vec<[f64; 3]> = (0..self.pairs.len())
+            .map(|p| pairing_slide(&slid[p], &self.pairs[p].primary_surface))
             .collect();
+        let drifted: Vec<usize> = (0..self.pairs.len())
+            .filter(|&p| {
+                let left = (state.pairings[p].iter())
+                    .any(|(slid, set)| *slid == pairings[p] && *set == state.active);
+                pairings[p] != self.operators[p].slid && !left
+            })
+            .collect();
+        //    The gaps settle before the slide does: each row holds its node along the normal
+        //    of the iterate it was linearized at, and the traction's tangential part follows
+        //    that normal. A slid pair (paired for a slide other than none) whose gaps settled
+        //    but whose slide still moved by more than the settling margin is solved again,
+        //    while that motion at least halves from one iteration to the next. (Unslid, the
+        //    slide is the mesh's asymmetry, and the pairing does not follow it.)
+        let slide_change = (0..self.pairs.len())
+            .filter(|&p| update.settled && self.operators[p].slid != [0.0; 3])
+            .filter_map(|p| {
+                let before = state.slides[p]?;
+                let margin = SETTLED * self.pairs[p].settings.penetration_tolerance;
+                let s1 = &self.pairs[p].primary_surface;
+                Some(pairing_drift(&before, &slid[p], s1, &nodes[p]) / margin)
+            })
+            .fold(0.0, f64::max);
+        let slide_moving = slide_change > 1.0
+            && (state.slide_change).is_none_or(|last| slide_change <= CONTRACTION * last);
+        state.slides = slid.iter().copied().map(Some).collect();
         let step = match state.safeguard.next(&state.active, &update) {
             Step::Stop(ContactStatus::Converged) if !drifted.is_empty() => {
                 for &p in &drifted {
-                    timed(&mut seconds.operators, || self.pair_again(p, slid[p]))?;
+                    let left = (self.operators[p].slid, state.active.clone());
+                    state.pairings[p].push(left);
+                    timed(&mut seconds.operators, || self.pair_again(p, pairings[p]))?;
                     state.corrections[p] = self.corrections(p, &solution, &gaps[p]);
                     if let Some(start) = state.friction[p].as_mut() {
                         let (s1, s2) = (
@@ -698,6 +755,11 @@ impl ContactSolver<'_> {
                     }
                 }
                 state.safeguard = Safeguard::default();
+                state.slide_change = None;
+                Step::Solve(state.active.clone())
+            }
+            Step::Stop(ContactStatus::Converged) if slide_moving => {
+                state.slide_change = Some(slide_change);
                 Step::Solve(state.active.clone())
             }
             // The first iteration of a solve goes on with the set the half-space model
