@@ -2,7 +2,7 @@
 //! test time, coarse: 0.004 at the corner, the block 1.4 times coarser). Against a stiff block the
 //! corner is solved and certified; against a block of the same material the loop does not settle
 //! in the crater the corner digs, and the answers it stops on are wrong. Where the tension bound
-//! alone refuses such an answer, by 2% to 4% of the bound, the force is 15% to 54% off the
+//! alone refuses such an answer, by 2% to 7% of the bound, the force is 15% to 54% off the
 //! same-mesh two-body reference; where the equilibrium bound alone refuses one (0.026 against
 //! 0.01), 1.7% off. The bounds are the scales of what they measure, not numbers to loosen for
 //! corners (`docs/method.md` 4.1).
@@ -84,7 +84,7 @@ fn a_corner_on_an_equal_block_refused_by_a_residual_bound_alone_is_wrong() {
             continue;
         }
         // Not solved, not merely inaccurate: the answer is far off, and where only the tension
-        // bound refuses it (by 2% to 4% of the bound) that bound is all that keeps it from being
+        // bound refuses it (by 2% to 7% of the bound) that bound is all that keeps it from being
         // called solved (exit 3, with its accuracy report failed) or, were the indicators to
         // pass, certified.
         assert!(
@@ -100,7 +100,7 @@ fn a_corner_on_an_equal_block_refused_by_a_residual_bound_alone_is_wrong() {
                 .find(|check| check.name == CheckKind::Tension)
                 .unwrap();
             assert!(
-                tension.value <= 1.05 * tension.tolerance,
+                tension.value <= 1.1 * tension.tolerance,
                 "{label}: refused by tension {} against {}: not the margin this test is about",
                 tension.value,
                 tension.tolerance

@@ -55,9 +55,10 @@ half-space at the full model's force 2F); of the displacement run: ``displacemen
 (its force on the upper plate against F), ``approach`` (the floating disc's mean vertical
 displacement against the force run's, relative) and ``same contact zone`` (the nodes in contact,
 node for node: the discrete contact radius; every node's displacement against the force run's is
-reported with it, not gated: the two runs pair their interface operators at slides up to 0.05 h
-apart, docs/method.md 3.5, so their fields differ at the rim of the zone by more than the loop's
-gap precision while forces and approach agree to it).
+reported with it, not gated: the two runs reach their answers through different iterates, and
+their fields differ at the rim of the zone by more than the loop's gap precision while forces and
+approach agree to it; neither run pairs its interface again, the disc does not slide, so the
+pairing is not the cause).
 
 Every run also has, per pair, ``status`` (converged), ``solved`` and ``accuracy`` (the solver's
 two reports, ``suite.report_rows``) and ``exit`` (0: the answer is trusted).
@@ -630,11 +631,11 @@ def plates_checks(binary: Path, case: MultiCase, msh: Path) -> tuple[list[Check]
         raise RunFailed("the force and displacement runs have different meshes")
     # The contact zone: the same nodes in contact (primary: active; secondary: compressed and
     # touching), node for node. The field itself is reported, not gated: the two runs reach
-    # their answers through different iterates, and each pairs its interface operators again
-    # only when the surfaces have slid 0.05 h from the last pairing (docs/method.md 3.5), so
-    # they solve discrete problems whose pairings differ by up to that slide; their nodal fields
-    # differ by more than the gap-settling precision at the rim of the zone (measured: 1.4e-5 of
-    # the approach at level 1), while their forces and approach agree to it.
+    # their answers through different iterates, and their nodal fields differ by more than the
+    # gap-settling precision at the rim of the zone (measured: 1.4e-5 of the approach at level
+    # 1), while their forces and approach agree to it. Neither run pairs its interface again
+    # (the disc does not slide: the answers are the same bit for bit whether the pairing
+    # follows the slide on a grid or from 0.05 spacings), so the pairing is not the cause.
     zones = force["contact_active"] != 0, shown["contact_active"] != 0
     differing = int(np.count_nonzero(zones[0] != zones[1]))
     difference = np.abs(force["displacement"] - shown["displacement"]).max(axis=1)
@@ -746,8 +747,8 @@ independent answer, before any run was judged):
   solver's own imbalance bound of F (1e-2: the interpolation transfer is not conservative). The
   displacement-controlled run must give back F and the approach within the loop's stopping
   precision (gaps settled to 1e-5 h_c), expressed over the approach, and the same contact zone,
-  node for node (its field is reported: the two runs pair their operators at slides up to 0.05 h
-  apart). Hertz's half-width (full model's force 2F) within 3%, the fit centred on the symmetry
+  node for node (its field is reported: the two runs' iterates differ, and their fields at the
+  rim by more than the gap precision; the pairing is the same unslid one). Hertz's half-width (full model's force 2F) within 3%, the fit centred on the symmetry
   axis.
 """
 
