@@ -105,7 +105,9 @@ uz = 0.0
 
 def run(binary: Path, case_file: Path, output: Path) -> dict:
     start = time.perf_counter()
-    result = subprocess.run([str(binary), "solve", str(case_file), "--output", str(output)],
+    # -vv: the active-set iterations (-v) and the coupled GMRES lines (-vv) are not in the
+    # default log.
+    result = subprocess.run([str(binary), "solve", str(case_file), "--output", str(output), "-vv"],
                             capture_output=True, text=True)
     wall = time.perf_counter() - start
     if result.returncode != 0:
