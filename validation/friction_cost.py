@@ -119,8 +119,10 @@ def run(binary: Path, case_file: Path, output: Path) -> dict:
     # The log's lines of the second step: its active-set iterations and GMRES iterations.
     log = result.stderr + result.stdout
     second = log.split("load step 2/2", 1)[-1]
-    gmres = [int(n) for n in re.findall(r"coupled GMRES: (\d+) iterations", second)]
-    iterations = len(re.findall(r"iteration +\d+:", second))
+    # Anchored at the line's start: a progress line of a long iteration
+    # ("  iteration 5: 5 s (coupled GMRES: 17 iterations, ...)") matches neither.
+    gmres = [int(n) for n in re.findall(r"^\s+coupled GMRES: (\d+) iterations", second, re.M)]
+    iterations = len(re.findall(r"^\s+iteration +\d+: active", second, re.M))
     return {"wall": wall, "steps": step_seconds, "iterations": iterations, "gmres": sum(gmres),
             "statuses": [s["status"] for s in contact["steps"]], "dofs": sum(b["num_dofs"] for b in summary["bodies"]),
             "friction": contact["steps"][-1].get("friction"), "timings": timings}
