@@ -14,9 +14,9 @@
 //!   3. gaps of every candidate: geometric g (closest point, deformed); L <- linearized at u
 //!      (tied: e <- g - g_lin); the slide s of the surfaces over each other
 //!   4. A' <- {i in A : p_i >= -tol_t p_max}  +  {i not in A : g_i < -tol_p h_i}
-//!   5. if A' = A, settled, and s rounded to the pairing grid (0.05 h) is not the operators'
-//!      pairing, nor one this solve left: pair the operators again for it (each node moved
-//!      by it), A' <- A
+//!   5. if A' = A, settled, and s rounded to the pairing grid (0.05 h; none below 0.05 h) is
+//!      not the operators' pairing, nor one this solve left: pair the operators again for it
+//!      (each node moved by it), A' <- A
 //! until A' = A and every active node lies on the other surface (|g_i| <= 0.01 tol_p h_i),
 //!   or A' = A and |g_i| stopped shrinking (by half, twice): converged within tol_p h_i,
 //!   stalled beyond
@@ -146,26 +146,30 @@ fn motions_left_free(coords: &[[f64; 3]], body: &AssembledBody) -> nalgebra::DMa
 /// ([`ContactSolver::check_held`]).
 type HeldRow = ([f64; 3], Vec<[f64; 3]>);
 
-/// The grid the pairing follows the slide on, in spacings of the pair's primary candidates
-/// (the smallest): [`pairing_slide`].
+/// The grid the pairing follows the slide on, and the slide below which the surfaces are
+/// paired unslid, in spacings of the active primary nodes (the smallest): [`pairing_slide`].
 const PAIRING_STEP_OVER_H: f64 = 0.05;
 
 /// The slide the interface operators of a pair whose surfaces have slid by `slide`
-/// ([`InterfaceOperators::slide`]) are paired for: each component rounded to a multiple of
-/// `PAIRING_STEP_OVER_H` times the smallest spacing of the primary's candidates. A function
-/// of the answer's slide alone, the same on every path to it (one solve or load steps, force
-/// or displacement control, another preconditioner), so that two paths to one answer solve
-/// the same discrete problem; within 0.043 spacings of the slide (half a step along each of
-/// three components). Following the slide itself (pairing again once it moved 0.05 spacings
-/// from the last pairing) left each path on a pairing made where it happened to settle.
-fn pairing_slide(slide: &[f64; 3], primary: &ContactSurface) -> [f64; 3] {
-    let h = (primary.spacing.iter()).fold(f64::INFINITY, |h, &s| h.min(s));
+/// ([`InterfaceOperators::slide`]) are paired for, `h` the smallest spacing of its `active`
+/// primary nodes: none while `|slide| <= PAIRING_STEP_OVER_H h`, otherwise each component
+/// rounded to a multiple of `PAIRING_STEP_OVER_H h`. A function of the answer (its slide and
+/// its contact zone), the same on every path to it (one solve or load steps, force or
+/// displacement control), so that two paths to one answer solve the same discrete problem;
+/// within 0.043 spacings of the slide (half a step along each of three components). Following
+/// the slide itself (pairing again once it moved 0.05 spacings from the last pairing) left
+/// each path on a pairing made where it happened to settle. Unslid below one step, as that
+/// rule was: the Poisson expansion of flush blocks slides their surfaces by a few hundredths of
+/// a spacing, and pairing a flush block's end node past the other's end unbalanced a stack's
+/// forces by 2%.
+fn pairing_slide(slide: &[f64; 3], primary: &ContactSurface, active: &[usize]) -> [f64; 3] {
+    let h = (active.iter().map(|&i| primary.spacing[i])).fold(f64::INFINITY, f64::min);
     let step = PAIRING_STEP_OVER_H * h;
-    if step.is_finite() && step > 0.0 {
-        slide.map(|s| (s / step).round() * step)
-    } else {
-        [0.0; 3]
+    let length = slide.iter().map(|s| s * s).sum::<f64>().sqrt();
+    if !(step.is_finite() && step > 0.0) || length <= step {
+        return [0.0; 3];
     }
+    slide.map(|s| (s / step).round() * step)
 }
 
 /// How far the slide `now` is from the operators' `slid`, over the smallest spacing of the
@@ -711,7 +715,7 @@ impl ContactSolver<'_> {
         //    is not taken again: the slide lies at the edge of a step, within what the pairing
         //    itself moves it, and going back would cycle.
         let pairings: Vec<[f64; 3]> = (0..self.pairs.len())
-            .map(|p| pairing_slide(&slid[p], &self.pairs[p].primary_surface))
+            .map(|p| pairing_slide(&slid[p], &self.pairs[p].primary_surface, &nodes[p]))
             .collect();
         let drifted: Vec<usize> = (0..self.pairs.len())
             .filter(|&p| {
