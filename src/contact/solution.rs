@@ -93,8 +93,8 @@ pub struct IterationRecord {
     pub max_gap_error_over_h: f64,
     /// How far the surfaces have slid over each other from where the interface operators were
     /// paired (the active nodes' mean slide against the pairing's), over the smallest spacing
-    /// of the active primary nodes (the pairing follows the slide on a grid of 0.05 of the
-    /// smallest candidate spacing: `docs/method.md` 3.5).
+    /// of the active primary nodes (the pairing follows the slide on a grid of 0.05 of that
+    /// spacing, unslid within one step: `docs/method.md` 3.5).
     pub pairing_drift_over_h: f64,
     pub relative_residual: f64,
     /// GMRES iterations of the iteration's interface solves (a loose solve and, when its
