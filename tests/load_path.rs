@@ -162,6 +162,32 @@ fn largest_difference(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The loop's settling margin `0.01 tol_p h` (tol_p = 1e-3) of the case file `text` on the
+/// half-disc fixture, `h` the smallest spacing of its primary's candidates.
+fn settling_margin(text: &str) -> f64 {
+    let mesh = read_msh(&common::fixture("half_disc_on_block.msh")).unwrap();
+    let h_min = (Case::load(&write_case(text).1).unwrap())
+        .contact_problems(&mesh)
+        .unwrap()[0]
+        .primary_surface
+        .spacing
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    1e-2 * 1e-3 * h_min
+}
+
+/// Both bodies' displacements of `a` and `b` agree within `bound`.
+fn assert_displacements_agree(a: &ContactSolution, b: &ContactSolution, bound: f64) {
+    for (u, v) in [
+        (&a.primary.displacement, &b.primary.displacement),
+        (&a.secondary.displacement, &b.secondary.displacement),
+    ] {
+        let d = largest_difference(u, v);
+        assert!(d <= bound, "differs by {d:.2e} (bound {bound:.2e})");
+    }
+}
+
 #[test]
 fn frictionless_contact_ends_where_a_single_step_does() {
     // Pressed halfway, then fully, then squeezed: the last step has every factor at 1, and
@@ -189,27 +215,8 @@ fn frictionless_contact_ends_where_a_single_step_does() {
     }
     // The loop stops when every active node lies within 0.01 tol_p h of the other surface
     // (tol_p = 1e-3): two answers of one problem agree to that order.
-    let mesh = read_msh(&common::fixture("half_disc_on_block.msh")).unwrap();
-    let h_min = (Case::load(&write_case(&case.to_toml()).1).unwrap())
-        .contact_problems(&mesh)
-        .unwrap()[0]
-        .primary_surface
-        .spacing
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let settled = 1e-2 * 1e-3 * h_min;
     assert_eq!(stepped.primary_fields.active, single.primary_fields.active);
-    for (a, b) in [
-        (&stepped.primary.displacement, &single.primary.displacement),
-        (
-            &stepped.secondary.displacement,
-            &single.secondary.displacement,
-        ),
-    ] {
-        let d = largest_difference(a, b);
-        assert!(d <= settled, "differs by {d:.2e} (bound {settled:.2e})");
-    }
+    assert_displacements_agree(stepped, single, settling_margin(&case.to_toml()));
     let force = |s: &ContactSolution| s.force_primary[1];
     let relative = (force(stepped) - force(single)).abs() / force(single).abs();
     assert!(relative < 1e-6, "contact force differs by {relative:.2e}");
@@ -548,24 +555,5 @@ fn a_slide_reached_in_steps_ends_where_a_single_step_does() {
     let seen = (single.history.iter()).fold(0.0f64, |m, r| m.max(r.pairing_drift_over_h));
     assert!(seen > 1.0, "the slide was not seen: {seen} h");
     assert_eq!(stepped.primary_fields.active, single.primary_fields.active);
-    let mesh = read_msh(&common::fixture("half_disc_on_block.msh")).unwrap();
-    let h_min = (Case::load(&write_case(&case(1)).1).unwrap())
-        .contact_problems(&mesh)
-        .unwrap()[0]
-        .primary_surface
-        .spacing
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let margin = 1e-2 * 1e-3 * h_min;
-    for (a, b) in [
-        (&stepped.primary.displacement, &single.primary.displacement),
-        (
-            &stepped.secondary.displacement,
-            &single.secondary.displacement,
-        ),
-    ] {
-        let d = largest_difference(a, b);
-        assert!(d <= 2.0 * margin, "differs by {d:.2e} (m = {margin:.2e})");
-    }
+    assert_displacements_agree(stepped, single, 2.0 * settling_margin(&case(1)));
 }
