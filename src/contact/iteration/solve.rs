@@ -163,13 +163,19 @@ const PAIRING_STEP_OVER_H: f64 = 0.05;
 /// a spacing, and pairing a flush block's end node past the other's end unbalanced a stack's
 /// forces by 2%.
 fn pairing_slide(slide: &[f64; 3], primary: &ContactSurface, active: &[usize]) -> [f64; 3] {
-    let h = (active.iter().map(|&i| primary.spacing[i])).fold(f64::INFINITY, f64::min);
+    let h = smallest_spacing(primary, active);
     let step = PAIRING_STEP_OVER_H * h;
     let length = slide.iter().map(|s| s * s).sum::<f64>().sqrt();
     if !(step.is_finite() && step > 0.0) || length <= step {
         return [0.0; 3];
     }
     slide.map(|s| (s / step).round() * step)
+}
+
+/// The smallest spacing of the `active` primary nodes (infinite when there is none): the
+/// length the slide and the pairing are measured in.
+fn smallest_spacing(primary: &ContactSurface, active: &[usize]) -> f64 {
+    (active.iter().map(|&i| primary.spacing[i])).fold(f64::INFINITY, f64::min)
 }
 
 /// How far the slide `now` is from the operators' `slid`, over the smallest spacing of the
@@ -180,7 +186,7 @@ fn pairing_drift(
     primary: &ContactSurface,
     active: &[usize],
 ) -> f64 {
-    let h = (active.iter().map(|&i| primary.spacing[i])).fold(f64::INFINITY, f64::min);
+    let h = smallest_spacing(primary, active);
     let distance = (0..3)
         .map(|k| (now[k] - slid[k]).powi(2))
         .sum::<f64>()
@@ -730,8 +736,8 @@ impl ContactSolver<'_> {
         //    but whose slide still moved by more than the settling margin is solved again,
         //    while that motion at least halves from one iteration to the next. (Unslid, the
         //    slide is the mesh's asymmetry, and the pairing does not follow it.)
-        let slide_change = (0..self.pairs.len())
-            .filter(|&p| update.settled && self.operators[p].slid != [0.0; 3])
+        let slid_pairs = (0..self.pairs.len()).filter(|&p| self.operators[p].slid != [0.0; 3]);
+        let slide_change = (slid_pairs.filter(|_| update.settled))
             .filter_map(|p| {
                 let before = state.slides[p]?;
                 let margin = SETTLED * self.pairs[p].settings.penetration_tolerance;
