@@ -22,8 +22,10 @@ use std::fmt;
 /// Where a solve stops and what it may spend.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GmresSettings {
-    /// The solve stops once the true residual `|b - A x|` is at most this (absolute).
+    /// The solve stops once the true residual `|b - A x|` is at most this (absolute)...
     pub tolerance: f64,
+    /// ...and, if set, at most this fraction of the starting guess's residual.
+    pub reduction: Option<f64>,
     /// The most products with `A P^-1` (iterations) the solve may take.
     pub max_iterations: usize,
     /// Krylov vectors kept before a restart.
@@ -99,6 +101,7 @@ pub fn solve<O: Operators>(
     let mut stats = GmresStats::default();
     let mut residual = vec![0.0; n];
     let mut last = f64::INFINITY;
+    let mut tolerance = settings.tolerance;
     loop {
         operators.apply(x, &mut residual)?;
         stats.residual_products += 1;
@@ -109,10 +112,13 @@ pub fn solve<O: Operators>(
         stats.residual = beta;
         if stats.residual_products == 1 {
             stats.initial_residual = beta;
+            if let Some(reduction) = settings.reduction {
+                tolerance = tolerance.min(reduction * beta);
+            }
         }
         stats.failure = if !beta.is_finite() {
             Some(GmresFailure::NotFinite)
-        } else if beta <= settings.tolerance {
+        } else if beta <= tolerance {
             return Ok(stats);
         } else if stats.iterations >= settings.max_iterations {
             Some(GmresFailure::IterationLimit)
@@ -135,7 +141,7 @@ pub fn solve<O: Operators>(
             &residual,
             beta,
             steps,
-            settings.tolerance,
+            tolerance,
             &mut stats,
         )?;
         if let Some(failure) = cycle.failure {
@@ -298,6 +304,7 @@ mod tests {
         let mut x = vec![0.0; n];
         let settings = GmresSettings {
             tolerance: 1e-12 * norm(&b),
+            reduction: None,
             max_iterations: 500,
             restart: 5,
         };
@@ -314,6 +321,35 @@ mod tests {
     }
 
     #[test]
+    fn a_reduction_is_asked_of_a_start_already_within_the_tolerance() {
+        let n = 200;
+        let mut ops = Tridiagonal { n };
+        let exact: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        let mut b = vec![0.0; n];
+        ops.apply(&exact, &mut b).unwrap();
+        // A start 1e-4 off the answer: within an absolute tolerance of 1e-3 |b|.
+        let start: Vec<f64> = exact.iter().map(|v| v + 1e-4 * (v * 7.0).cos()).collect();
+        for reduction in [None, Some(1e-2)] {
+            let mut x = start.clone();
+            let settings = GmresSettings {
+                tolerance: 1e-3 * norm(&b),
+                reduction,
+                max_iterations: 500,
+                restart: 50,
+            };
+            let stats = solve(&mut ops, &b, &mut x, settings).unwrap();
+            assert_eq!(stats.failure, None);
+            match reduction {
+                None => assert_eq!(stats.iterations, 0),
+                Some(r) => {
+                    assert!(stats.iterations > 0);
+                    assert!(stats.residual <= r * stats.initial_residual, "{stats:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn names_the_iteration_limit() {
         let n = 200;
         let mut ops = Tridiagonal { n };
@@ -321,6 +357,7 @@ mod tests {
         let mut x = vec![0.0; n];
         let settings = GmresSettings {
             tolerance: 1e-14,
+            reduction: None,
             max_iterations: 3,
             restart: 50,
         };

@@ -193,7 +193,7 @@ impl BodyFactors {
     /// Solves the coupled system of `pairs` on `bodies`; returns `x = [u_1; ...; u_N; lambda
     /// / s]`.
     ///
-    /// On the Krylov path a [`Tightness::Loose`] solve stops at a relative residual the
+    /// On the Krylov path a loose solve ([`Tightness`]) stops at a relative residual the
     /// caller's active-set decision needs, not at round-off; the caller then owns the residual
     /// check. A GMRES failure under `auto` moves this and every later iteration to the dense
     /// Schur complement ([`Self::fell_back`] says why).
@@ -520,7 +520,7 @@ mod tests {
     use super::*;
     use crate::contact::coupled::half_space::compliance_factor;
     use crate::contact::coupled::system::Coupling;
-    use crate::contact::law::{ContactLaw, Tangential};
+    use crate::contact::law::{ContactLaw, Restates, Tangential};
     use crate::elastic::{
         DirichletCondition, ElasticProblem, SolveStats, StepFactors, assemble, solve,
     };
@@ -758,5 +758,82 @@ mod tests {
                 .unwrap();
             check(solver.name(), &x);
         }
+    }
+
+    /// A Krylov solve of the system just solved starts from its answer and needs no iteration,
+    /// also where a node's traction is the sum of several multipliers along directions other
+    /// than the axes (a sticking Coulomb node's normal and tangent): the start maps the
+    /// tractions kept per node and component back onto each multiplier, so each component must
+    /// keep the sum of the node's multipliers, not the last one's share.
+    #[test]
+    fn a_solve_restarted_from_its_own_answer_takes_no_iteration() {
+        let meshes = [grid("left", 0.0, NX), grid("right", 1.0, NX)];
+        let mut stats = SolveStats::default();
+        let bodies: Vec<AssembledBody> = (meshes.iter().zip([0.01, 0.01]))
+            .map(|(mesh, push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
+            .collect();
+        let bodies: Vec<&AssembledBody> = bodies.iter().collect();
+        // The tied coupling of the two columns that meet, between their clamped and pushed
+        // ends (where a turned multiplier would restate a prescribed component), its two
+        // multipliers per node along a basis turned by 30 degrees.
+        let whole = tied(NX, NX, NX, 0, 1.0);
+        let inner = 1..NY;
+        let mut coupling = Coupling {
+            primary_nodes: whole.primary_nodes[inner.clone()].to_vec(),
+            normals: whole.normals[inner.clone()].to_vec(),
+            areas1: whole.areas1[inner.clone()].to_vec(),
+            multipliers: whole.multipliers[inner.clone()].to_vec(),
+            geometric: whole.geometric[inner.clone()].to_vec(),
+            interpolated: whole.interpolated[inner.clone()].to_vec(),
+            loads2: whole.loads2[inner.clone()].to_vec(),
+            gaps: whole.gaps[inner].to_vec(),
+        };
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        for multipliers in &mut coupling.multipliers {
+            for (multiplier, direction) in multipliers.iter_mut().zip([[c, s, 0.0], [-s, c, 0.0]]) {
+                multiplier.force = direction;
+                multiplier.row = direction;
+                multiplier.restates = Restates::Node;
+            }
+        }
+        let pairs = [Pair {
+            primary: 0,
+            secondary: 1,
+            coupling: &coupling,
+        }];
+        let system =
+            CoupledSystem::assemble(&bodies, &pairs, 2, &StepFactors::uniform(1.0)).unwrap();
+        let settings = SolverSettings {
+            verbose: false,
+            ..SolverSettings::default()
+        };
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let contact = ContactSettings {
+            solver: CoupledSolver::Krylov,
+            ..ContactSettings::default()
+        };
+        let candidates = vec![
+            (0..=NY).map(|j| NX + j * (NX + 1)).collect::<Vec<_>>(),
+            (0..=NY).map(|j| j * (NX + 1)).collect(),
+        ];
+        let mut factors = BodyFactors::new(
+            &bodies,
+            candidates,
+            vec![compliance_factor([&material, &material], 2)],
+            &settings,
+            BodySolverKind::Cholesky,
+            &contact,
+            None,
+        )
+        .unwrap();
+        let first = (factors.solve(&system, &pairs, &bodies, Tightness::Tight)).unwrap();
+        let cold = factors.last_krylov.unwrap();
+        assert!(cold.iterations > 0, "{cold:?}");
+        let again = (factors.solve(&system, &pairs, &bodies, Tightness::Tight)).unwrap();
+        let warm = factors.last_krylov.unwrap();
+        assert_eq!(warm.iterations, 0, "restarted: {warm:?}, first solve: {cold:?}");
+        let change = (first.iter().zip(&again)).map(|(a, b)| (a - b).abs());
+        let scale = first.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        assert!(change.fold(0.0, f64::max) <= 1e-12 * scale);
     }
 }

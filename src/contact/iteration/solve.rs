@@ -1281,7 +1281,8 @@ impl ContactSolver<'_> {
     /// coupled solve; the gaps of every primary candidate of each pair, geometric (the search)
     /// and linearized at the iterate (into `rows`), and how far each pair's active nodes have
     /// slid; the primal-dual active set update. On the Krylov path the solve is first loose
-    /// ([`Tightness::Loose`]) and solved again tightly when its update would keep the node
+    /// ([`Tightness::Loose`]; [`Tightness::Reduced`] where a Coulomb pair's slip directions are
+    /// iterated on) and solved again tightly when its update would keep the node
     /// states (and no slipping direction still turns) or return to states seen before: no
     /// answer, status or check rests on a loose solve.
     /// The time of each phase is added to `seconds`.
@@ -1298,10 +1299,10 @@ impl ContactSolver<'_> {
         let mut krylov_iterations = None;
         loop {
             let solution = timed(&mut seconds.solve, || {
-                let tightness = if loose {
-                    Tightness::Loose
-                } else {
-                    Tightness::Tight
+                let tightness = match (loose, self.laws.iter().any(ContactLaw::has_friction)) {
+                    (false, _) => Tightness::Tight,
+                    (true, false) => Tightness::Loose,
+                    (true, true) => Tightness::Reduced,
                 };
                 self.coupled_solve(couplings, factors, tightness)
             })?;
@@ -1494,8 +1495,7 @@ impl ContactSolver<'_> {
     }
 
     /// The coupled system of the pairs' `couplings`, solved and checked by its relative
-    /// residual; or, a [`Tightness::Loose`] solve on the Krylov path, its residual only
-    /// recorded.
+    /// residual; or, a loose solve on the Krylov path, its residual only recorded.
     fn coupled_solve(
         &mut self,
         couplings: &[Coupling],
@@ -1516,7 +1516,7 @@ impl ContactSolver<'_> {
             None => coupled_solver::solve_monolithic(&system, &bodies)?,
             Some(factors) => factors.solve(&system, &pairs, &bodies, tightness)?,
         };
-        let loose = tightness == Tightness::Loose
+        let loose = tightness != Tightness::Tight
             && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
         let solvers = self.factors.as_ref().map(BodyFactors::solvers);
         let residual = system.relative_residual(&bodies, solvers, &x)?;
