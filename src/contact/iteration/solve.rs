@@ -1374,9 +1374,10 @@ impl ContactSolver<'_> {
             // serves while they turn by more than a hundred times the settled change (a loose
             // solve's own error turned them by about 1e-6 on the 3D sphere, the settled change
             // itself, and held the loop there to its cap).
-            let turning = update.max_direction_change > 100.0 * coulomb::DIRECTION_SETTLED;
+            let turning = update.max_direction_change > coulomb::STILL_TURNING;
             let keeps = update.next == *active && !turning;
-            if loose && (keeps || safeguard.seen.contains(&update.next)) {
+            let seen = safeguard.seen.contains(&update.next) && !turning;
+            if loose && (keeps || seen) {
                 loose = false;
                 continue;
             }

@@ -39,6 +39,12 @@ use super::{Multiplier, Reads, Restates, Tangential};
 /// after 50 iterations when unweighed.
 pub const DIRECTION_SETTLED: f64 = 1e-6;
 
+/// The slipping nodes' directions still turn when a change is over this, a hundred times
+/// [`DIRECTION_SETTLED`]: the loop then goes on from a loose solve
+/// (`crate::contact::iteration::solve`), and a partition open / stick / slip it has seen before
+/// is not a state it has seen before (`crate::contact::iteration::safeguard`).
+pub const STILL_TURNING: f64 = 100.0 * DIRECTION_SETTLED;
+
 /// A unit tangent basis at the unit normal `n`: one tangent in 2D (`n` rotated by +90
 /// degrees in the x-y plane), two in 3D (`t_1` orthogonal to `n` and to the axis least aligned
 /// with it, `t_2 = n x t_1`).
