@@ -136,14 +136,7 @@ pub fn solve<O: Operators>(
             .min(n)
             .min(settings.max_iterations - stats.iterations)
             .max(1);
-        let cycle = cycle(
-            operators,
-            &residual,
-            beta,
-            steps,
-            tolerance,
-            &mut stats,
-        )?;
+        let cycle = cycle(operators, &residual, beta, steps, tolerance, &mut stats)?;
         if let Some(failure) = cycle.failure {
             stats.failure = Some(failure);
             return Ok(stats);

@@ -831,7 +831,10 @@ mod tests {
         assert!(cold.iterations > 0, "{cold:?}");
         let again = (factors.solve(&system, &pairs, &bodies, Tightness::Tight)).unwrap();
         let warm = factors.last_krylov.unwrap();
-        assert_eq!(warm.iterations, 0, "restarted: {warm:?}, first solve: {cold:?}");
+        assert_eq!(
+            warm.iterations, 0,
+            "restarted: {warm:?}, first solve: {cold:?}"
+        );
         let change = (first.iter().zip(&again)).map(|(a, b)| (a - b).abs());
         let scale = first.iter().map(|v| v.abs()).fold(0.0, f64::max);
         assert!(change.fold(0.0, f64::max) <= 1e-12 * scale);

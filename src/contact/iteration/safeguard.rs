@@ -222,7 +222,11 @@ mod tests {
             let mut back = unchanged(&second, 1e-4, false);
             back.next = first.clone();
             back.max_direction_change = turn;
-            assert_eq!(status(safeguard.next(&second, &back)), expected, "turn {turn}");
+            assert_eq!(
+                status(safeguard.next(&second, &back)),
+                expected,
+                "turn {turn}"
+            );
         }
     }
 
