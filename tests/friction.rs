@@ -342,6 +342,23 @@ fn a_sphere_pressed_then_sheared_has_the_stick_zone_of_mindlin() {
             fit.a
         );
         assert!(ratio > 0.1 && ratio < 0.9, "shift {shift}: partial slip");
+        // The slip directions settle by Newton's method (`docs/method.md` 1.4): near the
+        // answer one iteration shrinks their change by far more than a fixed-point update of
+        // the directions does (Anderson-accelerated, at best 0.17 per iteration here).
+        let changes: Vec<f64> = (answer.history.iter())
+            .filter_map(|record| record.max_direction_change)
+            .filter(|&change| change > 0.0)
+            .collect();
+        let fastest = (changes.windows(2))
+            .map(|pair| pair[1] / pair[0])
+            .fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "shift {shift}: direction changes {changes:?}, fastest contraction {fastest:.1e}"
+        );
+        assert!(
+            fastest < 1e-2,
+            "shift {shift}: direction changes {changes:?}"
+        );
         // The edge lies between the outermost sticking node and the innermost slipping one,
         // within a spacing (R/67 = 0.015) of each.
         let h = 0.015;

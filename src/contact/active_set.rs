@@ -4,6 +4,7 @@
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 
 use crate::contact::law::NodeStates;
+use crate::contact::law::coulomb::Turning;
 
 use crate::contact::geometry::gap::GapRow;
 use crate::contact::problem::ContactProblem;
@@ -50,6 +51,8 @@ pub(super) struct Update {
     /// largest change of a slipping node's direction weighed by its pressure over the largest
     /// ([`crate::contact::law::coulomb::DIRECTION_SETTLED`]).
     pub(super) directions: BTreeMap<usize, [f64; 3]>,
+    /// Coulomb pairs in 3D: how the direction of each node slipping next is linearized.
+    pub(super) turnings: BTreeMap<usize, Turning>,
     pub(super) max_direction_change: f64,
     /// Coulomb pairs: the nodes in contact whose tangential state changes (stick to slip or
     /// back), with how far beyond the edge of the cone the update found them, over `mu p_max`.
@@ -120,6 +123,7 @@ impl Update {
         Self {
             next: NodeStates::in_contact(next),
             directions: BTreeMap::new(),
+            turnings: BTreeMap::new(),
             max_direction_change: 0.0,
             switching: Vec::new(),
             settled: max_gap_error_over_h <= SETTLED * settings.penetration_tolerance,
@@ -141,6 +145,7 @@ impl Update {
         let mut merged = Self {
             next: NodeStates::default(),
             directions: BTreeMap::new(),
+            turnings: BTreeMap::new(),
             max_direction_change: 0.0,
             switching: Vec::new(),
             tension: Vec::new(),
@@ -156,6 +161,7 @@ impl Update {
             merged.next.contact.extend(shifted(&update.next.contact));
             merged.next.slip.extend(shifted(&update.next.slip));
             (merged.directions).extend(update.directions.iter().map(|(&i, &d)| (offset + i, d)));
+            (merged.turnings).extend(update.turnings.iter().map(|(&i, &t)| (offset + i, t)));
             merged.max_direction_change =
                 merged.max_direction_change.max(update.max_direction_change);
             merged.switching.extend(shift(&update.switching, offset));

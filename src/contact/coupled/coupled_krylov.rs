@@ -79,7 +79,7 @@ const RESTART: usize = 50;
 
 /// How far below its starting residual a [`Tightness::Reduced`] solve goes at least: the
 /// forcing term of an inexact Newton method (Eisenstat and Walker), constant. Why: the slip
-/// directions of a Coulomb pair are a fixed point that the loop iterates on one set of nodes
+/// directions of a Coulomb pair are iterated on by the loop on one set of nodes
 /// (`crate::contact::law::coulomb`), and a direction's turn of 1e-2 changes the coupled system by
 /// less than [`LOOSE_RTOL`] of its right-hand side (which the bodies' Dirichlet lift dominates).
 /// A solve that starts from the last answer, as every solve does, then returned it unchanged
@@ -371,12 +371,8 @@ impl Operators for Blocks<'_> {
         for &(k, l, value) in &system.d_coupled {
             out_l[k] += value * x[n + l];
         }
-        for (row, k, value) in system.b_entries() {
-            out[row] += value * x[n + k];
-        }
-        for &(k, col, value) in &system.c {
-            out[n + k] += value * x[col];
-        }
+        system.add_b_product(&x[n..], 1.0, out);
+        system.add_c_product(&x[..n], &mut out[n..]);
         Ok(())
     }
 
@@ -391,9 +387,7 @@ impl Operators for Blocks<'_> {
         }
         self.rigid.apply(&r[n..], out_l);
         self.scratch.copy_from_slice(&r[..n]);
-        for (row, k, value) in system.b_entries() {
-            self.scratch[row] -= value * out_l[k];
-        }
+        system.add_b_product(out_l, -1.0, &mut self.scratch);
         system
             .body_parts(out_u)
             .into_par_iter()

@@ -395,7 +395,7 @@ fn eliminate(
     let mut z = f.to_vec();
     solve_bodies(system, solvers, &mut z)?;
     let mut r = DVector::from_column_slice(g);
-    for &(k, col, value) in &system.c {
+    for (k, col, value) in system.c_entries() {
         r[k] -= value * z[col];
     }
     let lambda = if m > 0 {
@@ -406,9 +406,7 @@ fn eliminate(
         DVector::zeros(0)
     };
     let mut w = vec![0.0; n];
-    for (row, k, value) in system.b_entries() {
-        w[row] += value * lambda[k];
-    }
+    system.add_b_product(lambda.as_slice(), 1.0, &mut w);
     solve_bodies(system, solvers, &mut w)?;
     let mut x: Vec<f64> = z.iter().zip(&w).map(|(z, w)| z - w).collect();
     x.extend(lambda.iter());
@@ -469,7 +467,7 @@ fn schur_complement(system: &CoupledSystem, responses: &[SurfaceResponse]) -> DM
     }
     for (body, response) in responses.iter().enumerate() {
         let dofs = system.body_dofs(body);
-        let mut read: Vec<usize> = (system.c.iter())
+        let mut read: Vec<usize> = (system.c_entries())
             .filter(|e| dofs.contains(&e.1))
             .map(|e| e.1 - dofs.start)
             .collect();
@@ -480,7 +478,7 @@ fn schur_complement(system: &CoupledSystem, responses: &[SurfaceResponse]) -> DM
         }
         let position = |dof: usize| read.binary_search(&dof).expect("listed dof");
         let mut c = DMatrix::<f64>::zeros(m, read.len());
-        for &(k, col, value) in &system.c {
+        for (k, col, value) in system.c_entries() {
             if dofs.contains(&col) {
                 c[(k, position(col - dofs.start))] += value;
             }
@@ -520,7 +518,7 @@ mod tests {
     use super::*;
     use crate::contact::coupled::half_space::compliance_factor;
     use crate::contact::coupled::system::Coupling;
-    use crate::contact::law::{ContactLaw, Restates, Tangential};
+    use crate::contact::law::{ContactLaw, Reads, Restates, Tangential};
     use crate::elastic::{
         DirichletCondition, ElasticProblem, SolveStats, StepFactors, assemble, solve,
     };
@@ -758,6 +756,103 @@ mod tests {
                 .unwrap();
             check(solver.name(), &x);
         }
+    }
+
+    /// The products the Krylov and Schur paths take without the entries (a unit load shared by
+    /// a node's multipliers, a jump read once by its rows: `CoupledSystem::add_b_product`,
+    /// `add_c_product`) and a multiplier's own term in its row (`D`, a slipping node's
+    /// direction row) give the answer of the monolithic LU, which assembles the entries one
+    /// by one; and the answer holds that row, `r . (u1 - u2) + compliance lambda = 0`.
+    #[test]
+    fn shared_loads_and_reads_and_a_multipliers_own_term_give_the_entries_answer() {
+        let meshes = [grid("left", 0.0, NX), grid("right", 1.0, NX)];
+        let mut stats = SolveStats::default();
+        let bodies: Vec<AssembledBody> = (meshes.iter().zip([0.01, 0.02]))
+            .map(|(mesh, push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
+            .collect();
+        let bodies: Vec<&AssembledBody> = bodies.iter().collect();
+        // Two multipliers per node along a basis turned by 30 degrees: each reads both
+        // components of the jump and loads both components of the node (shared), and the
+        // second has its own term in its row.
+        let mut coupling = tied(NX, NX, NX, 0, 1.0);
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let compliance = 1e-4;
+        for multipliers in &mut coupling.multipliers {
+            for (j, (multiplier, direction)) in
+                (multipliers.iter_mut().zip([[c, s, 0.0], [-s, c, 0.0]])).enumerate()
+            {
+                multiplier.force = direction;
+                multiplier.row = direction;
+                multiplier.reads = Reads::Interpolated;
+                multiplier.restates = Restates::Node;
+                multiplier.compliance = if j == 1 { compliance } else { 0.0 };
+            }
+        }
+        let pairs = [Pair {
+            primary: 0,
+            secondary: 1,
+            coupling: &coupling,
+        }];
+        let system =
+            CoupledSystem::assemble(&bodies, &pairs, 2, &StepFactors::uniform(1.0)).unwrap();
+        // Every node but the clamped one (its multipliers restate its Dirichlet condition).
+        assert_eq!(system.shared_jumps.len(), coupling.primary_nodes.len() - 1);
+        assert!(
+            system
+                .unit_loads
+                .iter()
+                .all(|unit| unit.multipliers.len() == 2)
+        );
+        let reference = solve_monolithic(&system, &bodies).unwrap();
+        let scale = reference.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let settings = SolverSettings {
+            verbose: false,
+            ..SolverSettings::default()
+        };
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let candidates = vec![
+            (0..=NY).map(|j| NX + j * (NX + 1)).collect::<Vec<_>>(),
+            (0..=NY).map(|j| j * (NX + 1)).collect(),
+        ];
+        for solver in [CoupledSolver::Schur, CoupledSolver::Krylov] {
+            let contact = ContactSettings {
+                solver,
+                ..ContactSettings::default()
+            };
+            let mut factors = BodyFactors::new(
+                &bodies,
+                candidates.clone(),
+                vec![compliance_factor([&material, &material], 2)],
+                &settings,
+                BodySolverKind::Cholesky,
+                &contact,
+                None,
+            )
+            .unwrap();
+            let x = (factors.solve(&system, &pairs, &bodies, Tightness::Tight)).unwrap();
+            let off = (x.iter().zip(&reference)).map(|(a, b)| (a - b).abs());
+            assert!(
+                off.fold(0.0, f64::max) <= 1e-8 * scale,
+                "{}: off the monolithic answer",
+                solver.name()
+            );
+        }
+        let solution = system.solution(&reference, &bodies, &pairs, 2, 0.0);
+        let u_scale = (solution.u.iter().flatten()).fold(0.0_f64, |m, u| m.max(u.abs()));
+        let mut largest = 0.0_f64;
+        for (k, &node) in coupling.primary_nodes.iter().enumerate() {
+            let (node2, _) = coupling.interpolated[k][0];
+            let jump: Vec<f64> = (0..2)
+                .map(|c| solution.u[0][2 * node + c] - solution.u[1][2 * node2 + c])
+                .collect();
+            let lambda = solution.traction[0][k];
+            let along = |d: [f64; 2], v: &[f64]| d[0] * v[0] + d[1] * v[1];
+            let held = along([-s, c], &jump) + compliance * along([-s, c], &lambda[..2]);
+            assert!(held.abs() <= 1e-9 * u_scale, "node {k}: {held}");
+            largest = largest.max(along([-s, c], &lambda[..2]).abs());
+        }
+        // The own term is not idle: the multiplier carries a traction.
+        assert!(largest * compliance > 1e-3 * u_scale, "{largest}");
     }
 
     /// A Krylov solve of the system just solved starts from its answer and needs no iteration,

@@ -37,7 +37,10 @@
 //! With several contact pairs, `S~` is block diagonal, one such block per pair: one pair's
 //! tractions reach another pair's gaps only through the far field of a body they share, a
 //! coupling of lower order that the Krylov iteration absorbs. A multiplier that only restates a
-//! Dirichlet condition (`D_kk != 0`, no coupling) keeps its exact block `D_kk`. `S~` is dense and factored by LU once per active-set iteration (`m` is
+//! Dirichlet condition (no column, `D_kk != 0`) keeps its exact block `D_kk`; a coupled one with
+//! its own term in its row (a slipping node's direction row, `crate::contact::law::coulomb`) has
+//! `D_kk` added to its diagonal of `S~`. `S~` is dense and factored by LU once per active-set
+//! iteration (`m` is
 //! hundreds to a few thousand: `m^3 / 3` multiply-adds, 4e8 for the 1048 multipliers of the
 //! largest active set at the contact benchmark's 99k DOFs).
 
@@ -53,10 +56,10 @@ use crate::fem::Material;
 
 /// The half-space approximation of the Schur complement, LU-factored.
 pub struct HalfSpace {
-    /// The pair's multipliers it acts on (`D_kk = 0`), numbered within the pair.
+    /// The pair's coupled multipliers (those with a column), numbered within the pair.
     coupled: Vec<usize>,
     lu: faer::linalg::solvers::PartialPivLu<f64>,
-    /// `D_kk` of every multiplier of the pair (non-zero on the uncoupled ones).
+    /// `D_kk` of every multiplier of the pair (an uncoupled one is solved by it alone).
     diagonal: Vec<f64>,
 }
 
@@ -101,9 +104,6 @@ impl HalfSpace {
             let Some((key, _)) = column.first() else {
                 continue;
             };
-            if diagonal[k] != 0.0 {
-                continue;
-            }
             let MultiplierKey::Traction { node, .. } = *key else {
                 continue;
             };
@@ -125,9 +125,11 @@ impl HalfSpace {
         let p = Mat::<f64>::from_fn(points.len(), points.len(), |i, j| {
             // Row i's direction against column j's: the same vector but at a slipping node.
             let ((xi, ei, _, ai), (xj, _, ej, aj)) = (&points[i], &points[j]);
+            // A multiplier's own term in its row (`D_kk`, a slipping node's direction row).
+            let own = if i == j { diagonal[coupled[i]] } else { 0.0 };
             let along: f64 = (0..3).map(|c| ei[c] * ej[c]).sum();
             if along == 0.0 {
-                return 0.0;
+                return own;
             }
             let r = (0..3).map(|c| (xi[c] - xj[c]).powi(2)).sum::<f64>().sqrt();
             // Distinct nodes of a mesh never coincide; the same node's components have
@@ -137,7 +139,7 @@ impl HalfSpace {
             } else {
                 kernel.between(r)
             };
-            scale * along * g * aj
+            own + scale * along * g * aj
         });
         Self {
             coupled,

@@ -41,7 +41,7 @@ use crate::contact::coupled::system::Coupling;
 use crate::contact::geometry::gap::GapRow;
 use crate::contact::geometry::rbf::{Interpolation, interpolation_radii};
 use crate::contact::geometry::surface::ContactSurface;
-use crate::contact::law::{ContactLaw, Tangential, coulomb};
+use crate::contact::law::{ContactLaw, Multiplier, Reads, Tangential, coulomb};
 
 /// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
 /// rows and columns of the transfers computed so far (an explicit cache: callers hold it `mut`).
@@ -223,25 +223,31 @@ impl InterfaceOperators {
                 tangential,
             } => {
                 let state = |i: usize| tangential.map_or(Tangential::Stick, |states| states[i]);
-                let sticks = |i: usize| law.has_friction() && state(i) == Tangential::Stick;
+                let multipliers: Vec<Vec<Multiplier>> = (active.iter())
+                    .map(|&i| law.multipliers(rows[i].normal, state(i), dim))
+                    .collect();
+                // A node whose rows read its tangential jump (a sticking node, a slipping one's
+                // direction in 3D) holds it against the jump at the start of the step.
+                let reads_jump: Vec<bool> = (multipliers.iter())
+                    .map(|node| node.iter().any(|m| m.reads == Reads::Interpolated))
+                    .collect();
                 (
                     active
                         .iter()
                         .map(|&i| to_body2(&rows[i].corners, &|_, b| b))
                         .collect(),
-                    (active.iter())
-                        .map(|&i| match sticks(i) {
+                    (active.iter().zip(&reads_jump))
+                        .map(|(&i, &reads)| match reads {
                             true => interpolated(i),
                             false => Vec::new(),
                         })
                         .collect(),
                     active.iter().map(|&i| rows[i].normal).collect(),
-                    active
-                        .iter()
-                        .map(|&i| {
+                    (active.iter().zip(&reads_jump))
+                        .map(|(&i, &reads)| {
                             let n = rows[i].normal;
                             let normal = n.map(|n| rows[i].target * n);
-                            match (sticks(i), start_jumps) {
+                            match (reads, start_jumps) {
                                 (true, Some(jumps)) => {
                                     let t = coulomb::tangential_part(jumps[i], n);
                                     std::array::from_fn(|k| normal[k] + t[k])
@@ -250,10 +256,7 @@ impl InterfaceOperators {
                             }
                         })
                         .collect(),
-                    active
-                        .iter()
-                        .map(|&i| law.multipliers(rows[i].normal, state(i), dim))
-                        .collect(),
+                    multipliers,
                 )
             }
         };

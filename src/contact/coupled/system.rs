@@ -27,6 +27,10 @@
 //! `lambda = 0` and it acts on neither body. Keeping it would leave an empty column, since the
 //! rows of prescribed dofs carry no coupling.
 //!
+//! A multiplier may have a term of its own in its row, `r . (u_a - u_b(point)) + c lambda = r .
+//! d` (a slipping Coulomb node's row across its direction, `crate::contact::law::coulomb`): its
+//! entry `t s c` of `D`.
+//!
 //! A force-controlled group (`crate::elastic::RigidColumn`) adds one unknown per controlled
 //! component after all the pairs' multipliers: its displacement `a`, with its column `k` in
 //! its body's rows, the same `k` as its row, `d` (and the couplings to the body's other such
@@ -217,7 +221,8 @@ impl Coupling {
 /// ```text
 /// [ K  B ] [u     ]   [f]      K = diag(K_1 .. K_N) (constrained), B the scaled coupling
 /// [ C  D ] [lambda] = [g]      columns, C the scaled constraint rows, D = t on dropped
-///                              multipliers
+///                              multipliers, a multiplier's own term in its row
+///                              (`Multiplier::compliance`), force control
 /// ```
 ///
 /// The unknowns are the bodies' displacements one body after another, then the pairs'
@@ -238,16 +243,21 @@ pub struct CoupledSystem {
     /// depend on nothing else).
     pub columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// The force that a unit traction of one component at one active primary node puts on
-    /// the bodies, with the multiplier it belongs to: `B` itself, kept once
-    /// ([`Self::b_entries`]). Through the interpolation transfer a unit load reaches most of
-    /// the facing secondary surface, so these are the bulk of the system's coupling memory.
+    /// the bodies, with the multipliers whose columns it is part of: `B` itself, each unit
+    /// load kept once ([`Self::b_entries`], [`Self::add_b_product`]). Through the
+    /// interpolation transfer a unit load reaches most of the facing secondary surface, so
+    /// these are the bulk of the system's coupling memory, and of a product with `B`: a
+    /// sticking node's three multipliers share its three unit loads.
     pub unit_loads: Vec<UnitLoad>,
     /// Multiplier scaling: the unknown is `lambda / s`.
     pub s: f64,
     /// Constraint row scaling: a row's residual is `t` times the gap error of its node.
     pub t: f64,
-    /// Entries `(multiplier, column < offsets[N], value)` of C.
+    /// Entries `(multiplier, column < offsets[N], value)` of C, but for the rows in
+    /// [`Self::shared_jumps`] ([`Self::c_entries`] lists them all).
     pub c: Vec<(usize, usize, f64)>,
+    /// The rows of C that read one node's jump together ([`SharedJump`]).
+    pub shared_jumps: Vec<SharedJump>,
     /// The direction of each pair multiplier's constraint row (zero for a force-controlled
     /// component): the half-space preconditioner (`crate::contact::coupled::half_space`) pairs it
     /// with the columns' directions, which differ from it at a slipping node
@@ -332,6 +342,7 @@ impl CoupledSystem {
             s,
             t,
             c: blocks.c,
+            shared_jumps: blocks.shared_jumps,
             rows: blocks.rows,
             d: blocks.d,
             d_coupled: blocks.d_coupled,
@@ -347,8 +358,66 @@ impl CoupledSystem {
     pub fn b_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
         let s = self.s;
         self.unit_loads.iter().flat_map(move |unit| {
-            (unit.load.iter()).map(move |&(row, v)| (row, unit.multiplier, s * v * unit.weight))
+            (unit.multipliers.iter()).flat_map(move |&(multiplier, weight)| {
+                (unit.load.iter()).map(move |&(row, v)| (row, multiplier, s * v * weight))
+            })
         })
+    }
+
+    /// The entries `(multiplier, column < offsets[N], value)` of C.
+    pub fn c_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        let shared = self.shared_jumps.iter().flat_map(|jump| {
+            (jump.rows.iter()).flat_map(move |&(multiplier, row)| {
+                (jump.reads.iter())
+                    .filter(move |&&(c, _, _)| row[c] != 0.0)
+                    .map(move |&(c, column, coefficient)| {
+                        (multiplier, column, row[c] * coefficient)
+                    })
+            })
+        });
+        self.c.iter().copied().chain(shared)
+    }
+
+    /// `out[k] += (C x)_k` over the multipliers (`x` the displacements): each shared jump
+    /// read once.
+    pub fn add_c_product(&self, x: &[f64], out: &mut [f64]) {
+        for &(k, col, value) in &self.c {
+            out[k] += value * x[col];
+        }
+        for jump in &self.shared_jumps {
+            let mut jump_value = [0.0; 3];
+            for &(c, column, coefficient) in &jump.reads {
+                jump_value[c] += coefficient * x[column];
+            }
+            for &(multiplier, row) in &jump.rows {
+                out[multiplier] += (0..3).map(|c| row[c] * jump_value[c]).sum::<f64>();
+            }
+        }
+    }
+
+    /// `out += sign B y` on the displacement rows (`sign` is 1 or -1): each unit load once,
+    /// times the traction component its multipliers' `y` make together.
+    pub fn add_b_product(&self, y: &[f64], sign: f64, out: &mut [f64]) {
+        let s = self.s;
+        for unit in &self.unit_loads {
+            match unit.multipliers[..] {
+                // One multiplier: the product of its entries of `B` (the arithmetic of
+                // `b_entries`, term by term).
+                [(multiplier, weight)] => {
+                    for &(row, v) in &unit.load {
+                        out[row] += sign * (s * v * weight * y[multiplier]);
+                    }
+                }
+                _ => {
+                    let traction: f64 = (unit.multipliers.iter())
+                        .map(|&(multiplier, weight)| weight * y[multiplier])
+                        .sum();
+                    for &(row, v) in &unit.load {
+                        out[row] += sign * (s * v * traction);
+                    }
+                }
+            }
+        }
     }
 
     /// The number of bodies.
@@ -403,7 +472,7 @@ impl CoupledSystem {
             }
         }
         triplets.extend(self.b_entries().map(|(i, k, v)| Triplet::new(i, n + k, v)));
-        triplets.extend(self.c.iter().map(|&(k, j, v)| Triplet::new(n + k, j, v)));
+        triplets.extend(self.c_entries().map(|(k, j, v)| Triplet::new(n + k, j, v)));
         triplets.extend(
             self.d
                 .iter()
@@ -441,12 +510,8 @@ impl CoupledSystem {
         for &(k, l, value) in &self.d_coupled {
             ax[n + k] += value * x[n + l];
         }
-        for (row, k, value) in self.b_entries() {
-            ax[row] += value * x[n + k];
-        }
-        for &(k, col, value) in &self.c {
-            ax[n + k] += value * x[col];
-        }
+        self.add_b_product(&x[n..], 1.0, &mut ax);
+        self.add_c_product(&x[..n], &mut ax[n..]);
         let rhs = self.rhs();
         Ok(rhs.iter().zip(&ax).map(|(b, a)| b - a).collect())
     }
@@ -550,11 +615,25 @@ struct Placement {
 /// The force a unit traction of one component at one active primary node puts on the bodies.
 pub struct UnitLoad {
     pub key: MultiplierKey,
-    /// The multiplier whose column it is part of, and its weight there.
-    pub multiplier: usize,
-    pub weight: f64,
+    /// The multipliers whose columns it is part of, each with its weight there.
+    pub multipliers: Vec<(usize, f64)>,
     /// `(row < offsets[N], force)`, unscaled; rows of prescribed dofs left out.
     pub load: Vec<(usize, f64)>,
+}
+
+/// Rows of C that read the same jump of one active node through the interpolation, `J_i = u1_i
+/// - (R12 u2)_i`: a sticking node's two tangential rows in 3D, which read each of its
+/// components. The jump is read once and each row takes its projection, where entries of `C`
+/// would read the `R12` row once per row (a row of `R12` reaches hundreds of secondary nodes).
+/// A node's rows share a read only when two of them read a component in common: tied rows
+/// (one component each) stay entries of `C`.
+pub struct SharedJump {
+    /// `(multiplier, t * row)` of each row: its direction, scaled.
+    pub rows: Vec<(usize, [f64; 3])>,
+    /// `(component, unknown, coefficient)`: component `c` of the jump is the sum of the
+    /// coefficients times the unknowns (`1` at the node's own dof, `-w` at the secondary's; a
+    /// force-controlled dof's part is in `D`).
+    pub reads: Vec<(usize, usize, f64)>,
 }
 
 /// The coupling blocks of the pairs, added one pair at a time.
@@ -565,6 +644,8 @@ struct PairBlocks {
     unit_loads: Vec<UnitLoad>,
     /// [`CoupledSystem::c`].
     c: Vec<(usize, usize, f64)>,
+    /// [`CoupledSystem::shared_jumps`].
+    shared_jumps: Vec<SharedJump>,
     /// [`CoupledSystem::rows`].
     rows: Vec<[f64; 3]>,
     /// [`CoupledSystem::d`].
@@ -581,6 +662,7 @@ impl PairBlocks {
             columns: vec![Vec::new(); m],
             unit_loads: Vec::new(),
             c: Vec::new(),
+            shared_jumps: Vec::new(),
             rows: vec![[0.0; 3]; m],
             d: vec![0.0; m],
             d_coupled: Vec::new(),
@@ -616,6 +698,14 @@ impl PairBlocks {
         ];
         let node_offsets = coupling.node_offsets();
         for (k, &node) in coupling.primary_nodes.iter().enumerate() {
+            // The unit loads of this node so far, by key: its multipliers share them.
+            let mut node_loads: HashMap<MultiplierKey, usize> = HashMap::new();
+            let mut shared = shares_jump(&coupling.multipliers[k]).then(|| SharedJump {
+                rows: Vec::new(),
+                reads: Vec::new(),
+            });
+            // The components of the shared jump read so far.
+            let mut components_read: Vec<usize> = Vec::new();
             for (j, law_multiplier) in coupling.multipliers[k].iter().enumerate() {
                 let multiplier = first + node_offsets[k] + j;
                 self.rows[multiplier] = law_multiplier.row;
@@ -623,6 +713,8 @@ impl PairBlocks {
                     self.d[multiplier] = t;
                     continue;
                 }
+                // The multiplier's own term in its row (the unknown is `lambda / s`).
+                self.d[multiplier] = t * s * law_multiplier.compliance;
                 for c in 0..dim {
                     let (weight, row_weight) = (law_multiplier.force[c], law_multiplier.row[c]);
                     if weight == 0.0 && row_weight == 0.0 {
@@ -652,18 +744,57 @@ impl PairBlocks {
                             component: c,
                         };
                         self.columns[multiplier].push((key, weight));
-                        self.unit_loads.push(UnitLoad {
-                            key,
-                            multiplier,
-                            weight,
-                            load,
-                        });
+                        match node_loads.get(&key) {
+                            Some(&unit) => {
+                                self.unit_loads[unit].multipliers.push((multiplier, weight))
+                            }
+                            None => {
+                                node_loads.insert(key, self.unit_loads.len());
+                                self.unit_loads.push(UnitLoad {
+                                    key,
+                                    multipliers: vec![(multiplier, weight)],
+                                    load,
+                                });
+                            }
+                        }
                     }
                     if row_weight == 0.0 {
                         continue;
                     }
                     // The row: component c of the jump between the node and its secondary
                     // point, along the row's direction.
+                    self.g[multiplier] += t * row_weight * coupling.gaps[k][c];
+                    if let Some(jump) = shared
+                        .as_mut()
+                        .filter(|_| law_multiplier.reads == Reads::Interpolated)
+                    {
+                        if jump.rows.last().is_none_or(|&(last, _)| last != multiplier) {
+                            jump.rows
+                                .push((multiplier, law_multiplier.row.map(|r| t * r)));
+                        }
+                        let first_read = !components_read.contains(&c);
+                        let reads = std::iter::once((0, dof, 1.0)).chain(
+                            (coupling.reads(k, law_multiplier).iter())
+                                .map(|&(node2, w)| (1, dim * node2 + c, -w)),
+                        );
+                        for (side, dof, coefficient) in reads {
+                            match sides[side].unknown(dof) {
+                                Unknown::Forced(a) => (self.d_coupled).push((
+                                    multiplier,
+                                    a,
+                                    t * row_weight * coefficient,
+                                )),
+                                _ if first_read => {
+                                    (jump.reads).push((c, sides[side].offset + dof, coefficient))
+                                }
+                                _ => {}
+                            }
+                        }
+                        if first_read {
+                            components_read.push(c);
+                        }
+                        continue;
+                    }
                     let reads = std::iter::once((0, dof, t * row_weight)).chain(
                         (coupling.reads(k, law_multiplier).iter())
                             .map(|&(node2, w)| (1, dim * node2 + c, -t * w * row_weight)),
@@ -676,11 +807,25 @@ impl PairBlocks {
                             _ => self.c.push((multiplier, sides[side].offset + dof, value)),
                         }
                     }
-                    self.g[multiplier] += t * row_weight * coupling.gaps[k][c];
                 }
             }
+            self.shared_jumps
+                .extend(shared.filter(|jump| !jump.rows.is_empty()));
         }
     }
+}
+
+/// Whether two of a node's `multipliers` read a component of its interpolated jump in common
+/// ([`SharedJump`]).
+fn shares_jump(multipliers: &[Multiplier]) -> bool {
+    let reading: Vec<&Multiplier> = (multipliers.iter())
+        .filter(|m| m.reads == Reads::Interpolated)
+        .collect();
+    reading.iter().enumerate().any(|(a, first)| {
+        reading[a + 1..]
+            .iter()
+            .any(|second| (0..3).any(|c| first.row[c] != 0.0 && second.row[c] != 0.0))
+    })
 }
 
 /// What stands for a body dof in the coupled system.
@@ -751,8 +896,7 @@ impl PairBlocks {
                 .extend(load.iter().map(|&(row, v)| (multiplier, row, v)));
             self.unit_loads.push(UnitLoad {
                 key,
-                multiplier,
-                weight: 1.0 / s,
+                multipliers: vec![(multiplier, 1.0 / s)],
                 load,
             });
             self.d[multiplier] = rigid.diagonal;

@@ -110,8 +110,9 @@ impl Safeguard {
             }
         }
         if update.next == *active {
-            // A slipping node's direction (3D Coulomb) is a fixed point of its own: the loop
-            // goes on with the same states until it stops moving (`crate::contact::law::coulomb`).
+            // A slipping node's direction (3D Coulomb) is iterated on by Newton's method: the
+            // loop goes on with the same states until it stops moving
+            // (`crate::contact::law::coulomb`).
             let directions_settled = update.max_direction_change <= DIRECTION_SETTLED;
             if update.settled && directions_settled {
                 return Step::Stop(ContactStatus::Converged);
@@ -186,6 +187,7 @@ mod tests {
         Update {
             next: active.clone(),
             directions: Default::default(),
+            turnings: Default::default(),
             max_direction_change: 0.0,
             switching: Vec::new(),
             tension: Vec::new(),

@@ -77,8 +77,8 @@ use crate::contact::coupled::interface::{Constraint, InterfaceOperators};
 use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
-use crate::contact::iteration::anderson::DirectionAcceleration;
 use crate::contact::iteration::safeguard::{CONTRACTION, Safeguard, Step};
+use crate::contact::law::coulomb::Turning;
 use crate::contact::law::{ContactLaw, NodeStates, Tangential, coulomb};
 use crate::contact::problem::ContactProblem;
 use crate::contact::settings::{ContactSettings, CoupledSolver, Transfer};
@@ -544,7 +544,7 @@ impl<'a> ContactSolver<'a> {
             solved: active.clone(),
             active,
             directions,
-            acceleration: DirectionAcceleration::default(),
+            turnings: BTreeMap::new(),
             friction,
             rows,
             corrections,
@@ -593,8 +593,9 @@ struct LoopState {
     /// The direction of the friction traction of each slipping node (and of nodes that
     /// slipped before: only those in `active.slip` are read).
     directions: BTreeMap<usize, [f64; 3]>,
-    /// The history of the slip directions' iteration (3D Coulomb).
-    acceleration: DirectionAcceleration,
+    /// How each slipping node's direction is linearized (3D Coulomb; a node absent slipped in
+    /// no iterate of this solve yet: [`Turning::HELD`]).
+    turnings: BTreeMap<usize, Turning>,
     /// Each Coulomb pair's start of the load step.
     friction: Vec<Option<StepStart>>,
     /// Each pair's gap rows and tied corrections.
@@ -621,20 +622,15 @@ struct LoopState {
 }
 
 impl LoopState {
-    /// Moves on to the directions `update` finds for the nodes that slip next: in 3D, where a
-    /// slipping node's direction is a fixed point, accelerated by [`DirectionAcceleration`] from
-    /// the directions just solved with; in 2D, where it is one of two tangents (a choice, as
-    /// the normal state is), as they are.
-    fn turn_directions(&mut self, update: &BTreeMap<usize, [f64; 3]>, accelerate: bool) {
-        let next = if accelerate {
-            let solved: BTreeMap<usize, [f64; 3]> = (self.active.slip.iter())
-                .filter_map(|&i| Some((i, *self.directions.get(&i)?)))
-                .collect();
-            self.acceleration.next(&solved, update)
-        } else {
-            update.clone()
-        };
-        self.directions.extend(next);
+    /// Moves on to the directions `update` finds for the nodes that slip next, and (3D) the
+    /// linearizations of their directions at the iterate ([`Turning`]).
+    fn turn_directions(
+        &mut self,
+        directions: &BTreeMap<usize, [f64; 3]>,
+        turnings: &BTreeMap<usize, Turning>,
+    ) {
+        self.directions.extend(directions);
+        self.turnings.extend(turnings);
     }
 
     /// Keeps an iteration's `record` and `last` iterate, and moves on to its `step`: the status
@@ -673,7 +669,7 @@ impl ContactSolver<'_> {
         let nodes: Vec<Vec<usize>> = (0..self.pairs.len())
             .map(|p| self.pair_nodes(&state.active.contact, p))
             .collect();
-        let tangential = self.tangential_states(&state.active, &state.directions);
+        let tangential = self.tangential_states(&state.active, &state.directions, &state.turnings);
         let couplings = timed(&mut seconds.operators, || {
             self.couplings(&nodes, state, &tangential)
         });
@@ -713,8 +709,7 @@ impl ContactSolver<'_> {
                     .collect();
             }
         }
-        let accelerate = self.pairs[0].primary_surface.dim == 3;
-        state.turn_directions(&update.directions, accelerate);
+        state.turn_directions(&update.directions, &update.turnings);
         // 5. Stop, or go on with the next set (safeguarded against repeats); a set that
         //    settled on a pairing its slide no longer rounds to is paired again where the
         //    surfaces touch, and solved again. A pairing this solve has left on the same set
@@ -1128,6 +1123,7 @@ impl ContactSolver<'_> {
         &self,
         states: &NodeStates,
         directions: &BTreeMap<usize, [f64; 3]>,
+        turnings: &BTreeMap<usize, Turning>,
     ) -> Vec<Option<Vec<Tangential>>> {
         (0..self.pairs.len())
             .map(|p| {
@@ -1135,7 +1131,10 @@ impl ContactSolver<'_> {
                     let offset = self.offsets[p];
                     (offset..self.offsets[p + 1])
                         .map(|i| match (states.slip.contains(&i), directions.get(&i)) {
-                            (true, Some(&direction)) => Tangential::Slip { direction },
+                            (true, Some(&direction)) => Tangential::Slip {
+                                direction,
+                                turning: turnings.get(&i).copied().unwrap_or(Turning::HELD),
+                            },
                             _ => Tangential::Stick,
                         })
                         .collect()
@@ -1270,9 +1269,10 @@ impl ContactSolver<'_> {
             if active.contains_key(&i) && slips(state) != slips(node.next) && p_max > 0.0 {
                 update.switching.push((i, node.margin / (mu * p_max)));
             }
-            if let Tangential::Slip { direction } = node.next {
+            if let Tangential::Slip { direction, turning } = node.next {
                 update.next.slip.insert(i);
                 update.directions.insert(i, direction);
+                update.turnings.insert(i, turning);
             }
         }
     }
@@ -1405,7 +1405,7 @@ impl ContactSolver<'_> {
         let dim = self.pairs[0].primary_surface.dim;
         let mut answers = Vec::with_capacity(self.pairs.len());
         // Each Coulomb pair's tangential states the last iterate was solved with.
-        let tangential = self.tangential_states(&state.solved, &state.directions);
+        let tangential = self.tangential_states(&state.solved, &state.directions, &state.turnings);
         for (p, problem) in self.pairs.iter().enumerate() {
             let [a, b] = self.pair_bodies[p];
             let nodes = self.pair_nodes(&state.active.contact, p);
@@ -1443,7 +1443,7 @@ impl ContactSolver<'_> {
                     }
                     let slip = (fields.state.iter().enumerate())
                         .filter_map(|(i, s)| match s {
-                            Some(Tangential::Slip { direction }) => Some((i, *direction)),
+                            Some(Tangential::Slip { direction, .. }) => Some((i, *direction)),
                             _ => None,
                         })
                         .collect();

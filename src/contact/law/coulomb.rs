@@ -9,8 +9,8 @@
 //! u2)_i) = t_a . J0_i`, `J0_i` the jump `u1_i - (R12 u2)_i` at the start of the step, read
 //! through the same interpolation the tied formulation reads. A slipping node carries one,
 //! `lambda_n (n - mu d)` with the normal row: its friction traction `mu p d` (`p = -lambda_n`)
-//! rides on its pressure, in the direction `d` the last update chose. Its column is not its
-//! row: the coupled system is unsymmetric (the coupled GMRES and its half-space preconditioner,
+//! rides on its pressure, in the direction `d` the last update chose, and in 3D a second one
+//! across `d` ([`Turning`]). Its first column is not its row: the coupled system is unsymmetric (the coupled GMRES and its half-space preconditioner,
 //! `crate::contact::coupled::half_space`, take rows and columns apart).
 //!
 //! **The update** is the primal-dual active set (semismooth Newton) step of the complementarity
@@ -25,9 +25,11 @@
 //! A slipping node goes on slipping while its slip opposes its traction (`v . d <= 0` gives
 //! `|xi| >= mu p`), and sticks again when it would slip along its traction. In 2D `d` is one
 //! of the two tangents: the update is a choice among finitely many states, as the normal
-//! active-set update is. In 3D the direction is a fixed point: each slipping node's direction
-//! is updated from the iterate and the loop settles only when no direction changes by more
-//! than [`DIRECTION_SETTLED`] (`docs/method.md`: why, and what happens when it does not).
+//! active-set update is. In 3D the direction turns: a slipping node also carries a multiplier
+//! across its direction whose row is the slip law linearized at the iterate ([`Turning`]), so
+//! that the directions follow Newton's method, and the loop settles only when no direction
+//! changes by more than [`DIRECTION_SETTLED`] (`docs/method.md` 1.4: why, and what happens when
+//! it does not).
 
 use super::{Multiplier, Reads, Restates, Tangential};
 
@@ -60,6 +62,50 @@ pub fn tangents(n: [f64; 3], dim: usize) -> Vec<[f64; 3]> {
     vec![t1, cross(n, t1)]
 }
 
+/// How a slipping node's direction `d` is linearized in 3D: the Newton step of the slip law
+/// `t_T = mu p d`, `v = -|v| d` (`docs/method.md` 1.4). A traction `t_perp` along the tangent
+/// `e = n x d` across the direction turns the slip the other way, `v_perp = -|v| t_perp / (mu
+/// p)` to first order, which the node's second multiplier (column `e`) holds as the row
+///
+/// ```text
+/// a v_perp + (1 - a) t_perp / c_t = 0,      a = mu p / (mu p + c_t |v|)
+/// ```
+///
+/// at the iterate's `p` and `|v|`, with `v_perp = e . (J - J0)` read through the interpolation
+/// as a sticking node's tangential rows are. The weights `a` and `1 - a` keep it bounded at
+/// both ends: a node that has just started to slip (`v = 0`) is held across its direction, a
+/// rim node whose pressure vanishes takes no traction across it. At the solution `t_perp = 0`
+/// and the row holds with `v_perp = 0`: the slip runs against the traction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Turning {
+    /// `a`: the weight of the slip across the direction in the row.
+    pub slip_weight: f64,
+    /// `(1 - a) / c_t`: the multiplier's own term in the row.
+    pub compliance: f64,
+}
+
+impl Turning {
+    /// The linearization of a node that has not slipped yet (`v = 0`): held across its
+    /// direction.
+    pub const HELD: Self = Self {
+        slip_weight: 1.0,
+        compliance: 0.0,
+    };
+
+    /// The linearization at pressure `p`, slip `v` (tangential), with `c_t`.
+    fn at(mu: f64, p: f64, v: [f64; 3], c_t: f64) -> Self {
+        let (bound, slip) = (mu * p.max(0.0), c_t * norm(v));
+        if bound + slip <= 0.0 {
+            return Self::HELD;
+        }
+        let slip_weight = bound / (bound + slip);
+        Self {
+            slip_weight,
+            compliance: (1.0 - slip_weight) / c_t,
+        }
+    }
+}
+
 pub(super) fn multipliers(
     normal: [f64; 3],
     tangential: Tangential,
@@ -71,14 +117,29 @@ pub(super) fn multipliers(
         row: normal,
         reads: Reads::Geometric,
         restates: Restates::Node,
+        compliance: 0.0,
     };
     match tangential {
-        Tangential::Slip { direction } => {
+        Tangential::Slip { direction, turning } => {
             // The direction was chosen tangent to the last iterate's normal; made tangent to
             // this one, so that the traction's normal part is the pressure and its tangential
             // part exactly `mu p` (the cone's edge).
             let d = unit(tangential_part(direction, normal));
-            vec![normal_row(std::array::from_fn(|k| normal[k] - mu * d[k]))]
+            let slipping = normal_row(std::array::from_fn(|k| normal[k] - mu * d[k]));
+            if dim == 2 {
+                return vec![slipping];
+            }
+            let across = cross(normal, d);
+            vec![
+                slipping,
+                Multiplier {
+                    force: across,
+                    row: across.map(|x| turning.slip_weight * x),
+                    reads: Reads::Interpolated,
+                    restates: Restates::Node,
+                    compliance: turning.compliance,
+                },
+            ]
         }
         Tangential::Stick => std::iter::once(normal_row(normal))
             .chain(tangents(normal, dim).into_iter().map(|t| Multiplier {
@@ -86,6 +147,7 @@ pub(super) fn multipliers(
                 row: t,
                 reads: Reads::Interpolated,
                 restates: Restates::Node,
+                compliance: 0.0,
             }))
             .collect(),
     }
@@ -125,7 +187,7 @@ pub fn update(
     let bound = mu * p.max(0.0);
     let stick = match state {
         Tangential::Stick => size <= bound + slack,
-        Tangential::Slip { direction } => {
+        Tangential::Slip { direction, .. } => {
             let along: f64 = (0..3).map(|k| v[k] * direction[k]).sum();
             size < bound - slack && along > settled
         }
@@ -140,11 +202,16 @@ pub fn update(
     }
     let direction = xi.map(|x| x / size);
     let direction_change = match state {
-        Tangential::Slip { direction: old } => norm(std::array::from_fn(|k| direction[k] - old[k])),
+        Tangential::Slip { direction: old, .. } => {
+            norm(std::array::from_fn(|k| direction[k] - old[k]))
+        }
         Tangential::Stick => 0.0,
     };
     NodeUpdate {
-        next: Tangential::Slip { direction },
+        next: Tangential::Slip {
+            direction,
+            turning: Turning::at(mu, p, v, c_t),
+        },
         margin,
         direction_change,
     }
@@ -223,7 +290,8 @@ mod tests {
         assert_eq!(
             outside.next,
             Tangential::Slip {
-                direction: [-1.0, 0.0, 0.0]
+                direction: [-1.0, 0.0, 0.0],
+                turning: Turning::HELD,
             }
         );
     }
@@ -232,6 +300,7 @@ mod tests {
     fn a_slipping_node_slips_on_while_its_slip_opposes_its_traction() {
         let state = Tangential::Slip {
             direction: [1.0, 0.0, 0.0],
+            turning: Turning::HELD,
         };
         // Traction mu p along +x, slip along -x: a valid slip.
         let on = update(
@@ -244,7 +313,13 @@ mod tests {
             0.0,
             0.0,
         );
-        assert_eq!(on.next, state);
+        // Linearized at its slip: a = mu p / (mu p + c_t |v|) = 0.3 / 0.31.
+        let Tangential::Slip { direction, turning } = on.next else {
+            panic!("{:?}", on.next);
+        };
+        assert_eq!(direction, [1.0, 0.0, 0.0]);
+        assert!((turning.slip_weight - 0.3 / 0.31).abs() < 1e-15);
+        assert!((turning.compliance - (1.0 - 0.3 / 0.31) / 10.0).abs() < 1e-15);
         assert_eq!(on.direction_change, 0.0);
         // Slipping along its own traction: it sticks.
         let back = update(
@@ -266,6 +341,7 @@ mod tests {
             N,
             Tangential::Slip {
                 direction: [1.0, 0.0, 0.0],
+                turning: Turning::HELD,
             },
             0.5,
             2,
@@ -274,5 +350,36 @@ mod tests {
         assert_eq!(slip[0].force, [-0.5, 1.0, 0.0]);
         assert_eq!(slip[0].row, N);
         assert_eq!(multipliers(N, Tangential::Stick, 0.5, 3).len(), 3);
+    }
+
+    #[test]
+    fn in_3d_a_slipping_node_is_also_held_across_its_direction_as_linearized() {
+        let turning = Turning::at(0.5, 2.0, [0.0, 0.0, -0.1], 10.0);
+        // mu p = 1, c_t |v| = 1: half the row on the slip, half on the traction.
+        assert_eq!(turning.slip_weight, 0.5);
+        assert_eq!(turning.compliance, 0.05);
+        let slip = multipliers(
+            N,
+            Tangential::Slip {
+                direction: [1.0, 0.0, 0.0],
+                turning,
+            },
+            0.5,
+            3,
+        );
+        assert_eq!(slip.len(), 2);
+        assert_eq!(slip[0].force, [-0.5, 1.0, 0.0]);
+        // Across the direction: the tangent n x d, its row half of it, read through the
+        // interpolation, with its own term.
+        let across = slip[1];
+        assert_eq!(across.force, [0.0, 0.0, -1.0]);
+        assert_eq!(across.row, [0.0, 0.0, -0.5]);
+        assert_eq!(across.reads, Reads::Interpolated);
+        assert_eq!(across.compliance, 0.05);
+        // A node that has not slipped yet is held across it; one without pressure takes no
+        // traction across it.
+        assert_eq!(Turning::at(0.5, 2.0, [0.0; 3], 10.0), Turning::HELD);
+        let unloaded = Turning::at(0.5, 0.0, [0.0, 0.0, -0.1], 10.0);
+        assert_eq!((unloaded.slip_weight, unloaded.compliance), (0.0, 0.1));
     }
 }

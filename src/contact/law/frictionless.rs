@@ -12,5 +12,6 @@ pub(super) fn multipliers(normal: [f64; 3]) -> Vec<Multiplier> {
         row: normal,
         reads: Reads::Geometric,
         restates: Restates::Node,
+        compliance: 0.0,
     }]
 }

@@ -15,7 +15,7 @@
 //! | frictionless | contact             | 1: `lambda_n n`               | the normal gap, node to segment (`crate::contact::geometry::gap`) |
 //! | tied         | contact             | `dim`: the traction's components | `u1 - R12 u2 = (d + e) n` (`crate::contact::coupled::interface`) |
 //! | Coulomb      | stick               | `dim`: `lambda_n n + sum lambda_a t_a` | the normal gap; `t_a . (u1 - R12 u2)` unchanged over the step |
-//! | Coulomb      | slip along `d`      | 1: `lambda_n (n - mu d)`      | the normal gap  |
+//! | Coulomb      | slip along `d`      | 1: `lambda_n (n - mu d)`; 3D also `lambda_e e`, `e = n x d` | the normal gap; 3D the slip law across `d`, linearized (`coulomb::Turning`) |
 //!
 //! A multiplier ([`Multiplier`]) is a column (the traction one unit of it exerts on the
 //! primary) and a row (a direction of the constraint, read at a point of the secondary): the
@@ -61,6 +61,10 @@ pub struct Multiplier {
     pub row: [f64; 3],
     pub reads: Reads,
     pub restates: Restates,
+    /// The multiplier's own term in its row, `row . (u1_i - u2(point)) + compliance lambda =
+    /// row . target_i` (a length per traction): zero but on the row that linearizes a
+    /// slipping node's direction in 3D ([`coulomb::Turning`]).
+    pub compliance: f64,
 }
 
 /// The tangential state of an active node of a Coulomb pair.
@@ -68,8 +72,12 @@ pub struct Multiplier {
 pub enum Tangential {
     /// No slip over the load step.
     Stick,
-    /// Slipping: the friction traction on the primary is `mu p d` (`d` a unit tangent).
-    Slip { direction: [f64; 3] },
+    /// Slipping: the friction traction on the primary is `mu p d` (`d` a unit tangent), and in
+    /// 3D the direction is linearized as `turning` says.
+    Slip {
+        direction: [f64; 3],
+        turning: coulomb::Turning,
+    },
 }
 
 /// The contact law of a pair.

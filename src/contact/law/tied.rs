@@ -16,6 +16,7 @@ pub(super) fn multipliers(dim: usize) -> Vec<Multiplier> {
                 row: axis,
                 reads: Reads::Interpolated,
                 restates: Restates::Component(c),
+                compliance: 0.0,
             }
         })
         .collect()

@@ -233,7 +233,7 @@ pub fn friction(
         }
         let along = match state {
             Tangential::Stick => norm(slip[i]),
-            Tangential::Slip { direction } => (0..3).map(|k| slip[i][k] * direction[k]).sum(),
+            Tangential::Slip { direction, .. } => (0..3).map(|k| slip[i][k] * direction[k]).sum(),
         };
         slipping.offer(along / s1.spacing[i], s1, i);
     }
