@@ -1370,12 +1370,17 @@ impl ContactSolver<'_> {
             }
             let update = Update::merge(updates);
             // An iterate that keeps the node states while slipping nodes' directions still turn
-            // (3D Coulomb) only turns them further: the loop goes on from it, and a loose solve
-            // serves while they turn by more than a hundred times the settled change (a loose
-            // solve's own error turned them by about 1e-6 on the 3D sphere, the settled change
-            // itself, and held the loop there to its cap).
+            // (3D Coulomb) only turns them further: the loop goes on from it, so a loose solve
+            // serves until they settle and the loop would stop on it. Its solves are
+            // `Tightness::Reduced`, each a hundred times below its start, and the start's
+            // residual falls with the directions' change: their own error falls with it. (Plain
+            // loose solves, to a fixed 1e-6, turned the directions of the 3D sphere by about
+            // 1e-6 themselves and held the loop there to its cap.) A partition seen before is
+            // a repeat only once the directions turn by less than `coulomb::STILL_TURNING`,
+            // the safeguard's rule.
+            let settled = update.max_direction_change <= coulomb::DIRECTION_SETTLED;
             let turning = update.max_direction_change > coulomb::STILL_TURNING;
-            let keeps = update.next == *active && !turning;
+            let keeps = update.next == *active && settled;
             let seen = safeguard.seen.contains(&update.next) && !turning;
             if loose && (keeps || seen) {
                 loose = false;
