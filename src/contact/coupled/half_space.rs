@@ -40,9 +40,8 @@
 //! Dirichlet condition (no column, `D_kk != 0`) keeps its exact block `D_kk`; a coupled one with
 //! its own term in its row (a slipping node's direction row, `crate::contact::law::coulomb`) has
 //! `D_kk` added to its diagonal of `S~`. `S~` is dense and factored by LU once per active-set
-//! iteration (`m` is
-//! hundreds to a few thousand: `m^3 / 3` multiply-adds, 4e8 for the 1048 multipliers of the
-//! largest active set at the contact benchmark's 99k DOFs).
+//! iteration (`m` is hundreds to a few thousand: `m^3 / 3` multiply-adds, 4e8 for the 1048
+//! multipliers of the largest active set at the contact benchmark's 99k DOFs).
 
 use std::collections::HashMap;
 
