@@ -53,9 +53,9 @@ def mesh(level: float) -> Path:
 
 
 def case(msh: Path, formulation: str, output: Path, press: tuple[float, ...] = (1.0, 1.0),
-         shear: tuple[float, ...] = (0.0, 1.0)) -> Path:
+         shear: tuple[float, ...] = (0.0, 1.0), approach: float = APPROACH, shift: float = SHEAR) -> Path:
     """The case file of one run, beside ``output``: the sphere's top pressed down by
-    ``APPROACH`` times the factors ``press`` and moved along x by ``SHEAR`` times ``shear``."""
+    ``approach`` times the factors ``press`` and moved along x by ``shift`` times ``shear``."""
     friction = f"\nfriction_coefficient = {MU}" if formulation == "coulomb" else ""
     text = f"""mesh = {json.dumps(str(msh))}
 output = {json.dumps(str(output))}
@@ -77,12 +77,12 @@ poisson_ratio = 0.3
 
 [[body.dirichlet]]
 group = "sphere_top"
-uz = {-APPROACH}
+uz = {-approach}
 path = "press"
 
 [[body.dirichlet]]
 group = "sphere_top"
-ux = {SHEAR}
+ux = {shift}
 uy = 0.0
 path = "shear"
 
