@@ -649,6 +649,39 @@ mod tests {
         }
     }
 
+    /// The bodies of `meshes`, each with its top pushed down by its `push`, assembled.
+    fn assembled(meshes: &[BodyMesh], pushes: &[f64]) -> Vec<AssembledBody> {
+        let mut stats = SolveStats::default();
+        (meshes.iter().zip(pushes))
+            .map(|(mesh, &push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
+            .collect()
+    }
+
+    /// The bodies' factors (Cholesky) for the interface `solver`, on the primary `candidates`,
+    /// with `pairs` pairs of one material.
+    fn factors(
+        bodies: &[&AssembledBody],
+        candidates: Vec<Vec<usize>>,
+        pairs: usize,
+        solver: CoupledSolver,
+    ) -> BodyFactors {
+        let settings = SolverSettings {
+            verbose: false,
+            ..SolverSettings::default()
+        };
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let contact = ContactSettings {
+            solver,
+            ..ContactSettings::default()
+        };
+        let compliance = vec![compliance_factor([&material, &material], 2); pairs];
+        let kind = BodySolverKind::Cholesky;
+        BodyFactors::new(
+            bodies, candidates, compliance, &settings, kind, &contact, None,
+        )
+        .unwrap()
+    }
+
     #[test]
     fn bodies_tied_side_by_side_are_one_body_on_every_path() {
         let meshes = [
@@ -657,11 +690,7 @@ mod tests {
             grid("right", 2.0, NX),
             grid("alone", 5.0, NX),
         ];
-        let pushes = [0.01, 0.01, 0.01, 0.02];
-        let mut stats = SolveStats::default();
-        let bodies: Vec<AssembledBody> = (meshes.iter().zip(pushes))
-            .map(|(mesh, push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
-            .collect();
+        let bodies = assembled(&meshes, &[0.01, 0.01, 0.01, 0.02]);
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
         let couplings = [tied(NX, NX, NX, 0, 1.0), tied(NX, 0, NX, NX, -1.0)];
         let pairs = [
@@ -726,8 +755,6 @@ mod tests {
             "monolithic LU",
             &solve_monolithic(&system, &bodies).unwrap(),
         );
-        let material = Material::new(1000.0, 0.3).unwrap();
-        let compliance = vec![compliance_factor([&material, &material], 2); 2];
         let candidates = vec![
             (0..=NY).map(|j| NX + j * (NX + 1)).collect::<Vec<_>>(),
             (0..=NY)
@@ -737,20 +764,7 @@ mod tests {
             Vec::new(),
         ];
         for solver in [CoupledSolver::Schur, CoupledSolver::Krylov] {
-            let contact = ContactSettings {
-                solver,
-                ..ContactSettings::default()
-            };
-            let mut factors = BodyFactors::new(
-                &bodies,
-                candidates.clone(),
-                compliance.clone(),
-                &settings,
-                BodySolverKind::Cholesky,
-                &contact,
-                None,
-            )
-            .unwrap();
+            let mut factors = factors(&bodies, candidates.clone(), 2, solver);
             let x = factors
                 .solve(&system, &pairs, &bodies, Tightness::Tight)
                 .unwrap();
@@ -766,10 +780,7 @@ mod tests {
     #[test]
     fn shared_loads_and_reads_and_a_multipliers_own_term_give_the_entries_answer() {
         let meshes = [grid("left", 0.0, NX), grid("right", 1.0, NX)];
-        let mut stats = SolveStats::default();
-        let bodies: Vec<AssembledBody> = (meshes.iter().zip([0.01, 0.02]))
-            .map(|(mesh, push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
-            .collect();
+        let bodies = assembled(&meshes, &[0.01, 0.02]);
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
         // Two multipliers per node along a basis turned by 30 degrees: each reads both
         // components of the jump and loads both components of the node (shared), and the
@@ -805,30 +816,12 @@ mod tests {
         );
         let reference = solve_monolithic(&system, &bodies).unwrap();
         let scale = reference.iter().map(|v| v.abs()).fold(0.0, f64::max);
-        let settings = SolverSettings {
-            verbose: false,
-            ..SolverSettings::default()
-        };
-        let material = Material::new(1000.0, 0.3).unwrap();
         let candidates = vec![
             (0..=NY).map(|j| NX + j * (NX + 1)).collect::<Vec<_>>(),
             (0..=NY).map(|j| j * (NX + 1)).collect(),
         ];
         for solver in [CoupledSolver::Schur, CoupledSolver::Krylov] {
-            let contact = ContactSettings {
-                solver,
-                ..ContactSettings::default()
-            };
-            let mut factors = BodyFactors::new(
-                &bodies,
-                candidates.clone(),
-                vec![compliance_factor([&material, &material], 2)],
-                &settings,
-                BodySolverKind::Cholesky,
-                &contact,
-                None,
-            )
-            .unwrap();
+            let mut factors = factors(&bodies, candidates.clone(), 1, solver);
             let x = (factors.solve(&system, &pairs, &bodies, Tightness::Tight)).unwrap();
             let off = (x.iter().zip(&reference)).map(|(a, b)| (a - b).abs());
             assert!(
@@ -863,10 +856,7 @@ mod tests {
     #[test]
     fn a_solve_restarted_from_its_own_answer_takes_no_iteration() {
         let meshes = [grid("left", 0.0, NX), grid("right", 1.0, NX)];
-        let mut stats = SolveStats::default();
-        let bodies: Vec<AssembledBody> = (meshes.iter().zip([0.01, 0.01]))
-            .map(|(mesh, push)| assemble(&problem(mesh, push), &mut stats, false).unwrap())
-            .collect();
+        let bodies = assembled(&meshes, &[0.01, 0.01]);
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
         // The tied coupling of the two columns that meet, between their clamped and pushed
         // ends (where a turned multiplier would restate a prescribed component), its two
@@ -898,29 +888,11 @@ mod tests {
         }];
         let system =
             CoupledSystem::assemble(&bodies, &pairs, 2, &StepFactors::uniform(1.0)).unwrap();
-        let settings = SolverSettings {
-            verbose: false,
-            ..SolverSettings::default()
-        };
-        let material = Material::new(1000.0, 0.3).unwrap();
-        let contact = ContactSettings {
-            solver: CoupledSolver::Krylov,
-            ..ContactSettings::default()
-        };
         let candidates = vec![
             (0..=NY).map(|j| NX + j * (NX + 1)).collect::<Vec<_>>(),
             (0..=NY).map(|j| j * (NX + 1)).collect(),
         ];
-        let mut factors = BodyFactors::new(
-            &bodies,
-            candidates,
-            vec![compliance_factor([&material, &material], 2)],
-            &settings,
-            BodySolverKind::Cholesky,
-            &contact,
-            None,
-        )
-        .unwrap();
+        let mut factors = factors(&bodies, candidates, 1, CoupledSolver::Krylov);
         let first = (factors.solve(&system, &pairs, &bodies, Tightness::Tight)).unwrap();
         let cold = factors.last_krylov.unwrap();
         assert!(cold.iterations > 0, "{cold:?}");
