@@ -724,6 +724,16 @@ impl PairBlocks {
                     if weight != 0.0 {
                         // The column: the unit force of component c at the node, on both
                         // bodies.
+                        let key = MultiplierKey::Traction {
+                            pair: place.pair,
+                            node,
+                            component: c,
+                        };
+                        self.columns[multiplier].push((key, weight));
+                        // The node's unit load of component c, made by its first multiplier
+                        // that has one and shared by the others; the forces on a
+                        // force-controlled group are each multiplier's own entries of `D`.
+                        let shared_load = node_loads.get(&key).copied();
                         let mut load = Vec::new();
                         let forces = std::iter::once((0, dof, -coupling.areas1[k])).chain(
                             (coupling.loads2[k].iter())
@@ -731,21 +741,17 @@ impl PairBlocks {
                         );
                         for (side, dof, value) in forces {
                             match sides[side].unknown(dof) {
-                                Unknown::Free(row) => load.push((row, value)),
+                                Unknown::Free(row) if shared_load.is_none() => {
+                                    load.push((row, value))
+                                }
                                 Unknown::Forced(a) => {
                                     self.d_coupled.push((a, multiplier, s * value * weight));
                                 }
-                                Unknown::Prescribed => {}
+                                _ => {}
                             }
                         }
-                        let key = MultiplierKey::Traction {
-                            pair: place.pair,
-                            node,
-                            component: c,
-                        };
-                        self.columns[multiplier].push((key, weight));
-                        match node_loads.get(&key) {
-                            Some(&unit) => {
+                        match shared_load {
+                            Some(unit) => {
                                 self.unit_loads[unit].multipliers.push((multiplier, weight))
                             }
                             None => {
