@@ -37,6 +37,10 @@ pub enum CheckKind {
     /// The secondary's sag between constrained primary nodes, over the indentation depth.
     #[serde(rename = "secondary sag")]
     SecondarySag,
+    /// The penalty method's overlap `p / eps` (pressure-weighted), over the indentation depth:
+    /// the relative error of the force it makes.
+    #[serde(rename = "penalty overlap")]
+    PenaltyOverlap,
     /// The contact zone's width in spacings, against the minimum.
     #[serde(rename = "resolution")]
     Resolution,
@@ -66,6 +70,7 @@ impl CheckKind {
             Self::FrictionCone => "friction cone",
             Self::Slip => "slip",
             Self::SecondarySag => "secondary sag",
+            Self::PenaltyOverlap => "penalty overlap",
             Self::Resolution => "resolution",
             Self::ForceCentre => "force centre",
             Self::StickResolution => "stick zone resolution",
@@ -96,7 +101,7 @@ impl CheckKind {
             }
             Self::FrictionCone => " of mu times the largest pressure",
             Self::Tension => " of the largest pressure",
-            Self::SecondarySag => " of the indentation depth",
+            Self::SecondarySag | Self::PenaltyOverlap => " of the indentation depth",
             Self::ForceCentre => {
                 " of the coarser spacing (between the two bodies' centres of normal force)"
             }
@@ -201,6 +206,7 @@ pub struct ErrorCoverage {
 impl Certificate {
     /// Which errors of what a user reads the accuracy report estimates, and which it does not
     /// (`docs/method.md` 4.2):
+    /// - the penalty method's overlap, where it enforced the contact: by the penalty overlap;
     /// - the coupling of the two meshes at the interface (the multiplier space, the transfer,
     ///   the secondary's sag between primary nodes): by the sag and the force centres, and by
     ///   another discretization of the coupling only where the other primary or the automatic
@@ -215,7 +221,14 @@ impl Certificate {
         };
         use CheckKind::*;
         let compared = has(PrimaryAgreement) || has(TransferAgreement);
-        vec![
+        // The penalty method's own error, where it enforced the contact.
+        let penalty = has(PenaltyOverlap).then(|| ErrorCoverage {
+            error: "penalty",
+            affects: "contact force, contact zone (the bodies overlap by p / eps)",
+            estimated_by: vec![PenaltyOverlap],
+            not_estimated: None,
+        });
+        let mut coverage = vec![
             ErrorCoverage {
                 error: "interface coupling",
                 affects: "contact force and where it acts",
@@ -258,7 +271,9 @@ impl Certificate {
                      sequence (internodes study CASE.toml --parameter level=0,1,2)",
                 ),
             },
-        ]
+        ];
+        coverage.splice(1..1, penalty);
+        coverage
     }
 }
 

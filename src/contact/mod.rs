@@ -13,6 +13,8 @@
 //! - the contact law, `law/` (frictionless, tied, Coulomb): each active node's multipliers
 //!   (column and row), the tangential state of a Coulomb node (stick, slip) and its update, and
 //!   the loop's per-node state; the only place that tells the laws apart;
+//! - `method.rs`: how the law is enforced, INTERNODES or the penalty method (a row's own term,
+//!   and where the secondary receives the force); the only place that tells them apart;
 //! - `coupled/`: the linear algebra of an iteration, for any number of bodies and pairs: the
 //!   bodies' responses to unit tractions, the coupled system of an active set, the INTERNODES
 //!   interface operators (built once over all candidates: the interpolation evaluated at each
@@ -39,6 +41,7 @@ mod driver;
 mod geometry;
 mod iteration;
 pub mod law;
+mod method;
 mod problem;
 mod settings;
 mod solution;
@@ -55,7 +58,9 @@ pub use iteration::solve::ContactSolver;
 pub use problem::{
     ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,
 };
-pub use settings::{ContactSettings, CoupledSolver, Formulation, SettingsError, Transfer};
+pub use settings::{
+    ContactSettings, CoupledSolver, DEFAULT_PENALTY, Formulation, Method, SettingsError, Transfer,
+};
 pub use solution::{
     ContactSolution, ContactStatus, ForcedDisplacement, FrictionFields, FrictionState, HertzFit,
     IterationRecord, LinearSolvers, PhaseSeconds, SurfaceFields,

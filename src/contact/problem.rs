@@ -222,6 +222,14 @@ impl<'m> ContactProblem<'m> {
         [k1 / (k1 + k2), k2 / (k1 + k2)]
     }
 
+    /// The penalty `eps = penalty E* / h` of a penalty pair (`crate::contact::method`), `h` the
+    /// primary's spacing where contact starts ([`contact_zone_spacing`]): one number per pair,
+    /// as the penalty codes take it; `None` under INTERNODES.
+    pub fn penalty_stiffness(&self) -> Option<f64> {
+        let factor = self.settings.penalty_factor()?;
+        Some(factor * self.contact_modulus() / self.contact_spacing[0])
+    }
+
     /// The combined contact modulus `E* = 1 / (1 / E1' + 1 / E2')`, `E' = E / (1 - nu^2)`.
     pub fn contact_modulus(&self) -> f64 {
         let modulus = |p: &ElasticProblem| {

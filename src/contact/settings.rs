@@ -30,6 +30,37 @@ impl Formulation {
     }
 }
 
+/// How a pair's contact law is enforced (`docs/method.md` 5): the one thing that differs
+/// between the two methods (`crate::contact::method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Lagrange multipliers on the primary's active nodes, the traction carried to the
+    /// secondary by the transfer (`transfer`): the constraint holds exactly.
+    #[default]
+    Internodes,
+    /// A pressure `eps max(0, -g)` on each primary node's gap `g` (the same gap as
+    /// INTERNODES'), carried to the secondary by the same transfer, `eps = penalty E* / h`: the
+    /// bodies overlap by `p / eps` where they touch.
+    Penalty,
+}
+
+impl Method {
+    /// The name used in case files and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Internodes => "internodes",
+            Self::Penalty => "penalty",
+        }
+    }
+}
+
+/// The penalty factor of `method = "penalty"` when the case gives none: `eps = 100 E* / h`,
+/// an overlap of `p / (100 E*)` spacings, 1e-4 of a spacing at a pressure of `E* / 100` (a
+/// contact zone a tenth of the radius of a Hertzian contact): a tenth of
+/// `penetration_tolerance`'s default.
+pub const DEFAULT_PENALTY: f64 = 100.0;
+
 /// How the multiplier's force reaches the secondary body (`docs/method.md` 2.4).
 ///
 /// - `Interpolation` (INTERNODES' own transfer): the secondary receives the traction
@@ -113,6 +144,12 @@ const KRYLOV_MAX_ITERATIONS_CAP: usize = 10_000;
 pub struct ContactSettings {
     /// Default: frictionless.
     pub formulation: Formulation,
+    /// How the law is enforced (default: INTERNODES, [`Method`]).
+    pub method: Method,
+    /// The penalty `eps` of `method = "penalty"` as a multiple of the contact stiffness
+    /// `E* / h` (`E*` the pair's contact modulus, `h` the primary's spacing where contact
+    /// starts; default [`DEFAULT_PENALTY`]); refused with `method = "internodes"`.
+    pub penalty: Option<f64>,
     /// The Coulomb friction coefficient `mu` (> 0, finite): required by `formulation =
     /// "coulomb"`, refused by the others.
     pub friction_coefficient: Option<f64>,
@@ -190,6 +227,8 @@ impl Default for ContactSettings {
     fn default() -> Self {
         Self {
             formulation: Formulation::default(),
+            method: Method::default(),
+            penalty: None,
             friction_coefficient: None,
             transfer: Transfer::default(),
             solver: CoupledSolver::default(),
@@ -211,6 +250,14 @@ impl Default for ContactSettings {
 }
 
 impl ContactSettings {
+    /// The penalty factor of a penalty pair (times `E* / h`); `None` under INTERNODES.
+    pub fn penalty_factor(&self) -> Option<f64> {
+        match self.method {
+            Method::Internodes => None,
+            Method::Penalty => Some(self.penalty.unwrap_or(DEFAULT_PENALTY)),
+        }
+    }
+
     /// Checks every setting's range.
     pub fn validate(&self) -> Result<(), SettingsError> {
         let error = |name, expected, value| {
@@ -237,6 +284,25 @@ impl ContactSettings {
                     "left out unless formulation = \"coulomb\" (frictionless and tied \
                      contact have no friction coefficient)",
                     mu,
+                );
+            }
+            _ => {}
+        }
+        match (self.method, self.penalty) {
+            (Method::Internodes, Some(penalty)) => {
+                return error(
+                    "penalty",
+                    "left out unless method = \"penalty\" (INTERNODES holds the constraint \
+                     exactly)",
+                    penalty,
+                );
+            }
+            // Beyond 1e12 the overlap `p / eps` is below the round-off of the gap.
+            (Method::Penalty, Some(penalty)) if !(penalty > 0.0 && penalty <= 1e12) => {
+                return error(
+                    "penalty",
+                    "a number > 0 and <= 1e12 (times E* / h)",
+                    penalty,
                 );
             }
             _ => {}

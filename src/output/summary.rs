@@ -80,6 +80,10 @@ pub struct ContactSummary {
     /// Whether the last load step's answer can be trusted: its accuracy indicators.
     pub accuracy: AccuracyReport,
     pub settings: ContactSettings,
+    /// The penalty `eps = penalty E* / h` of a penalty pair (a pressure per length of
+    /// overlap); absent under INTERNODES.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub penalty_stiffness: Option<f64>,
     /// The body and interface solvers that ran (`auto` resolved).
     pub linear_solvers: LinearSolvers,
     /// Total contact force on each body, and `|F1 + F2| / |F1|`.

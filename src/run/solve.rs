@@ -137,15 +137,23 @@ fn solve_contact_pairs(
     timings: &mut Timings,
 ) -> Result<(Vec<SolvedContact>, Vec<SolvedBody>, Vec<Vec<SolvedBody>>), RunError> {
     for problem in &problems {
+        let method = match problem.penalty_stiffness() {
+            Some(eps) => format!(
+                ", penalty {:.3e} ({} E*/h)",
+                eps,
+                problem.settings.penalty_factor().unwrap_or_default()
+            ),
+            None => String::new(),
+        };
         log::info!(
-            "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}",
+            "contact: '{}' ({}, {} candidate nodes) on '{}' ({}, {} candidate nodes), {}{method}",
             problem.primary.body.name,
             problem.primary_surface.group,
             problem.primary_surface.len(),
             problem.secondary.body.name,
             problem.secondary_surface.group,
             problem.secondary_surface.len(),
-            serde_json::to_value(problem.settings.formulation).expect("a unit enum serializes")
+            problem.settings.formulation.name(),
         );
         log::info!(
             "primary body '{}' ({}): {}",
@@ -332,6 +340,7 @@ fn summarize_contact(
         secondary: problem.secondary.body.name.clone(),
         primary_choice: problem.primary_report.clone(),
         transfer: problem.transfer(),
+        penalty_stiffness: problem.penalty_stiffness(),
         solved,
         accuracy,
         settings: problem.settings,

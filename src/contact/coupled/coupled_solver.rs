@@ -638,7 +638,12 @@ mod tests {
             normals: vec![[normal, 0.0, 0.0]; NY + 1],
             areas1: (0..=NY).map(area).collect(),
             multipliers: vec![
-                ContactLaw::Tied.multipliers([normal, 0.0, 0.0], Tangential::Stick, 2);
+                ContactLaw::Tied.multipliers(
+                    [normal, 0.0, 0.0],
+                    Tangential::Stick,
+                    2,
+                    0.0
+                );
                 NY + 1
             ],
             geometric: vec![Vec::new(); NY + 1],

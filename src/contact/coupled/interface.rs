@@ -42,6 +42,7 @@ use crate::contact::geometry::gap::GapRow;
 use crate::contact::geometry::rbf::{Interpolation, interpolation_radii};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::law::{ContactLaw, Multiplier, Reads, Tangential, coulomb};
+use crate::contact::method::Enforcement;
 
 /// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
 /// rows and columns of the transfers computed so far (an explicit cache: callers hold it `mut`).
@@ -158,7 +159,7 @@ impl InterfaceOperators {
         &mut self,
         primary: &ContactSurface,
         secondary: &ContactSurface,
-        law: ContactLaw,
+        (law, enforcement): (ContactLaw, Enforcement),
         active: &[usize],
         constraint: Constraint,
     ) -> Coupling {
@@ -179,6 +180,7 @@ impl InterfaceOperators {
                 .map(|&(j, w)| (secondary.nodes[j], weight(j, w)))
                 .collect()
         };
+        let gap_compliance = enforcement.gap_compliance();
         let loads2 = active
             .iter()
             .map(|&i| {
@@ -214,7 +216,9 @@ impl InterfaceOperators {
                     .collect(),
                 active
                     .iter()
-                    .map(|&i| law.multipliers(self.normals[i], Tangential::Stick, dim))
+                    .map(|&i| {
+                        law.multipliers(self.normals[i], Tangential::Stick, dim, gap_compliance)
+                    })
                     .collect(),
             ),
             Constraint::Geometric {
@@ -224,7 +228,7 @@ impl InterfaceOperators {
             } => {
                 let state = |i: usize| tangential.map_or(Tangential::Stick, |states| states[i]);
                 let multipliers: Vec<Vec<Multiplier>> = (active.iter())
-                    .map(|&i| law.multipliers(rows[i].normal, state(i), dim))
+                    .map(|&i| law.multipliers(rows[i].normal, state(i), dim, gap_compliance))
                     .collect();
                 // A node whose rows read its tangential jump (a sticking node, a slipping one's
                 // direction in 3D) holds it against the jump at the start of the step.

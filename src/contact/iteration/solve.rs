@@ -80,6 +80,7 @@ use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::iteration::safeguard::{CONTRACTION, Safeguard, Step};
 use crate::contact::law::coulomb::Turning;
 use crate::contact::law::{ContactLaw, NodeStates, Tangential, coulomb};
+use crate::contact::method::Enforcement;
 use crate::contact::problem::ContactProblem;
 use crate::contact::settings::{ContactSettings, CoupledSolver, Transfer};
 use crate::contact::solution::{
@@ -231,6 +232,8 @@ pub struct ContactSolver<'a> {
     operators: Vec<InterfaceOperators>,
     /// Each pair's contact law.
     laws: Vec<ContactLaw>,
+    /// How each pair's law is enforced.
+    methods: Vec<Enforcement>,
 }
 
 /// The interface operators of `problem`, paired with the primary surface slid by `slid` over
@@ -418,6 +421,7 @@ impl<'a> ContactSolver<'a> {
             free_motions,
             operators,
             laws: pairs.iter().map(|p| ContactLaw::of(&p.settings)).collect(),
+            methods: pairs.iter().map(Enforcement::of).collect(),
         })
     }
 
@@ -1112,7 +1116,8 @@ impl ContactSolver<'_> {
             };
             let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
             let operators = &mut self.operators[p];
-            couplings.push(operators.coupling(s1, s2, law, &nodes[p], constraint));
+            let enforced = (law, self.methods[p]);
+            couplings.push(operators.coupling(s1, s2, enforced, &nodes[p], constraint));
         }
         couplings
     }
@@ -1327,11 +1332,17 @@ impl ContactSolver<'_> {
                     (gaps, jumps, slid)
                 });
                 let pair_linear = operators.linearized_gaps(&jumps);
-                // The gap each active node's constraint holds: the gap of its linearization.
-                let held: Vec<f64> = match self.laws[p].holds_geometric_gap() {
+                // The gap each active node's constraint holds: the gap of its linearization (under
+                // the penalty method, less the overlap its pressure allows).
+                let mut held: Vec<f64> = match self.laws[p].holds_geometric_gap() {
                     true => rows.iter().map(|r| r.gap).collect(),
                     false => pair_gaps.clone(),
                 };
+                let (traction, normals) = (&solution.traction[p], &couplings[p].normals);
+                for (k, &i) in nodes.iter().enumerate() {
+                    let pressure = -(0..3).map(|c| traction[k][c] * normals[k][c]).sum::<f64>();
+                    held[i] = self.methods[p].row_residual(held[i], pressure);
+                }
                 let offset = self.offsets[p];
                 let update = timed(&mut seconds.checks, || {
                     let (traction, normals) = (&solution.traction[p], &couplings[p].normals);

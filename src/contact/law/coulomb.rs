@@ -111,13 +111,14 @@ pub(super) fn multipliers(
     tangential: Tangential,
     mu: f64,
     dim: usize,
+    gap_compliance: f64,
 ) -> Vec<Multiplier> {
     let normal_row = |force: [f64; 3]| Multiplier {
         force,
         row: normal,
         reads: Reads::Geometric,
         restates: Restates::Node,
-        compliance: 0.0,
+        compliance: gap_compliance,
     };
     match tangential {
         Tangential::Slip { direction, turning } => {
@@ -345,11 +346,12 @@ mod tests {
             },
             0.5,
             2,
+            0.0,
         );
         assert_eq!(slip.len(), 1);
         assert_eq!(slip[0].force, [-0.5, 1.0, 0.0]);
         assert_eq!(slip[0].row, N);
-        assert_eq!(multipliers(N, Tangential::Stick, 0.5, 3).len(), 3);
+        assert_eq!(multipliers(N, Tangential::Stick, 0.5, 3, 0.0).len(), 3);
     }
 
     #[test]
@@ -366,6 +368,7 @@ mod tests {
             },
             0.5,
             3,
+            0.0,
         );
         assert_eq!(slip.len(), 2);
         assert_eq!(slip[0].force, [-0.5, 1.0, 0.0]);

@@ -4,14 +4,14 @@
 
 use super::{Multiplier, Reads, Restates};
 
-/// `lambda = lambda_n n`, the row `n . (u1 - u2(point)) = n . target`; dropped where every dof
-/// of the node is prescribed.
-pub(super) fn multipliers(normal: [f64; 3]) -> Vec<Multiplier> {
+/// `lambda = lambda_n n`, the row `n . (u1 - u2(point)) + gap_compliance lambda_n = n . target`;
+/// dropped where every dof of the node is prescribed.
+pub(super) fn multipliers(normal: [f64; 3], gap_compliance: f64) -> Vec<Multiplier> {
     vec![Multiplier {
         force: normal,
         row: normal,
         reads: Reads::Geometric,
         restates: Restates::Node,
-        compliance: 0.0,
+        compliance: gap_compliance,
     }]
 }

@@ -62,8 +62,9 @@ pub struct Multiplier {
     pub reads: Reads,
     pub restates: Restates,
     /// The multiplier's own term in its row, `row . (u1_i - u2(point)) + compliance lambda =
-    /// row . target_i` (a length per traction): zero but on the row that linearizes a
-    /// slipping node's direction in 3D ([`coulomb::Turning`]).
+    /// row . target_i` (a length per traction): the penalty method's `1 / eps` on the rows
+    /// that hold the gap (`crate::contact::method`), and the row that linearizes a slipping
+    /// node's direction in 3D ([`coulomb::Turning`]); zero on the others.
     pub compliance: f64,
 }
 
@@ -102,18 +103,29 @@ impl ContactLaw {
 
     /// The multipliers of an active node in `tangential` state (ignored but by Coulomb)
     /// whose constraint acts along the unit normal `normal` (pointing out of the primary).
+    /// `gap_compliance` is the own term of the rows that hold the node on the other surface
+    /// (`crate::contact::method`: zero under INTERNODES, `1 / eps` under the penalty method):
+    /// the normal row, and every row of tied contact's glue; a Coulomb node's stick is held
+    /// exactly under either method.
     pub fn multipliers(
         &self,
         normal: [f64; 3],
         tangential: Tangential,
         dim: usize,
+        gap_compliance: f64,
     ) -> Vec<Multiplier> {
         match *self {
-            Self::Frictionless => frictionless::multipliers(normal),
-            Self::Tied => tied::multipliers(dim),
+            Self::Frictionless => frictionless::multipliers(normal, gap_compliance),
+            Self::Tied => tied::multipliers(dim, gap_compliance),
             Self::Coulomb {
                 friction_coefficient,
-            } => coulomb::multipliers(normal, tangential, friction_coefficient, dim),
+            } => coulomb::multipliers(
+                normal,
+                tangential,
+                friction_coefficient,
+                dim,
+                gap_compliance,
+            ),
         }
     }
 

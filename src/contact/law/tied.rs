@@ -5,9 +5,10 @@
 
 use super::{Multiplier, Reads, Restates};
 
-/// `lambda = sum_c lambda_c e_c`, row `c` the component `c` of the constraint; each dropped
+/// `lambda = sum_c lambda_c e_c`, row `c` the component `c` of the constraint (plus
+/// `gap_compliance lambda_c`: the glue is a spring under the penalty method); each dropped
 /// where its own dof is prescribed.
-pub(super) fn multipliers(dim: usize) -> Vec<Multiplier> {
+pub(super) fn multipliers(dim: usize, gap_compliance: f64) -> Vec<Multiplier> {
     (0..dim)
         .map(|c| {
             let axis: [f64; 3] = std::array::from_fn(|k| f64::from(u8::from(k == c)));
@@ -16,7 +17,7 @@ pub(super) fn multipliers(dim: usize) -> Vec<Multiplier> {
                 row: axis,
                 reads: Reads::Interpolated,
                 restates: Restates::Component(c),
-                compliance: 0.0,
+                compliance: gap_compliance,
             }
         })
         .collect()

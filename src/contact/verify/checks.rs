@@ -6,7 +6,8 @@
 //! first five; [`contact_status`] turns them into the status):
 //! - **Penetration** (primal feasibility). Every candidate node of both bodies, active or not,
 //!   is projected onto the other body's displaced P1 surface ([`geometric_gaps`]); the largest
-//!   penetration over the node's spacing must not exceed `penetration_tolerance` on the
+//!   penetration (a primary node's beyond the penalty method's overlap `p / eps`) over the node's
+//!   spacing must not exceed `penetration_tolerance` on the
 //!   primary surface, whose nodes the constraint holds, and `secondary_penetration_tolerance`
 //!   on the secondary one, whose nodes only the transfer holds, counted where no active
 //!   primary node is within a facet ([`Held::Not`]: contact the active set missed; between
@@ -18,8 +19,9 @@
 //!   ([`ContactSurface::mean_pressure`], along the node's own outward normal); the largest
 //!   tension over the largest pressure must not exceed `certificate_tension_tolerance`, a
 //!   bound for the undershoot of the RBF transfer of the multiplier to the secondary surface.
-//! - **Complementarity.** Every active node lies on the other surface: the gap its constraint
-//!   holds, measured again at the answer, within `penetration_tolerance` of its spacing.
+//! - **Complementarity.** Every active node lies on the other surface (under the penalty method,
+//!   `p / eps` inside it): the gap its constraint holds, measured again at the answer, within
+//!   `penetration_tolerance` of its spacing.
 //! - **Equilibrium.** `|F1 + F2| / |F1|`, the total contact forces on the two bodies, must not
 //!   exceed `imbalance_tolerance`: the interpolation transfer `R21` conserves force only to its
 //!   accuracy; the conservative transfer (`R12^T`, [`crate::contact::Transfer`]) balances to
@@ -31,6 +33,8 @@
 //!   penetration between constrained primary nodes makes, estimated from the pressure-weighted
 //!   sag over how far the bodies are pressed into each other (`secondary_sag`), must not
 //!   exceed `accuracy_tolerance`.
+//! - **Penalty overlap** (penalty pairs, `crate::contact::method`): the relative error of the
+//!   force that the overlap `p / eps` makes, estimated as the sag's ([`penalty_overlap`]).
 //! - **Resolution.** The contact zone must be at least `min_zone_width` primary spacings wide,
 //!   and `secondary_min_zone_width` secondary spacings unless the secondary is nearly rigid
 //!   ([`zone_resolution`]): with one or two nodes across it, the pressure profile has too few
@@ -59,10 +63,11 @@ use std::collections::HashSet;
 
 use crate::contact::certificate::{Certificate, CertificateCheck, CheckKind};
 use crate::contact::coupled::system::CoupledSolution;
-use crate::contact::geometry::gap::{gap_rows, geometric_gaps};
+use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::law::coulomb::norm;
 use crate::contact::law::{ContactLaw, Tangential};
+use crate::contact::method::Enforcement;
 use crate::contact::problem::ContactProblem;
 use crate::contact::solution::ContactStatus;
 
@@ -111,22 +116,43 @@ pub fn certify(
         })
         .collect();
 
-    let [penetration1, penetration2] = penetration(&sides, &gaps, &held);
+    // The penalty method's overlap `p / eps` at each primary node: what its law allows
+    // (`crate::contact::method`); zero under INTERNODES.
+    let law = ContactLaw::of(settings);
+    let rows = gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal());
+    let enforcement = Enforcement::of(problem);
+    let mut overlap = vec![0.0; s1.len()];
+    for (k, &i) in active.iter().enumerate() {
+        let n = rows[i].normal;
+        let pressure = -(0..3)
+            .map(|c| solution.traction[0][k][c] * n[c])
+            .sum::<f64>();
+        overlap[i] = enforcement.row_residual(0.0, pressure.max(0.0));
+    }
+    let [penetration1, penetration2] = penetration(&sides, &gaps, &held, &overlap);
     let indentation = indentation_depth(s1, s2, [u1, u2], &gaps[0], &mean[0])
         .max(elastic_approach(s1, &mean[0], problem.contact_modulus()));
     // A nearly rigid secondary's spacing does not bound the answer: only its position does.
     let secondary_width =
         (!problem.secondary_is_nearly_rigid()).then_some(settings.secondary_min_zone_width);
-    let checks = vec![
+    let mut checks = vec![
         penetration1.check(CheckKind::Penetration, settings.penetration_tolerance),
         penetration2.check(
             CheckKind::SecondaryPenetration,
             settings.secondary_penetration_tolerance,
         ),
         tension(problem, &sides, &mean),
-        complementarity(problem, solution, &gaps[0], active),
+        complementarity(problem, &rows, &gaps[0], active, &overlap),
         equilibrium(solution, s1.dim, settings.imbalance_tolerance),
-        secondary_sag(s2, &held, &gaps[1], &mean[1], indentation, settings),
+        secondary_sag(
+            s2,
+            &held,
+            &gaps[1],
+            &mean[1],
+            indentation,
+            settings,
+            enforcement,
+        ),
         zone_resolution(
             [(s1, Some(settings.min_zone_width)), (s2, secondary_width)],
             &mean,
@@ -134,16 +160,30 @@ pub fn certify(
         ),
         force_centres(&sides, &mean).check(settings.force_centre_tolerance),
     ];
+    if let Enforcement::Penalty { .. } = enforcement {
+        checks.insert(
+            6,
+            penalty_overlap(s1, &overlap, &mean[0], indentation, settings),
+        );
+    }
     (Certificate { checks }, gaps)
 }
 
-/// The deepest penetration over the node's spacing on each surface: every primary node, and
+/// The deepest penetration over the node's spacing on each surface: every primary node, beyond
+/// the `overlap` its law allows (the penalty method's `p / eps`, zero under INTERNODES), and
 /// the secondary nodes no active primary node holds ([`Held::Not`]).
-fn penetration(sides: &[Side; 2], gaps: &[Vec<f64>; 2], held: &[Held]) -> [Worst; 2] {
+fn penetration(
+    sides: &[Side; 2],
+    gaps: &[Vec<f64>; 2],
+    held: &[Held],
+    overlap: &[f64],
+) -> [Worst; 2] {
     let mut worst = [Worst::default(), Worst::default()];
     for (b, (worst, &(own, ..))) in worst.iter_mut().zip(sides).enumerate() {
         for (s, g) in gaps[b].iter().enumerate() {
-            if b == 0 || held[s] == Held::Not {
+            if b == 0 {
+                worst.offer((-g - overlap[s]) / own.spacing[s], own, s);
+            } else if held[s] == Held::Not {
                 worst.offer(-g / own.spacing[s], own, s);
             }
         }
@@ -177,25 +217,23 @@ fn tension(problem: &ContactProblem, sides: &[Side; 2], mean: &[Vec<f64>]) -> Ce
 /// Complementarity: the gap each active node's constraint holds, measured again at the
 /// answer (frictionless: the gap of its linearization, `crate::contact::geometry::gap`, which is
 /// the geometric gap wherever the node faces the inside of a secondary facet; tied: the geometric
-/// gap `gaps1`), over the node's spacing.
+/// gap `gaps1`), plus the `overlap` its law allows (the penalty method's `p / eps`), over the
+/// node's spacing.
 fn complementarity(
     problem: &ContactProblem,
-    solution: &CoupledSolution,
+    rows: &[GapRow],
     gaps1: &[f64],
     active: &[usize],
+    overlap: &[f64],
 ) -> CertificateCheck {
-    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-    let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
-    let law = ContactLaw::of(&problem.settings);
-    let held: Vec<f64> = match law.holds_geometric_gap() {
-        true => (gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal()).into_iter())
-            .map(|row| row.gap)
-            .collect(),
+    let s1 = &problem.primary_surface;
+    let held: Vec<f64> = match ContactLaw::of(&problem.settings).holds_geometric_gap() {
+        true => rows.iter().map(|row| row.gap).collect(),
         false => gaps1.to_vec(),
     };
     let mut worst = Worst::default();
     for &i in active {
-        worst.offer(held[i].abs() / s1.spacing[i], s1, i);
+        worst.offer((held[i] + overlap[i]).abs() / s1.spacing[i], s1, i);
     }
     let tolerance = problem.settings.penetration_tolerance;
     worst.check(CheckKind::Complementarity, tolerance)
@@ -497,7 +535,8 @@ fn elastic_approach(primary: &ContactSurface, pressure: &[f64], contact_modulus:
 /// ```
 ///
 /// over the secondary nodes in contact, `F_s` a node's compressive force (mean pressure times
-/// area), `sag_s` its penetration into the primary where it lies [`Held::Inside`] the zone
+/// area), `sag_s` its penetration into the primary (less the penalty method's overlap `p_s /
+/// eps` at its mean pressure) where it lies [`Held::Inside`] the zone
 /// (beyond the primary's penetration tolerance times its spacing; 0 elsewhere), `delta` the
 /// indentation depth (the larger of the geometric one and the [`elastic_approach`]). Only the
 /// transfer holds the secondary nodes: between two constrained primary nodes `h_p` apart, a
@@ -520,6 +559,7 @@ fn secondary_sag(
     pressure: &[f64],
     indentation: f64,
     settings: &crate::contact::settings::ContactSettings,
+    enforcement: Enforcement,
 ) -> CertificateCheck {
     let mut deepest = Worst::default();
     let (mut weighted, mut total) = (0.0, 0.0);
@@ -528,10 +568,13 @@ fn secondary_sag(
         if held[s] != Held::Not {
             total += force;
         }
+        // Under the penalty method the bodies overlap by `p / eps` where they touch: the
+        // penalty overlap indicator's part, not the sag.
+        let sag = -enforcement.row_residual(*g, pressure[s].max(0.0));
         let floor = settings.penetration_tolerance * secondary.spacing[s];
-        if held[s] == Held::Inside && -g > floor {
-            weighted += force * -g;
-            deepest.offer(-g, secondary, s);
+        if held[s] == Held::Inside && sag > floor {
+            weighted += force * sag;
+            deepest.offer(sag, secondary, s);
         }
     }
     let estimate = if total > 0.0 && indentation > 0.0 {
@@ -547,6 +590,45 @@ fn secondary_sag(
             check.value
         )
     });
+    check.value = estimate;
+    check.passed = estimate <= tolerance;
+    check
+}
+
+/// The relative error of the contact force that the penalty method's overlap makes, estimated
+/// (the "penalty overlap" indicator) as the secondary's sag is ([`secondary_sag`]):
+///
+/// ```text
+/// eta = (3/4) sum_i F_i o_i / (delta sum_i F_i)
+/// ```
+///
+/// over the primary nodes, `F_i` a node's compressive force (mean pressure times area), `o_i`
+/// its overlap `p_i / eps`, `delta` the indentation depth. The overlap takes that much of the
+/// bodies' approach at each node, and by reciprocity the force changes by the pressure-weighted
+/// mean of it over the approach. The note gives the largest overlap over its node's spacing.
+fn penalty_overlap(
+    primary: &ContactSurface,
+    overlap: &[f64],
+    pressure: &[f64],
+    indentation: f64,
+    settings: &crate::contact::settings::ContactSettings,
+) -> CertificateCheck {
+    let (mut weighted, mut total) = (0.0, 0.0);
+    let mut deepest = Worst::default();
+    for (s, o) in overlap.iter().enumerate() {
+        let force = pressure[s].max(0.0) * primary.nodal_area[s];
+        weighted += force * o;
+        total += force;
+        deepest.offer(o / primary.spacing[s], primary, s);
+    }
+    let estimate = if total > 0.0 && indentation > 0.0 {
+        0.75 * weighted / (total * indentation)
+    } else {
+        0.0
+    };
+    let tolerance = settings.accuracy_tolerance;
+    let mut check = deepest.check(CheckKind::PenaltyOverlap, tolerance);
+    check.note = Some(format!("largest overlap {:.3e} h", check.value));
     check.value = estimate;
     check.passed = estimate <= tolerance;
     check
