@@ -219,6 +219,50 @@ fn a_force_on_the_top_gives_the_exact_approach_through_a_floating_block() {
 }
 
 #[test]
+fn under_the_penalty_method_each_interface_is_a_spring_in_series_with_the_stack() {
+    // Both pairs enforced by the penalty method (`penalty = 1`: soft, so that the springs take
+    // a visible share): each interface overlaps by `sigma / eps_p`, in series with the blocks.
+    // Pushed by a displacement, sigma = push / (sum 1 / M_i + sum 1 / eps_p); pressed by a force
+    // through the floating blocks, the approach is the force times the same compliance.
+    let keys = format!("{TIGHT}\nmethod = \"penalty\"\npenalty = 1.0");
+    let compliance = |solution: &CaseSolution| {
+        let springs: f64 = (solution.contacts.iter())
+            .map(|c| 1.0 / c.summary.penalty_stiffness.expect("a penalty pair"))
+            .sum();
+        1.0 / exact_stress(1.0) + springs
+    };
+    for dim in [2, 3] {
+        let pushed = solve(&pushed_in(dim, &pairs(&keys))).unwrap();
+        let sigma = PUSH / compliance(&pushed);
+        assert!(
+            sigma < 0.9 * exact_stress(PUSH),
+            "{dim}D: the springs take a share"
+        );
+        for (p, (force, status)) in forces(&pushed).into_iter().enumerate() {
+            assert_eq!(status, ContactStatus::Converged, "{dim}D, pair {p}");
+            assert!(
+                (force - sigma).abs() < 1e-9 * sigma,
+                "{dim}D, pair {p}: force {force}, exact {sigma}"
+            );
+        }
+        let force = 4.0;
+        let component = ["fx", "fy", "fz"][dim - 1];
+        let top = format!(
+            "[[body.force]]\ngroup = \"upper_top\"\n{component} = {}",
+            -force
+        );
+        let pressed = solve(&stack(dim, &pairs(&keys), &top)).unwrap();
+        let forced = &pressed.contacts[0].summary.steps.last().unwrap().forced[0];
+        let approach = force * compliance(&pressed);
+        assert!(
+            (forced.displacement + approach).abs() < 1e-9 * approach,
+            "{dim}D: approach {} against {approach}",
+            -forced.displacement
+        );
+    }
+}
+
+#[test]
 fn a_pair_that_does_not_touch_is_no_contact_while_the_other_converges() {
     // The upper block is lifted off; the middle block, held at its sides, presses on the
     // lower one.

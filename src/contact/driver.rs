@@ -203,7 +203,7 @@ pub fn solve_contact_steps<'m>(
     let retried: Vec<usize> = (0..run.problems.len())
         .filter(|&p| {
             run.problems[p].primary_report.other_primary == OtherPrimary::RetryIfUntrusted
-                && !run.solutions[p].is_trusted()
+                && run.solutions[p].wants_other_primary()
         })
         .collect();
     if !retried.is_empty() {

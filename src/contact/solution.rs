@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::contact::active_set::ActiveSet;
-use crate::contact::certificate::Certificate;
+use crate::contact::certificate::{Certificate, CheckKind};
 use crate::contact::settings::Formulation;
 use crate::elastic::ElasticSolution;
 
@@ -280,7 +280,8 @@ pub struct ForcedDisplacement {
 
 impl ContactSolution {
     /// How the solve ended, in the one line of the default log: for an answer the iterations,
-    /// the force, the contact size and the accuracy report's failed indicators by name (the
+    /// the force, the contact size (and the penalty method's largest overlap) and the accuracy
+    /// report's failed indicators by name (the
     /// checks themselves are [`Self::details`]); any other ending with its explanation, which
     /// the error message (the status's name) does not give.
     pub fn summary(&self) -> String {
@@ -297,8 +298,13 @@ impl ContactSolution {
                 self.certificate.failed_names()
             ),
         };
+        // The penalty method's overlap, its own error (the indicator's note holds it).
+        let overlap = (self.certificate.checks.iter())
+            .find(|c| c.name == CheckKind::PenaltyOverlap)
+            .and_then(|c| c.note.clone())
+            .map_or(String::new(), |note| format!(", {note}"));
         format!(
-            "{}{accuracy}; force {:.4e}, {nodes} contact nodes{slipping}",
+            "{}{accuracy}; force {:.4e}, {nodes} contact nodes{slipping}{overlap}",
             self.outcome(),
             norm(&self.force_primary)
         )
@@ -392,6 +398,15 @@ impl ContactSolution {
     /// accuracy report passed.
     pub fn is_trusted(&self) -> bool {
         self.status.is_solution() && self.certificate.accurate()
+    }
+
+    /// Whether another primary could give a better answer: not where this one is solved and
+    /// every indicator passed but the penalty overlap, the penalty method's own error, which
+    /// another primary does not mend (it only changes `eps` with the primary's spacing).
+    pub fn wants_other_primary(&self) -> bool {
+        let discretized = (self.certificate.indicators())
+            .all(|c| c.passed || c.name == CheckKind::PenaltyOverlap);
+        !(self.status.is_solution() && discretized)
     }
 
     /// Adds an accuracy indicator computed after the loop (e.g.

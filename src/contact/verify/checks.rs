@@ -628,7 +628,7 @@ fn penalty_overlap(
     };
     let tolerance = settings.accuracy_tolerance;
     let mut check = deepest.check(CheckKind::PenaltyOverlap, tolerance);
-    check.note = Some(format!("largest overlap {:.3e} h", check.value));
+    check.note = Some(format!("overlap up to {:.2e} h", check.value));
     check.value = estimate;
     check.passed = estimate <= tolerance;
     check
