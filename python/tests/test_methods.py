@@ -28,7 +28,7 @@ def test_the_penalty_method_is_one_key_and_tends_to_internodes():
         exact.raise_for_status()
         assert "penalty_stiffness" not in exact.summary["contact"]
         stiff = internodes.solve(case(method="penalty", penalty=1e8, **law), mesh=mesh)
-        soft = internodes.solve(case(method="penalty", penalty=10.0, **law), mesh=mesh)
+        soft = internodes.solve(case(method="penalty", **law), mesh=mesh)  # the default, 100
         for penalized in (stiff, soft):
             penalized.raise_for_status()
             record = penalized.summary["contact"]
@@ -39,4 +39,4 @@ def test_the_penalty_method_is_one_key_and_tends_to_internodes():
         force = {name: np.array(result.summary["contact"]["force_primary"])
                  for name, result in [("exact", exact), ("stiff", stiff), ("soft", soft)]}
         assert np.allclose(force["stiff"], force["exact"], rtol=1e-6, atol=1e-6)
-        assert force["soft"][1] < force["exact"][1] * (1 - 1e-3)
+        assert force["soft"][1] < force["exact"][1] * (1 - 1e-4)
