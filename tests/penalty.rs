@@ -7,7 +7,9 @@
 mod common;
 
 use common::case_builder::CaseFile;
-use common::contact::{half_disc_on_block, pinned_at_corners, solve, two_blocks};
+use common::contact::{
+    half_disc_on_block, hemisphere_on_block, pinned_at_corners, solve, two_blocks,
+};
 use internodes::case::Case;
 use internodes::contact::{CheckKind, ContactSolution, ContactStatus};
 use internodes::mesh::read_msh;
@@ -135,6 +137,48 @@ fn a_tied_pair_under_the_penalty_method_is_glued_by_springs() {
             (stress / expected - 1.0).abs() <= 1e-9,
             "{dim}D: {stress} against {expected}"
         );
+    }
+}
+
+#[test]
+fn a_coulomb_pair_under_a_stiff_penalty_gives_the_internodes_answer_in_2d_and_3d() {
+    // Pushed down and sideways in one step: a stick zone inside a slip annulus. The penalty
+    // relaxes the normal rows only, and at 1e8 times `E* / h` the answer is INTERNODES': the
+    // same nodes sticking and slipping, the force vector within 1e-6.
+    let oblique = [
+        half_disc_on_block().with_support("disc", "disc_top", |d| d.ux(0.002)),
+        hemisphere_on_block("hemisphere_on_block.msh", 0.01, 1000.0, 1000.0).with_support(
+            "sphere",
+            "sphere_top",
+            |d| d.ux(0.001),
+        ),
+    ];
+    for case in oblique {
+        let case = (case.contact_setting("formulation", "coulomb"))
+            .contact_setting("friction_coefficient", 0.3);
+        let exact = solve(&case).unwrap();
+        let stiff = solve(&penalized(case, 1e8)).unwrap();
+        for solution in [&exact, &stiff] {
+            assert_eq!(solution.status, ContactStatus::Converged);
+        }
+        let states = |s: &ContactSolution| {
+            let friction = s.primary_fields.friction.as_ref().expect("a Coulomb pair");
+            (friction.stick_nodes, friction.slip_nodes)
+        };
+        assert_eq!(states(&exact), states(&stiff));
+        assert!(
+            states(&exact).0 > 0 && states(&exact).1 > 0,
+            "{:?}",
+            states(&exact)
+        );
+        let scale = exact
+            .force_primary
+            .iter()
+            .map(|f| f.abs())
+            .fold(0.0, f64::max);
+        for (a, b) in exact.force_primary.iter().zip(&stiff.force_primary) {
+            assert!((a - b).abs() <= 1e-6 * scale, "{a} against {b}");
+        }
     }
 }
 
