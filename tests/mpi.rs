@@ -318,6 +318,12 @@ fn a_load_path_on_two_ranks_gives_the_serial_answer() {
 }
 
 #[test]
+fn the_penalty_method_on_two_ranks_gives_the_serial_answer() {
+    // The demo under the penalty method: the rows' own term 1 / eps on the distributed path.
+    ranks_give_the_serial_answer(2, "hemisphere_on_block", "method = \"penalty\"", 1);
+}
+
+#[test]
 fn the_demo_on_three_ranks_gives_the_serial_answer() {
     // Any number of ranks, not only two: three parts per body (oversubscribed on two cores).
     ranks_give_the_serial_answer(3, "hemisphere_on_block", "", 1);
