@@ -11,7 +11,7 @@ LEVELS  ?= 0 1 2
 # builds and tests without it.
 FEATURES ?= petsc
 
-.PHONY: deps build python demo picture test validate foreign-meshes outside-check meshes bench clean
+.PHONY: deps build python akantu demo picture test validate foreign-meshes outside-check meshes bench clean
 
 deps:
 	bash .ci/install-deps.sh
@@ -45,8 +45,14 @@ test: build python
 	$(PYTHON) validation/run.py --quick
 
 # The full validation: every suite at every level; writes validation/report/ (committed).
-validate: build
+validate: build akantu
 	$(PYTHON) validation/run.py
+
+# Akantu (the penalty contact the validation compares ours with), from PyPI into its own virtual
+# environment: the validation's only, never the solver's.
+akantu:
+	test -x build/akantu/bin/python || $(PYTHON) -m venv build/akantu
+	build/akantu/bin/pip install --quiet "akantu==5.0.7.post1"
 
 # The README's picture (docs/demo.png), drawn from the demo's output files.
 picture: demo

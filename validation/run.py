@@ -64,7 +64,7 @@ QUICK_REPORT = BUILD / "report-quick"
 # Contact suites: module name, whether its checks gate the run.
 SUITES = {"body_by_body": True, "hertz_suite": False, "rigid_flat": False, "sweep": True, "flat_sweep": True,
           "edge_sweep": True, "multi_body": True, "refinement_study": False, "friction_suite": True,
-          "penalty_suite": True}
+          "penalty_suite": True, "akantu_suite": True}
 # Regression bands on the target suites' figures, one section per mode.
 BANDS = VALIDATION / "bands.json"
 # A figure may grow to BAND_RELATIVE times its committed value plus BAND_ABSOLUTE before the band
