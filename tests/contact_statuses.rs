@@ -73,6 +73,30 @@ fn the_iteration_cap_is_a_status() {
 }
 
 #[test]
+fn a_loop_stopped_before_its_set_settles_is_certified_on_the_set_it_solved() {
+    // After one iteration the update has moved on to the next active set, which the last
+    // iterate's tractions do not belong to: reading them by that set went out of bounds (a
+    // Coulomb pair's fields, and the penalty method's overlap).
+    let pushed = half_disc_on_block().with_support("disc", "disc_top", |d| d.ux(0.002));
+    let cases = [
+        ("frictionless", pushed.clone()),
+        (
+            "penalty",
+            pushed.clone().contact_setting("method", "penalty"),
+        ),
+        (
+            "coulomb",
+            (pushed.contact_setting("formulation", "coulomb"))
+                .contact_setting("friction_coefficient", 0.3),
+        ),
+    ];
+    for (label, case) in cases {
+        let solution = solve(&case.contact_setting("max_iterations", 1)).unwrap();
+        assert_eq!(solution.status, ContactStatus::IterationLimit, "{label}");
+    }
+}
+
+#[test]
 fn a_missing_candidate_group_is_named() {
     let case = two_blocks(2, "frictionless").contact_surfaces(["upper_contct", "lower_contact"]);
     let text = case.to_toml();

@@ -1425,13 +1425,16 @@ impl ContactSolver<'_> {
         for (p, problem) in self.pairs.iter().enumerate() {
             let [a, b] = self.pair_bodies[p];
             let nodes = self.pair_nodes(&state.active.contact, p);
+            // The nodes the last iterate was solved on, which its tractions belong to: the
+            // active set unless the loop stopped before settling (`active` then holds the next).
+            let solved = self.pair_nodes(&state.solved.contact, p);
             let pair = Pair {
                 primary: a,
                 secondary: b,
                 coupling: &couplings[p],
             };
             let view = solution.of_pair(p, &pair, dim);
-            let (mut certificate, gaps) = certify(problem, &view, &nodes);
+            let (mut certificate, gaps) = certify(problem, &view, [&nodes, &solved]);
             let (slip, history, friction) = match (&state.friction[p], self.laws[p]) {
                 (
                     Some(start),
@@ -1441,7 +1444,7 @@ impl ContactSolver<'_> {
                 ) => {
                     let fields = self.friction_fields(
                         p,
-                        &nodes,
+                        &solved,
                         &view,
                         &couplings[p],
                         start,

@@ -88,13 +88,14 @@ pub fn contact_status(
     }
 }
 
-/// Certifies the displacements and interface forces of a solution (module doc); also returns
-/// the geometric gaps it measured on the primary and secondary surfaces (the `normal_gap`
-/// output).
+/// Certifies the displacements and interface forces of a solution (module doc) with the
+/// active set `active`, the solution's tractions at the primary nodes `solved` (the same set
+/// unless the loop stopped before settling); also returns the geometric gaps it measured on
+/// the primary and secondary surfaces (the `normal_gap` output).
 pub fn certify(
     problem: &ContactProblem,
     solution: &CoupledSolution,
-    active: &[usize],
+    [active, solved]: [&[usize]; 2],
 ) -> (Certificate, [Vec<f64>; 2]) {
     let settings = &problem.settings;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
@@ -122,7 +123,7 @@ pub fn certify(
     let rows = gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal());
     let enforcement = Enforcement::of(problem);
     let mut overlap = vec![0.0; s1.len()];
-    for (k, &i) in active.iter().enumerate() {
+    for (k, &i) in solved.iter().enumerate() {
         let n = rows[i].normal;
         let pressure = -(0..3)
             .map(|c| solution.traction[0][k][c] * n[c])
