@@ -24,6 +24,9 @@
 //!   complementarity, equilibrium) decide the status; the accuracy indicators are reported
 //! ```
 //!
+//! Under the penalty method (`crate::contact::method`) every row carries its own term `p_i / eps`
+//! and "on the other surface" reads `|g_i + p_i / eps|`: the loop is the same.
+//!
 //! **Why it converges.** On a fixed active set, step 3 linearizes the very gap step 4 and the
 //! checks measure (`crate::contact::geometry::gap`): steps 1-3 are Newton's method on `g_A(u) = 0`,
 //! exact in one step where the secondary surface is flat and quadratic where it is smooth; on
