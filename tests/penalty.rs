@@ -182,6 +182,16 @@ fn a_coulomb_pair_under_a_stiff_penalty_gives_the_internodes_answer_in_2d_and_3d
     }
 }
 
+#[test]
+fn a_vanishing_penalty_ends_with_its_overlap_named() {
+    // Pressures of 1e-298 once hung the Hertz fit (its SVD, on a normal of 0 / 0): the run now
+    // ends, its accuracy report naming the overlap (the bodies pass through each other).
+    let solution = solve(&penalized(half_disc_on_block(), 1e-300)).unwrap();
+    assert!(solution.status.is_solution(), "{}", solution.status.name());
+    let failed = solution.certificate.failed();
+    assert!(failed.contains(&CheckKind::PenaltyOverlap), "{failed:?}");
+}
+
 /// The error a case that must be refused gets.
 fn refused(case: &CaseFile) -> String {
     match solve(case) {

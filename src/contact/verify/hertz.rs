@@ -14,10 +14,13 @@
 //! recovery that FE contact codes and our dolfinx reference use; with the lumped interface mass
 //! it is the nodal pressure itself.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, SVD};
 
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::solution::{HertzFit, SurfaceFields};
+
+/// The SVD's sweeps at most: a design of a few columns converges in a few dozen.
+const SVD_ITERATIONS: usize = 1000;
 
 /// The fit over the active nodes of `surface` with positive mean pressure; `None` with fewer
 /// nodes than unknowns (plus one), a profile that does not decrease outward, or a fitted radius
@@ -32,7 +35,14 @@ pub fn fit(surface: &ContactSurface, fields: &SurfaceFields) -> Option<HertzFit>
     if loaded.len() < unknowns + 1 {
         return None;
     }
-    let pressure = &fields.mean_pressure;
+    // The fit is the same for any unit of pressure: in units of the largest, so that neither
+    // the weights nor the squares underflow (pressures of 1e-298 made the mean normal 0 / 0, on
+    // which the SVD below never returned).
+    let scale = loaded
+        .iter()
+        .map(|&i| fields.mean_pressure[i])
+        .fold(0.0, f64::max);
+    let pressure: Vec<f64> = fields.mean_pressure.iter().map(|p| p / scale).collect();
     let total: f64 = loaded.iter().map(|&i| pressure[i]).sum();
     let mut centroid = [0.0; 3];
     let mut normal = [0.0; 3];
@@ -62,7 +72,9 @@ pub fn fit(surface: &ContactSurface, fields: &SurfaceFields) -> Option<HertzFit>
         }
     });
     let target = DVector::from_iterator(rows, loaded.iter().map(|&i| pressure[i].powi(2)));
-    let solution = design.svd(true, true).solve(&target, 1e-12).ok()?;
+    // Bounded, as `svd()` is not: a design that is not finite ends here with no fit.
+    let svd = SVD::try_new(design, true, true, f64::EPSILON, SVD_ITERATIONS)?;
+    let solution = svd.solve(&target, 1e-12).ok()?;
     let slope = solution[unknowns - 1];
     if slope <= 0.0 {
         return None;
@@ -94,7 +106,7 @@ pub fn fit(surface: &ContactSurface, fields: &SurfaceFields) -> Option<HertzFit>
     }
     Some(HertzFit {
         a,
-        p0: p0_squared.sqrt(),
+        p0: p0_squared.sqrt() * scale,
         center,
     })
 }
@@ -135,11 +147,16 @@ mod tests {
     /// `tests/fixtures/hemisphere_on_block_hertz.msh`, on the nodes where `keep` holds: the fit must
     /// give back `a`, `p0` and the centre, `p^2` being exactly its paraboloid.
     fn fitted(keep: impl Fn(&[f64; 3]) -> bool) -> HertzFit {
+        fitted_at(30.0, keep)
+    }
+
+    /// [`fitted`] with the peak pressure `p0`.
+    fn fitted_at(p0: f64, keep: impl Fn(&[f64; 3]) -> bool) -> HertzFit {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/fixtures/hemisphere_on_block_hertz.msh");
         let mesh = crate::mesh::read_msh(&path).unwrap();
         let surface = ContactSurface::new(mesh.body("block").unwrap(), "block_contact").unwrap();
-        let (a, p0) = (0.1, 30.0);
+        let a = 0.1;
         let pressure: Vec<f64> = (surface.coords.iter())
             .map(|x| {
                 let r2 = x[0] * x[0] + x[1] * x[1];
@@ -173,6 +190,17 @@ mod tests {
                 "{what}: {:?}",
                 fit.center
             );
+        }
+    }
+
+    #[test]
+    fn the_fit_holds_at_any_unit_of_pressure() {
+        // At 1e-298 the squares and the pressure-weighted normal underflowed, and the SVD of a
+        // design of NaN never returned.
+        for p0 in [1e-298, 1e298] {
+            let fit = fitted_at(p0, |_| true);
+            assert!((fit.a - 0.1).abs() < 1e-9, "p0 {p0}: a = {}", fit.a);
+            assert!((fit.p0 / p0 - 1.0).abs() < 1e-9, "p0 {p0}: {}", fit.p0);
         }
     }
 }
