@@ -263,6 +263,29 @@ fn under_the_penalty_method_each_interface_is_a_spring_in_series_with_the_stack(
 }
 
 #[test]
+fn a_penalty_pair_beside_an_internodes_pair_is_the_only_spring() {
+    // The method is per pair: the upper interface penalized, the lower one held exactly.
+    let mixed = format!(
+        "[[contact]]\nbodies = [\"upper\", \"middle\"]\nsurfaces = [\"upper_contact\", \
+         \"middle_top\"]\n{TIGHT}\nmethod = \"penalty\"\npenalty = 1.0\n\n[[contact]]\nbodies = \
+         [\"middle\", \"lower\"]\nsurfaces = [\"middle_bottom\", \"lower_contact\"]\n{TIGHT}\n"
+    );
+    let solution = solve(&pushed(&mixed)).unwrap();
+    let springs =
+        [&solution.contacts[0], &solution.contacts[1]].map(|c| c.summary.penalty_stiffness);
+    let eps = springs[0].expect("the upper pair is penalized");
+    assert_eq!(springs[1], None, "the lower pair is INTERNODES");
+    let sigma = PUSH / (1.0 / exact_stress(1.0) + 1.0 / eps);
+    for (p, (force, status)) in forces(&solution).into_iter().enumerate() {
+        assert_eq!(status, ContactStatus::Converged, "pair {p}");
+        assert!(
+            (force - sigma).abs() < 1e-9 * sigma,
+            "pair {p}: {force} against {sigma}"
+        );
+    }
+}
+
+#[test]
 fn a_pair_that_does_not_touch_is_no_contact_while_the_other_converges() {
     // The upper block is lifted off; the middle block, held at its sides, presses on the
     // lower one.
