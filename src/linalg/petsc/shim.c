@@ -239,9 +239,8 @@ int internodes_cgamg_set_up(InternodesCgAmg *s, const char **step)
     TRY(KSPGetPC(s->ksp, &pc));
     /* GAMG makes its coarse operators P^T A P and its smoothed prolongators A P as PETSc
      * matrix products, each keeping the intermediate data of a reuse that never comes (the
-     * hierarchy is built once): on several ranks that data doubled a rank's hierarchy
-     * (heaptrack, hemisphere at 217k DOFs on 2 ranks: 261-267 MB per rank against 131 MB in
-     * one process). It is freed here; the matrices stay as they are. */
+     * hierarchy is built once): on several ranks it made a rank's hierarchy larger than the
+     * whole serial one (docs/parallel.md). It is freed here; the matrices stay as they are. */
     TRY(PCMGGetLevels(pc, &levels));
     for (PetscInt level = 0; level < levels; level++) {
         KSP smoother;
