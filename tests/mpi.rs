@@ -352,6 +352,19 @@ fn a_floating_ball_between_plates_under_a_force_on_two_ranks_gives_the_serial_an
 }
 
 #[test]
+fn two_pairs_sharing_a_block_on_three_ranks_give_the_serial_answer() {
+    // Several pairs: two hemispheres pressed on one block, each pair with its own interface
+    // operators, the block's rows shared among three ranks.
+    ranks_give_the_serial_answer(3, "two_hemispheres_on_block", "", 1);
+}
+
+#[test]
+fn a_stack_of_three_2d_bodies_on_two_ranks_gives_the_serial_answer() {
+    // Two pairs in a chain (the middle body in both) in 2D, two load steps.
+    ranks_give_the_serial_answer(2, "stack_2d", "", 1);
+}
+
+#[test]
 fn a_single_body_on_two_ranks_gives_the_serial_answer() {
     let dir = tempfile::tempdir().unwrap();
     let case = example_case(dir.path(), "block_3d", "\n[solver]\nbody = \"cg-amg\"\n");
