@@ -46,6 +46,7 @@ import tomllib
 from pathlib import Path
 
 from memory_breakdown import PARTS, breakdown
+from suite import mesh_geo
 
 REPO = Path(__file__).resolve().parent.parent
 BUILD = REPO / "validation" / "build" / "memory_model"
@@ -60,16 +61,11 @@ BUFFER = PARTS[0][0]  # faer's dense-product buffer: reserved, mostly never writ
 
 
 def case_file(level: float) -> Path:
-    """The demo case in one load step on its mesh at ``level`` (meshed here once)."""
-    BUILD.mkdir(parents=True, exist_ok=True)
+    """The demo case in one load step on its mesh at ``level`` (meshed once: ``suite.mesh_geo``
+    caches it)."""
     case = tomllib.loads(CASE.read_text())
-    msh = BUILD / f"hemisphere_on_block_level{level}.msh"
-    if not msh.exists():
-        parameters = {**case["geo_parameters"], "level": level}
-        command = ["gmsh", "-3", str(REPO / "geo" / case["mesh"]), "-format", "msh41", "-o", str(msh)]
-        for key, value in parameters.items():
-            command += ["-setnumber", key, str(value)]
-        subprocess.run(command, check=True, capture_output=True)
+    msh = mesh_geo(Path(case["mesh"]).stem, 3, {**case["geo_parameters"], "level": level},
+                   BUILD / f"hemisphere_on_block_level{level}.msh")
     text = CASE.read_text()
     text = re.sub(r'^mesh = .*$', f'mesh = "{msh.name}"', text, flags=re.M)
     text = re.sub(r'^geo_parameters = .*\n', "", text, flags=re.M)

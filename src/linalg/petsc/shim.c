@@ -244,17 +244,16 @@ int internodes_cgamg_set_up(InternodesCgAmg *s, const char **step)
     TRY(PCMGGetLevels(pc, &levels));
     for (PetscInt level = 0; level < levels; level++) {
         KSP smoother;
-        Mat a, p;
+        Mat operator, preconditioning, interpolation;
         TRY(PCMGGetSmoother(pc, level, &smoother));
-        TRY(KSPGetOperators(smoother, &a, &p));
-        TRY(MatProductClear(a));
-        TRY(MatProductClear(p));
+        TRY(KSPGetOperators(smoother, &operator, &preconditioning));
+        TRY(MatProductClear(operator));
+        TRY(MatProductClear(preconditioning));
         if (level > 0) {
-            TRY(PCMGGetInterpolation(pc, level, &p));
-            TRY(MatProductClear(p));
+            TRY(PCMGGetInterpolation(pc, level, &interpolation));
+            TRY(MatProductClear(interpolation));
         }
     }
-    TRY(KSPGetPC(s->ksp, &pc));
     /* One V-cycle now, while the caller holds PETSc exclusively: PETSc finishes the set-up on
      * the first application (the coarse level's block Jacobi factors its LU in
      * PCSetUpOnBlocks, through PCSetUp, MatGetFactor and MatGetOrdering, which touch
