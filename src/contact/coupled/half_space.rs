@@ -39,9 +39,14 @@
 //! coupling of lower order that the Krylov iteration absorbs. A multiplier that only restates a
 //! Dirichlet condition (no column, `D_kk != 0`) keeps its exact block `D_kk`; a coupled one with
 //! its own term in its row (a slipping node's direction row, `crate::contact::law::coulomb`) has
-//! `D_kk` added to its diagonal of `S~`. `S~` is dense and factored by LU once per active-set
-//! iteration (`m` is hundreds to a few thousand: `m^3 / 3` multiply-adds, 4e8 for the 1048
-//! multipliers of the largest active set at the contact benchmark's 99k DOFs).
+//! `D_kk` added to its diagonal of `S~`.
+//!
+//! `S~^-1` is applied exactly on a small zone (at most [`DENSE_LIMIT`] multipliers: `S~`
+//! assembled and LU-factored once per active-set iteration), and beyond it by the two-level
+//! approximate inverse of `crate::contact::coupled::two_level_inverse`, which never assembles
+//! `S~`: the dense LU takes `2 m^2` numbers and `m^3 / 3` multiply-adds (at 90,000 multipliers,
+//! the contact zone of 100M DOFs, 130 GB), the two-level inverse about `m (20 u + dim m / 128)`
+//! (`u` multipliers per node).
 
 use std::collections::HashMap;
 
@@ -49,18 +54,35 @@ use faer::Mat;
 use faer::prelude::*;
 
 use crate::contact::coupled::compliance::MultiplierKey;
+use crate::contact::coupled::far_field::LumpedSums;
 use crate::contact::coupled::system::{CoupledSystem, Coupling};
+use crate::contact::coupled::two_level_inverse::{TwoLevelInverse, Unknown};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::fem::Material;
 
-/// The half-space approximation of the Schur complement, LU-factored.
+/// The half-space approximation of the Schur complement, inverted exactly or approximately.
 pub struct HalfSpace {
     /// The pair's coupled multipliers (those with a column), numbered within the pair.
     coupled: Vec<usize>,
-    lu: faer::linalg::solvers::PartialPivLu<f64>,
+    inverse: Inverse,
     /// `D_kk` of every multiplier of the pair (an uncoupled one is solved by it alone).
     diagonal: Vec<f64>,
 }
+
+/// How `S~^-1` is applied on the coupled multipliers.
+enum Inverse {
+    /// Assembled and LU-factored: at most [`DENSE_LIMIT`] multipliers.
+    Dense(faer::linalg::solvers::PartialPivLu<f64>),
+    /// Above: never assembled, `crate::contact::coupled::two_level_inverse`.
+    TwoLevel(TwoLevelInverse),
+}
+
+/// The most coupled multipliers whose `S~` is assembled and factored exactly. Why 1000: above,
+/// the two-level inverse is as good a preconditioner and cheaper (the hemisphere on block at
+/// 217k and 1M DOFs, up to 1,834 and 3,900 multipliers: the same active sets and V-cycles, forces
+/// within 1.5e-9 of the force, and at 1M 124 MB less at the peak; `docs/decisions.md`); below, the exact
+/// inverse costs nothing (16 MB, 3e8 multiply-adds) and the small zone leaves few clusters.
+pub const DENSE_LIMIT: usize = 1000;
 
 /// `c0` of the module doc: the compliance factor of two half-spaces of `materials` in
 /// dimension `dim` (2D: plane strain).
@@ -98,6 +120,7 @@ impl HalfSpace {
         // Node, direction and area of each coupled multiplier (its column of B combines the
         // components of one node's traction).
         let mut coupled = Vec::new();
+        let mut owners = Vec::new();
         let mut points = Vec::new();
         for (k, column) in system.columns[multipliers].iter().enumerate() {
             let Some((key, _)) = column.first() else {
@@ -117,11 +140,12 @@ impl HalfSpace {
             x[..dim].copy_from_slice(&coordinates[dim * node..dim * node + dim]);
             let a = area.get(&node).copied().unwrap_or(0.0);
             coupled.push(k);
+            owners.push(node);
             points.push((x, row, e, a));
         }
         let kernel = Kernel::new(dim, points.iter().map(|(x, _, _, a)| (*x, *a)));
         let scale = system.t * system.s * c0;
-        let p = Mat::<f64>::from_fn(points.len(), points.len(), |i, j| {
+        let entry = |i: usize, j: usize| {
             // Row i's direction against column j's: the same vector but at a slipping node.
             let ((xi, ei, _, ai), (xj, _, ej, aj)) = (&points[i], &points[j]);
             // A multiplier's own term in its row (`D_kk`, a slipping node's direction row).
@@ -139,10 +163,30 @@ impl HalfSpace {
                 kernel.between(r)
             };
             own + scale * along * g * aj
-        });
+        };
+        let inverse = if points.len() <= DENSE_LIMIT {
+            Inverse::Dense(Mat::<f64>::from_fn(points.len(), points.len(), entry).partial_piv_lu())
+        } else {
+            // The multipliers of one node share its point.
+            let mut nodes: Vec<[f64; 3]> = Vec::new();
+            let mut node_of: HashMap<usize, usize> = HashMap::new();
+            let unknowns: Vec<Unknown> = (points.iter().zip(&owners))
+                .map(|((x, _, e, _), owner)| {
+                    let node = *node_of.entry(*owner).or_insert_with(|| {
+                        nodes.push(*x);
+                        nodes.len() - 1
+                    });
+                    Unknown {
+                        node,
+                        direction: *e,
+                    }
+                })
+                .collect();
+            Inverse::TwoLevel(TwoLevelInverse::new(&nodes, &unknowns, dim, entry))
+        };
         Self {
             coupled,
-            lu: p.partial_piv_lu(),
+            inverse,
             diagonal,
         }
     }
@@ -155,10 +199,21 @@ impl HalfSpace {
         if self.coupled.is_empty() {
             return;
         }
-        let mut rhs = Mat::<f64>::from_fn(self.coupled.len(), 1, |i, _| v[self.coupled[i]]);
-        self.lu.solve_in_place(rhs.as_mut());
-        for (i, &k) in self.coupled.iter().enumerate() {
-            out[k] = rhs[(i, 0)];
+        let rhs: Vec<f64> = self.coupled.iter().map(|&k| v[k]).collect();
+        let solution = match &self.inverse {
+            Inverse::Dense(lu) => {
+                let mut x = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
+                lu.solve_in_place(x.as_mut());
+                (0..rhs.len()).map(|i| x[(i, 0)]).collect()
+            }
+            Inverse::TwoLevel(inverse) => {
+                let mut x = vec![0.0; rhs.len()];
+                inverse.apply(&rhs, &mut x);
+                x
+            }
+        };
+        for (&k, x) in self.coupled.iter().zip(solution) {
+            out[k] = x;
         }
     }
 }
@@ -198,6 +253,15 @@ impl Kernel {
             1.0 / r
         } else {
             -(r / self.length).ln()
+        }
+    }
+
+    /// `dG / dr` at a distance `r`.
+    fn slope(&self, r: f64) -> f64 {
+        if self.dim == 3 {
+            -1.0 / (r * r)
+        } else {
+            -1.0 / r
         }
     }
 
@@ -352,7 +416,9 @@ const FORCE_BRACKETING: usize = 40;
 const FORCE_STEPS: usize = 60;
 
 /// The pressures `p` and model gaps `r` of the half-space contact problem of
-/// [`predicted_set`] on `candidates`.
+/// [`predicted_set`] on `candidates`: `C` assembled on at most [`DENSE_LIMIT`] candidates, its
+/// far part lumped beyond (`crate::contact::coupled::far_field`: `m^2` numbers are 200 MB at
+/// 5,000 candidates, 65 GB at 90,000).
 fn half_space_contact(
     surface: &ContactSurface,
     candidates: &[usize],
@@ -360,48 +426,68 @@ fn half_space_contact(
     p0: &[f64],
     c0: f64,
 ) -> (Vec<f64>, Vec<f64>) {
-    let m = candidates.len();
-    let dim = surface.dim;
-    let x = |i: usize| surface.coords[candidates[i]];
-    let area = |i: usize| surface.nodal_area[candidates[i]];
-    let kernel = Kernel::new(dim, (0..m).map(|i| (x(i), area(i))));
-    let g = |i: usize, j: usize| {
-        if i == j {
-            return kernel.own(area(i));
-        }
-        let r = (0..3)
-            .map(|c| (x(i)[c] - x(j)[c]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        kernel.between(r)
-    };
-    // G is symmetric: row i holds both C's row (times A_j) and its column (times A_i).
-    let kernel: Vec<f64> = (0..m * m).map(|k| g(k / m, k % m)).collect();
-    let row = |i: usize| &kernel[i * m..(i + 1) * m];
-    let areas: Vec<f64> = (0..m).map(area).collect();
-    let mut p: Vec<f64> = candidates.iter().map(|&i| p0[i].max(0.0)).collect();
-    // r = g + C (p - p0): the model's gap of each candidate.
-    let mut r: Vec<f64> = (0..m)
-        .map(|i| {
-            let shift: f64 = (row(i).iter().enumerate())
-                .map(|(j, g)| c0 * g * areas[j] * (p[j] - p0[candidates[j]]))
-                .sum();
-            gaps[candidates[i]] + shift
-        })
+    let points: Vec<[f64; 3]> = candidates.iter().map(|&i| surface.coords[i]).collect();
+    let areas: Vec<f64> = candidates.iter().map(|&i| surface.nodal_area[i]).collect();
+    let p: Vec<f64> = candidates.iter().map(|&i| p0[i].max(0.0)).collect();
+    let shifts: Vec<f64> = (candidates.iter().zip(&p))
+        .map(|(&i, p)| p - p0[i])
         .collect();
-    let scale = r.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    let gaps: Vec<f64> = candidates.iter().map(|&i| gaps[i]).collect();
+    let zone = ModelZone {
+        points: &points,
+        areas: &areas,
+        dim: surface.dim,
+    };
+    let lumped = candidates.len() > DENSE_LIMIT;
+    model_contact(&zone, gaps, p, &shifts, c0, lumped)
+}
+
+/// The points of a half-space model: where they are, their areas, in `dim` dimensions.
+struct ModelZone<'a> {
+    points: &'a [[f64; 3]],
+    areas: &'a [f64],
+    dim: usize,
+}
+
+/// The pressures `p` and model gaps `r` of the half-space contact problem on `zone` with the
+/// gaps `gaps` at the pressures `p - shifts`, from the pressures `p`: `C` assembled, or its far
+/// part `lumped`.
+fn model_contact(
+    zone: &ModelZone,
+    gaps: Vec<f64>,
+    mut p: Vec<f64>,
+    shifts: &[f64],
+    c0: f64,
+    lumped: bool,
+) -> (Vec<f64>, Vec<f64>) {
+    let (points, areas) = (zone.points, zone.areas);
+    let kernel = Kernel::new(zone.dim, points.iter().copied().zip(areas.iter().copied()));
+    if lumped {
+        let mut model = LumpedGaps::new(points, areas, &kernel, c0, gaps, shifts, zone.dim);
+        projected_gauss_seidel(&mut model, &mut p);
+        let r = (0..p.len()).map(|i| model.gap(i)).collect();
+        (p, r)
+    } else {
+        let mut model = DenseGaps::new(points, areas, &kernel, c0, &gaps, shifts);
+        projected_gauss_seidel(&mut model, &mut p);
+        (p, model.r)
+    }
+}
+
+/// Solves the half-space contact problem by projected Gauss-Seidel on the `model`'s gaps from
+/// the pressures `p` (it converges for a symmetric positive definite `C`), at most
+/// [`PREDICTION_SWEEPS`] sweeps.
+fn projected_gauss_seidel(model: &mut impl ModelGaps, p: &mut [f64]) {
+    let scale = (0..p.len()).map(|i| model.gap(i).abs()).fold(0.0, f64::max);
     for _ in 0..PREDICTION_SWEEPS {
         let mut largest_change = 0.0_f64;
-        for i in 0..m {
-            let diagonal = c0 * row(i)[i] * areas[i];
-            let new = (p[i] - r[i] / diagonal).max(0.0);
-            let delta = new - p[i];
+        for (i, pressure) in p.iter_mut().enumerate() {
+            let diagonal = model.diagonal(i);
+            let new = (*pressure - model.gap(i) / diagonal).max(0.0);
+            let delta = new - *pressure;
             if delta != 0.0 {
-                p[i] = new;
-                let column = c0 * areas[i] * delta;
-                for (rk, g) in r.iter_mut().zip(row(i)) {
-                    *rk += g * column;
-                }
+                *pressure = new;
+                model.change(i, delta);
                 largest_change = largest_change.max((delta * diagonal).abs());
             }
         }
@@ -409,7 +495,164 @@ fn half_space_contact(
             break;
         }
     }
-    (p, r)
+}
+
+/// The model gaps `r = g + C (p - p0)` of the half-space contact problem, as projected
+/// Gauss-Seidel reads and updates them.
+trait ModelGaps {
+    /// `r_i` at the current pressures.
+    fn gap(&self, i: usize) -> f64;
+    /// `C_ii`.
+    fn diagonal(&self, i: usize) -> f64;
+    /// The pressure of `i` changed by `delta`.
+    fn change(&mut self, i: usize, delta: f64);
+}
+
+/// `C = c0 G A` assembled (`G` symmetric: row `i` holds both `C`'s row, times `A_j`, and its
+/// column, times `A_i`), and `r` kept up to date.
+struct DenseGaps {
+    kernel: Vec<f64>,
+    areas: Vec<f64>,
+    c0: f64,
+    r: Vec<f64>,
+}
+
+impl DenseGaps {
+    /// The model of the points `x` of `areas` with the gaps `gaps` at pressures `p0 + shifts`.
+    fn new(
+        x: &[[f64; 3]],
+        areas: &[f64],
+        kernel: &Kernel,
+        c0: f64,
+        gaps: &[f64],
+        shifts: &[f64],
+    ) -> Self {
+        let m = x.len();
+        let g = |i: usize, j: usize| {
+            if i == j {
+                return kernel.own(areas[i]);
+            }
+            let r = (0..3)
+                .map(|c| (x[i][c] - x[j][c]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            kernel.between(r)
+        };
+        let kernel: Vec<f64> = (0..m * m).map(|k| g(k / m, k % m)).collect();
+        let r = (0..m)
+            .map(|i| {
+                let shift: f64 = (kernel[i * m..(i + 1) * m].iter().enumerate())
+                    .map(|(j, g)| c0 * g * areas[j] * shifts[j])
+                    .sum();
+                gaps[i] + shift
+            })
+            .collect();
+        Self {
+            kernel,
+            areas: areas.to_vec(),
+            c0,
+            r,
+        }
+    }
+
+    fn row(&self, i: usize) -> &[f64] {
+        let m = self.r.len();
+        &self.kernel[i * m..(i + 1) * m]
+    }
+}
+
+impl ModelGaps for DenseGaps {
+    fn gap(&self, i: usize) -> f64 {
+        self.r[i]
+    }
+
+    fn diagonal(&self, i: usize) -> f64 {
+        self.c0 * self.row(i)[i] * self.areas[i]
+    }
+
+    fn change(&mut self, i: usize, delta: f64) {
+        let m = self.r.len();
+        let column = self.c0 * self.areas[i] * delta;
+        let row = &self.kernel[i * m..(i + 1) * m];
+        for (rk, g) in self.r.iter_mut().zip(row) {
+            *rk += g * column;
+        }
+    }
+}
+
+/// `C = c0 G A` never assembled: `r_i` summed afresh at each visit, with the zone's far part
+/// lumped into clusters (`crate::contact::coupled::far_field`).
+struct LumpedGaps<'a> {
+    points: &'a [[f64; 3]],
+    areas: &'a [f64],
+    kernel: &'a Kernel,
+    c0: f64,
+    gaps: Vec<f64>,
+    /// `A_j (p_j - p0_j)`.
+    weights: Vec<f64>,
+    sums: LumpedSums,
+}
+
+impl<'a> LumpedGaps<'a> {
+    /// The model of the points `points` of `areas` with the gaps `gaps` at pressures
+    /// `p0 + shifts`, in `dim` dimensions.
+    fn new(
+        points: &'a [[f64; 3]],
+        areas: &'a [f64],
+        kernel: &'a Kernel,
+        c0: f64,
+        gaps: Vec<f64>,
+        shifts: &[f64],
+        dim: usize,
+    ) -> Self {
+        let mut sums = LumpedSums::new(points, areas, dim);
+        let weights: Vec<f64> = areas.iter().zip(shifts).map(|(a, s)| a * s).collect();
+        for (j, w) in weights.iter().enumerate() {
+            sums.add(j, *w);
+        }
+        Self {
+            points,
+            areas,
+            kernel,
+            c0,
+            gaps,
+            weights,
+            sums,
+        }
+    }
+}
+
+impl ModelGaps for LumpedGaps<'_> {
+    fn gap(&self, i: usize) -> f64 {
+        let distance =
+            |x: &[f64; 3], y: &[f64; 3]| (0..3).map(|c| (x[c] - y[c]).powi(2)).sum::<f64>().sqrt();
+        let sum = self.sums.sum(
+            i,
+            &self.weights,
+            |i| self.kernel.own(self.areas[i]),
+            |i, j| {
+                self.kernel
+                    .between(distance(&self.points[i], &self.points[j]))
+            },
+            |i, centre| {
+                let (x, d) = (&self.points[i], distance(&self.points[i], centre));
+                let (g, slope) = (self.kernel.between(d), self.kernel.slope(d));
+                // d G(|x - y|) / dy = -G'(d) (x - y) / d.
+                (g, std::array::from_fn(|c| -slope * (x[c] - centre[c]) / d))
+            },
+        );
+        self.gaps[i] + self.c0 * sum
+    }
+
+    fn diagonal(&self, i: usize) -> f64 {
+        self.c0 * self.kernel.own(self.areas[i]) * self.areas[i]
+    }
+
+    fn change(&mut self, i: usize, delta: f64) {
+        let change = self.areas[i] * delta;
+        self.weights[i] += change;
+        self.sums.add(i, change);
+    }
 }
 
 /// [`predicted_set`] also keeps the candidates whose model gap is below this fraction of their
@@ -432,3 +675,97 @@ const PREDICTION_SWEEPS: usize = 200;
 
 /// [`predicted_set`] stops when no sweep moves a gap by more than this fraction of the largest.
 const PREDICTION_TOLERANCE: f64 = 1e-4;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::Material;
+
+    /// The model's pressures and predicted set.
+    type Prediction = (Vec<f64>, Vec<usize>);
+
+    /// A sphere of radius 1 pressed by `approach` into a flat, both of `E = 1000`, `nu = 0.3`,
+    /// on a jittered grid of spacing `h` over a disc twice the Hertz radius: the model's
+    /// prediction, assembled and lumped, with the zone, the Hertz radius and force.
+    fn hertz(h: f64, approach: f64) -> (ModelZone<'static>, [Prediction; 2], f64, f64) {
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let c0 = compliance_factor([&material, &material], 3);
+        let e_star = 1.0 / (std::f64::consts::PI * c0);
+        let a = approach.sqrt();
+        let n = (2.0 * a / h).ceil() as i64;
+        let mut points = Vec::new();
+        for i in -n..=n {
+            for j in -n..=n {
+                let jitter = ((i * 7919 + j * 104_729).rem_euclid(97) as f64 / 97.0 - 0.5) * 0.2;
+                let x = [(i as f64 + jitter) * h, (j as f64 - jitter) * h, 0.0];
+                if x[0].hypot(x[1]) <= 2.0 * a {
+                    points.push(x);
+                }
+            }
+        }
+        let m = points.len();
+        let areas = vec![h * h; m];
+        let gaps: Vec<f64> = (points.iter())
+            .map(|x| (x[0] * x[0] + x[1] * x[1]) / 2.0 - approach)
+            .collect();
+        let zone = ModelZone {
+            points: points.leak(),
+            areas: areas.leak(),
+            dim: 3,
+        };
+        let solve = |lumped| {
+            let (p, r) =
+                model_contact(&zone, gaps.clone(), vec![0.0; m], &vec![0.0; m], c0, lumped);
+            // predicted_set's rule.
+            let set = (0..m)
+                .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * h)
+                .collect();
+            (p, set)
+        };
+        let pressures = [solve(false), solve(true)];
+        let force = 4.0 * e_star * a.powi(3) / 3.0;
+        (zone, pressures, a, force)
+    }
+
+    #[test]
+    fn the_lumped_model_gives_the_hertz_contact_of_the_assembled_one() {
+        for (h, approach) in [(0.004, 0.01), (0.003, 0.004)] {
+            let (zone, [(dense, dense_set), (lumped, lumped_set)], a, force) = hertz(h, approach);
+            let m = zone.points.len();
+            for (name, p) in [("assembled", &dense), ("lumped", &lumped)] {
+                // Against Hertz (an exact solution of the continuous model): the force, and the
+                // zone's radius to within a spacing.
+                let carried: f64 = p.iter().zip(zone.areas).map(|(p, a)| p * a).sum();
+                let radius = (zone.points.iter().zip(p.iter()))
+                    .filter(|(_, p)| **p > 0.0)
+                    .map(|(x, _)| x[0].hypot(x[1]))
+                    .fold(0.0, f64::max);
+                eprintln!(
+                    "h {h}, m {m}, {name}: force {:+.4} from Hertz, radius {:+.2} spacings",
+                    carried / force - 1.0,
+                    (radius - a) / h
+                );
+                assert!(
+                    (carried / force - 1.0).abs() < 0.01,
+                    "{name}: force {carried} against {force}"
+                );
+                assert!(
+                    (radius - a).abs() < h,
+                    "{name}: radius {radius} against {a}"
+                );
+            }
+            // The predicted sets: the same but for a few nodes of the rim (about 2 pi a / h).
+            let differ = (dense_set.iter())
+                .filter(|i| !lumped_set.contains(i))
+                .chain(lumped_set.iter().filter(|i| !dense_set.contains(i)))
+                .count();
+            let rim = 2.0 * std::f64::consts::PI * a / h;
+            eprintln!(
+                "h {h}: predicted sets of {} and {} nodes, {differ} differ (rim {rim:.0})",
+                dense_set.len(),
+                lumped_set.len()
+            );
+            assert!((differ as f64) < 0.05 * rim, "{differ} nodes differ");
+        }
+    }
+}
