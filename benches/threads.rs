@@ -81,7 +81,7 @@ fn main() {
             let problem = case.elastic_problem(body, spec).unwrap_or_else(exit);
             let system = assemble(&problem, &mut SolveStats::default(), false).unwrap();
             let symbolic = CholeskySymbolic::new(
-                &system.graph,
+                system.graph.as_ref().expect("the whole K_c has its graph"),
                 system.stiffness.whole().unwrap().symbolic(),
                 case.solver.ordering,
             )
@@ -107,7 +107,7 @@ fn main() {
 
                     let (seconds, _) = timed(|| {
                         let symbolic = CholeskySymbolic::new(
-                            &system.graph,
+                            system.graph.as_ref().expect("the whole K_c has its graph"),
                             system.stiffness.whole().unwrap().symbolic(),
                             case.solver.ordering,
                         )

@@ -233,7 +233,9 @@ pub fn solve(
         }
         (None, Some(k_c), _) => {
             let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
-                CholeskySymbolic::new(&system.graph, k_c.symbolic(), settings.ordering)
+                let graph = (system.graph.as_ref())
+                    .ok_or_else(|| LinalgError::Sizes("the whole K_c has no node graph".into()))?;
+                CholeskySymbolic::new(graph, k_c.symbolic(), settings.ordering)
             })
             .map_err(linalg)?;
             stats.factor_nnz = symbolic.factor_nnz();

@@ -308,7 +308,9 @@ pub fn held_by_contacts_only(
 /// The Cholesky factor of a body's constrained stiffness.
 fn cholesky(body: &AssembledBody, ordering: Ordering) -> Result<BodySolver, ContactError> {
     let k_c = assembled(body)?;
-    CholeskySymbolic::new(&body.graph, k_c.symbolic(), ordering)
+    let graph = (body.graph.as_ref())
+        .ok_or_else(|| ContactError::Linalg("a body's whole K_c has no node graph".into()))?;
+    CholeskySymbolic::new(graph, k_c.symbolic(), ordering)
         .and_then(|symbolic| Cholesky::factorize(symbolic, k_c))
         .map(BodySolver::Cholesky)
         .map_err(|e| ContactError::Linalg(format!("Cholesky of a body's stiffness: {e}")))
