@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -35,7 +36,7 @@ REPO = Path(__file__).resolve().parent.parent
 # faer's dense products (through the crate private-gemm-x86) reserve, on each thread's first
 # product, a thread-local packing buffer of twice the L3 cache the processor reports (480 MiB on
 # this machine's virtual processor: 1.0 GB), whichever part calls first (the RBF interpolation's
-# supernodal LU, or the half-space predictor's dense LU). The heap counts the reservation; the
+# supernodal LU, or the half-space preconditioner's dense LU). The heap counts the reservation; the
 # resident memory only the pages a product writes (217k DOFs in one process: heap peak 1718 MB,
 # resident peak 777 MB). So it is a part of its own.
 PARTS = [
@@ -47,7 +48,7 @@ PARTS = [
     ("coupled system blocks", "CoupledSystem::assemble"),
     ("interface coupling", "InterfaceOperators::coupling"),
     ("interface operators (other)", "InterfaceOperators::"),
-    ("half-space predictor", "HalfSpace::new"),
+    ("half-space preconditioner (S~^-1)", "HalfSpace::new"),
     ("GMRES basis and vectors", "gmres::"),
     ("coupled Krylov solve (other)", "coupled_krylov::"),
     ("mesh", "internodes::mesh::"),
@@ -81,7 +82,10 @@ def breakdown(case: Path, ranks: int, binary: Path) -> tuple[list[dict[str, int]
                    "-o", str(work / "out")]
         if ranks > 1:
             command = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(ranks), *command]
-        run = subprocess.run(command, cwd=work, capture_output=True, text=True)
+        # The environment as this script started (os.environ), not the process's own: dolfinx,
+        # imported through suite.py, initializes MPI, which sets variables in the C environment
+        # that make a child mpirun exit 1 without a word.
+        run = subprocess.run(command, cwd=work, capture_output=True, text=True, env=dict(os.environ))
         if run.returncode not in (0, 2, 3):
             raise RuntimeError(f"{' '.join(command)} exited with {run.returncode}:\n{run.stdout}{run.stderr}")
         profiles = sorted(work.glob("heaptrack.internodes.*.zst"), key=lambda p: int(p.name.split(".")[2]))

@@ -44,9 +44,9 @@
 //! `S~^-1` is applied exactly on a small zone (at most [`DENSE_LIMIT`] multipliers: `S~`
 //! assembled and LU-factored once per active-set iteration), and beyond it by the two-level
 //! approximate inverse of `crate::contact::coupled::two_level_inverse`, which never assembles
-//! `S~`: the dense LU takes `2 m^2` numbers and `m^3 / 3` multiply-adds (at 90,000 multipliers,
-//! the contact zone of 100M DOFs, 130 GB), the two-level inverse about `m (20 u + dim m / 128)`
-//! (`u` multipliers per node).
+//! `S~`: the dense LU takes `2 m^2` numbers and `m^3 / 3` multiply-adds (by the memory model of
+//! `docs/parallel.md`, 65 GB per rank at 100M DOFs), the two-level inverse about
+//! `m (20 u + dim m / 128)` (`u` multipliers per node).
 
 use std::collections::HashMap;
 
@@ -79,9 +79,10 @@ enum Inverse {
 
 /// The most coupled multipliers whose `S~` is assembled and factored exactly. Why 1000: above,
 /// the two-level inverse is as good a preconditioner and cheaper (the hemisphere on block at
-/// 217k and 1M DOFs, up to 1,834 and 3,900 multipliers: the same active sets and V-cycles, forces
-/// within 1.5e-9 of the force, and at 1M 124 MB less at the peak; `docs/decisions.md`); below, the exact
-/// inverse costs nothing (16 MB, 3e8 multiply-adds) and the small zone leaves few clusters.
+/// 217k and 1M DOFs, up to 1,834 and 2,982 multipliers: the same active sets and V-cycles,
+/// forces within 1.5e-9 of the force, and at 1M 124 MB less at the peak; `docs/decisions.md`);
+/// below, the exact inverse costs nothing (16 MB, 3e8 multiply-adds) and the small zone leaves
+/// few clusters.
 pub const DENSE_LIMIT: usize = 1000;
 
 /// `c0` of the module doc: the compliance factor of two half-spaces of `materials` in

@@ -7,8 +7,8 @@
 //! normal), `far_field.rs` (sums of a slowly decaying kernel with the zone's far part lumped into
 //! clusters), `two_level_inverse.rs` (an approximate inverse of a boundary-integral operator on a
 //! zone too large to factor), `half_space.rs` (the interface Schur complement approximated by two
-//! elastic half-spaces), `coupled_krylov.rs` (the whole coupled system by one preconditioned GMRES),
-//! `coupled_solver.rs` (which solver, behind one call).
+//! elastic half-spaces), `coupled_krylov.rs` (the whole coupled system by one preconditioned
+//! GMRES), `coupled_solver.rs` (which solver, behind one call).
 
 pub mod compliance;
 pub mod coupled_krylov;
