@@ -577,6 +577,30 @@ impl<'a> ContactSolver<'a> {
     }
 }
 
+/// The bodies that `held` (held by their contacts alone) among `sides` and those linked to
+/// them through pairs whose linking side is such a body: the bodies whose forces reach a pair
+/// of `sides` through bodies that nothing else supports.
+fn held_chain(
+    pair_bodies: &[[usize; 2]],
+    sides: [usize; 2],
+    held: impl Fn(usize) -> bool,
+) -> BTreeSet<usize> {
+    let mut chain: BTreeSet<usize> = sides.into_iter().filter(|&k| held(k)).collect();
+    loop {
+        let before = chain.len();
+        for pair in pair_bodies {
+            for (from, to) in [(pair[0], pair[1]), (pair[1], pair[0])] {
+                if chain.contains(&from) && held(to) {
+                    chain.insert(to);
+                }
+            }
+        }
+        if chain.len() == before {
+            return chain;
+        }
+    }
+}
+
 /// The bodies linked to body `k` through pairs (`k` among them), in increasing order.
 fn linked_bodies(pair_bodies: &[[usize; 2]], k: usize) -> Vec<usize> {
     let mut linked = BTreeSet::from([k]);
@@ -806,8 +830,9 @@ impl ContactSolver<'_> {
     /// loop starts cold or such a body has no node in contact: with no node in contact its
     /// system is singular (the force would move it without bound), and from the nodes that
     /// merely touch (a sphere's pole) the first iterate would carry the whole force on them.
-    /// Each pair of such a body starts on the half-space model's zone for the resultant of
-    /// its bodies' loads and forces (`crate::contact::coupled::half_space::force_controlled_set`);
+    /// Each pair of such a body starts on the half-space model's zone for the largest
+    /// resultant of the loads and forces that reach it through the bodies only their contacts
+    /// hold ([`held_chain`]; `crate::contact::coupled::half_space::force_controlled_set`);
     /// where the model finds none (no force: a floating block between two others), on the nodes
     /// that touch already, or the closest node. If the loop lets go of every contact of such a
     /// body after that, its loads pull it off: an error that names it.
@@ -856,12 +881,14 @@ impl ContactSolver<'_> {
                 Some(u) => geometric_gaps(s1, s2, Some(&u[sides[0]]), Some(&u[sides[1]])),
                 None => geometric_gaps(s1, s2, None, None),
             };
-            // The force the contact carries, at most: the resultant of the loads and of the
-            // forces on the force-controlled groups of a body held by its contacts alone (its
-            // supports may carry part of it; the zone then errs on the large side, which the
-            // loop corrects).
-            let force = (sides.iter().filter(|&&k| held(k)))
-                .map(|&k| self.bodies[k].resultant(factors))
+            // The force the contact carries, at most: the largest resultant of the loads and
+            // of the forces on the force-controlled groups of the bodies held by their contacts
+            // alone that push through it: its own sides and those linked to them through such
+            // bodies (a floating ball between two plates passes the force on one plate to its
+            // other contact; its supports may carry part of it; the zone then errs on the large
+            // side, which the loop corrects).
+            let force = (held_chain(&self.pair_bodies, sides, held).into_iter())
+                .map(|k| self.bodies[k].resultant(factors))
                 .fold(0.0, f64::max);
             let materials = [&problem.primary.material, &problem.secondary.material];
             let c0 = compliance_factor(materials, s1.dim);
