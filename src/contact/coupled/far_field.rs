@@ -172,7 +172,8 @@ impl LumpedSums {
     }
 }
 
-fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+/// The Euclidean distance of two points.
+pub fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>().sqrt()
 }
 

@@ -54,7 +54,7 @@ use faer::Mat;
 use faer::prelude::*;
 
 use crate::contact::coupled::compliance::MultiplierKey;
-use crate::contact::coupled::far_field::LumpedSums;
+use crate::contact::coupled::far_field::{LumpedSums, distance};
 use crate::contact::coupled::system::{CoupledSystem, Coupling};
 use crate::contact::coupled::two_level_inverse::{TwoLevelInverse, Unknown};
 use crate::contact::geometry::surface::ContactSurface;
@@ -155,7 +155,7 @@ impl HalfSpace {
             if along == 0.0 {
                 return own;
             }
-            let r = (0..3).map(|c| (xi[c] - xj[c]).powi(2)).sum::<f64>().sqrt();
+            let r = distance(xi, xj);
             // Distinct nodes of a mesh never coincide; the same node's components have
             // orthogonal directions, so only the self term is left.
             let g = if i == j || r == 0.0 {
@@ -511,18 +511,18 @@ trait ModelGaps {
 
 /// `C = c0 G A` assembled (`G` symmetric: row `i` holds both `C`'s row, times `A_j`, and its
 /// column, times `A_i`), and `r` kept up to date.
-struct DenseGaps {
+struct DenseGaps<'a> {
     kernel: Vec<f64>,
-    areas: Vec<f64>,
+    areas: &'a [f64],
     c0: f64,
     r: Vec<f64>,
 }
 
-impl DenseGaps {
+impl<'a> DenseGaps<'a> {
     /// The model of the points `x` of `areas` with the gaps `gaps` at pressures `p0 + shifts`.
     fn new(
         x: &[[f64; 3]],
-        areas: &[f64],
+        areas: &'a [f64],
         kernel: &Kernel,
         c0: f64,
         gaps: &[f64],
@@ -533,11 +533,7 @@ impl DenseGaps {
             if i == j {
                 return kernel.own(areas[i]);
             }
-            let r = (0..3)
-                .map(|c| (x[i][c] - x[j][c]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            kernel.between(r)
+            kernel.between(distance(&x[i], &x[j]))
         };
         let kernel: Vec<f64> = (0..m * m).map(|k| g(k / m, k % m)).collect();
         let r = (0..m)
@@ -550,7 +546,7 @@ impl DenseGaps {
             .collect();
         Self {
             kernel,
-            areas: areas.to_vec(),
+            areas,
             c0,
             r,
         }
@@ -562,7 +558,7 @@ impl DenseGaps {
     }
 }
 
-impl ModelGaps for DenseGaps {
+impl ModelGaps for DenseGaps<'_> {
     fn gap(&self, i: usize) -> f64 {
         self.r[i]
     }
@@ -625,8 +621,6 @@ impl<'a> LumpedGaps<'a> {
 
 impl ModelGaps for LumpedGaps<'_> {
     fn gap(&self, i: usize) -> f64 {
-        let distance =
-            |x: &[f64; 3], y: &[f64; 3]| (0..3).map(|c| (x[c] - y[c]).powi(2)).sum::<f64>().sqrt();
         let sum = self.sums.sum(
             i,
             &self.weights,

@@ -347,7 +347,7 @@ mod tests {
                 return 0.0;
             }
             let (x, y) = (self.nodes[a.node], self.nodes[b.node]);
-            let r = (0..3).map(|c| (x[c] - y[c]).powi(2)).sum::<f64>().sqrt();
+            let r = crate::contact::coupled::far_field::distance(&x, &y);
             let g = match (self.dim, a.node == b.node) {
                 (3, true) => 2.0 / (self.area / std::f64::consts::PI).sqrt(),
                 (3, false) => 1.0 / r,

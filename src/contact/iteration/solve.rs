@@ -391,7 +391,8 @@ impl<'a> ContactSolver<'a> {
         let held = |k: usize| held_by_contact.iter().any(|h| h.0 == k);
         // Each group of bodies linked by pairs needs a body its own supports hold.
         for k in 0..bodies.len() {
-            let linked = linked_bodies(&pair_bodies, k);
+            // The group of `k`, in increasing order.
+            let linked: Vec<usize> = linked(&pair_bodies, [k], |_| true).into_iter().collect();
             if linked.iter().all(|&j| held(j)) && linked[0] == k {
                 let named: Vec<String> = linked
                     .iter()
@@ -577,42 +578,25 @@ impl<'a> ContactSolver<'a> {
     }
 }
 
-/// The bodies that `held` (held by their contacts alone) among `sides` and those linked to
-/// them through pairs whose linking side is such a body: the bodies whose forces reach a pair
-/// of `sides` through bodies that nothing else supports.
-fn held_chain(
+/// The bodies linked through pairs to the bodies `start`, each reached from one already in the
+/// set through a pair, and only those that `admit` lets in (with `start`, in increasing order).
+fn linked(
     pair_bodies: &[[usize; 2]],
-    sides: [usize; 2],
-    held: impl Fn(usize) -> bool,
+    start: impl IntoIterator<Item = usize>,
+    admit: impl Fn(usize) -> bool,
 ) -> BTreeSet<usize> {
-    let mut chain: BTreeSet<usize> = sides.into_iter().filter(|&k| held(k)).collect();
+    let mut linked: BTreeSet<usize> = start.into_iter().collect();
     loop {
-        let before = chain.len();
+        let before = linked.len();
         for pair in pair_bodies {
             for (from, to) in [(pair[0], pair[1]), (pair[1], pair[0])] {
-                if chain.contains(&from) && held(to) {
-                    chain.insert(to);
+                if linked.contains(&from) && admit(to) {
+                    linked.insert(to);
                 }
             }
         }
-        if chain.len() == before {
-            return chain;
-        }
-    }
-}
-
-/// The bodies linked to body `k` through pairs (`k` among them), in increasing order.
-fn linked_bodies(pair_bodies: &[[usize; 2]], k: usize) -> Vec<usize> {
-    let mut linked = BTreeSet::from([k]);
-    loop {
-        let before = linked.len();
-        for sides in pair_bodies {
-            if sides.iter().any(|b| linked.contains(b)) {
-                linked.extend(sides.iter().copied());
-            }
-        }
         if linked.len() == before {
-            return linked.into_iter().collect();
+            return linked;
         }
     }
 }
@@ -832,7 +816,7 @@ impl ContactSolver<'_> {
     /// merely touch (a sphere's pole) the first iterate would carry the whole force on them.
     /// Each pair of such a body starts on the half-space model's zone for the largest
     /// resultant of the loads and forces that reach it through the bodies only their contacts
-    /// hold ([`held_chain`]; `crate::contact::coupled::half_space::force_controlled_set`);
+    /// hold ([`linked`]; `crate::contact::coupled::half_space::force_controlled_set`);
     /// where the model finds none (no force: a floating block between two others), on the nodes
     /// that touch already, or the closest node. If the loop lets go of every contact of such a
     /// body after that, its loads pull it off: an error that names it.
@@ -887,7 +871,14 @@ impl ContactSolver<'_> {
             // bodies (a floating ball between two plates passes the force on one plate to its
             // other contact; its supports may carry part of it; the zone then errs on the large
             // side, which the loop corrects).
-            let force = (held_chain(&self.pair_bodies, sides, held).into_iter())
+            // The held bodies among its sides, and those linked to them through held bodies:
+            // the bodies whose forces reach it through bodies nothing else supports.
+            let chain = linked(
+                &self.pair_bodies,
+                sides.into_iter().filter(|&k| held(k)),
+                held,
+            );
+            let force = (chain.into_iter())
                 .map(|k| self.bodies[k].resultant(factors))
                 .fold(0.0, f64::max);
             let materials = [&problem.primary.material, &problem.secondary.material];
