@@ -212,7 +212,7 @@ def plane_solve(msh: Path, dim: int, body: str, delta: float, youngs_modulus: fl
 
 def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio: float,
                    reach: float = 2.0, max_iterations: int = 400,
-                   block_modulus: float | None = None) -> dict:
+                   block_modulus: float | None = None, update: str = "exact") -> dict:
     """The square of ``geo/tilted_square_2d.geo`` pressed by ``delta`` into the block of the same
     material, both elastic (module doc, ``two_body_solve``).
 
@@ -234,6 +234,14 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
     1e-6 delta (the force then known to about 1e-5; where rows switch between the walls the
     convergence is linear: about 300 steps at h 0.001, block spacing 0.7 h, a 4% approach). The first step, paired in the reference configuration (small sliding), is
     ``force_small_sliding``.
+
+    ``update="primal-dual"``: a second path to the same discrete problem, the one internodes's loop
+    takes: each linearization takes one primal-dual active-set update (rows active where their
+    gap is negative or their multiplier was positive at the last step, solved as equalities), the set
+    carried from step to step by (node, facet). Where both paths stop on an answer whose KKT
+    conditions hold, the two are solutions of the same discrete problem; where they differ, that
+    problem has more than one (the gap measured on the deformed surfaces is not convex in the
+    displacements), and no solver of it can be held to closer than their difference.
 
     ``block_modulus``: the block's (default: the square's; a rigid block's check, module doc).
     Candidates: the square's contact nodes within ``reach`` delta of the block in the reference
@@ -290,7 +298,7 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
     def constraints(u):
         xs, xb = position(u)
         a, b = xb[segments[:, 0]], xb[segments[:, 1]]
-        rows, gaps, owners = [], [], []
+        rows, gaps, owners, walls = [], [], [], []
         for node in candidates:
             p = xs[node]
             t = np.clip(np.einsum("ij,ij->i", p - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
@@ -311,9 +319,13 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
                 rows.append(row)
                 gaps.append(float(m @ (p - closest[g])))
                 owners.append(int(node))
-        return np.array(rows), np.array(gaps), np.array(owners)
+                walls.append((int(node), int(g)))
+        return np.array(rows), np.array(gaps), np.array(owners), walls
 
+    if update not in ("exact", "primal-dual"):
+        raise ValueError(f"update: 'exact' or 'primal-dual', not {update!r}")
     u = u0.copy()
+    held = set()  # primal-dual: the (node, facet) rows whose multiplier was positive
     small_sliding = None
     change = math.inf
     for iteration in range(1, max_iterations + 1):
@@ -328,8 +340,9 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
                 rows[r, 2 * ns + 2 * segments[f, 0] + 1] -= 1.0 - t
                 rows[r, 2 * ns + 2 * segments[f, 1] + 1] -= t
             gaps, owners = square.x[candidates, 1].copy(), candidates
+            walls = [(int(node), -1) for node in candidates]
         else:
-            rows, gaps, owners = constraints(u)
+            rows, gaps, owners, walls = constraints(u)
         solved = np.zeros_like(rows)
         for r in range(len(rows)):
             solved[r, free] = factor.solve(rows[r, free])
@@ -337,8 +350,15 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
         W = 0.5 * (W + W.T)
         at = np.zeros(size) if iteration == 1 else u  # the linearization point
         q = gaps + rows @ (u0 - at)
-        L = np.linalg.cholesky(W + 1e-13 * np.trace(W) / len(W) * np.eye(len(W)))
-        lam, _ = nnls(L.T, -scipy.linalg.solve_triangular(L, q, lower=True), maxiter=50 * len(q))
+        if update == "exact" or iteration == 1:
+            L = np.linalg.cholesky(W + 1e-13 * np.trace(W) / len(W) * np.eye(len(W)))
+            lam, _ = nnls(L.T, -scipy.linalg.solve_triangular(L, q, lower=True), maxiter=50 * len(q))
+        else:
+            # (node, -1): a node the first step (small sliding, one row per node) held
+            active = np.array([wall in held or (wall[0], -1) in held or gap < 0.0 for wall, gap in zip(walls, gaps)])
+            lam = np.zeros(len(q))
+            lam[active] = np.linalg.solve(W[np.ix_(active, active)], -q[active])
+        held = {wall for wall, value in zip(walls, lam) if value > 0.0}
         new = u0 + solved.T @ lam
         change = float(np.abs(new - u).max())
         u = new
@@ -346,7 +366,7 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
             small_sliding = float(lam.sum())
         if iteration > 1 and change <= 1e-6 * delta:
             break
-    rows, gaps, owners = constraints(u)
+    rows, gaps, owners, _ = constraints(u)
     # the last step's multipliers belong to the last linearization (equal at convergence)
     linear = q + W @ lam
     reaction = K @ u
