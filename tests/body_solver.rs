@@ -278,6 +278,43 @@ mod with_petsc {
     }
 
     #[test]
+    fn a_solver_that_holds_the_only_copy_gives_products_and_the_matrix_back() {
+        // A contact solve frees its own K_c once PETSc holds it
+        // (`coupled_solver::petsc_solvers`): products read PETSc's rows, and a fallback to
+        // Cholesky factors copies them. The rows of a symmetric matrix are its columns, in the
+        // same order: the product is our own column sums, bit for bit, and the copy is K_c.
+        for file in ["block_3d.msh", "block_2d.msh"] {
+            let mesh = read_fixture(file);
+            let problem = hertz_block(&mesh.bodies[0]);
+            let mut stats = Default::default();
+            let system = assemble(&problem, &mut stats, false).unwrap();
+            let k_c = system.stiffness.whole().unwrap();
+            let solver = BodySolver::cg_amg(k_c, system.dim, &system.coordinates, 1e-10).unwrap();
+            let n = system.f_c.len();
+            let x: Vec<f64> = (0..n)
+                .map(|i| ((i * 7919) % 1000) as f64 / 1000.0 - 0.5)
+                .collect();
+            let (symbolic, values) = k_c.parts();
+            let ours: Vec<f64> = (0..n)
+                .map(|j| {
+                    (symbolic.col_ptr()[j]..symbolic.col_ptr()[j + 1])
+                        .map(|p| values[p] * x[symbolic.row_idx()[p]])
+                        .sum()
+                })
+                .collect();
+            let mut petsc = vec![f64::NAN; n];
+            solver.multiply(&x, &mut petsc).unwrap();
+            assert_eq!(petsc, ours, "{file}: the product");
+            let copy = solver.matrix().expect("a whole matrix on one process");
+            assert_eq!(copy.symbolic().col_ptr(), symbolic.col_ptr(), "{file}");
+            assert_eq!(copy.symbolic().row_idx(), symbolic.row_idx(), "{file}");
+            assert_eq!(copy.parts().1, values, "{file}: the values");
+            let mut short = vec![0.0; n - 1];
+            assert!(solver.multiply(&x, &mut short).is_err(), "{file}: sizes");
+        }
+    }
+
+    #[test]
     fn one_setup_serves_many_right_hand_sides() {
         let mesh = read_fixture("block_3d.msh");
         let problem = hertz_block(&mesh.bodies[0]);

@@ -216,6 +216,25 @@ fn a_gmres_failure_under_auto_moves_to_the_schur_complement_with_the_same_answer
 }
 
 #[test]
+fn a_gmres_failure_with_cg_amg_bodies_factors_the_matrices_petsc_holds() {
+    // With CG + AMG bodies a contact solve keeps each K_c only as PETSc's copy; the fallback of
+    // `auto` after a GMRES failure factors a copy of it, and the answer is the Schur path's on
+    // Cholesky bodies.
+    let case = hemisphere_on_block("hemisphere_on_block_hertz.msh", 0.01, 1000.0, 1000.0);
+    let auto = solve(
+        &(case.clone())
+            .body_solver("cg-amg")
+            .contact_setting("krylov_max_iterations", 1),
+    )
+    .unwrap();
+    let schur = solve(&(case.body_solver("cholesky")).contact_setting("solver", "schur")).unwrap();
+    assert_eq!(auto.linear_solvers.body, "cholesky");
+    assert_eq!(auto.linear_solvers.interface, "schur");
+    assert!(auto.linear_solvers.krylov_failure.is_some());
+    assert_same_contact(&auto, &schur, 1e-10, "CG + AMG bodies, then Cholesky");
+}
+
+#[test]
 fn cg_amg_bodies_take_the_krylov_path_and_agree_with_cholesky() {
     // With CG + AMG bodies, `schur` runs the coupled GMRES (one V-cycle per body and
     // iteration, no per-node CG solves), to the same relative residual as on Cholesky factors.

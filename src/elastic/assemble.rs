@@ -157,7 +157,7 @@ pub enum Stiffness {
     Whole(SparseColMat<usize, f64>),
     /// This rank's rows (a distributed run), until its solver takes them.
     Rows(RankRows),
-    /// Taken by its distributed solver (PETSc), which makes the products.
+    /// Taken by its CG + AMG solver (PETSc), which makes the products.
     Released,
 }
 
@@ -167,6 +167,18 @@ impl Stiffness {
         match self {
             Self::Whole(k_c) => Some(k_c),
             _ => None,
+        }
+    }
+
+    /// The whole matrix, taken for a solver that keeps its own copy (`Released` is left);
+    /// `None`, and nothing changed, if this process does not hold it whole.
+    pub fn take_whole(&mut self) -> Option<SparseColMat<usize, f64>> {
+        match std::mem::replace(self, Self::Released) {
+            Self::Whole(k_c) => Some(k_c),
+            other => {
+                *self = other;
+                None
+            }
         }
     }
 

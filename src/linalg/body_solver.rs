@@ -100,6 +100,13 @@ impl BodySolverKind {
 #[allow(clippy::large_enum_variant)]
 pub enum BodySolver {
     Cholesky(Cholesky),
+    /// The factor of a matrix its body no longer holds, with the copy it was made from, which
+    /// makes the products: what a contact solve falls back to from CG + AMG, whose solver held
+    /// the only copy (`crate::contact::coupled::coupled_solver::petsc_solvers`).
+    CholeskyOfCopy {
+        factor: Cholesky,
+        matrix: SparseColMat<usize, f64>,
+    },
     #[cfg(feature = "petsc")]
     CgAmg(CgAmg),
 }
@@ -121,7 +128,7 @@ impl BodySolver {
     /// factor is never distributed).
     pub fn rank_dofs(&self) -> Vec<usize> {
         match self {
-            Self::Cholesky(factor) => vec![factor.size()],
+            Self::Cholesky(factor) | Self::CholeskyOfCopy { factor, .. } => vec![factor.size()],
             #[cfg(feature = "petsc")]
             Self::CgAmg(cg) => cg.rank_dofs(),
         }
@@ -163,21 +170,47 @@ impl BodySolver {
     }
 
     /// `y = K x` by the solver's own copy of the matrix: CG + AMG's (on several ranks, each
-    /// computes its rows). A factor keeps no matrix: [`LinalgError::Sizes`].
+    /// computes its rows), or the copy a factor was made from. A factor alone keeps no matrix:
+    /// [`LinalgError::Sizes`].
     #[cfg_attr(not(feature = "petsc"), allow(unused_variables))]
     pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
         match self {
             Self::Cholesky(_) => Err(LinalgError::Sizes(
                 "a product by a Cholesky factor, which keeps no matrix".to_string(),
             )),
+            Self::CholeskyOfCopy { matrix, .. } => {
+                if x.len() != matrix.ncols() || y.len() != matrix.nrows() {
+                    return Err(LinalgError::Sizes(format!(
+                        "a product of a {} x {} matrix with {} values into {}",
+                        matrix.nrows(),
+                        matrix.ncols(),
+                        x.len(),
+                        y.len()
+                    )));
+                }
+                y.copy_from_slice(&super::mat_vec(matrix, x));
+                Ok(())
+            }
             #[cfg(feature = "petsc")]
             Self::CgAmg(cg) => cg.multiply(x, y),
         }
     }
 
+    /// A copy of the matrix the solver holds, where it is whole on this process: CG + AMG's
+    /// (so that a process that freed its own can still factor it); `None` for a factor, which
+    /// keeps no matrix, and on several ranks.
+    pub fn matrix(&self) -> Option<SparseColMat<usize, f64>> {
+        match self {
+            Self::Cholesky(_) => None,
+            Self::CholeskyOfCopy { matrix, .. } => Some(matrix.clone()),
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.matrix(),
+        }
+    }
+
     pub fn kind(&self) -> BodySolverKind {
         match self {
-            Self::Cholesky(_) => BodySolverKind::Cholesky,
+            Self::Cholesky(_) | Self::CholeskyOfCopy { .. } => BodySolverKind::Cholesky,
             #[cfg(feature = "petsc")]
             Self::CgAmg(_) => BodySolverKind::CgAmg,
         }
@@ -203,7 +236,7 @@ impl BodySolver {
         rtol: Option<f64>,
     ) -> Result<usize, LinalgError> {
         match self {
-            Self::Cholesky(factor) => {
+            Self::Cholesky(factor) | Self::CholeskyOfCopy { factor, .. } => {
                 factor.solve_in_place(rhs, num_rhs);
                 Ok(0)
             }
@@ -232,7 +265,7 @@ impl BodySolver {
     /// [`super::petsc`]'s "PETSc in a Rust process"); those of one body take turns.
     pub fn precondition(&self, r: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
         match self {
-            Self::Cholesky(factor) => {
+            Self::Cholesky(factor) | Self::CholeskyOfCopy { factor, .. } => {
                 x.copy_from_slice(r);
                 factor.solve_in_place(x, 1);
                 Ok(())

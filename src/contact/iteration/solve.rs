@@ -340,14 +340,13 @@ impl<'a> ContactSolver<'a> {
                 })
                 .collect()
         };
-        // A distributed run hands each body's matrix to PETSc and releases ours before the
-        // multigrid hierarchies are built
-        // (`crate::contact::coupled::coupled_solver::distributed_solvers`).
+        // CG + AMG bodies hand their matrices to PETSc, and ours are released before the
+        // multigrid hierarchies are built (`coupled_solver::petsc_solvers`).
         let start = Instant::now();
         let ready = match settings.solver {
             CoupledSolver::MonolithicLu => None,
-            _ if kind == BodySolverKind::CgAmg && crate::parallel::distributed() => {
-                Some(coupled_solver::distributed_solvers(&mut bodies, solver)?)
+            _ if kind == BodySolverKind::CgAmg => {
+                Some(coupled_solver::petsc_solvers(&mut bodies, solver)?)
             }
             _ => None,
         };

@@ -23,7 +23,8 @@
 //! - PETSc is not thread-safe (Debian's 3.18 is built without `PETSC_HAVE_THREADSAFETY`), and
 //!   `cargo test` and rayon call from several threads. One global `RwLock` orders the calls:
 //!   initialization, [`CgAmgMatrix::new`] and [`CgAmgMatrix::set_up`] (set-up),
-//!   [`CgAmg::solve_within`] (CG), [`CgAmg::multiply`] and destruction hold it exclusively; [`CgAmg::precondition`] (one V-cycle, `PCApply`) holds it shared,
+//!   [`CgAmg::solve_within`] (CG), [`CgAmg::multiply`] on several ranks and destruction hold it
+//!   exclusively (on one process a product reads PETSc's arrays without it: `PetscRows`); [`CgAmg::precondition`] (one V-cycle, `PCApply`) holds it shared,
 //!   plus a mutex of its object, so that the V-cycles of two bodies in a coupled Krylov
 //!   solve (`rayon::join`) run at the same time, while one object is never applied from two
 //!   threads at once and nothing else runs beside an application.
@@ -124,6 +125,14 @@ unsafe extern "C" {
         y: *mut f64,
         step: *mut *const c_char,
     ) -> c_int;
+    fn internodes_cgamg_rows(
+        solver: *mut RawCgAmg,
+        row_ptr: *mut *const std::ffi::c_void,
+        col_idx: *mut *const std::ffi::c_void,
+        values: *mut *const f64,
+        index_bytes: *mut c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
     fn internodes_cgamg_destroy(solver: *mut RawCgAmg);
 }
 
@@ -173,6 +182,9 @@ pub struct CgAmg {
     /// How its rows are shared among the ranks (`None` on one process: PETSc has them all, in
     /// our numbering).
     distribution: Option<Distribution>,
+    /// PETSc's own arrays of the matrix, where it is whole on this process: what
+    /// [`Self::multiply`] reads and [`Self::matrix`] copies.
+    rows: Option<PetscRows>,
     /// The relative residual [`Self::solve`] stops at.
     rtol: f64,
     /// Held by [`Self::precondition`] under the shared [`PETSC`] lock: the object's vectors
@@ -286,6 +298,139 @@ impl CgAmgMatrix {
     }
 }
 
+/// PETSc's own compressed rows of a matrix whole on this process (`internodes_cgamg_rows`):
+/// pointers into the AIJ matrix of a live [`CgAmg`], which owns them. PETSc never moves or
+/// writes them after assembly (no nonzero is ever inserted; CG and GAMG only read the
+/// operator), so reading them from any thread beside a V-cycle is a read beside reads. They
+/// let one process hold `K_c` once: the caller may free its own copy
+/// (`crate::elastic::Stiffness::Released`) and still have products at the speed of its own
+/// (the same sums in the same order: `K_c` is symmetric, so PETSc's rows are its columns) and
+/// the matrix back for a Cholesky factor.
+struct PetscRows {
+    row_ptr: *const std::ffi::c_void,
+    columns: *const std::ffi::c_void,
+    values: *const f64,
+    /// The size of PETSc's index type (`PetscInt`: 4 in Debian's build, 8 in a 64-bit one).
+    index_bytes: usize,
+    n: usize,
+}
+
+/// An integer PETSc may index with.
+trait PetscIndex: Copy + Sync {
+    fn index(self) -> usize;
+}
+
+impl PetscIndex for i32 {
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl PetscIndex for i64 {
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl PetscRows {
+    /// The arrays of `raw`'s matrix of `n` rows.
+    ///
+    /// # Safety
+    /// `raw` is a live object whose matrix is whole on this process, and PETSc's lock is held.
+    unsafe fn of(raw: NonNull<RawCgAmg>, n: usize) -> Result<Self, LinalgError> {
+        let (mut row_ptr, mut columns, mut values) =
+            (std::ptr::null(), std::ptr::null(), std::ptr::null());
+        let (mut index_bytes, mut step) = (0, std::ptr::null());
+        // SAFETY: as the caller guarantees; the shim writes the four outputs.
+        let code = unsafe {
+            internodes_cgamg_rows(
+                raw.as_ptr(),
+                &mut row_ptr,
+                &mut columns,
+                &mut values,
+                &mut index_bytes,
+                &mut step,
+            )
+        };
+        if code != 0 {
+            return Err(petsc_error(step, code));
+        }
+        if !matches!(index_bytes, 4 | 8) || row_ptr.is_null() || columns.is_null() {
+            return Err(LinalgError::Sizes(format!(
+                "PETSc's rows: indices of {index_bytes} bytes"
+            )));
+        }
+        Ok(Self {
+            row_ptr,
+            columns,
+            values,
+            index_bytes: index_bytes as usize,
+            n,
+        })
+    }
+
+    /// `(row pointers, column indices, values)` as slices of PETSc's index type `I`.
+    ///
+    /// # Safety
+    /// `I` has `self.index_bytes` bytes.
+    unsafe fn slices<I: PetscIndex>(&self) -> (&[I], &[I], &[f64]) {
+        // SAFETY: the arrays live as long as the `CgAmg` that owns `self` (type doc); the row
+        // pointers are n + 1 of type `I` (caller), the last one the number of entries.
+        unsafe {
+            let row_ptr = std::slice::from_raw_parts(self.row_ptr.cast::<I>(), self.n + 1);
+            let nnz = row_ptr[self.n].index();
+            let columns = std::slice::from_raw_parts(self.columns.cast::<I>(), nnz);
+            let values = match nnz {
+                0 => &[][..],
+                _ => std::slice::from_raw_parts(self.values, nnz),
+            };
+            (row_ptr, columns, values)
+        }
+    }
+
+    fn multiply(&self, x: &[f64], y: &mut [f64]) {
+        // SAFETY: the index type matches `index_bytes` (checked in `of`).
+        match self.index_bytes {
+            4 => product(unsafe { self.slices::<i32>() }, x, y),
+            _ => product(unsafe { self.slices::<i64>() }, x, y),
+        }
+    }
+
+    /// A copy of the matrix, its rows read as columns (it is symmetric).
+    fn matrix(&self) -> SparseColMat<usize, f64> {
+        // SAFETY: the index type matches `index_bytes` (checked in `of`).
+        match self.index_bytes {
+            4 => columns_of(unsafe { self.slices::<i32>() }, self.n),
+            _ => columns_of(unsafe { self.slices::<i64>() }, self.n),
+        }
+    }
+}
+
+/// `y = A x` for compressed rows, each row's entries summed in their order.
+fn product<I: PetscIndex>(
+    (row_ptr, columns, values): (&[I], &[I], &[f64]),
+    x: &[f64],
+    y: &mut [f64],
+) {
+    use rayon::prelude::*;
+    y.par_iter_mut().enumerate().for_each(|(i, y)| {
+        *y = (row_ptr[i].index()..row_ptr[i + 1].index())
+            .map(|p| values[p] * x[columns[p].index()])
+            .sum();
+    });
+}
+
+/// The symmetric matrix of compressed rows as compressed columns.
+fn columns_of<I: PetscIndex>(
+    (row_ptr, columns, values): (&[I], &[I], &[f64]),
+    n: usize,
+) -> SparseColMat<usize, f64> {
+    let col_ptr = row_ptr.iter().map(|&p| p.index()).collect();
+    let row_idx = columns.iter().map(|&c| c.index()).collect();
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+    SparseColMat::new(symbolic, values.to_vec())
+}
+
 /// The rows this process hands PETSc, as the shim reads them: `num_rows + 1` row pointers from
 /// 0, each entry's global column and value, and the coordinates of the rows' nodes (`dim` per
 /// node: one value per row).
@@ -334,10 +479,16 @@ impl CgAmg {
         }
         debug_assert_eq!(comm.ranks.size > 1, distribution.is_some());
         let raw = NonNull::new(raw).ok_or_else(|| petsc_error(step, 0))?;
+        let rows = match distribution {
+            Some(_) => None,
+            // SAFETY: `raw` is alive and built, whole on this process; the lock is held.
+            None => Some(unsafe { PetscRows::of(raw, n) }?),
+        };
         Ok(Self {
             raw,
             n,
             distribution,
+            rows,
             rtol,
             applying: Mutex::new(()),
         })
@@ -349,6 +500,11 @@ impl CgAmg {
             None => vec![self.n],
             Some(d) => d.counts().to_vec(),
         }
+    }
+
+    /// A copy of the matrix, where it is whole on this process (`None` on several ranks).
+    pub fn matrix(&self) -> Option<SparseColMat<usize, f64>> {
+        self.rows.as_ref().map(PetscRows::matrix)
     }
 
     /// This rank's part of `whole` (our numbering), as PETSc's vectors hold it.
@@ -448,8 +604,21 @@ impl CgAmg {
 
 impl CgAmg {
     /// `y = K x` by PETSc's copy of the matrix (on several ranks each computes its rows, and
-    /// every rank receives all of `y`).
+    /// every rank receives all of `y`). On one process the product reads PETSc's arrays
+    /// from this side, on every thread, without PETSc's lock ([`PetscRows`]).
     pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
+        if let Some(rows) = &self.rows {
+            if x.len() != self.n || y.len() != self.n {
+                return Err(LinalgError::Sizes(format!(
+                    "a product of a {0} x {0} matrix with {1} values into {2}",
+                    self.n,
+                    x.len(),
+                    y.len()
+                )));
+            }
+            rows.multiply(x, y);
+            return Ok(());
+        }
         self.on_rows("a product", x, y, |x, y, step| {
             let _lock = petsc()?;
             // SAFETY: `x` and `y` hold this rank's rows, `raw` is alive, the lock is held.

@@ -279,6 +279,40 @@ int internodes_cgamg_multiply(InternodesCgAmg *s, const double *x, double *y, co
     return 0;
 }
 
+/* The matrix's compressed rows as PETSc holds them on one process (SEQAIJ): PETSc's own arrays,
+ * not copies: n + 1 row pointers and the column indices (PetscInt, *index_bytes each) and the
+ * values. They stay where they are while the object lives: an assembled AIJ matrix moves them
+ * only to insert a new nonzero, which nothing does here, and CG and GAMG only read them. The
+ * pointers are taken before the Restore calls, which may clear them but free nothing here. */
+int internodes_cgamg_rows(InternodesCgAmg *s, const void **row_ptr, const void **col_idx,
+                          const double **values, int *index_bytes, const char **step)
+{
+    PetscInt n;
+    const PetscInt *ia, *ja;
+    const PetscScalar *a;
+    PetscBool done;
+    PetscMPIInt size;
+
+    TRY(MPI_Comm_size(PetscObjectComm((PetscObject)s->a), &size));
+    if (size != 1) {
+        *step = "the rows of a matrix shared among ranks";
+        return PETSC_ERR_SUP;
+    }
+    TRY(MatGetRowIJ(s->a, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+    if (!done || n != s->n) {
+        *step = "MatGetRowIJ (no compressed rows)";
+        return PETSC_ERR_SUP;
+    }
+    *row_ptr = ia;
+    *col_idx = ja;
+    TRY(MatRestoreRowIJ(s->a, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+    TRY(MatSeqAIJGetArrayRead(s->a, &a));
+    *values = a;
+    TRY(MatSeqAIJRestoreArrayRead(s->a, &a));
+    *index_bytes = (int)sizeof(PetscInt);
+    return 0;
+}
+
 void internodes_cgamg_destroy(InternodesCgAmg *s)
 {
     if (!s) return;
