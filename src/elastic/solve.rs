@@ -220,15 +220,25 @@ pub fn solve(
     //    blocks, which the multigrid aggregates by (block size dim) and whose rigid-body modes
     //    are its near-null space; removing the fixed dofs instead would break the blocks of
     //    partly fixed nodes. dolfinx does the same, with 1 on the diagonal. A distributed run
-    //    hands each rank's rows to PETSc (CG + AMG on every rank).
+    //    hands each rank's rows to PETSc (CG + AMG on every rank); one process hands it the
+    //    whole K_c and frees ours before the hierarchy is built, so that K_c is held once.
     let kind = settings.body_solver(body.dim, body.num_dofs());
     let solver = match (system.stiffness.take_rows(), system.stiffness.whole(), kind) {
         (Some(rows), _, _) => timed(&mut stats, verbose, "CG + AMG setup", || {
             BodySolver::cg_amg_rows(rows, settings.rtol)?.set_up()
         }),
-        (None, Some(k_c), BodySolverKind::CgAmg) => {
+        (None, Some(_), BodySolverKind::CgAmg) => {
             timed(&mut stats, verbose, "CG + AMG setup", || {
-                BodySolver::cg_amg(k_c, system.dim, &system.coordinates, settings.rtol)
+                let k_c = (system.stiffness.take_whole())
+                    .ok_or_else(|| LinalgError::Sizes("the whole K_c was taken".into()))?;
+                let matrix = BodySolver::cg_amg_matrix(
+                    &k_c,
+                    system.dim,
+                    &system.coordinates,
+                    settings.rtol,
+                )?;
+                drop(k_c);
+                matrix.set_up()
             })
         }
         (None, Some(k_c), _) => {
@@ -245,7 +255,7 @@ pub fn solve(
             .map(BodySolver::Cholesky)
         }
         (None, None, _) => Err(LinalgError::Sizes(
-            "the stiffness was released to a distributed solver".into(),
+            "the stiffness was released to a PETSc solver".into(),
         )),
     }
     .map_err(linalg)?;
