@@ -223,25 +223,25 @@ pub fn solve(
     //    hands each rank's rows to PETSc (CG + AMG on every rank); one process hands it the
     //    whole K_c and frees ours before the hierarchy is built, so that K_c is held once.
     let kind = settings.body_solver(body.dim, body.num_dofs());
-    let solver = match (system.stiffness.take_rows(), system.stiffness.whole(), kind) {
+    let for_petsc = match kind {
+        BodySolverKind::CgAmg => system.stiffness.take_whole(),
+        _ => None,
+    };
+    let solver = match (
+        system.stiffness.take_rows(),
+        for_petsc,
+        system.stiffness.whole(),
+    ) {
         (Some(rows), _, _) => timed(&mut stats, verbose, "CG + AMG setup", || {
             BodySolver::cg_amg_rows(rows, settings.rtol)?.set_up()
         }),
-        (None, Some(_), BodySolverKind::CgAmg) => {
-            timed(&mut stats, verbose, "CG + AMG setup", || {
-                let k_c = (system.stiffness.take_whole())
-                    .ok_or_else(|| LinalgError::Sizes("the whole K_c was taken".into()))?;
-                let matrix = BodySolver::cg_amg_matrix(
-                    &k_c,
-                    system.dim,
-                    &system.coordinates,
-                    settings.rtol,
-                )?;
-                drop(k_c);
-                matrix.set_up()
-            })
-        }
-        (None, Some(k_c), _) => {
+        (None, Some(k_c), _) => timed(&mut stats, verbose, "CG + AMG setup", || {
+            let matrix =
+                BodySolver::cg_amg_matrix(&k_c, system.dim, &system.coordinates, settings.rtol)?;
+            drop(k_c);
+            matrix.set_up()
+        }),
+        (None, None, Some(k_c)) => {
             let symbolic = timed(&mut stats, verbose, "ordering + symbolic", || {
                 let graph = (system.graph.as_ref())
                     .ok_or_else(|| LinalgError::Sizes("the whole K_c has no node graph".into()))?;
@@ -254,7 +254,7 @@ pub fn solve(
             })
             .map(BodySolver::Cholesky)
         }
-        (None, None, _) => Err(LinalgError::Sizes(
+        (None, None, None) => Err(LinalgError::Sizes(
             "the stiffness was released to a PETSc solver".into(),
         )),
     }
