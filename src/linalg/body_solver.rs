@@ -25,7 +25,7 @@
 use faer::sparse::SparseColMat;
 use serde::{Deserialize, Serialize};
 
-use super::{Cholesky, LinalgError, RankRows};
+use super::{Cholesky, Distribution, LinalgError, RankRows};
 
 #[cfg(feature = "petsc")]
 use super::petsc::{CgAmg, CgAmgMatrix};
@@ -193,6 +193,35 @@ impl BodySolver {
             }
             #[cfg(feature = "petsc")]
             Self::CgAmg(cg) => cg.multiply(x, y),
+        }
+    }
+
+    /// How the body's unknowns are shared among the ranks of a distributed run (`None` on one
+    /// process, whose vectors are whole in our numbering).
+    pub fn distribution(&self) -> Option<&Distribution> {
+        match self {
+            Self::Cholesky(_) | Self::CholeskyOfCopy { .. } => None,
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.distribution(),
+        }
+    }
+
+    /// [`Self::multiply`] on this rank's rows alone ([`Self::distribution`]: `x` and `y` in
+    /// PETSc's order; collective); on one process, the whole vectors.
+    pub fn multiply_rows(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
+        match self {
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.multiply_rows(x, y),
+            _ => self.multiply(x, y),
+        }
+    }
+
+    /// [`Self::precondition`] on this rank's rows alone, as [`Self::multiply_rows`].
+    pub fn precondition_rows(&self, r: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
+        match self {
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) => cg.precondition_rows(r, x),
+            _ => self.precondition(r, x),
         }
     }
 

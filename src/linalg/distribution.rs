@@ -83,7 +83,7 @@ impl Distribution {
 
     /// This rank's nodes, increasing: the columns ([`NodeColumns`]) it assembles.
     pub fn nodes(&self) -> Vec<usize> {
-        self.ours[self.first..self.first + self.local]
+        self.own()
             .iter()
             .step_by(self.block)
             .map(|&dof| dof / self.block)
@@ -94,7 +94,7 @@ impl Distribution {
     /// read as rows, with global column indices in PETSc's numbering, sorted in each row, and
     /// `coords` (`block` values per node, in our order) of this rank's nodes.
     pub fn rows(self, columns: &NodeColumns, coords: &[f64]) -> RankRows {
-        let rows = &self.ours[self.first..self.first + self.local];
+        let rows = self.own();
         debug_assert_eq!(columns.num_columns(), rows.len());
         let mut petsc_of = vec![0usize; self.ours.len()];
         for (p, &ours) in self.ours.iter().enumerate() {
@@ -130,10 +130,12 @@ impl Distribution {
 
     /// This rank's rows of `whole` (our numbering), in PETSc's order.
     pub fn local_part(&self, whole: &[f64]) -> Vec<f64> {
-        self.ours[self.first..self.first + self.local]
-            .iter()
-            .map(|&ours| whole[ours])
-            .collect()
+        self.own().iter().map(|&ours| whole[ours]).collect()
+    }
+
+    /// Our unknown at each of this rank's rows, in PETSc's order.
+    pub fn own(&self) -> &[usize] {
+        &self.ours[self.first..self.first + self.local]
     }
 
     /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank.

@@ -81,6 +81,12 @@ pub trait Operators {
     fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Self::Error>;
     /// `out = P^-1 r`.
     fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), Self::Error>;
+    /// `a . b` of two vectors as the operators hold them: the default is the sum over `a`'s
+    /// entries, for vectors whole on this process; vectors shared among ranks add every rank's
+    /// part (`crate::contact::coupled::krylov_layout`).
+    fn dot(&mut self, a: &[f64], b: &[f64]) -> Result<f64, Self::Error> {
+        Ok(dot(a, b))
+    }
     /// Called after every iteration with the estimated residual norm: a progress report, or an
     /// error that stops the solve (a cancelled run).
     fn progress(&mut self, _stats: &GmresStats, _estimate: f64) -> Result<(), Self::Error> {
@@ -108,7 +114,7 @@ pub fn solve<O: Operators>(
         for (r, b) in residual.iter_mut().zip(b) {
             *r = b - *r;
         }
-        let beta = norm(&residual);
+        let beta = operators.dot(&residual, &residual)?.sqrt();
         stats.residual = beta;
         if stats.residual_products == 1 {
             stats.initial_residual = beta;
@@ -187,8 +193,8 @@ fn cycle<O: Operators>(
         operators.apply(&z, &mut w)?;
         stats.preconditioner_applications += 1;
         stats.iterations += 1;
-        orthogonalize(&mut w, &basis, &mut h, j);
-        let next = norm(&w);
+        orthogonalize(operators, &mut w, &basis, &mut h, j)?;
+        let next = operators.dot(&w, &w)?.sqrt();
         h[j + 1][j] = next;
         for i in 0..j {
             let (a, b) = (h[i][j], h[i + 1][j]);
@@ -240,23 +246,31 @@ fn cycle<O: Operators>(
 
 /// Modified Gram-Schmidt of `w` against `basis`, twice: the basis stays orthogonal to round-off
 /// however many vectors it holds. The coefficients accumulate in column `j` of `h`.
-fn orthogonalize(w: &mut [f64], basis: &[Vec<f64>], h: &mut [Vec<f64>], j: usize) {
+fn orthogonalize<O: Operators>(
+    operators: &mut O,
+    w: &mut [f64],
+    basis: &[Vec<f64>],
+    h: &mut [Vec<f64>],
+    j: usize,
+) -> Result<(), O::Error> {
     for _ in 0..2 {
         for (i, q) in basis.iter().enumerate() {
-            let c = dot(w, q);
+            let c = operators.dot(w, q)?;
             h[i][j] += c;
             for (wi, qi) in w.iter_mut().zip(q) {
                 *wi -= c * qi;
             }
         }
     }
+    Ok(())
 }
 
 pub fn norm(v: &[f64]) -> f64 {
     dot(v, v).sqrt()
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+/// `a . b`, summed in order.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -340,6 +354,74 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The tridiagonal system held as `y = S x` with `S = diag(s)`: every value `s_i` times
+    /// the unknown's, as a distributed vector holds its own rows in an order of its own. With
+    /// the inner product of the unknowns, `(a . b) = sum a_i b_i / s_i^2`, GMRES takes the
+    /// same iterates as on `x` itself.
+    struct Scaled {
+        inner: Tridiagonal,
+        s: Vec<f64>,
+    }
+
+    impl Scaled {
+        fn unscale(&self, y: &[f64]) -> Vec<f64> {
+            y.iter().zip(&self.s).map(|(y, s)| y / s).collect()
+        }
+    }
+
+    impl Operators for Scaled {
+        type Error = ();
+        fn apply(&mut self, y: &[f64], out: &mut [f64]) -> Result<(), ()> {
+            let x = self.unscale(y);
+            self.inner.apply(&x, out)?;
+            out.iter_mut().zip(&self.s).for_each(|(o, s)| *o *= s);
+            Ok(())
+        }
+        fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ()> {
+            let r = self.unscale(r);
+            self.inner.precondition(&r, out)?;
+            out.iter_mut().zip(&self.s).for_each(|(o, s)| *o *= s);
+            Ok(())
+        }
+        fn dot(&mut self, a: &[f64], b: &[f64]) -> Result<f64, ()> {
+            Ok(dot(&self.unscale(a), &self.unscale(b)))
+        }
+    }
+
+    #[test]
+    fn the_operators_inner_product_is_the_one_minimized() {
+        let n = 200;
+        let exact: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        let mut b = vec![0.0; n];
+        Tridiagonal { n }.apply(&exact, &mut b).unwrap();
+        let settings = GmresSettings {
+            tolerance: 1e-10 * norm(&b),
+            reduction: None,
+            max_iterations: 500,
+            restart: 5,
+        };
+        let mut x = vec![0.0; n];
+        let plain = solve(&mut Tridiagonal { n }, &b, &mut x, settings).unwrap();
+
+        let s: Vec<f64> = (0..n).map(|i| 1.0 + 99.0 * (i % 2) as f64).collect();
+        let mut scaled = Scaled {
+            inner: Tridiagonal { n },
+            s,
+        };
+        let b_scaled: Vec<f64> = b.iter().zip(&scaled.s).map(|(b, s)| b * s).collect();
+        let mut y = vec![0.0; n];
+        let held = solve(&mut scaled, &b_scaled, &mut y, settings).unwrap();
+        assert_eq!(held.failure, None);
+        // The residual it reports is the unknowns' (not the scaled values'), and the iterates
+        // are those of the plain solve: the same count, the same answer.
+        assert_eq!(held.iterations, plain.iterations);
+        assert!((held.residual - plain.residual).abs() <= 1e-6 * plain.residual);
+        let difference = (scaled.unscale(&y).iter().zip(&x))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(difference < 1e-12, "{difference}");
     }
 
     #[test]

@@ -1,12 +1,14 @@
 //! The MPI ranks of a run: `mpirun -n N internodes solve CASE` runs the same program on `N`
 //! processes (`docs/parallel.md`).
 //!
-//! Every rank reads the case and the mesh and runs the contact loop and its coupled GMRES on
-//! whole vectors; what is distributed is each body's stiffness and linear algebra: each rank
-//! assembles the rows of its own nodes (a METIS partition, `crate::linalg::Distribution`) and
-//! hands them to PETSc, which builds the GAMG hierarchy and runs the V-cycles, CG solves and
-//! products on them, whose results every rank then receives whole (`crate::linalg::petsc`). So every rank takes the same decisions on the same numbers, and
-//! only rank 0 writes: the output folder is the serial run's, with the ranks recorded.
+//! Every rank reads the case and the mesh and runs the contact loop; what is distributed is
+//! each body's stiffness and linear algebra: each rank assembles the rows of its own nodes (a
+//! METIS partition, `crate::linalg::Distribution`) and hands them to PETSc, which builds the
+//! GAMG hierarchy and runs the V-cycles, CG solves and products on them
+//! (`crate::linalg::petsc`), and the coupled GMRES, whose vectors hold each rank's rows of the
+//! bodies (`crate::contact::coupled::krylov_layout`). The answers every rank then receives whole,
+//! so every rank takes the same decisions on the same numbers, and only rank 0 writes: the
+//! output folder is the serial run's, with the ranks recorded.
 //!
 //! A rank runs one thread (one rank per core): the calls into PETSc are collective, and with
 //! one thread every rank makes them in the same order.

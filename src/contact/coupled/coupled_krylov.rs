@@ -47,6 +47,7 @@ use crate::cancel::Cancel;
 use crate::contact::ContactError;
 use crate::contact::coupled::compliance::MultiplierKey;
 use crate::contact::coupled::half_space::HalfSpace;
+use crate::contact::coupled::krylov_layout::KrylovLayout;
 use crate::contact::coupled::system::{CoupledSystem, Pair, stiffness_product};
 use crate::elastic::{AssembledBody, StepFactors};
 use crate::linalg::BodySolver;
@@ -229,7 +230,7 @@ pub fn solve(
 ) -> Result<Vec<f64>, ContactError> {
     let system = problem.system;
     let rhs = system.rhs();
-    let mut x = starting_guess(system, state);
+    let x = starting_guess(system, state);
     let rhs_norm = gmres::norm(&rhs);
     let tolerance = tightness.relative();
     let schur = (problem.pairs.iter().enumerate())
@@ -240,6 +241,11 @@ pub fn solve(
         })
         .collect();
     let num_bodies = system.num_bodies();
+    let layout = KrylovLayout::new(system, problem.solvers)?;
+    let local_scratch = match &layout {
+        KrylovLayout::Whole => Vec::new(),
+        KrylovLayout::Shared(shared) => vec![0.0; shared.num_local()],
+    };
     let mut operators = Blocks {
         system,
         bodies: problem.bodies,
@@ -251,6 +257,8 @@ pub fn solve(
         rhs_norm,
         cancel: &state.cancel,
         scratch: vec![0.0; system.num_displacements()],
+        local_scratch,
+        layout,
     };
     let settings = GmresSettings {
         tolerance: tolerance * rhs_norm,
@@ -258,7 +266,9 @@ pub fn solve(
         max_iterations,
         restart: RESTART,
     };
-    let outcome = gmres::solve(&mut operators, &rhs, &mut x, settings);
+    let rhs = operators.layout.local_part(rhs);
+    let mut local_x = operators.layout.local_part(x);
+    let outcome = gmres::solve(&mut operators, &rhs, &mut local_x, settings);
     state.body_applications.resize(num_bodies, 0);
     for (total, new) in state
         .body_applications
@@ -284,6 +294,7 @@ pub fn solve(
             tolerance,
         }));
     }
+    let x = operators.layout.whole(local_x)?;
     keep(system, &x, state);
     Ok(x)
 }
@@ -345,60 +356,68 @@ struct Blocks<'a> {
     tolerance: f64,
     rhs_norm: f64,
     cancel: &'a Cancel,
-    /// `r_u - B y_l` of an application of `P^-1`.
+    /// The bodies' displacements, whole: `r_u - B y_l` of an application of `P^-1`; when the
+    /// vectors are shared among ranks, a product's `u` gathered for `C u`, or `B y` before
+    /// this rank takes its rows.
     scratch: Vec<f64>,
+    /// `r_u - B y_l` on this rank's rows, when the vectors are shared (empty otherwise).
+    local_scratch: Vec<f64>,
+    /// How the GMRES vectors are held: whole, or this rank's rows of each body.
+    layout: KrylovLayout<'a>,
 }
 
 impl Operators for Blocks<'_> {
     type Error = ContactError;
 
     fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        let KrylovLayout::Shared(layout) = &self.layout else {
+            return self.apply_whole(x, out);
+        };
+        // As `apply_whole` on this rank's rows: `K u` by each body's rows, `C u` from every
+        // rank's rows gathered, `B lambda` on every row and then this rank's taken.
         let system = self.system;
-        let n = system.num_displacements();
-        let (out_u, out_l) = out.split_at_mut(n);
-        system
-            .body_parts(out_u)
-            .into_par_iter()
-            .zip(self.bodies)
-            .zip(self.solvers)
-            .zip(system.offsets.par_windows(2))
-            .try_for_each(|(((out, body), solver), range)| {
-                stiffness_product(body, Some(solver), &x[range[0]..range[1]], out)
-            })?;
-        for ((o, d), l) in out_l.iter_mut().zip(&system.d).zip(&x[n..]) {
-            *o = d * l;
+        let rows = layout.num_local();
+        let (out_u, out_l) = out.split_at_mut(rows);
+        for (k, solver) in self.solvers.iter().enumerate() {
+            let range = layout.local_range(k);
+            solver
+                .multiply_rows(&x[range.clone()], &mut out_u[range])
+                .map_err(|e| ContactError::Linalg(format!("a body's stiffness product: {e}")))?;
         }
-        for &(k, l, value) in &system.d_coupled {
-            out_l[k] += value * x[n + l];
-        }
-        system.add_b_product(&x[n..], 1.0, out);
-        system.add_c_product(&x[..n], &mut out[n..]);
+        multiplier_rows(system, &x[rows..], out_l);
+        layout.gather_displacements(&x[..rows], &mut self.scratch)?;
+        system.add_c_product(&self.scratch, out_l);
+        self.scratch.fill(0.0);
+        system.add_b_product(&x[rows..], 1.0, &mut self.scratch);
+        layout.add_local_part(&self.scratch, out_u);
         Ok(())
     }
 
     fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
         self.cancel.check()?;
+        let KrylovLayout::Shared(layout) = &self.layout else {
+            return self.precondition_whole(r, out);
+        };
         let system = self.system;
-        let n = system.num_displacements();
-        let (out_u, out_l) = out.split_at_mut(n);
-        for (p, schur) in self.schur.iter().enumerate() {
-            let range = system.pair_multipliers(p);
-            schur.apply(&r[n + range.start..n + range.end], &mut out_l[range]);
-        }
-        self.rigid.apply(&r[n..], out_l);
-        self.scratch.copy_from_slice(&r[..n]);
+        let rows = layout.num_local();
+        let (out_u, out_l) = out.split_at_mut(rows);
+        self.apply_schur(&r[rows..], out_l);
+        self.scratch.fill(0.0);
         system.add_b_product(out_l, -1.0, &mut self.scratch);
-        system
-            .body_parts(out_u)
-            .into_par_iter()
-            .zip(self.solvers)
-            .zip(system.offsets.par_windows(2))
-            .try_for_each(|((out, solver), range)| {
-                solver.precondition(&self.scratch[range[0]..range[1]], out)
-            })
-            .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
+        self.local_scratch.copy_from_slice(&r[..rows]);
+        layout.add_local_part(&self.scratch, &mut self.local_scratch);
+        for (k, solver) in self.solvers.iter().enumerate() {
+            let range = layout.local_range(k);
+            solver
+                .precondition_rows(&self.local_scratch[range.clone()], &mut out_u[range])
+                .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
+        }
         self.applications.iter_mut().for_each(|a| *a += 1);
         Ok(())
+    }
+
+    fn dot(&mut self, a: &[f64], b: &[f64]) -> Result<f64, ContactError> {
+        self.layout.dot(a, b)
     }
 
     /// How far the solve is, for the progress line of a long active-set iteration.
@@ -415,6 +434,68 @@ impl Operators for Blocks<'_> {
             )
         });
         Ok(())
+    }
+}
+
+impl Blocks<'_> {
+    /// `out = A x` on whole vectors, the bodies' products on their threads.
+    fn apply_whole(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        let system = self.system;
+        let n = system.num_displacements();
+        let (out_u, out_l) = out.split_at_mut(n);
+        system
+            .body_parts(out_u)
+            .into_par_iter()
+            .zip(self.bodies)
+            .zip(self.solvers)
+            .zip(system.offsets.par_windows(2))
+            .try_for_each(|(((out, body), solver), range)| {
+                stiffness_product(body, Some(solver), &x[range[0]..range[1]], out)
+            })?;
+        multiplier_rows(system, &x[n..], out_l);
+        system.add_b_product(&x[n..], 1.0, out);
+        system.add_c_product(&x[..n], &mut out[n..]);
+        Ok(())
+    }
+
+    /// `out = P^-1 r` on whole vectors, the bodies' blocks on their threads.
+    fn precondition_whole(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        let system = self.system;
+        let n = system.num_displacements();
+        let (out_u, out_l) = out.split_at_mut(n);
+        self.apply_schur(&r[n..], out_l);
+        self.scratch.copy_from_slice(&r[..n]);
+        system.add_b_product(out_l, -1.0, &mut self.scratch);
+        system
+            .body_parts(out_u)
+            .into_par_iter()
+            .zip(self.solvers)
+            .zip(system.offsets.par_windows(2))
+            .try_for_each(|((out, solver), range)| {
+                solver.precondition(&self.scratch[range[0]..range[1]], out)
+            })
+            .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
+        self.applications.iter_mut().for_each(|a| *a += 1);
+        Ok(())
+    }
+
+    /// `y_l = S~^-1 r_l`: each pair's half-space block and the force-controlled block.
+    fn apply_schur(&self, r_l: &[f64], y_l: &mut [f64]) {
+        for (p, schur) in self.schur.iter().enumerate() {
+            let range = self.system.pair_multipliers(p);
+            schur.apply(&r_l[range.clone()], &mut y_l[range]);
+        }
+        self.rigid.apply(r_l, y_l);
+    }
+}
+
+/// `out = D lambda` on the multiplier rows (`lambda` the multiplier block of a vector).
+fn multiplier_rows(system: &CoupledSystem, lambda: &[f64], out: &mut [f64]) {
+    for ((o, d), l) in out.iter_mut().zip(&system.d).zip(lambda) {
+        *o = d * l;
+    }
+    for &(k, l, value) in &system.d_coupled {
+        out[k] += value * lambda[l];
     }
 }
 

@@ -7,8 +7,9 @@
 //! normal), `far_field.rs` (sums of a slowly decaying kernel with the zone's far part lumped into
 //! clusters), `two_level_inverse.rs` (an approximate inverse of a boundary-integral operator on a
 //! zone too large to factor), `half_space.rs` (the interface Schur complement approximated by two
-//! elastic half-spaces), `coupled_krylov.rs` (the whole coupled system by one preconditioned
-//! GMRES), `coupled_solver.rs` (which solver, behind one call).
+//! elastic half-spaces), `krylov_layout.rs` (how a process holds the vectors of the coupled
+//! GMRES), `coupled_krylov.rs` (the whole coupled system by that preconditioned GMRES),
+//! `coupled_solver.rs` (which solver, behind one call).
 
 pub mod compliance;
 pub mod coupled_krylov;
@@ -16,5 +17,6 @@ pub mod coupled_solver;
 pub mod far_field;
 pub mod half_space;
 pub mod interface;
+pub mod krylov_layout;
 pub mod system;
 pub mod two_level_inverse;

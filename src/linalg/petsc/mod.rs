@@ -59,8 +59,10 @@
 //! - A whole matrix ([`CgAmgMatrix::new`]) goes to PETSc on `PETSC_COMM_SELF`; in a
 //!   distributed run ([`crate::parallel`]) each rank hands PETSc only its own rows of a body
 //!   ([`CgAmgMatrix::distributed`], on `PETSC_COMM_WORLD`; `crate::linalg::Distribution`),
-//!   and a solve or a V-cycle takes and returns whole vectors in our numbering (each rank
-//!   passes its rows in, and receives every rank's rows of the result). Every call on
+//!   and a solve, a product or a V-cycle takes and returns whole vectors in our numbering
+//!   (each rank passes its rows in, and receives every rank's rows of the result), or this
+//!   rank's rows alone (`multiply_rows`, `precondition_rows`: the coupled GMRES, whose vectors
+//!   hold them, `crate::contact::coupled::krylov_layout`). Every call on
 //!   such an object is collective: a distributed run has one thread per rank, so every rank
 //!   makes them in the same order, and V-cycles never overlap.
 
@@ -517,12 +519,14 @@ impl CgAmg {
 
     /// A buffer for this rank's part of a result.
     fn local_buffer(&self) -> Vec<f64> {
-        vec![
-            0.0;
-            self.distribution
-                .as_ref()
-                .map_or(self.n, Distribution::local)
-        ]
+        vec![0.0; self.local_len()]
+    }
+
+    /// This rank's number of rows (the whole matrix's on one process).
+    fn local_len(&self) -> usize {
+        self.distribution
+            .as_ref()
+            .map_or(self.n, Distribution::local)
     }
 
     /// Every rank's part of a result (`local`) into `whole`, on every rank.
@@ -607,19 +611,22 @@ impl CgAmg {
     /// every rank receives all of `y`). On one process the product reads PETSc's arrays
     /// from this side, on every thread, without PETSc's lock ([`PetscRows`]).
     pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
+        match self.distribution {
+            None => self.multiply_rows(x, y),
+            Some(_) => self.on_whole("a product", x, y, |x, y| self.multiply_rows(x, y)),
+        }
+    }
+
+    /// `y = K x` on this rank's rows alone (PETSc's order, [`Self::distribution`]): `x` and `y`
+    /// hold this rank's rows, and PETSc exchanges the rows of `x` the product reads across
+    /// ranks (collective). On one process, the whole vectors.
+    pub fn multiply_rows(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
         if let Some(rows) = &self.rows {
-            if x.len() != self.n || y.len() != self.n {
-                return Err(LinalgError::Sizes(format!(
-                    "a product of a {0} x {0} matrix with {1} values into {2}",
-                    self.n,
-                    x.len(),
-                    y.len()
-                )));
-            }
+            self.check_rows("a product", x, y)?;
             rows.multiply(x, y);
             return Ok(());
         }
-        self.on_rows("a product", x, y, |x, y, step| {
+        self.call_on_rows("a product", x, y, |x, y, step| {
             let _lock = petsc()?;
             // SAFETY: `x` and `y` hold this rank's rows, `raw` is alive, the lock is held.
             Ok(unsafe { internodes_cgamg_multiply(self.raw.as_ptr(), x, y, step) })
@@ -634,7 +641,13 @@ impl CgAmg {
     /// (unless PETSc's options database holds options of its own: see the module's doc); those
     /// of one object take turns.
     pub fn precondition(&self, rhs: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
-        self.on_rows("a V-cycle", rhs, x, |rhs, x, step| {
+        self.on_whole("a V-cycle", rhs, x, |rhs, x| self.precondition_rows(rhs, x))
+    }
+
+    /// [`Self::precondition`] on this rank's rows alone (PETSc's order, [`Self::distribution`];
+    /// collective). On one process, the whole vectors.
+    pub fn precondition_rows(&self, rhs: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
+        self.call_on_rows("a V-cycle", rhs, x, |rhs, x, step| {
             // PETSc is initialized (`self` exists). `applying` is taken under the shared lock,
             // never the other way round, and released first (reverse order of declaration).
             // A distributed V-cycle is collective: never beside another call.
@@ -649,15 +662,19 @@ impl CgAmg {
         })
     }
 
-    /// A linear map of the shim (`call`: this rank's rows of `input` in, of the result out; it
-    /// returns the shim's code and sets `step` on error) applied to whole vectors in our
-    /// numbering: every rank receives every rank's rows of `output`.
-    fn on_rows(
+    /// How the matrix's rows are shared among the ranks (`None` on one process).
+    pub fn distribution(&self) -> Option<&Distribution> {
+        self.distribution.as_ref()
+    }
+
+    /// A linear map on this rank's rows (`on_rows`) applied to whole vectors in our numbering:
+    /// every rank receives every rank's rows of `output`.
+    fn on_whole(
         &self,
         what: &str,
         input: &[f64],
         output: &mut [f64],
-        call: impl FnOnce(*const f64, *mut f64, &mut *const c_char) -> Result<c_int, LinalgError>,
+        on_rows: impl FnOnce(&[f64], &mut [f64]) -> Result<(), LinalgError>,
     ) -> Result<(), LinalgError> {
         if input.len() != self.n || output.len() != self.n {
             return Err(LinalgError::Sizes(format!(
@@ -669,9 +686,36 @@ impl CgAmg {
         }
         let local_input = self.local_part(input);
         let mut local_output = self.local_buffer();
+        on_rows(&local_input, &mut local_output)?;
+        self.assemble_whole(local_output, output)
+    }
+
+    /// `input` and `output` hold this rank's rows.
+    fn check_rows(&self, what: &str, input: &[f64], output: &[f64]) -> Result<(), LinalgError> {
+        let local = self.local_len();
+        if input.len() != local || output.len() != local {
+            return Err(LinalgError::Sizes(format!(
+                "{what} on {} values into {} for this rank's {local} rows",
+                input.len(),
+                output.len(),
+            )));
+        }
+        Ok(())
+    }
+
+    /// A call of the shim (`call`: this rank's rows of `input` in, of the result out; it
+    /// returns the shim's code and sets `step` on error) on vectors of this rank's rows.
+    fn call_on_rows(
+        &self,
+        what: &str,
+        input: &[f64],
+        output: &mut [f64],
+        call: impl FnOnce(*const f64, *mut f64, &mut *const c_char) -> Result<c_int, LinalgError>,
+    ) -> Result<(), LinalgError> {
+        self.check_rows(what, input, output)?;
         let mut step = std::ptr::null();
-        match call(local_input.as_ptr(), local_output.as_mut_ptr(), &mut step)? {
-            0 => self.assemble_whole(local_output, output),
+        match call(input.as_ptr(), output.as_mut_ptr(), &mut step)? {
+            0 => Ok(()),
             code => Err(petsc_error(step, code)),
         }
     }

@@ -1,0 +1,165 @@
+//! How this process holds the vectors of the coupled GMRES
+//! (`crate::contact::coupled::coupled_krylov`).
+//!
+//! On one process a vector of the coupled system is whole: `[u_1; ...; u_N; lambda / s]`, each
+//! body's unknowns in our numbering. In a distributed run each body's unknowns are shared among
+//! the ranks (`crate::linalg::Distribution`), and a Krylov vector holds only this rank's rows of
+//! each body, in PETSc's order, followed by every multiplier (and force-controlled
+//! displacement):
+//!
+//! ```text
+//! local = [u_1 (this rank's rows); ...; u_N (this rank's rows); lambda / s (all of them)]
+//! ```
+//!
+//! The multipliers are of the interface's size, and every rank holds all of them: every rank
+//! computes them from the same numbers, so they are the same bits on every rank. The GMRES
+//! basis, up to 50 vectors, then takes `n / P + m` values per vector on each of `P` ranks
+//! instead of `n + m`.
+//!
+//! Inner products: each rank sums over its rows; every rank receives every rank's sum
+//! (`MPI_Allgatherv` of one value each) and adds them in rank order, then adds the multipliers'
+//! part, which it computes itself. The result is the same bits on every rank and from one run to
+//! the next (`MPI_Allreduce` would leave the order of the sum to the library).
+
+use std::ops::Range;
+
+use crate::contact::ContactError;
+use crate::contact::coupled::system::CoupledSystem;
+use crate::linalg::{BodySolver, Distribution, gmres};
+
+/// Where the values of a Krylov vector are held (module doc).
+pub enum KrylovLayout<'a> {
+    /// The whole vector on this process.
+    Whole,
+    /// This rank's rows of each body, then every multiplier.
+    Shared(SharedLayout<'a>),
+}
+
+/// The layout of a distributed run's Krylov vectors.
+pub struct SharedLayout<'a> {
+    /// How each body's unknowns are shared.
+    bodies: Vec<&'a Distribution>,
+    /// Body `k`'s rows of this rank are `local[k]..local[k + 1]` of a Krylov vector.
+    local: Vec<usize>,
+    /// Body `k`'s unknowns are `whole[k]..whole[k + 1]` of the whole vector.
+    whole: Vec<usize>,
+}
+
+impl<'a> KrylovLayout<'a> {
+    /// The layout of `system`'s vectors given the bodies' `solvers`: shared when they are
+    /// shared among ranks, which in a distributed run every body's is (CG + AMG on its rows).
+    pub fn new(system: &CoupledSystem, solvers: &'a [BodySolver]) -> Result<Self, ContactError> {
+        let shared: Vec<&Distribution> = solvers.iter().filter_map(|s| s.distribution()).collect();
+        if shared.is_empty() {
+            return Ok(Self::Whole);
+        }
+        if shared.len() != solvers.len() {
+            return Err(ContactError::Linalg(format!(
+                "{} of {} bodies are shared among the ranks: the coupled GMRES needs all or none",
+                shared.len(),
+                solvers.len()
+            )));
+        }
+        let mut local = vec![0];
+        for body in &shared {
+            local.push(local.last().unwrap() + body.local());
+        }
+        Ok(Self::Shared(SharedLayout {
+            bodies: shared,
+            local,
+            whole: system.offsets.clone(),
+        }))
+    }
+
+    /// This process's part of the whole vector `whole`.
+    pub fn local_part(&self, whole: Vec<f64>) -> Vec<f64> {
+        match self {
+            Self::Whole => whole,
+            Self::Shared(layout) => {
+                let n = layout.num_displacements();
+                let mut local = Vec::with_capacity(layout.num_local() + whole.len() - n);
+                for (k, body) in layout.bodies.iter().enumerate() {
+                    local.extend(body.local_part(&whole[layout.whole_range(k)]));
+                }
+                local.extend_from_slice(&whole[n..]);
+                local
+            }
+        }
+    }
+
+    /// The whole vector of which every rank holds its `local` part (collective).
+    pub fn whole(&self, local: Vec<f64>) -> Result<Vec<f64>, ContactError> {
+        match self {
+            Self::Whole => Ok(local),
+            Self::Shared(layout) => {
+                let mut whole = vec![0.0; layout.num_displacements()];
+                layout.gather_displacements(&local, &mut whole)?;
+                whole.extend_from_slice(&local[layout.num_local()..]);
+                Ok(whole)
+            }
+        }
+    }
+
+    /// `a . b` of two vectors of this layout (collective when shared).
+    pub fn dot(&self, a: &[f64], b: &[f64]) -> Result<f64, ContactError> {
+        match self {
+            Self::Whole => Ok(gmres::dot(a, b)),
+            Self::Shared(layout) => {
+                let rows = layout.num_local();
+                let partial = gmres::dot(&a[..rows], &b[..rows]);
+                let partials = crate::parallel::gather(partial).map_err(mpi_error)?;
+                let bodies: f64 = partials.iter().sum();
+                Ok(bodies + gmres::dot(&a[rows..], &b[rows..]))
+            }
+        }
+    }
+}
+
+impl SharedLayout<'_> {
+    /// This rank's rows of every body: where the multipliers start in a Krylov vector.
+    pub fn num_local(&self) -> usize {
+        *self.local.last().expect("offsets start with 0")
+    }
+
+    /// Every body's unknowns: where the multipliers start in a whole vector.
+    pub fn num_displacements(&self) -> usize {
+        *self.whole.last().expect("offsets start with 0")
+    }
+
+    /// Body `k`'s rows of this rank, within a Krylov vector.
+    pub fn local_range(&self, k: usize) -> Range<usize> {
+        self.local[k]..self.local[k + 1]
+    }
+
+    fn whole_range(&self, k: usize) -> Range<usize> {
+        self.whole[k]..self.whole[k + 1]
+    }
+
+    /// Every body's displacements, whole in our numbering, from every rank's rows of them in
+    /// `local` (collective: one `MPI_Allgatherv` per body).
+    pub fn gather_displacements(
+        &self,
+        local: &[f64],
+        whole: &mut [f64],
+    ) -> Result<(), ContactError> {
+        for (k, body) in self.bodies.iter().enumerate() {
+            body.gather(&local[self.local_range(k)], &mut whole[self.whole_range(k)])
+                .map_err(|e| ContactError::Linalg(format!("gathering a body's vector: {e}")))?;
+        }
+        Ok(())
+    }
+
+    /// `local += ` this rank's rows of `whole` (the bodies' displacements in our numbering).
+    pub fn add_local_part(&self, whole: &[f64], local: &mut [f64]) {
+        for (k, body) in self.bodies.iter().enumerate() {
+            let whole = &whole[self.whole_range(k)];
+            for (value, &ours) in local[self.local_range(k)].iter_mut().zip(body.own()) {
+                *value += whole[ours];
+            }
+        }
+    }
+}
+
+fn mpi_error(e: crate::parallel::ParallelError) -> ContactError {
+    ContactError::Linalg(format!("an inner product of the coupled GMRES: {e}"))
+}
