@@ -241,24 +241,17 @@ pub fn solve(
         })
         .collect();
     let num_bodies = system.num_bodies();
-    let layout = KrylovLayout::new(system, problem.solvers)?;
-    let local_scratch = match &layout {
-        KrylovLayout::Whole => Vec::new(),
-        KrylovLayout::Shared(shared) => vec![0.0; shared.num_local()],
-    };
+    let product = CoupledProduct::new(problem)?;
+    let local_scratch = vec![0.0; product.layout.num_rows(system)];
     let mut operators = Blocks {
-        system,
-        bodies: problem.bodies,
-        solvers: problem.solvers,
+        product,
         schur,
         rigid: RigidBlock::new(system),
         applications: vec![0; num_bodies],
         tolerance,
         rhs_norm,
         cancel: &state.cancel,
-        scratch: vec![0.0; system.num_displacements()],
         local_scratch,
-        layout,
     };
     let settings = GmresSettings {
         tolerance: tolerance * rhs_norm,
@@ -266,8 +259,8 @@ pub fn solve(
         max_iterations,
         restart: RESTART,
     };
-    let rhs = operators.layout.local_part(rhs);
-    let mut local_x = operators.layout.local_part(x);
+    let rhs = operators.product.layout.local_part(rhs);
+    let mut local_x = operators.product.layout.local_part(x);
     let outcome = gmres::solve(&mut operators, &rhs, &mut local_x, settings);
     state.body_applications.resize(num_bodies, 0);
     for (total, new) in state
@@ -294,7 +287,7 @@ pub fn solve(
             tolerance,
         }));
     }
-    let x = operators.layout.whole(local_x)?;
+    let x = operators.product.layout.whole(local_x)?;
     keep(system, &x, state);
     Ok(x)
 }
@@ -341,41 +334,78 @@ fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
     }
 }
 
-/// The operator `A` and the block preconditioner `P^-1` of the module doc.
-struct Blocks<'a> {
-    system: &'a CoupledSystem,
-    /// Each body's constrained stiffness (symmetric), `k_c` (or its distributed solver's copy).
-    bodies: &'a [&'a AssembledBody],
-    solvers: &'a [BodySolver],
-    /// `S~` of each pair, on its multipliers: the pairs' blocks of the preconditioner.
-    schur: Vec<HalfSpace>,
-    /// `S~` of the force-controlled displacements: their block of `D`.
-    rigid: RigidBlock,
-    /// Applications of each body's block.
-    applications: Vec<usize>,
-    tolerance: f64,
-    rhs_norm: f64,
-    cancel: &'a Cancel,
-    /// The bodies' displacements, whole: `r_u - B y_l` of an application of `P^-1`; when the
-    /// vectors are shared among ranks, a product's `u` gathered for `C u`, or `B y` before
-    /// this rank takes its rows.
-    scratch: Vec<f64>,
-    /// `r_u - B y_l` on this rank's rows, when the vectors are shared (empty otherwise).
-    local_scratch: Vec<f64>,
-    /// How the GMRES vectors are held: whole, or this rank's rows of each body.
-    layout: KrylovLayout<'a>,
+/// `relative_residual = |[f; g] - A x| / |[f; g]|` of the whole vector `x` by the coupled
+/// GMRES's own product: on several ranks, where a rank's coupled system holds only its entries
+/// of `B` and `C` (`crate::contact::coupled::system::Unknowns::RankRows`), the residual check
+/// of a solve (collective); on one process the same sum as `CoupledSystem::relative_residual`
+/// but for the order of its terms.
+pub fn relative_residual(problem: &KrylovProblem, x: Vec<f64>) -> Result<f64, ContactError> {
+    let mut product = CoupledProduct::new(problem)?;
+    let rhs = problem.system.rhs();
+    let rhs_norm = gmres::norm(&rhs);
+    let (rhs, x) = (product.layout.local_part(rhs), product.layout.local_part(x));
+    let mut residual = vec![0.0; x.len()];
+    product.apply(&x, &mut residual)?;
+    residual.iter_mut().zip(&rhs).for_each(|(r, b)| *r = b - *r);
+    let norm = product.layout.dot(&residual, &residual)?.sqrt();
+    Ok(if rhs_norm > 0.0 {
+        norm / rhs_norm
+    } else {
+        norm
+    })
 }
 
-impl Operators for Blocks<'_> {
-    type Error = ContactError;
+/// The operator `A` of the module doc, on vectors held as `layout` says.
+struct CoupledProduct<'a> {
+    system: &'a CoupledSystem,
+    /// Each body's constrained stiffness (symmetric), `k_c` (or its solver's copy).
+    bodies: &'a [&'a AssembledBody],
+    solvers: &'a [BodySolver],
+    /// How the vectors are held: whole, or this rank's rows of each body.
+    layout: KrylovLayout<'a>,
+    /// A rank's part of `C u` over its columns (empty on one process).
+    partial: Vec<f64>,
+}
 
-    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
-        let KrylovLayout::Shared(layout) = &self.layout else {
-            return self.apply_whole(x, out);
+impl<'a> CoupledProduct<'a> {
+    fn new(problem: &KrylovProblem<'a>) -> Result<Self, ContactError> {
+        let layout = KrylovLayout::new(problem.system, problem.solvers)?;
+        let partial = match &layout {
+            KrylovLayout::Whole => Vec::new(),
+            KrylovLayout::Shared(_) => vec![0.0; problem.system.m],
         };
-        // As `apply_whole` on this rank's rows: `K u` by each body's rows, `C u` from every
-        // rank's rows gathered, `B lambda` on every row and then this rank's taken.
+        Ok(Self {
+            system: problem.system,
+            bodies: problem.bodies,
+            solvers: problem.solvers,
+            layout,
+            partial,
+        })
+    }
+
+    /// `out = A x`.
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
         let system = self.system;
+        let KrylovLayout::Shared(layout) = &self.layout else {
+            // Whole vectors: the bodies' products on their threads.
+            let n = system.num_displacements();
+            let (out_u, out_l) = out.split_at_mut(n);
+            system
+                .body_parts(out_u)
+                .into_par_iter()
+                .zip(self.bodies)
+                .zip(self.solvers)
+                .zip(system.offsets.par_windows(2))
+                .try_for_each(|(((out, body), solver), range)| {
+                    stiffness_product(body, Some(solver), &x[range[0]..range[1]], out)
+                })?;
+            multiplier_rows(system, &x[n..], out_l);
+            system.add_b_product(&x[n..], 1.0, out);
+            system.add_c_product(&x[..n], &mut out[n..]);
+            return Ok(());
+        };
+        // This rank's rows: `K u` by each body's rows, `B lambda` by this rank's entries, and
+        // `C u` as every rank's part over its columns, summed.
         let rows = layout.num_local();
         let (out_u, out_l) = out.split_at_mut(rows);
         for (k, solver) in self.solvers.iter().enumerate() {
@@ -385,39 +415,76 @@ impl Operators for Blocks<'_> {
                 .map_err(|e| ContactError::Linalg(format!("a body's stiffness product: {e}")))?;
         }
         multiplier_rows(system, &x[rows..], out_l);
-        layout.gather_displacements(&x[..rows], &mut self.scratch)?;
-        system.add_c_product(&self.scratch, out_l);
-        self.scratch.fill(0.0);
-        system.add_b_product(&x[rows..], 1.0, &mut self.scratch);
-        layout.add_local_part(&self.scratch, out_u);
+        self.partial.fill(0.0);
+        system.add_c_product(&x[..rows], &mut self.partial);
+        layout.add_rank_sums(&self.partial, out_l)?;
+        system.add_b_product(&x[rows..], 1.0, out);
         Ok(())
+    }
+}
+
+/// The operator `A` and the block preconditioner `P^-1` of the module doc.
+struct Blocks<'a> {
+    product: CoupledProduct<'a>,
+    /// `S~` of each pair, on its multipliers: the pairs' blocks of the preconditioner.
+    schur: Vec<HalfSpace>,
+    /// `S~` of the force-controlled displacements: their block of `D`.
+    rigid: RigidBlock,
+    /// Applications of each body's block.
+    applications: Vec<usize>,
+    tolerance: f64,
+    rhs_norm: f64,
+    cancel: &'a Cancel,
+    /// `r_u - B y_l` of an application of `P^-1`, on the rows the vectors hold.
+    local_scratch: Vec<f64>,
+}
+
+impl Operators for Blocks<'_> {
+    type Error = ContactError;
+
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        self.product.apply(x, out)
     }
 
     fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
         self.cancel.check()?;
-        let KrylovLayout::Shared(layout) = &self.layout else {
-            return self.precondition_whole(r, out);
-        };
-        let system = self.system;
-        let rows = layout.num_local();
+        let system = self.product.system;
+        let solvers = self.product.solvers;
+        let rows = self.product.layout.num_rows(system);
         let (out_u, out_l) = out.split_at_mut(rows);
-        self.apply_schur(&r[rows..], out_l);
-        self.scratch.fill(0.0);
-        system.add_b_product(out_l, -1.0, &mut self.scratch);
-        self.local_scratch.copy_from_slice(&r[..rows]);
-        layout.add_local_part(&self.scratch, &mut self.local_scratch);
-        for (k, solver) in self.solvers.iter().enumerate() {
-            let range = layout.local_range(k);
-            solver
-                .precondition_rows(&self.local_scratch[range.clone()], &mut out_u[range])
-                .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
+        for (p, schur) in self.schur.iter().enumerate() {
+            let range = system.pair_multipliers(p);
+            schur.apply(&r[rows + range.start..rows + range.end], &mut out_l[range]);
         }
+        self.rigid.apply(&r[rows..], out_l);
+        self.local_scratch.copy_from_slice(&r[..rows]);
+        system.add_b_product(out_l, -1.0, &mut self.local_scratch);
+        let scratch = &self.local_scratch;
+        match &self.product.layout {
+            // Whole vectors: the bodies' blocks on their threads.
+            KrylovLayout::Whole => system
+                .body_parts(out_u)
+                .into_par_iter()
+                .zip(solvers)
+                .zip(system.offsets.par_windows(2))
+                .try_for_each(|((out, solver), range)| {
+                    solver.precondition(&scratch[range[0]..range[1]], out)
+                }),
+            // This rank's rows: each body's V-cycle on them (collective, in body order).
+            KrylovLayout::Shared(layout) => {
+                (solvers.iter().enumerate()).try_for_each(|(k, solver)| {
+                    let range = layout.local_range(k);
+                    solver.precondition_rows(&scratch[range.clone()], &mut out_u[range])
+                })
+            }
+        }
+        .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
         self.applications.iter_mut().for_each(|a| *a += 1);
         Ok(())
     }
 
     fn dot(&mut self, a: &[f64], b: &[f64]) -> Result<f64, ContactError> {
-        self.layout.dot(a, b)
+        self.product.layout.dot(a, b)
     }
 
     /// How far the solve is, for the progress line of a long active-set iteration.
@@ -434,58 +501,6 @@ impl Operators for Blocks<'_> {
             )
         });
         Ok(())
-    }
-}
-
-impl Blocks<'_> {
-    /// `out = A x` on whole vectors, the bodies' products on their threads.
-    fn apply_whole(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
-        let system = self.system;
-        let n = system.num_displacements();
-        let (out_u, out_l) = out.split_at_mut(n);
-        system
-            .body_parts(out_u)
-            .into_par_iter()
-            .zip(self.bodies)
-            .zip(self.solvers)
-            .zip(system.offsets.par_windows(2))
-            .try_for_each(|(((out, body), solver), range)| {
-                stiffness_product(body, Some(solver), &x[range[0]..range[1]], out)
-            })?;
-        multiplier_rows(system, &x[n..], out_l);
-        system.add_b_product(&x[n..], 1.0, out);
-        system.add_c_product(&x[..n], &mut out[n..]);
-        Ok(())
-    }
-
-    /// `out = P^-1 r` on whole vectors, the bodies' blocks on their threads.
-    fn precondition_whole(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
-        let system = self.system;
-        let n = system.num_displacements();
-        let (out_u, out_l) = out.split_at_mut(n);
-        self.apply_schur(&r[n..], out_l);
-        self.scratch.copy_from_slice(&r[..n]);
-        system.add_b_product(out_l, -1.0, &mut self.scratch);
-        system
-            .body_parts(out_u)
-            .into_par_iter()
-            .zip(self.solvers)
-            .zip(system.offsets.par_windows(2))
-            .try_for_each(|((out, solver), range)| {
-                solver.precondition(&self.scratch[range[0]..range[1]], out)
-            })
-            .map_err(|e| ContactError::Linalg(format!("a body's preconditioner: {e}")))?;
-        self.applications.iter_mut().for_each(|a| *a += 1);
-        Ok(())
-    }
-
-    /// `y_l = S~^-1 r_l`: each pair's half-space block and the force-controlled block.
-    fn apply_schur(&self, r_l: &[f64], y_l: &mut [f64]) {
-        for (p, schur) in self.schur.iter().enumerate() {
-            let range = self.system.pair_multipliers(p);
-            schur.apply(&r_l[range.clone()], &mut y_l[range]);
-        }
-        self.rigid.apply(r_l, y_l);
     }
 }
 

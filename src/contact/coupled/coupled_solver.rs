@@ -39,7 +39,8 @@ use rayon::prelude::*;
 use crate::contact::ContactError;
 use crate::contact::coupled::compliance::SurfaceResponse;
 use crate::contact::coupled::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
-use crate::contact::coupled::system::{CoupledSystem, Pair, assembled};
+use crate::contact::coupled::row_ownership::RowOwnership;
+use crate::contact::coupled::system::{CoupledSystem, Pair, Unknowns, assembled};
 use crate::contact::settings::{ContactSettings, CoupledSolver};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
@@ -52,6 +53,9 @@ use crate::linalg::{
 /// multipliers computed so far (dense Schur), or the warm start (Krylov).
 pub struct BodyFactors {
     solvers: Vec<BodySolver>,
+    /// Where this rank's rows of the bodies are, in a distributed run: its coupled systems
+    /// hold only its entries of `B` and `C` (`CoupledSystem::assemble_on`).
+    ownership: Option<RowOwnership>,
     /// The half-space compliance factor of each pair's two materials
     /// (`crate::contact::coupled::half_space`).
     compliance: Vec<f64>,
@@ -124,6 +128,7 @@ impl BodyFactors {
                 .map(factor)
                 .collect::<Result<Vec<_>, _>>()?,
         };
+        let ownership = RowOwnership::of(&solvers)?;
         let cg = kind == BodySolverKind::CgAmg;
         let krylov = cg || matches!(method, CoupledSolver::Krylov | CoupledSolver::Auto);
         let interface = if krylov {
@@ -139,6 +144,7 @@ impl BodyFactors {
             .then_some(candidates);
         Ok(Self {
             solvers,
+            ownership,
             compliance,
             interface,
             fallback,
@@ -164,9 +170,35 @@ impl BodyFactors {
         matches!(self.interface, Interface::Krylov { .. })
     }
 
-    /// Each body's solver.
-    pub fn solvers(&self) -> &[BodySolver] {
-        &self.solvers
+    /// Where this rank's rows of the bodies are, in a distributed run (`None` on one process).
+    pub fn ownership(&self) -> Option<&RowOwnership> {
+        self.ownership.as_ref()
+    }
+
+    /// `|[f; g] - A x| / |[f; g]|` of the answer `x` of [`Self::solve`]: by the system's blocks,
+    /// or on several ranks, whose systems hold only their entries, by the coupled GMRES's
+    /// product (collective).
+    pub fn relative_residual(
+        &self,
+        system: &CoupledSystem,
+        pairs: &[Pair],
+        bodies: &[&AssembledBody],
+        x: &[f64],
+    ) -> Result<f64, ContactError> {
+        match system.unknowns {
+            Unknowns::Whole => system.relative_residual(bodies, Some(&self.solvers), x),
+            Unknowns::RankRows => {
+                let problem = coupled_krylov::KrylovProblem {
+                    system,
+                    pairs,
+                    bodies,
+                    solvers: &self.solvers,
+                    compliance: &self.compliance,
+                    dim: self.dim,
+                };
+                coupled_krylov::relative_residual(&problem, x.to_vec())
+            }
+        }
     }
 
     /// Each body's share of its unknowns among the MPI ranks (`BodySolver::rank_dofs`).
@@ -551,6 +583,8 @@ mod tests {
         DirichletCondition, ElasticProblem, SolveStats, StepFactors, assemble, solve,
     };
     use crate::fem::Material;
+    use crate::fem::assembly::stiffness_graph;
+    use crate::linalg::Distribution;
     use crate::mesh::{BodyMesh, FacetGroup};
 
     const NX: usize = 4;
@@ -680,6 +714,25 @@ mod tests {
             gaps: vec![[0.0; 3]; NY + 1],
             primary_nodes,
         }
+    }
+
+    /// `coupling` with two multipliers per node along a basis turned by 30 degrees: each reads
+    /// both components of the jump and loads both components of the node (shared), and the
+    /// second has its own term `compliance` in its row.
+    fn turned(mut coupling: Coupling, compliance: f64) -> Coupling {
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        for multipliers in &mut coupling.multipliers {
+            for (j, (multiplier, direction)) in
+                (multipliers.iter_mut().zip([[c, s, 0.0], [-s, c, 0.0]])).enumerate()
+            {
+                multiplier.force = direction;
+                multiplier.row = direction;
+                multiplier.reads = Reads::Interpolated;
+                multiplier.restates = Restates::Node;
+                multiplier.compliance = if j == 1 { compliance } else { 0.0 };
+            }
+        }
+        coupling
     }
 
     /// The bodies of `meshes`, each with its top pushed down by its `push`, assembled.
@@ -815,23 +868,9 @@ mod tests {
         let meshes = [grid("left", 0.0, NX), grid("right", 1.0, NX)];
         let bodies = assembled(&meshes, &[0.01, 0.02]);
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
-        // Two multipliers per node along a basis turned by 30 degrees: each reads both
-        // components of the jump and loads both components of the node (shared), and the
-        // second has its own term in its row.
-        let mut coupling = tied(NX, NX, NX, 0, 1.0);
-        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
         let compliance = 1e-4;
-        for multipliers in &mut coupling.multipliers {
-            for (j, (multiplier, direction)) in
-                (multipliers.iter_mut().zip([[c, s, 0.0], [-s, c, 0.0]])).enumerate()
-            {
-                multiplier.force = direction;
-                multiplier.row = direction;
-                multiplier.reads = Reads::Interpolated;
-                multiplier.restates = Restates::Node;
-                multiplier.compliance = if j == 1 { compliance } else { 0.0 };
-            }
-        }
+        let coupling = turned(tied(NX, NX, NX, 0, 1.0), compliance);
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
         let pairs = [Pair {
             primary: 0,
             secondary: 1,
@@ -879,6 +918,85 @@ mod tests {
         }
         // The own term is not idle: the multiplier carries a traction.
         assert!(largest * compliance > 1e-3 * u_scale, "{largest}");
+    }
+
+    /// A distributed run's coupled system holds on each rank the entries of `B` on its rows
+    /// and of `C` on its columns, numbered by their place in its Krylov vectors: over the
+    /// ranks of 2- and 3-way partitions they make the whole system's products, each row of
+    /// `B y` on one rank alone (the same terms in the same order: the same bits) and `C x` as
+    /// the sum of the ranks' parts; the multiplier blocks are every rank's.
+    #[test]
+    fn each_ranks_share_of_the_coupling_blocks_adds_up_to_the_whole() {
+        let meshes = [grid("left", 0.0, NX), grid("right", 1.0, NX)];
+        let bodies = assembled(&meshes, &[0.01, 0.02]);
+        let bodies: Vec<&AssembledBody> = bodies.iter().collect();
+        let factors = StepFactors::uniform(1.0);
+        for coupling in [
+            tied(NX, NX, NX, 0, 1.0),
+            turned(tied(NX, NX, NX, 0, 1.0), 1e-4),
+        ] {
+            let pairs = [Pair {
+                primary: 0,
+                secondary: 1,
+                coupling: &coupling,
+            }];
+            let whole = CoupledSystem::assemble(&bodies, &pairs, 2, &factors).unwrap();
+            let (n, m) = (whole.num_displacements(), whole.m);
+            let x: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin()).collect();
+            let y: Vec<f64> = (0..m).map(|k| (0.71 * k as f64).cos()).collect();
+            let mut c_whole = vec![0.0; m];
+            whole.add_c_product(&x, &mut c_whole);
+            let mut b_whole = vec![0.0; n];
+            whole.add_b_product(&y, 1.0, &mut b_whole);
+            for size in [2, 3] {
+                let mut c_sum = vec![0.0; m];
+                let mut b_rows = vec![None; n];
+                for rank in 0..size {
+                    let ranks = crate::parallel::Ranks { rank, size };
+                    let distributions: Vec<Distribution> = (meshes.iter())
+                        .map(|mesh| Distribution::new(&stiffness_graph(mesh), ranks).unwrap())
+                        .collect();
+                    let shared: Vec<&Distribution> = distributions.iter().collect();
+                    let ownership = RowOwnership::from_distributions(&shared).unwrap();
+                    let system =
+                        CoupledSystem::assemble_on(&bodies, &pairs, 2, &factors, Some(&ownership))
+                            .unwrap();
+                    assert_eq!(system.unknowns, Unknowns::RankRows);
+                    assert_eq!(
+                        (system.d.clone(), system.g.clone()),
+                        (whole.d.clone(), whole.g.clone())
+                    );
+                    assert!(system.residual(&bodies, None, &x).is_err());
+                    // This rank's rows, in the order of its Krylov vectors.
+                    let own: Vec<usize> = (distributions.iter().zip(&whole.offsets))
+                        .flat_map(|(d, &offset)| d.own().iter().map(move |&dof| offset + dof))
+                        .collect();
+                    let x_rank: Vec<f64> = own.iter().map(|&row| x[row]).collect();
+                    let mut c_rank = vec![0.0; m];
+                    system.add_c_product(&x_rank, &mut c_rank);
+                    c_sum
+                        .iter_mut()
+                        .zip(&c_rank)
+                        .for_each(|(sum, part)| *sum += part);
+                    let mut b_rank = vec![0.0; own.len()];
+                    system.add_b_product(&y, 1.0, &mut b_rank);
+                    for (&row, value) in own.iter().zip(b_rank) {
+                        assert!(b_rows[row].is_none(), "row {row} on two ranks");
+                        b_rows[row] = Some(value);
+                    }
+                }
+                let b_rows: Vec<f64> = b_rows.into_iter().map(Option::unwrap).collect();
+                assert_eq!(b_rows, b_whole, "B y on {size} ranks");
+                let scale = c_whole.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+                assert!(scale > 0.0);
+                let off =
+                    (c_sum.iter().zip(&c_whole)).fold(0.0_f64, |a, (s, w)| a.max((s - w).abs()));
+                assert!(
+                    off <= 1e-14 * scale,
+                    "C x on {size} ranks: off by {off:.1e}"
+                );
+            }
+        }
     }
 
     /// A Krylov solve of the system just solved starts from its answer and needs no iteration,

@@ -20,11 +20,18 @@
 //! (`MPI_Allgatherv` of one value each) and adds them in rank order, then adds the multipliers'
 //! part, which it computes itself. The result is the same bits on every rank and from one run to
 //! the next (`MPI_Allreduce` would leave the order of the sum to the library).
+//!
+//! The coupling blocks follow the vectors (`crate::contact::coupled::row_ownership`): a rank's coupled system holds
+//! the entries of `B` on its rows and those of `C` on its columns, numbered by their place in
+//! this rank's Krylov vectors (`crate::contact::coupled::system::CoupledSystem::assemble_on`).
+//! So `B lambda` is computed on this rank's rows alone, and `C u` is every rank's part over its
+//! columns, added in rank order as the inner products are (one `MPI_Allgatherv` of the `m`
+//! values each): no rank holds or gathers a whole displacement vector during the solve.
 
 use std::ops::Range;
 
 use crate::contact::ContactError;
-use crate::contact::coupled::system::CoupledSystem;
+use crate::contact::coupled::system::{CoupledSystem, Unknowns};
 use crate::linalg::{BodySolver, Distribution, gmres};
 
 /// Where the values of a Krylov vector are held (module doc).
@@ -47,17 +54,25 @@ pub struct SharedLayout<'a> {
 
 impl<'a> KrylovLayout<'a> {
     /// The layout of `system`'s vectors given the bodies' `solvers`: shared when they are
-    /// shared among ranks, which in a distributed run every body's is (CG + AMG on its rows).
+    /// shared among ranks, which in a distributed run every body's is (CG + AMG on its rows);
+    /// then `system` must hold this rank's entries ([`Unknowns::RankRows`]).
     pub fn new(system: &CoupledSystem, solvers: &'a [BodySolver]) -> Result<Self, ContactError> {
         let shared: Vec<&Distribution> = solvers.iter().filter_map(|s| s.distribution()).collect();
-        if shared.is_empty() {
+        let rank_rows = system.unknowns == Unknowns::RankRows;
+        if shared.is_empty() && !rank_rows {
             return Ok(Self::Whole);
         }
-        if shared.len() != solvers.len() {
+        if shared.len() != solvers.len() || !rank_rows {
             return Err(ContactError::Linalg(format!(
-                "{} of {} bodies are shared among the ranks: the coupled GMRES needs all or none",
+                "{} of {} bodies are shared among the ranks, and the coupled system holds {}: \
+                 the coupled GMRES needs every body shared and this rank's entries, or neither",
                 shared.len(),
-                solvers.len()
+                solvers.len(),
+                if rank_rows {
+                    "this rank's entries"
+                } else {
+                    "every entry"
+                },
             )));
         }
         let mut local = vec![0];
@@ -69,6 +84,14 @@ impl<'a> KrylovLayout<'a> {
             local,
             whole: system.offsets.clone(),
         }))
+    }
+
+    /// The displacement rows of a vector: where its multipliers start.
+    pub fn num_rows(&self, system: &CoupledSystem) -> usize {
+        match self {
+            Self::Whole => system.num_displacements(),
+            Self::Shared(layout) => layout.num_local(),
+        }
     }
 
     /// This process's part of the whole vector `whole`.
@@ -149,17 +172,20 @@ impl SharedLayout<'_> {
         Ok(())
     }
 
-    /// `local += ` this rank's rows of `whole` (the bodies' displacements in our numbering).
-    pub fn add_local_part(&self, whole: &[f64], local: &mut [f64]) {
-        for (k, body) in self.bodies.iter().enumerate() {
-            let whole = &whole[self.whole_range(k)];
-            for (value, &ours) in local[self.local_range(k)].iter_mut().zip(body.own()) {
-                *value += whole[ours];
-            }
+    /// `out += ` the sum over the ranks of every rank's `partial` (of one length on every
+    /// rank), added in rank order (collective).
+    pub fn add_rank_sums(&self, partial: &[f64], out: &mut [f64]) -> Result<(), ContactError> {
+        let ranks = crate::parallel::ranks().size;
+        let all =
+            crate::parallel::all_gather(partial, &vec![partial.len(); ranks]).map_err(mpi_error)?;
+        for (k, value) in out.iter_mut().enumerate() {
+            let sum: f64 = (0..ranks).map(|r| all[r * partial.len() + k]).sum();
+            *value += sum;
         }
+        Ok(())
     }
 }
 
 fn mpi_error(e: crate::parallel::ParallelError) -> ContactError {
-    ContactError::Linalg(format!("an inner product of the coupled GMRES: {e}"))
+    ContactError::Linalg(format!("a sum over the ranks in the coupled GMRES: {e}"))
 }

@@ -58,6 +58,7 @@ use faer::sparse::{SparseColMat, Triplet};
 
 use crate::contact::ContactError;
 use crate::contact::coupled::compliance::MultiplierKey;
+use crate::contact::coupled::row_ownership::RowOwnership;
 use crate::contact::law::{Multiplier, Reads, Restates};
 use rayon::prelude::*;
 
@@ -231,6 +232,9 @@ pub struct CoupledSystem {
     /// Body `k`'s dofs are the unknowns `offsets[k]..offsets[k + 1]`; the multipliers follow
     /// `offsets[N]`.
     pub offsets: Vec<usize>,
+    /// What the rows of `B` and the columns of `C` number: every unknown of the bodies, or
+    /// this rank's rows of them in a distributed run.
+    pub unknowns: Unknowns,
     /// Pair `p`'s multipliers are `multiplier_offsets[p]..multiplier_offsets[p + 1]` of the
     /// multiplier block.
     pub multiplier_offsets: Vec<usize>,
@@ -281,6 +285,17 @@ pub struct CoupledSystem {
     pub g: Vec<f64>,
 }
 
+/// What the rows of `B` and the columns of `C` of a [`CoupledSystem`] number.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unknowns {
+    /// Every unknown of the bodies, one body after another (`offsets`).
+    Whole,
+    /// This rank's rows of each body, by their place in its Krylov vectors
+    /// (`crate::contact::coupled::krylov_layout`): the entries of `B` on other ranks' rows and
+    /// of `C` on their columns are theirs. Only the coupled GMRES reads such a system.
+    RankRows,
+}
+
 impl CoupledSystem {
     /// Assembles the blocks of the coupled system of `bodies` and `pairs` (`docs/method.md`
     /// 2.5), with the loads and prescribed displacements scaled by the step's `factors`.
@@ -289,6 +304,18 @@ impl CoupledSystem {
         pairs: &[Pair],
         dim: usize,
         factors: &StepFactors,
+    ) -> Result<Self, ContactError> {
+        Self::assemble_on(bodies, pairs, dim, factors, None)
+    }
+
+    /// [`Self::assemble`], holding only this rank's entries of `B` and `C` where `ownership`
+    /// is given ([`Unknowns::RankRows`]): a distributed run's coupled system.
+    pub fn assemble_on(
+        bodies: &[&AssembledBody],
+        pairs: &[Pair],
+        dim: usize,
+        factors: &StepFactors,
+        ownership: Option<&RowOwnership>,
     ) -> Result<Self, ContactError> {
         let mut offsets = vec![0];
         for body in bodies {
@@ -314,7 +341,7 @@ impl CoupledSystem {
         }
         let s = if m_pairs > 0 { k_scale / m_scale } else { 1.0 };
         let t = k_scale;
-        let mut blocks = PairBlocks::new(m);
+        let mut blocks = PairBlocks::new(m, ownership);
         for (p, pair) in pairs.iter().enumerate() {
             let place = Placement {
                 pair: p,
@@ -335,6 +362,10 @@ impl CoupledSystem {
         let f: Vec<f64> = (bodies.iter()).flat_map(|body| body.rhs(factors)).collect();
         Ok(Self {
             offsets,
+            unknowns: match ownership {
+                None => Unknowns::Whole,
+                Some(_) => Unknowns::RankRows,
+            },
             multiplier_offsets,
             m,
             columns: blocks.columns,
@@ -458,6 +489,7 @@ impl CoupledSystem {
         &self,
         bodies: &[&AssembledBody],
     ) -> Result<SparseColMat<usize, f64>, ContactError> {
+        self.whole("the whole matrix")?;
         let n = self.num_displacements();
         let mut triplets = Vec::new();
         for (body, &offset) in bodies.iter().zip(&self.offsets) {
@@ -494,6 +526,7 @@ impl CoupledSystem {
         solvers: Option<&[BodySolver]>,
         x: &[f64],
     ) -> Result<Vec<f64>, ContactError> {
+        self.whole("its residual")?;
         let n = self.num_displacements();
         let mut ax = vec![0.0; n];
         for (k, body) in bodies.iter().enumerate() {
@@ -527,6 +560,17 @@ impl CoupledSystem {
         let r = norm(&self.residual(bodies, solvers, x)?);
         let nb = norm(&self.rhs());
         Ok(if nb > 0.0 { r / nb } else { r })
+    }
+
+    /// Fails unless the system holds every entry of `B` and `C` ([`Unknowns::Whole`]): what
+    /// `purpose` needs.
+    fn whole(&self, purpose: &str) -> Result<(), ContactError> {
+        match self.unknowns {
+            Unknowns::Whole => Ok(()),
+            Unknowns::RankRows => Err(ContactError::Linalg(format!(
+                "{purpose} needs the whole coupled system, and this rank holds its own rows of it"
+            ))),
+        }
     }
 
     /// `[f; g]`.
@@ -637,7 +681,9 @@ pub struct SharedJump {
 }
 
 /// The coupling blocks of the pairs, added one pair at a time.
-struct PairBlocks {
+struct PairBlocks<'o> {
+    /// Where this rank's rows are, in a distributed run (`None`: every unknown, as it is).
+    ownership: Option<&'o RowOwnership>,
     /// [`CoupledSystem::columns`].
     columns: Vec<Vec<(MultiplierKey, f64)>>,
     /// [`CoupledSystem::unit_loads`].
@@ -656,9 +702,10 @@ struct PairBlocks {
     g: Vec<f64>,
 }
 
-impl PairBlocks {
-    fn new(m: usize) -> Self {
+impl<'o> PairBlocks<'o> {
+    fn new(m: usize, ownership: Option<&'o RowOwnership>) -> Self {
         Self {
+            ownership,
             columns: vec![Vec::new(); m],
             unit_loads: Vec::new(),
             c: Vec::new(),
@@ -667,6 +714,15 @@ impl PairBlocks {
             d: vec![0.0; m],
             d_coupled: Vec::new(),
             g: vec![0.0; m],
+        }
+    }
+
+    /// Where the entry of the bodies' unknown `global` goes: `global` itself, or its place
+    /// among this rank's rows (`None`: another rank's).
+    fn place(&self, global: usize) -> Option<usize> {
+        match self.ownership {
+            None => Some(global),
+            Some(ownership) => ownership.place(global),
         }
     }
 
@@ -742,7 +798,7 @@ impl PairBlocks {
                         for (side, dof, value) in forces {
                             match sides[side].unknown(dof) {
                                 Unknown::Free(row) if shared_load.is_none() => {
-                                    load.push((row, value))
+                                    load.extend(self.place(row).map(|row| (row, value)))
                                 }
                                 Unknown::Forced(a) => {
                                     self.d_coupled.push((a, multiplier, s * value * weight));
@@ -790,9 +846,10 @@ impl PairBlocks {
                                     a,
                                     t * row_weight * coefficient,
                                 )),
-                                _ if first_read => {
-                                    (jump.reads).push((c, sides[side].offset + dof, coefficient))
-                                }
+                                _ if first_read => (jump.reads).extend(
+                                    (self.place(sides[side].offset + dof))
+                                        .map(|column| (c, column, coefficient)),
+                                ),
                                 _ => {}
                             }
                         }
@@ -810,13 +867,17 @@ impl PairBlocks {
                             Unknown::Forced(a) => self.d_coupled.push((multiplier, a, value)),
                             // A prescribed dof's unknown holds its value (`K_c`'s row is its
                             // diagonal).
-                            _ => self.c.push((multiplier, sides[side].offset + dof, value)),
+                            _ => self.c.extend(
+                                (self.place(sides[side].offset + dof))
+                                    .map(|column| (multiplier, column, value)),
+                            ),
                         }
                     }
                 }
             }
+            // A jump none of whose reads is this rank's adds nothing here.
             self.shared_jumps
-                .extend(shared.filter(|jump| !jump.rows.is_empty()));
+                .extend(shared.filter(|jump| !jump.rows.is_empty() && !jump.reads.is_empty()));
         }
     }
 }
@@ -877,7 +938,7 @@ impl<'a> Side<'a> {
     }
 }
 
-impl PairBlocks {
+impl PairBlocks<'_> {
     /// The blocks of `body`'s force-controlled components (the module doc), body `k` of the
     /// system, its unknowns from `offset`, its rigid unknowns from multiplier `first`; `s` is
     /// the multipliers' scaling (which the weight `1 / s` cancels) and the step's `factors`
@@ -896,7 +957,7 @@ impl PairBlocks {
             let key = MultiplierKey::Rigid { body: k, index: r };
             self.columns[multiplier].push((key, 1.0 / s));
             let load: Vec<(usize, f64)> = (rigid.column.iter())
-                .map(|&(dof, v)| (offset + dof, v))
+                .filter_map(|&(dof, v)| Some((self.place(offset + dof)?, v)))
                 .collect();
             self.c
                 .extend(load.iter().map(|&(row, v)| (multiplier, row, v)));

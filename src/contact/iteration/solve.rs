@@ -1551,15 +1551,18 @@ impl ContactSolver<'_> {
                 coupling,
             })
             .collect();
-        let system = CoupledSystem::assemble(&bodies, &pairs, dim, factors)?;
+        let ownership = self.factors.as_ref().and_then(BodyFactors::ownership);
+        let system = CoupledSystem::assemble_on(&bodies, &pairs, dim, factors, ownership)?;
         let x = match self.factors.as_mut() {
             None => coupled_solver::solve_monolithic(&system, &bodies)?,
             Some(factors) => factors.solve(&system, &pairs, &bodies, tightness)?,
         };
         let loose = tightness != Tightness::Tight
             && self.factors.as_ref().is_some_and(BodyFactors::is_krylov);
-        let solvers = self.factors.as_ref().map(BodyFactors::solvers);
-        let residual = system.relative_residual(&bodies, solvers, &x)?;
+        let residual = match self.factors.as_ref() {
+            Some(factors) => factors.relative_residual(&system, &pairs, &bodies, &x)?,
+            None => system.relative_residual(&bodies, None, &x)?,
+        };
         if residual.is_nan() || (!loose && residual > self.solver.residual_tolerance) {
             return Err(ContactError::Inaccurate {
                 residual,
