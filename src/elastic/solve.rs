@@ -6,9 +6,8 @@ use super::StepFactors;
 use super::assemble::{AssembledBody, assemble};
 use super::error::SolveError;
 use super::problem::ElasticProblem;
-use super::solution::{ElasticSolution, SolveStats, timed};
+use super::solution::{ElasticSolution, SolveStats, timed, written_cell_fields};
 use crate::cancel::Cancel;
-use crate::fem::stress::cell_fields;
 use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
     relative_difference, relative_residual,
@@ -324,7 +323,7 @@ pub fn solve(
         .collect();
     let reactions = reactions(problem, &system, &u, &full, &[]);
     let cell_fields = timed(&mut stats, verbose, "strain and stress", || {
-        cell_fields(body, &problem.material, &u)
+        written_cell_fields(body, &problem.material, &u)
     });
     Ok(ElasticSolution {
         displacement: u,

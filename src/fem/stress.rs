@@ -35,7 +35,14 @@ fn von_mises(s: &[f64; 9]) -> f64 {
 /// Strain and stress of the displacement `u` (interleaved, `dim` per node) on every cell.
 pub fn cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellFields {
     let dim = body.dim;
-    let mut fields = CellFields::default();
+    // Sized once: grown by doubling, the three vectors would reserve up to twice their 152
+    // bytes a cell (1.9M cells at 1M DOFs: 480 MB at the peak instead of 290).
+    let cells = body.num_cells();
+    let mut fields = CellFields {
+        strain: Vec::with_capacity(cells),
+        stress: Vec::with_capacity(cells),
+        von_mises: Vec::with_capacity(cells),
+    };
     let (lambda, _) = material.lame();
     for c in 0..body.num_cells() {
         let cell = body.cell(c);

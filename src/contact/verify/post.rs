@@ -14,8 +14,8 @@ use crate::contact::solution::{
 use crate::contact::verify::hertz;
 use crate::elastic::{
     AssembledBody, ElasticProblem, ElasticSolution, SolveStats, StepFactors, reactions,
+    written_cell_fields,
 };
-use crate::fem::stress::cell_fields;
 
 /// What an active-set loop hands over: the problem with its assembled bodies, and how the loop
 /// ended with its last iterate and that iterate's certificate.
@@ -180,7 +180,7 @@ fn body_solution(
 ) -> ElasticSolution {
     ElasticSolution {
         reactions: reactions(problem, body, &u, factors, contact_force),
-        cell_fields: cell_fields(problem.body, &problem.material, &u),
+        cell_fields: written_cell_fields(problem.body, &problem.material, &u),
         displacement: u,
         stats: SolveStats {
             relative_residual: residual,
