@@ -352,6 +352,12 @@ fn a_floating_ball_between_plates_under_a_force_on_two_ranks_gives_the_serial_an
 }
 
 #[test]
+fn the_demo_on_four_ranks_gives_the_serial_answer() {
+    // Four parts per body (oversubscribed on two cores).
+    ranks_give_the_serial_answer(4, "hemisphere_on_block", "", 1);
+}
+
+#[test]
 fn two_pairs_sharing_a_block_on_three_ranks_give_the_serial_answer() {
     // Several pairs: two hemispheres pressed on one block, each pair with its own interface
     // operators, the block's rows shared among three ranks.
