@@ -15,11 +15,12 @@ run is
 ``c`` and ``p`` from the 2-rank runs at the two largest sizes, the share ``s`` that the ranks
 divide from the 2- and 4-rank runs at the largest size (a rank's mean over the ranks). The other
 runs are not used by the fit: they test it (the 4-rank run at 217k and the 31k runs, printed
-against the model). The fit reads each part where the heap peaks, so the runs it uses must peak
-in the same phase, the contact loop (the report marks each run's phase by whether the GMRES
-basis is live at the peak): since the ranks keep only their rows of the Krylov vectors and of the
-coupling blocks, the 4-rank run at 217k peaks outside the loop, and the 2-rank runs took its
-place in the fit. One process is another program (it keeps the whole stiffness for the body
+against the model). The fit reads each part at each rank's peak, and the moment of that peak moves
+between runs: since the ranks keep only their rows of the Krylov vectors and of the coupling
+blocks, the 4-rank run at 217k peaked where its GMRES basis held 0.4 MB (23 MB on 2 ranks), so
+the 2-rank runs took its place in the fit; and rank 0, which computes the strain and stress
+fields it writes, peaked at 1M in the post-processing while the other ranks peaked in the
+contact loop (the report marks whether the GMRES basis is live at a run's peak). One process is another program (it keeps the whole stiffness for the body
 solves, and several threads run dense products), so the serial runs are shown, not fitted. The
 contact surface grows like ``n^(2/3)`` under uniform refinement and the half-space blocks like
 its square: the exponents are measured, not assumed (but the one of ``FIXED_EXPONENTS``, whose
