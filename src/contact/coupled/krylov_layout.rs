@@ -21,9 +21,10 @@
 //! part, which it computes itself. The result is the same bits on every rank and from one run to
 //! the next (`MPI_Allreduce` would leave the order of the sum to the library).
 //!
-//! The coupling blocks follow the vectors (`crate::contact::coupled::row_ownership`): a rank's coupled system holds
-//! the entries of `B` on its rows and those of `C` on its columns, numbered by their place in
-//! this rank's Krylov vectors (`crate::contact::coupled::system::CoupledSystem::assemble_on`).
+//! The coupling blocks follow the vectors (`crate::contact::coupled::row_ownership`): a rank's
+//! coupled system holds the entries of `B` on its rows and those of `C` on its columns,
+//! numbered by their place in this rank's Krylov vectors
+//! (`crate::contact::coupled::system::CoupledSystem::assemble_on`).
 //! So `B lambda` is computed on this rank's rows alone, and `C u` is every rank's part over its
 //! columns, added in rank order as the inner products are (one `MPI_Allgatherv` of the `m`
 //! values each): no rank holds or gathers a whole displacement vector during the solve.
@@ -31,6 +32,7 @@
 use std::ops::Range;
 
 use crate::contact::ContactError;
+use crate::contact::coupled::row_ownership::shared_bodies;
 use crate::contact::coupled::system::{CoupledSystem, Unknowns};
 use crate::linalg::{BodySolver, Distribution, gmres};
 
@@ -57,24 +59,21 @@ impl<'a> KrylovLayout<'a> {
     /// shared among ranks, which in a distributed run every body's is (CG + AMG on its rows);
     /// then `system` must hold this rank's entries ([`Unknowns::RankRows`]).
     pub fn new(system: &CoupledSystem, solvers: &'a [BodySolver]) -> Result<Self, ContactError> {
-        let shared: Vec<&Distribution> = solvers.iter().filter_map(|s| s.distribution()).collect();
-        let rank_rows = system.unknowns == Unknowns::RankRows;
-        if shared.is_empty() && !rank_rows {
-            return Ok(Self::Whole);
-        }
-        if shared.len() != solvers.len() || !rank_rows {
-            return Err(ContactError::Linalg(format!(
-                "{} of {} bodies are shared among the ranks, and the coupled system holds {}: \
-                 the coupled GMRES needs every body shared and this rank's entries, or neither",
-                shared.len(),
-                solvers.len(),
-                if rank_rows {
-                    "this rank's entries"
-                } else {
-                    "every entry"
-                },
-            )));
-        }
+        let shared = match (shared_bodies(solvers)?, system.unknowns) {
+            (None, Unknowns::Whole) => return Ok(Self::Whole),
+            (Some(shared), Unknowns::RankRows) => shared,
+            (shared, unknowns) => {
+                return Err(ContactError::Linalg(format!(
+                    "the bodies are {} and the coupled system holds {unknowns:?}: the coupled \
+                     GMRES needs both shared among the ranks, or neither",
+                    if shared.is_some() {
+                        "shared among the ranks"
+                    } else {
+                        "whole"
+                    },
+                )));
+            }
+        };
         let mut local = vec![0];
         for body in &shared {
             local.push(local.last().unwrap() + body.local());

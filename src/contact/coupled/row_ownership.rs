@@ -21,18 +21,9 @@ impl RowOwnership {
     /// The ownership of the bodies whose `solvers` are shared among the ranks; `None` where
     /// they are whole on this process.
     pub fn of(solvers: &[BodySolver]) -> Result<Option<Self>, ContactError> {
-        let shared: Vec<&Distribution> = solvers.iter().filter_map(|s| s.distribution()).collect();
-        if shared.is_empty() {
-            return Ok(None);
-        }
-        if shared.len() != solvers.len() {
-            return Err(ContactError::Linalg(format!(
-                "{} of {} bodies are shared among the ranks: the coupled GMRES needs all or none",
-                shared.len(),
-                solvers.len()
-            )));
-        }
-        Self::from_distributions(&shared).map(Some)
+        shared_bodies(solvers)?
+            .map(|shared| Self::from_distributions(&shared))
+            .transpose()
     }
 
     /// The ownership of the bodies shared as `bodies` say, one after another.
@@ -64,5 +55,19 @@ impl RowOwnership {
             Self::ELSEWHERE => None,
             local => Some(local as usize),
         }
+    }
+}
+
+/// How each body is shared among the ranks, from its solver: every body's distribution, or
+/// `None` where every body is whole on this process (the coupled GMRES takes no mixture).
+pub fn shared_bodies(solvers: &[BodySolver]) -> Result<Option<Vec<&Distribution>>, ContactError> {
+    let shared: Vec<&Distribution> = solvers.iter().filter_map(|s| s.distribution()).collect();
+    match shared.len() {
+        0 => Ok(None),
+        n if n == solvers.len() => Ok(Some(shared)),
+        n => Err(ContactError::Linalg(format!(
+            "{n} of {} bodies are shared among the ranks: the coupled GMRES needs all or none",
+            solvers.len()
+        ))),
     }
 }
