@@ -271,6 +271,39 @@ fn twice_the_spacing_interpolates_a_linear_field_better_than_algorithm_1_on_cont
 }
 
 #[test]
+fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
+    // A rank of a distributed run keeps the entries at its own nodes only: exactly the whole
+    // row's (column's) entries there, bit for bit, and nothing elsewhere.
+    let sources = arc(1.0, &(0..40).map(|k| 0.02 * k as f64).collect::<Vec<_>>());
+    let targets = arc(
+        1.0,
+        &(0..30)
+            .map(|k| 0.011 + 0.025 * k as f64)
+            .collect::<Vec<_>>(),
+    );
+    let radii = interpolation_radii(&sources, 2.0).unwrap();
+    let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+    let mine = |i: usize| i % 3 != 1;
+    let all_targets: Vec<usize> = (0..targets.len()).collect();
+    let all_sources: Vec<usize> = (0..sources.len()).collect();
+    let pairs = [
+        (r.rows(&all_targets, |_| true), r.rows(&all_targets, mine)),
+        (
+            r.columns(&all_sources, |_| true),
+            r.columns(&all_sources, mine),
+        ),
+    ];
+    for (whole, kept) in pairs {
+        for (whole, kept) in whole.iter().zip(&kept) {
+            let expected: Vec<(usize, f64)> =
+                whole.iter().copied().filter(|&(i, _)| mine(i)).collect();
+            assert!(expected.len() < whole.len(), "some entries are left out");
+            assert_eq!(kept, &expected);
+        }
+    }
+}
+
+#[test]
 fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
     // Sources on an arc, targets on a shifted arc: R is dense, its rows and columns computed by
     // transposed and plain solves must match it to round-off, dropping only entries <= DROP_TOL.
@@ -292,7 +325,7 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         v
     };
     let all_targets: Vec<usize> = (0..targets.len()).collect();
-    for (t, row) in r.rows(&all_targets).iter().enumerate() {
+    for (t, row) in r.rows(&all_targets, |_| true).iter().enumerate() {
         let row = dense_of(row, sources.len());
         for (j, value) in row.iter().enumerate() {
             assert!(
@@ -306,7 +339,7 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         );
     }
     let all_sources: Vec<usize> = (0..sources.len()).collect();
-    for (j, column) in r.columns(&all_sources).iter().enumerate() {
+    for (j, column) in r.columns(&all_sources, |_| true).iter().enumerate() {
         let column = dense_of(column, targets.len());
         for (t, value) in column.iter().enumerate() {
             assert!(

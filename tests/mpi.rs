@@ -365,6 +365,20 @@ fn two_pairs_sharing_a_block_on_three_ranks_give_the_serial_answer() {
 }
 
 #[test]
+fn a_coulomb_pair_sheared_on_two_ranks_gives_the_serial_answer() {
+    // Friction: a sticking node's tangential rows read the interpolation R12, whose entries
+    // each rank keeps at its own nodes only; a 2D half-disc pressed, then sheared in steps.
+    ranks_give_the_serial_answer(2, "half_disc_sheared", "", 1);
+}
+
+#[test]
+fn the_conservative_transfer_on_two_ranks_gives_the_serial_answer() {
+    // The demo with the force on the secondary sent by R12^T (its rows, each rank's entries
+    // at its own nodes) instead of the columns of R21.
+    ranks_give_the_serial_answer(2, "hemisphere_on_block", "transfer = \"conservative\"", 1);
+}
+
+#[test]
 fn a_stack_of_three_2d_bodies_on_two_ranks_gives_the_serial_answer() {
     // Two pairs in a chain (the middle body in both) in 2D, two load steps.
     ranks_give_the_serial_answer(2, "stack_2d", "", 1);

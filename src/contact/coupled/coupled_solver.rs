@@ -39,13 +39,13 @@ use rayon::prelude::*;
 use crate::contact::ContactError;
 use crate::contact::coupled::compliance::SurfaceResponse;
 use crate::contact::coupled::coupled_krylov::{self, KrylovState, KrylovStats, Tightness};
-use crate::contact::coupled::row_ownership::RowOwnership;
+use crate::contact::coupled::row_ownership::{self, RowOwnership, shared_bodies};
 use crate::contact::coupled::system::{CoupledSystem, Pair, Unknowns, assembled};
 use crate::contact::settings::{ContactSettings, CoupledSolver};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
 use crate::linalg::{
-    BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
+    BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Distribution, LinalgError, Ordering,
 };
 
 /// The solvers (Cholesky factors, or CG + AMG) of every body's constrained stiffness matrix,
@@ -173,6 +173,37 @@ impl BodyFactors {
     /// Where this rank's rows of the bodies are, in a distributed run (`None` on one process).
     pub fn ownership(&self) -> Option<&RowOwnership> {
         self.ownership.as_ref()
+    }
+
+    /// The nodes of each of `bodies` at which this rank keeps the interface transfers' entries,
+    /// in a distributed run ([`row_ownership::kept_nodes`]); `None` on one process, which keeps
+    /// them all.
+    pub fn kept_nodes(
+        &self,
+        bodies: &[&AssembledBody],
+    ) -> Result<Option<Vec<Vec<bool>>>, ContactError> {
+        Ok(shared_bodies(&self.solvers)?.map(|shared| {
+            (shared.iter().zip(bodies))
+                .map(|(distribution, body)| row_ownership::kept_nodes(distribution, body))
+                .collect()
+        }))
+    }
+
+    /// The forces on the bodies numbered `which`, made on this rank from the entries it keeps,
+    /// completed from the ranks that own them ([`row_ownership::complete_forces`]); nothing
+    /// to do on one process (collective).
+    pub fn complete_forces(
+        &self,
+        which: &[usize],
+        forces: &mut [&mut Vec<f64>],
+    ) -> Result<(), ContactError> {
+        match shared_bodies(&self.solvers)? {
+            None => Ok(()),
+            Some(shared) => {
+                let bodies: Vec<&Distribution> = which.iter().map(|&k| shared[k]).collect();
+                row_ownership::complete_forces(&bodies, forces)
+            }
+        }
     }
 
     /// `|[f; g] - A x| / |[f; g]|` of the answer `x` of [`Self::solve`]: by the system's blocks,

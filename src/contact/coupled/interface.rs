@@ -155,6 +155,12 @@ impl InterfaceOperators {
     /// The coupling of the active primary candidates `active` (surface indices) under
     /// `constraint`: each node's multipliers as `law` lays them out, the traction columns of
     /// the transfers, and the constraint rows.
+    ///
+    /// `kept` (over the secondary candidates; `None`: all) says at which secondary nodes the
+    /// transfers' entries are kept: a rank of a distributed run keeps those of its own nodes
+    /// (the rows of `B` and columns of `C` it holds) and of force-controlled groups
+    /// (`crate::contact::coupled::row_ownership::kept_nodes`). The cache holds what the first
+    /// call kept, so every call of one solve passes the same `kept`.
     pub fn coupling(
         &mut self,
         primary: &ContactSurface,
@@ -162,17 +168,20 @@ impl InterfaceOperators {
         (law, enforcement): (ContactLaw, Enforcement),
         active: &[usize],
         constraint: Constraint,
+        kept: Option<&[bool]>,
     ) -> Coupling {
         let missing: Vec<usize> = active
             .iter()
             .copied()
             .filter(|i| !self.rows12.contains_key(i))
             .collect();
+        let keeps = |j: usize| kept.is_none_or(|kept| kept[j]);
         self.rows12
-            .extend(missing.iter().copied().zip(self.r12.rows(&missing)));
+            .extend(missing.iter().copied().zip(self.r12.rows(&missing, keeps)));
         if let Some(r21) = &self.r21 {
-            self.columns21
-                .extend(missing.iter().copied().zip(r21.columns(&missing)));
+            let receiving = &self.receiving;
+            let columns = r21.columns(&missing, |t| keeps(receiving[t]));
+            self.columns21.extend(missing.iter().copied().zip(columns));
         }
         let to_body2 = |entries: &[(usize, f64)], weight: &dyn Fn(usize, f64) -> f64| {
             entries

@@ -395,10 +395,10 @@ impl Interpolation {
     }
 
     /// Rows `targets` of `R_NM`, each as its entries `(source, weight)` with `|weight| >`
-    /// [`DROP_TOL`]: `R[t, :] = D_tt^-1 Phi_NM[t, :] Phi_MM^-1`, one transposed solve with
-    /// `Phi_MM` per row (in blocks). `Phi_MM^-1` is dense but its entries decay fast away from
-    /// the diagonal, so the rows are short.
-    pub fn rows(&self, targets: &[usize]) -> Vec<Vec<(usize, f64)>> {
+    /// [`DROP_TOL`] at the sources `keep` accepts: `R[t, :] = D_tt^-1 Phi_NM[t, :] Phi_MM^-1`,
+    /// one transposed solve with `Phi_MM` per row (in blocks). `Phi_MM^-1` is dense but its
+    /// entries decay fast away from the diagonal, so the rows are short.
+    pub fn rows(&self, targets: &[usize], keep: impl Fn(usize) -> bool) -> Vec<Vec<(usize, f64)>> {
         let m = self.num_sources;
         let mut rows = Vec::with_capacity(targets.len());
         for block in targets.chunks(BLOCK) {
@@ -416,16 +416,23 @@ impl Interpolation {
                 ));
             for (k, &t) in block.iter().enumerate() {
                 let scale = self.inv_d[t];
-                rows.push(sparse(z[k * m..(k + 1) * m].iter().map(|v| scale * v)));
+                rows.push(sparse(
+                    z[k * m..(k + 1) * m].iter().map(|v| scale * v),
+                    &keep,
+                ));
             }
         }
         rows
     }
 
     /// Columns `sources` of `R_NM`, each as its entries `(target, weight)` with `|weight| >`
-    /// [`DROP_TOL`]: `R[:, j] = D^-1 Phi_NM Phi_MM^-1 e_j`, one solve with `Phi_MM` per column
-    /// (in blocks).
-    pub fn columns(&self, sources: &[usize]) -> Vec<Vec<(usize, f64)>> {
+    /// [`DROP_TOL`] at the targets `keep` accepts: `R[:, j] = D^-1 Phi_NM Phi_MM^-1 e_j`, one
+    /// solve with `Phi_MM` per column (in blocks).
+    pub fn columns(
+        &self,
+        sources: &[usize],
+        keep: impl Fn(usize) -> bool,
+    ) -> Vec<Vec<(usize, f64)>> {
         let m = self.num_sources;
         let mut columns = Vec::with_capacity(sources.len());
         for block in sources.chunks(BLOCK) {
@@ -437,12 +444,17 @@ impl Interpolation {
                 .solve_in_place(MatMut::from_column_major_slice_mut(&mut x, m, block.len()));
             for k in 0..block.len() {
                 let x = &x[k * m..(k + 1) * m];
-                columns.push(sparse((0..self.num_targets()).map(|t| {
-                    let value: f64 = (self.phi_rows[t]..self.phi_rows[t + 1])
-                        .map(|p| self.phi_vals[p] * x[self.phi_cols[p]])
-                        .sum();
-                    self.inv_d[t] * value
-                })));
+                let column = (0..self.num_targets()).map(|t| match keep(t) {
+                    // A target left out reads as zero, which the drop tolerance leaves out.
+                    false => 0.0,
+                    true => {
+                        let value: f64 = (self.phi_rows[t]..self.phi_rows[t + 1])
+                            .map(|p| self.phi_vals[p] * x[self.phi_cols[p]])
+                            .sum();
+                        self.inv_d[t] * value
+                    }
+                });
+                columns.push(sparse(column, &|_| true));
             }
         }
         columns
@@ -464,11 +476,12 @@ pub const DROP_TOL: f64 = 1e-13;
 /// Right-hand sides per block of the row and column solves.
 const BLOCK: usize = 64;
 
-/// The entries of a dense vector above [`DROP_TOL`], with their positions.
-fn sparse(values: impl Iterator<Item = f64>) -> Vec<(usize, f64)> {
+/// The entries of a dense vector above [`DROP_TOL`] at the positions `keep` accepts, with
+/// their positions.
+fn sparse(values: impl Iterator<Item = f64>, keep: &impl Fn(usize) -> bool) -> Vec<(usize, f64)> {
     values
         .enumerate()
-        .filter(|(_, v)| v.abs() > DROP_TOL)
+        .filter(|&(i, v)| v.abs() > DROP_TOL && keep(i))
         .collect()
 }
 

@@ -233,6 +233,9 @@ pub struct ContactSolver<'a> {
     /// Each pair's operators, paired for the slide of the last solve; a solve without a start
     /// pairs them again unslid, so that it does not depend on earlier solves.
     operators: Vec<InterfaceOperators>,
+    /// Each pair's secondary candidates at which this rank keeps the transfers' entries, in a
+    /// distributed run (`crate::contact::coupled::row_ownership::kept_nodes`); `None`: all.
+    kept: Vec<Option<Vec<bool>>>,
     /// Each pair's contact law.
     laws: Vec<ContactLaw>,
     /// How each pair's law is enforced.
@@ -381,6 +384,17 @@ impl<'a> ContactSolver<'a> {
         let operators = (pairs.iter())
             .map(|problem| pair(problem, [0.0; 3]))
             .collect::<Result<Vec<_>, _>>()?;
+        let kept_nodes = match &factors {
+            Some(factors) => factors.kept_nodes(&body_refs)?,
+            None => None,
+        };
+        let kept = (pairs.iter().zip(&pair_bodies))
+            .map(|(problem, &[_, secondary])| {
+                let kept = kept_nodes.as_ref()?;
+                let nodes = &problem.secondary_surface.nodes;
+                Some(nodes.iter().map(|&node| kept[secondary][node]).collect())
+            })
+            .collect();
         let held_by_contact =
             coupled_solver::held_by_contacts_only(&body_refs, factors.as_ref(), solver.ordering)?
                 .into_iter()
@@ -423,6 +437,7 @@ impl<'a> ContactSolver<'a> {
             held_by_contact,
             free_motions,
             operators,
+            kept,
             laws: pairs.iter().map(|p| ContactLaw::of(&p.settings)).collect(),
             methods: pairs.iter().map(Enforcement::of).collect(),
         })
@@ -1137,7 +1152,8 @@ impl ContactSolver<'_> {
             let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
             let operators = &mut self.operators[p];
             let enforced = (law, self.methods[p]);
-            couplings.push(operators.coupling(s1, s2, enforced, &nodes[p], constraint));
+            let kept = self.kept[p].as_deref();
+            couplings.push(operators.coupling(s1, s2, enforced, &nodes[p], constraint, kept));
         }
         couplings
     }
@@ -1453,7 +1469,11 @@ impl ContactSolver<'_> {
                 secondary: b,
                 coupling: &couplings[p],
             };
-            let view = solution.of_pair(p, &pair, dim);
+            let mut view = solution.of_pair(p, &pair, dim);
+            if let Some(factors) = self.factors.as_ref() {
+                let mut forces: Vec<&mut Vec<f64>> = view.contact_force.iter_mut().collect();
+                factors.complete_forces(&[a, b], &mut forces)?;
+            }
             let (mut certificate, gaps) = certify(problem, &view, [&nodes, &solved]);
             let (slip, history, friction) = match (&state.friction[p], self.laws[p]) {
                 (
@@ -1569,7 +1589,13 @@ impl ContactSolver<'_> {
                 tolerance: self.solver.residual_tolerance,
             });
         }
-        Ok(system.solution(&x, &bodies, &pairs, dim, residual))
+        let mut solution = system.solution(&x, &bodies, &pairs, dim, residual);
+        if let Some(factors) = self.factors.as_ref() {
+            let all: Vec<usize> = (0..bodies.len()).collect();
+            let mut forces: Vec<&mut Vec<f64>> = solution.contact_force.iter_mut().collect();
+            factors.complete_forces(&all, &mut forces)?;
+        }
+        Ok(solution)
     }
 }
 
