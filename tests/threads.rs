@@ -191,11 +191,6 @@ fn an_elastic_solve_is_identical_for_any_thread_count() {
             bits(&solution.displacement) == bits(&reference.displacement),
             "{threads} threads: the displacement differs"
         );
-        assert!(
-            bits(reference.cell_fields.stress.as_flattened())
-                == bits(solution.cell_fields.stress.as_flattened()),
-            "{threads} threads: the stress differs"
-        );
     }
 }
 

@@ -52,7 +52,6 @@ PARTS = [
     ("GMRES basis and vectors", "gmres::"),
     ("coupled Krylov solve (other)", "coupled_krylov::"),
     ("mesh", "internodes::mesh::"),
-    ("strain and stress fields (written by rank 0)", "stress::cell_fields"),
     ("assembly: graph, partition, rows, loads", "internodes::elastic::"),
     ("assembly: graph, partition, rows, loads", "internodes::fem::"),
     ("assembly: graph, partition, rows, loads", "Distribution::"),

@@ -23,6 +23,7 @@ use pyo3::types::{PyDict, PyList};
 
 use internodes::case::{Case as CaseFile, CaseError, check_geo_parameters};
 use internodes::contact::{ContactStatus, StepRecord};
+use internodes::fem::stress::cell_fields;
 use internodes::mesh::{
     GmshModel, Mesh as BodyMeshes, MeshError, ModelElements, ModelGroup, mesh_from_model, mesh_geo,
     read_msh, read_msh_bytes,
@@ -1557,7 +1558,7 @@ impl BodyResult {
             .body(&solved.name)
             .expect("solved bodies are mesh bodies");
         let (n, m, dim) = (body.num_nodes(), body.num_cells(), body.dim);
-        let fields = &solved.solution.cell_fields;
+        let fields = cell_fields(body, &solved.material, &solved.solution.displacement);
         let coordinates = body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect();
         let tensors = |t: &[[f64; 9]]| t.iter().flatten().copied().collect::<Vec<f64>>();
         let surfaces = PyDict::new(py);

@@ -13,5 +13,5 @@ pub use factors::StepFactors;
 pub use problem::{
     DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, ProblemError,
 };
-pub use solution::{ElasticSolution, SolveStats, written_cell_fields};
+pub use solution::{ElasticSolution, SolveStats};
 pub use solve::{SolverSettings, reactions, rigid_stiffness, solve, unheld_components};

@@ -4,34 +4,20 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::fem::Material;
-use crate::fem::stress::{CellFields, cell_fields};
 use crate::linalg::BodySolverKind;
-use crate::mesh::BodyMesh;
 use crate::progress::Heartbeat;
 
-/// Displacement, cell fields, reactions and solver statistics of one body.
+/// Displacement, reactions and solver statistics of one body. Its strain and stress are
+/// computed from the displacement where they are read (`crate::fem::stress`): the output
+/// writes them a chunk of cells at a time, so that no process holds them whole.
 #[derive(Debug, Clone)]
 pub struct ElasticSolution {
     /// Nodal displacement, interleaved (`dim` per node).
     pub displacement: Vec<f64>,
-    /// Empty on the ranks of a distributed run that write nothing ([`written_cell_fields`]).
-    pub cell_fields: CellFields,
     /// Reaction force of each Dirichlet group: `sum (K u - f)` over its prescribed dofs, with
     /// `K`, `f` unconstrained (a node in two groups counts in both).
     pub reactions: Vec<(String, Vec<f64>)>,
     pub stats: SolveStats,
-}
-
-/// The strain and stress of `u` on every cell of `body`, where they are written: on one
-/// process, and on rank 0 of a distributed run, which writes the output. The other ranks read
-/// them nowhere and leave them empty: at 1M DOFs they would hold 290 MB each.
-pub fn written_cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellFields {
-    if crate::parallel::is_root() {
-        cell_fields(body, material, u)
-    } else {
-        CellFields::default()
-    }
 }
 
 /// Sizes, accuracy and timings of one solve, as written to the JSON summary.

@@ -6,7 +6,7 @@ use super::StepFactors;
 use super::assemble::{AssembledBody, assemble};
 use super::error::SolveError;
 use super::problem::ElasticProblem;
-use super::solution::{ElasticSolution, SolveStats, timed, written_cell_fields};
+use super::solution::{ElasticSolution, SolveStats, timed};
 use crate::cancel::Cancel;
 use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
@@ -315,19 +315,15 @@ pub fn solve(
         rigid.dofs.iter().for_each(|&dof| u[dof] = *a);
     }
 
-    // 6. Reactions and cell fields.
+    // 6. Reactions.
     // Every load and prescribed value at its full value: every path at factor 1.
     let mut full = StepFactors::uniform(1.0);
     full.paths = (problem.paths().into_iter())
         .map(|path| (path.to_string(), 1.0))
         .collect();
     let reactions = reactions(problem, &system, &u, &full, &[]);
-    let cell_fields = timed(&mut stats, verbose, "strain and stress", || {
-        written_cell_fields(body, &problem.material, &u)
-    });
     Ok(ElasticSolution {
         displacement: u,
-        cell_fields,
         reactions,
         stats,
     })

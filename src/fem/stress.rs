@@ -34,7 +34,6 @@ fn von_mises(s: &[f64; 9]) -> f64 {
 
 /// Strain and stress of the displacement `u` (interleaved, `dim` per node) on every cell.
 pub fn cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellFields {
-    let dim = body.dim;
     // Sized once: grown by doubling, the three vectors would reserve up to twice their 152
     // bytes a cell (1.9M cells at 1M DOFs: 480 MB at the peak instead of 290).
     let cells = body.num_cells();
@@ -43,34 +42,48 @@ pub fn cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellField
         stress: Vec::with_capacity(cells),
         von_mises: Vec::with_capacity(cells),
     };
-    let (lambda, _) = material.lame();
-    for c in 0..body.num_cells() {
-        let cell = body.cell(c);
-        let ue: Vec<f64> = cell
-            .iter()
-            .flat_map(|&a| u[dim * a..dim * a + dim].iter().copied())
-            .collect();
-        let (strain, stress) = if dim == 2 {
-            let (g, _) = triangle_gradients(&node_coords(&body.coords, cell));
-            let eps = strain_matrix_2d(&g) * nalgebra::SVector::<f64, 6>::from_column_slice(&ue);
-            let sig = material.plane_strain_matrix() * eps;
-            (
-                [eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]],
-                [sig[0], sig[1], lambda * (eps[0] + eps[1]), 0.0, 0.0, sig[2]],
-            )
-        } else {
-            let (g, _) = tetrahedron_gradients(&node_coords(&body.coords, cell));
-            let eps = strain_matrix_3d(&g) * nalgebra::SVector::<f64, 12>::from_column_slice(&ue);
-            let sig = material.elasticity_matrix_3d() * eps;
-            (
-                [eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]],
-                [sig[0], sig[1], sig[2], sig[3], sig[4], sig[5]],
-            )
-        };
-        let stress = tensor(stress, 1.0);
-        fields.strain.push(tensor(strain, 0.5));
-        fields.von_mises.push(von_mises(&stress));
+    for c in 0..cells {
+        let (strain, stress, von_mises) = cell_field(body, material, u, c);
+        fields.strain.push(strain);
         fields.stress.push(stress);
+        fields.von_mises.push(von_mises);
     }
     fields
+}
+
+/// Strain, stress and von Mises stress of the displacement `u` (interleaved, `dim` per node)
+/// on cell `c`: what the output writes a chunk of cells at a time, never holding the whole
+/// field (`crate::output::write_xdmf`).
+pub fn cell_field(
+    body: &BodyMesh,
+    material: &Material,
+    u: &[f64],
+    c: usize,
+) -> ([f64; 9], [f64; 9], f64) {
+    let dim = body.dim;
+    let cell = body.cell(c);
+    let ue: Vec<f64> = cell
+        .iter()
+        .flat_map(|&a| u[dim * a..dim * a + dim].iter().copied())
+        .collect();
+    let (strain, stress) = if dim == 2 {
+        let (lambda, _) = material.lame();
+        let (g, _) = triangle_gradients(&node_coords(&body.coords, cell));
+        let eps = strain_matrix_2d(&g) * nalgebra::SVector::<f64, 6>::from_column_slice(&ue);
+        let sig = material.plane_strain_matrix() * eps;
+        (
+            [eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]],
+            [sig[0], sig[1], lambda * (eps[0] + eps[1]), 0.0, 0.0, sig[2]],
+        )
+    } else {
+        let (g, _) = tetrahedron_gradients(&node_coords(&body.coords, cell));
+        let eps = strain_matrix_3d(&g) * nalgebra::SVector::<f64, 12>::from_column_slice(&ue);
+        let sig = material.elasticity_matrix_3d() * eps;
+        (
+            [eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]],
+            [sig[0], sig[1], sig[2], sig[3], sig[4], sig[5]],
+        )
+    };
+    let stress = tensor(stress, 1.0);
+    (tensor(strain, 0.5), stress, von_mises(&stress))
 }

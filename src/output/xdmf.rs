@@ -15,11 +15,10 @@
 
 use std::path::Path;
 
-use ndarray::{Array1, Array2};
-
 use super::OutputError;
 use crate::contact::SurfaceFields;
-use crate::fem::stress::CellFields;
+use crate::fem::Material;
+use crate::fem::stress::cell_field;
 use crate::mesh::BodyMesh;
 
 /// One body's mesh and fields, as written.
@@ -27,26 +26,44 @@ pub struct BodyFields<'a> {
     pub mesh: &'a BodyMesh,
     /// Interleaved, `dim` per node.
     pub displacement: &'a [f64],
-    pub cell_fields: &'a CellFields,
+    /// What the cell fields (strain, stress, von Mises) are computed with, a chunk of cells
+    /// at a time as they are written.
+    pub material: &'a Material,
     /// Interface fields on the body's contact candidate surfaces (one per pair it is in), in
     /// contact runs.
     pub surfaces: Vec<&'a SurfaceFields>,
 }
 
 /// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`.
+///
+/// Each dataset is written body by body, a bounded chunk of rows at a time
+/// ([`CHUNK_ROWS`]), straight from the bodies' own arrays: the writer never holds a copy of
+/// the whole grid (at 1M DOFs that copy was 470 MB beside the fields themselves, on the
+/// process that writes).
 pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
     let h5_path = dir.join(format!("{stem}.h5"));
     let dim = bodies.first().map_or(3, |b| b.mesh.dim);
-    let grid = Grid::gather(bodies, dim);
-    let (num_nodes, num_cells, contact) = (grid.num_nodes, grid.num_cells, grid.contact);
-    let friction = grid.friction;
-    grid.write_h5(&h5_path, dim)
+    let nodes: Vec<usize> = bodies.iter().map(|b| b.mesh.num_nodes()).collect();
+    let cells: Vec<usize> = bodies.iter().map(|b| b.mesh.num_cells()).collect();
+    let contact = bodies.iter().any(|b| !b.surfaces.is_empty());
+    let friction = (bodies.iter().flat_map(|b| &b.surfaces)).any(|s| s.friction.is_some());
+    let grid = Grid {
+        bodies,
+        dim,
+        nodes: &nodes,
+        cells: &cells,
+        contact,
+        friction,
+        chunk_rows: CHUNK_ROWS,
+    };
+    grid.write_h5(&h5_path)
         .map_err(|source| OutputError::Hdf5 {
             path: h5_path.clone(),
             source,
         })?;
 
     let xdmf_path = dir.join(format!("{stem}.xdmf"));
+    let (num_nodes, num_cells) = (nodes.iter().sum(), cells.iter().sum());
     std::fs::write(
         &xdmf_path,
         xdmf_text(stem, dim, num_nodes, num_cells, contact, friction),
@@ -57,164 +74,257 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
     })
 }
 
+/// Rows of a dataset written at a time: what the writer holds of a field beyond the bodies'
+/// own arrays (at most 4.7 MB, for the 9 values of a strain or stress row).
+const CHUNK_ROWS: usize = 1 << 16;
+
 /// Every body's nodes and cells one after the other, as the datasets of the module doc.
-struct Grid {
-    num_nodes: usize,
-    num_cells: usize,
+struct Grid<'a> {
+    bodies: &'a [BodyFields<'a>],
+    dim: usize,
+    /// Nodes and cells of each body.
+    nodes: &'a [usize],
+    cells: &'a [usize],
     /// Whether any body has interface fields (a contact run).
     contact: bool,
-    geometry: Vec<f64>,
-    displacement: Vec<f64>,
-    node_tag: Vec<i64>,
-    node_body: Vec<i32>,
-    topology: Vec<i64>,
-    cell_tag: Vec<i64>,
-    cell_body: Vec<i32>,
-    strain: Vec<f64>,
-    stress: Vec<f64>,
-    von_mises: Vec<f64>,
-    traction: Vec<f64>,
-    pressure: Vec<f64>,
-    mean_pressure: Vec<f64>,
-    gap: Vec<f64>,
-    active: Vec<i32>,
     /// Whether any surface has a Coulomb pair's tangential fields.
     friction: bool,
-    friction_state: Vec<i32>,
-    tangential_traction: Vec<f64>,
-    slip_increment: Vec<f64>,
-    accumulated_slip: Vec<f64>,
+    /// Rows written at a time ([`CHUNK_ROWS`]).
+    chunk_rows: usize,
 }
 
-impl Grid {
-    fn gather(bodies: &[BodyFields], dim: usize) -> Self {
-        let num_nodes: usize = bodies.iter().map(|b| b.mesh.num_nodes()).sum();
-        let num_cells: usize = bodies.iter().map(|b| b.mesh.num_cells()).sum();
-        let mut grid = Self {
-            num_nodes,
-            num_cells,
-            contact: bodies.iter().any(|b| !b.surfaces.is_empty()),
-            geometry: Vec::with_capacity(3 * num_nodes),
-            displacement: Vec::with_capacity(3 * num_nodes),
-            node_tag: Vec::with_capacity(num_nodes),
-            node_body: Vec::with_capacity(num_nodes),
-            topology: Vec::with_capacity((dim + 1) * num_cells),
-            cell_tag: Vec::new(),
-            cell_body: Vec::new(),
-            strain: Vec::new(),
-            stress: Vec::new(),
-            von_mises: Vec::new(),
-            traction: vec![0.0; 3 * num_nodes],
-            pressure: vec![0.0; num_nodes],
-            mean_pressure: vec![0.0; num_nodes],
-            gap: vec![0.0; num_nodes],
-            active: vec![0i32; num_nodes],
-            friction: (bodies.iter().flat_map(|b| &b.surfaces)).any(|s| s.friction.is_some()),
-            friction_state: vec![-1i32; num_nodes],
-            tangential_traction: vec![0.0; 3 * num_nodes],
-            slip_increment: vec![0.0; 3 * num_nodes],
-            accumulated_slip: vec![0.0; num_nodes],
-        };
-        let mut offset = 0;
-        for (id, body) in bodies.iter().enumerate() {
-            for surface in &body.surfaces {
-                grid.add_surface(surface, offset);
-            }
-            let m = body.mesh;
-            for (a, x) in m.coords.iter().enumerate() {
-                grid.geometry.extend_from_slice(x);
-                let mut u = [0.0; 3];
-                u[..dim].copy_from_slice(&body.displacement[dim * a..dim * a + dim]);
-                grid.displacement.extend_from_slice(&u);
-            }
-            grid.node_tag.extend(m.node_tags.iter().map(|&t| t as i64));
-            grid.node_body
-                .extend(std::iter::repeat_n(id as i32, m.num_nodes()));
-            grid.topology
-                .extend(m.cells.iter().map(|&n| (n + offset) as i64));
-            grid.cell_tag.extend(m.cell_tags.iter().map(|&t| t as i64));
-            grid.cell_body
-                .extend(std::iter::repeat_n(id as i32, m.num_cells()));
-            grid.strain.extend(body.cell_fields.strain.iter().flatten());
-            grid.stress.extend(body.cell_fields.stress.iter().flatten());
-            grid.von_mises
-                .extend_from_slice(&body.cell_fields.von_mises);
-            offset += m.num_nodes();
-        }
-        grid
-    }
+/// Values per row of a dataset: one (a dataset of one dimension) or a table's columns.
+#[derive(Clone, Copy)]
+enum Width {
+    Scalar,
+    Columns(usize),
+}
 
-    /// The interface fields of a body whose first node is node `offset` of the grid.
-    fn add_surface(&mut self, surface: &SurfaceFields, offset: usize) {
-        for (s, &node) in surface.nodes.iter().enumerate() {
-            let row = offset + node;
-            self.traction[3 * row..3 * row + 3].copy_from_slice(&surface.traction[s]);
-            self.pressure[row] = surface.pressure[s];
-            self.mean_pressure[row] = surface.mean_pressure[s];
-            self.gap[row] = surface.normal_gap[s];
-            self.active[row] = i32::from(surface.active[s]);
-            if let Some(friction) = &surface.friction {
-                self.friction_state[row] = friction.state[s].code() as i32;
-                let vector = 3 * row..3 * row + 3;
-                self.tangential_traction[vector.clone()]
-                    .copy_from_slice(&friction.tangential_traction[s]);
-                self.slip_increment[vector].copy_from_slice(&friction.slip_increment[s]);
-                self.accumulated_slip[row] = friction.accumulated_slip[s];
-            }
-        }
-    }
-
-    fn write_h5(self, path: &Path, dim: usize) -> hdf5::Result<()> {
+impl Grid<'_> {
+    fn write_h5(&self, path: &Path) -> hdf5::Result<()> {
+        let (bodies, dim) = (self.bodies, self.dim);
         let file = hdf5::File::create(path)?;
         let mesh = file.create_group("mesh")?;
         let fields = file.create_group("fields")?;
-        let table = |v: Vec<f64>, cols: usize| {
-            Array2::from_shape_vec((v.len() / cols, cols), v).expect("rows * cols")
+        let (nodes, cells) = (self.nodes, self.cells);
+        let body = |k: usize| &bodies[k];
+        let first_nodes: Vec<usize> = (nodes.iter())
+            .scan(0, |first, &n| {
+                let this = *first;
+                *first += n;
+                Some(this)
+            })
+            .collect();
+        let geometry = |k: usize| body(k).mesh.coords.iter().flatten().copied();
+        self.write_by_body(&mesh, "geometry", Width::Columns(3), nodes, geometry)?;
+        let topology = |k: usize| {
+            let first = first_nodes[k];
+            body(k).mesh.cells.iter().map(move |&n| (n + first) as i64)
         };
-        let topology =
-            Array2::from_shape_vec((self.num_cells, dim + 1), self.topology).expect("rows * cols");
-        write_dataset(&mesh, "geometry", &table(self.geometry, 3))?;
-        write_dataset(&mesh, "topology", &topology)?;
-        write_dataset(&mesh, "node_tag", &Array1::from(self.node_tag))?;
-        write_dataset(&mesh, "node_body", &Array1::from(self.node_body))?;
-        write_dataset(&mesh, "cell_tag", &Array1::from(self.cell_tag))?;
-        write_dataset(&mesh, "cell_body", &Array1::from(self.cell_body))?;
-        write_dataset(&fields, "displacement", &table(self.displacement, 3))?;
-        write_dataset(&fields, "strain", &table(self.strain, 9))?;
-        write_dataset(&fields, "stress", &table(self.stress, 9))?;
-        write_dataset(&fields, "von_mises", &Array1::from(self.von_mises))?;
+        self.write_by_body(&mesh, "topology", Width::Columns(dim + 1), cells, topology)?;
+        let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|&t| t as i64);
+        self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
+        let node_body = |k: usize| std::iter::repeat_n(k as i32, nodes[k]);
+        self.write_by_body(&mesh, "node_body", Width::Scalar, nodes, node_body)?;
+        let cell_tag = |k: usize| body(k).mesh.cell_tags.iter().map(|&t| t as i64);
+        self.write_by_body(&mesh, "cell_tag", Width::Scalar, cells, cell_tag)?;
+        let cell_body = |k: usize| std::iter::repeat_n(k as i32, cells[k]);
+        self.write_by_body(&mesh, "cell_body", Width::Scalar, cells, cell_body)?;
+        let displacement = |k: usize| {
+            (body(k).displacement.chunks_exact(dim)).flat_map(move |u| {
+                let mut padded = [0.0; 3];
+                padded[..dim].copy_from_slice(u);
+                padded
+            })
+        };
+        self.write_by_body(
+            &fields,
+            "displacement",
+            Width::Columns(3),
+            nodes,
+            displacement,
+        )?;
+        self.write_cell_fields(&fields)?;
         if self.contact {
-            write_dataset(&fields, "contact_traction", &table(self.traction, 3))?;
-            write_dataset(&fields, "contact_pressure", &Array1::from(self.pressure))?;
-            write_dataset(
+            let traction = |k: usize| {
+                on_surfaces(body(k), 3, 0.0, |f, s, v| v.copy_from_slice(&f.traction[s]))
+            };
+            self.write_by_body(
                 &fields,
-                "contact_mean_pressure",
-                &Array1::from(self.mean_pressure),
+                "contact_traction",
+                Width::Columns(3),
+                nodes,
+                traction,
             )?;
-            write_dataset(&fields, "normal_gap", &Array1::from(self.gap))?;
-            write_dataset(&fields, "contact_active", &Array1::from(self.active))?;
+            let pressure = |k: usize| on_surfaces(body(k), 1, 0.0, |f, s, v| v[0] = f.pressure[s]);
+            self.write_by_body(&fields, "contact_pressure", Width::Scalar, nodes, pressure)?;
+            let mean = |k: usize| on_surfaces(body(k), 1, 0.0, |f, s, v| v[0] = f.mean_pressure[s]);
+            self.write_by_body(&fields, "contact_mean_pressure", Width::Scalar, nodes, mean)?;
+            let gap = |k: usize| on_surfaces(body(k), 1, 0.0, |f, s, v| v[0] = f.normal_gap[s]);
+            self.write_by_body(&fields, "normal_gap", Width::Scalar, nodes, gap)?;
+            let active =
+                |k: usize| on_surfaces(body(k), 1, 0i32, |f, s, v| v[0] = i32::from(f.active[s]));
+            self.write_by_body(&fields, "contact_active", Width::Scalar, nodes, active)?;
         }
         if self.friction {
-            let state = Array1::from(self.friction_state);
-            write_dataset(&fields, "friction_state", &state)?;
-            let traction = table(self.tangential_traction, 3);
-            write_dataset(&fields, "tangential_traction", &traction)?;
-            write_dataset(&fields, "slip_increment", &table(self.slip_increment, 3))?;
-            let accumulated = Array1::from(self.accumulated_slip);
-            write_dataset(&fields, "accumulated_slip", &accumulated)?;
+            // Each field only on the surfaces of a Coulomb pair (-1, or zero, elsewhere).
+            let state = |k: usize| {
+                on_surfaces(body(k), 1, -1i32, |f, s, v| {
+                    if let Some(friction) = &f.friction {
+                        v[0] = friction.state[s].code() as i32;
+                    }
+                })
+            };
+            self.write_by_body(&fields, "friction_state", Width::Scalar, nodes, state)?;
+            let tangential = |k: usize| {
+                on_surfaces(body(k), 3, 0.0, |f, s, v| {
+                    if let Some(friction) = &f.friction {
+                        v.copy_from_slice(&friction.tangential_traction[s]);
+                    }
+                })
+            };
+            let width = Width::Columns(3);
+            self.write_by_body(&fields, "tangential_traction", width, nodes, tangential)?;
+            let slip = |k: usize| {
+                on_surfaces(body(k), 3, 0.0, |f, s, v| {
+                    if let Some(friction) = &f.friction {
+                        v.copy_from_slice(&friction.slip_increment[s]);
+                    }
+                })
+            };
+            self.write_by_body(&fields, "slip_increment", width, nodes, slip)?;
+            let accumulated = |k: usize| {
+                on_surfaces(body(k), 1, 0.0, |f, s, v| {
+                    if let Some(friction) = &f.friction {
+                        v[0] = friction.accumulated_slip[s];
+                    }
+                })
+            };
+            self.write_by_body(
+                &fields,
+                "accumulated_slip",
+                Width::Scalar,
+                nodes,
+                accumulated,
+            )?;
         }
         file.close()
     }
+
+    /// Creates the dataset `name` in `group`, `width` values for each of the `rows[k]` rows of
+    /// body `k`, the bodies one after the other, and writes it from `values(k)` (body `k`'s
+    /// values, row after row), [`Self::chunk_rows`] rows at a time.
+    fn write_by_body<T, I>(
+        &self,
+        group: &hdf5::Group,
+        name: &str,
+        width: Width,
+        rows: &[usize],
+        values: impl Fn(usize) -> I,
+    ) -> hdf5::Result<()>
+    where
+        T: hdf5::H5Type + Copy,
+        I: Iterator<Item = T>,
+    {
+        let (total, chunk_rows): (usize, usize) = (rows.iter().sum(), self.chunk_rows);
+        let (dataset, columns) = match width {
+            Width::Scalar => (group.new_dataset::<T>().shape(total).create(name)?, 1),
+            Width::Columns(c) => (group.new_dataset::<T>().shape((total, c)).create(name)?, c),
+        };
+        let mut chunk = Vec::with_capacity(chunk_rows.min(total) * columns);
+        let mut first = 0;
+        for (k, &count) in rows.iter().enumerate() {
+            let mut body = values(k);
+            let mut written = 0;
+            while written < count {
+                let n = chunk_rows.min(count - written);
+                chunk.clear();
+                chunk.extend(body.by_ref().take(n * columns));
+                if chunk.len() != n * columns {
+                    return Err(hdf5::Error::from(format!(
+                        "{name}: body {k} has {} values for {count} rows of {columns}",
+                        written * columns + chunk.len()
+                    )));
+                }
+                let rows = first..first + n;
+                match width {
+                    Width::Scalar => dataset.write_slice(&chunk[..], rows)?,
+                    Width::Columns(c) => {
+                        let table = ndarray::ArrayView2::from_shape((n, c), &chunk[..])
+                            .expect("n rows of c values");
+                        dataset.write_slice(table, ndarray::s![rows, ..])?
+                    }
+                }
+                first += n;
+                written += n;
+            }
+        }
+        Ok(())
+    }
+
+    /// The datasets `strain`, `stress` (9 values a cell) and `von_mises` of the bodies' `cells`,
+    /// each cell computed once from its body's displacement ([`cell_field`]), [`Self::chunk_rows`]
+    /// cells at a time.
+    fn write_cell_fields(&self, group: &hdf5::Group) -> hdf5::Result<()> {
+        let (bodies, cells, chunk_rows) = (self.bodies, self.cells, self.chunk_rows);
+        let total: usize = cells.iter().sum();
+        let strain = group
+            .new_dataset::<f64>()
+            .shape((total, 9))
+            .create("strain")?;
+        let stress = group
+            .new_dataset::<f64>()
+            .shape((total, 9))
+            .create("stress")?;
+        let von_mises = group
+            .new_dataset::<f64>()
+            .shape(total)
+            .create("von_mises")?;
+        let chunk = chunk_rows.min(total);
+        let mut values = [Vec::with_capacity(9 * chunk), Vec::with_capacity(9 * chunk)];
+        let mut equivalent = Vec::with_capacity(chunk);
+        let mut first = 0;
+        for (body, &count) in bodies.iter().zip(cells) {
+            for start in (0..count).step_by(chunk_rows) {
+                let end = count.min(start + chunk_rows);
+                values.iter_mut().for_each(Vec::clear);
+                equivalent.clear();
+                for c in start..end {
+                    let (e, s, v) = cell_field(body.mesh, body.material, body.displacement, c);
+                    values[0].extend(e);
+                    values[1].extend(s);
+                    equivalent.push(v);
+                }
+                let rows = first + start..first + end;
+                for (dataset, values) in [&strain, &stress].into_iter().zip(&values) {
+                    let table = ndarray::ArrayView2::from_shape((end - start, 9), &values[..])
+                        .expect("9 values a cell");
+                    dataset.write_slice(table, ndarray::s![rows.clone(), ..])?;
+                }
+                von_mises.write_slice(&equivalent[..], rows)?;
+            }
+            first += count;
+        }
+        Ok(())
+    }
 }
 
-/// Creates the dataset `name` in `group` holding `data`.
-fn write_dataset<T: hdf5::H5Type, D: ndarray::Dimension>(
-    group: &hdf5::Group,
-    name: &str,
-    data: &ndarray::Array<T, D>,
-) -> hdf5::Result<()> {
-    group.new_dataset_builder().with_data(data).create(name)?;
-    Ok(())
+/// A node field of `body` over all its nodes, `width` values a node: `default` off its
+/// candidate surfaces, and where `set(surface, s, values)` puts them at candidate `s` of each
+/// (a later surface's over an earlier one's at a shared node).
+fn on_surfaces<T: Copy>(
+    body: &BodyFields,
+    width: usize,
+    default: T,
+    set: impl Fn(&SurfaceFields, usize, &mut [T]),
+) -> std::vec::IntoIter<T> {
+    let mut values = vec![default; width * body.mesh.num_nodes()];
+    for surface in &body.surfaces {
+        for (s, &node) in surface.nodes.iter().enumerate() {
+            set(surface, s, &mut values[width * node..width * node + width]);
+        }
+    }
+    values.into_iter()
 }
 
 /// One `<Attribute>` of the grid: a dataset of the `.h5` by its path.
@@ -418,4 +528,146 @@ fn xdmf_text(
     }
     s += "    </Grid>\n  </Domain>\n</Xdmf>\n";
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::fem::stress::cell_fields;
+
+    /// A strip of `n` unit squares (two triangles each) from `x0`.
+    fn strip(name: &str, x0: f64, n: usize) -> BodyMesh {
+        let coords = (0..=n)
+            .flat_map(|i| [[x0 + i as f64, 0.0, 0.0], [x0 + i as f64, 1.0, 0.0]])
+            .collect();
+        let cells: Vec<usize> = (0..n)
+            .flat_map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 1])
+            .collect();
+        BodyMesh {
+            name: name.into(),
+            physical_tag: 1,
+            dim: 2,
+            coords,
+            node_tags: (0..2 * (n + 1)).map(|a| 100 + a as u64).collect(),
+            cell_tags: (0..2 * n).map(|c| 500 + c as u64).collect(),
+            cells,
+            boundary_groups: BTreeMap::new(),
+            point_groups: BTreeMap::new(),
+        }
+    }
+
+    #[test]
+    fn written_in_chunks_the_datasets_are_the_bodies_one_after_the_other() {
+        // Chunks of 3 rows: bodies of 14 and 10 cells cross chunk ends inside each body.
+        let meshes = [strip("a", 0.0, 7), strip("b", 10.0, 5)];
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let displacements: Vec<Vec<f64>> = (meshes.iter())
+            .map(|m| {
+                (m.coords.iter())
+                    .flat_map(|x| [1e-3 * x[0] * x[1], -2e-3 * x[1]])
+                    .collect()
+            })
+            .collect();
+        let bodies: Vec<BodyFields> = (meshes.iter().zip(&displacements))
+            .map(|(mesh, u)| BodyFields {
+                mesh,
+                displacement: u,
+                material: &material,
+                surfaces: Vec::new(),
+            })
+            .collect();
+        let (nodes, cells) = ([16, 12], [14, 10]);
+        let grid = Grid {
+            bodies: &bodies,
+            dim: 2,
+            nodes: &nodes,
+            cells: &cells,
+            contact: false,
+            friction: false,
+            chunk_rows: 3,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("grid.h5");
+        grid.write_h5(&path).unwrap();
+
+        let file = hdf5::File::open(&path).unwrap();
+        let read = |name: &str| file.dataset(name).unwrap().read_raw::<f64>().unwrap();
+        let topology = file
+            .dataset("mesh/topology")
+            .unwrap()
+            .read_raw::<i64>()
+            .unwrap();
+        let expected: Vec<i64> = (meshes[0].cells.iter().map(|&n| n as i64))
+            .chain(meshes[1].cells.iter().map(|&n| (n + 16) as i64))
+            .collect();
+        assert_eq!(topology, expected);
+        let cell_body = file
+            .dataset("mesh/cell_body")
+            .unwrap()
+            .read_raw::<i32>()
+            .unwrap();
+        assert_eq!(cell_body, [vec![0; 14], vec![1; 10]].concat());
+        let tags = file
+            .dataset("mesh/node_tag")
+            .unwrap()
+            .read_raw::<i64>()
+            .unwrap();
+        assert_eq!(
+            tags,
+            [(100..116).collect::<Vec<i64>>(), (100..112).collect()].concat()
+        );
+        let padded: Vec<f64> = (displacements.iter())
+            .flat_map(|u| u.chunks_exact(2).flat_map(|u| [u[0], u[1], 0.0]))
+            .collect();
+        assert_eq!(read("fields/displacement"), padded);
+        let whole: Vec<_> = (meshes.iter().zip(&displacements))
+            .map(|(mesh, u)| cell_fields(mesh, &material, u))
+            .collect();
+        let strain: Vec<f64> = (whole.iter())
+            .flat_map(|f| f.strain.iter().flatten().copied())
+            .collect();
+        let stress: Vec<f64> = (whole.iter())
+            .flat_map(|f| f.stress.iter().flatten().copied())
+            .collect();
+        let von_mises: Vec<f64> = whole.iter().flat_map(|f| f.von_mises.clone()).collect();
+        assert_eq!(read("fields/strain"), strain);
+        assert_eq!(read("fields/stress"), stress);
+        assert_eq!(read("fields/von_mises"), von_mises);
+    }
+
+    #[test]
+    fn a_body_with_fewer_values_than_rows_is_an_error_not_a_short_dataset() {
+        let meshes = [strip("a", 0.0, 2)];
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let u = vec![0.0; 12];
+        let bodies = [BodyFields {
+            mesh: &meshes[0],
+            displacement: &u,
+            material: &material,
+            surfaces: Vec::new(),
+        }];
+        let grid = Grid {
+            bodies: &bodies,
+            dim: 2,
+            nodes: &[6],
+            cells: &[4],
+            contact: false,
+            friction: false,
+            chunk_rows: 3,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let file = hdf5::File::create(dir.path().join("short.h5")).unwrap();
+        let group = file.create_group("g").unwrap();
+        let short = |_| [1.0, 2.0].into_iter();
+        let error = grid
+            .write_by_body(&group, "short", Width::Columns(3), &[1], short)
+            .unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("short: body 0 has 2 values for 1 rows of 3")
+        );
+    }
 }

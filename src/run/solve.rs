@@ -9,6 +9,7 @@ use crate::contact::{
     ContactProblem, ContactRun, ContactSolution, SurfaceFields, solve_contact_steps,
 };
 use crate::elastic::{DirichletCondition, ElasticSolution, solve};
+use crate::fem::Material;
 use crate::mesh::Mesh;
 use crate::output::{BodySummary, CaseSummary, ContactSummary, peak_memory_mb};
 
@@ -69,6 +70,9 @@ pub struct CaseSolution {
 /// in, in the case's order of pairs).
 pub struct SolvedBody {
     pub name: String,
+    /// Its material: its strain and stress are computed from the displacement where they are
+    /// read (`crate::fem::stress`).
+    pub material: Material,
     pub solution: ElasticSolution,
     pub surfaces: Vec<PairSurface>,
 }
@@ -230,6 +234,7 @@ fn bodies_in_contact(
                 Some(body) => body.surfaces.push(fields),
                 None => bodies.push(SolvedBody {
                     name: elastic.body.name.clone(),
+                    material: elastic.material,
                     solution: body_solution,
                     surfaces: vec![fields],
                 }),
@@ -263,6 +268,7 @@ fn solve_alone(
     timings.record(format!("solve {}", body.name), phase);
     Ok(SolvedBody {
         name: spec.name.clone(),
+        material: problem.material,
         solution,
         surfaces: Vec::new(),
     })

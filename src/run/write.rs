@@ -54,7 +54,7 @@ pub fn write_results(
         .map(|(s, body)| BodyFields {
             mesh: body,
             displacement: &s.solution.displacement,
-            cell_fields: &s.solution.cell_fields,
+            material: &s.material,
             surfaces: s.surfaces.iter().map(|s| &s.fields).collect(),
         })
         .collect();

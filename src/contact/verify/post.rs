@@ -14,7 +14,6 @@ use crate::contact::solution::{
 use crate::contact::verify::hertz;
 use crate::elastic::{
     AssembledBody, ElasticProblem, ElasticSolution, SolveStats, StepFactors, reactions,
-    written_cell_fields,
 };
 
 /// What an active-set loop hands over: the problem with its assembled bodies, and how the loop
@@ -168,7 +167,7 @@ fn max_tangential(traction: &[[f64; 3]], normals: &[[f64; 3]]) -> f64 {
 }
 
 /// One body's part of the answer: displacement `u`, the reactions of its Dirichlet groups
-/// (with the interface's `contact_force` on it), cell strains and stresses; the coupled
+/// (with the interface's `contact_force` on it); the coupled
 /// system's `residual` replaces the body's own.
 fn body_solution(
     problem: &ElasticProblem,
@@ -180,7 +179,6 @@ fn body_solution(
 ) -> ElasticSolution {
     ElasticSolution {
         reactions: reactions(problem, body, &u, factors, contact_force),
-        cell_fields: written_cell_fields(problem.body, &problem.material, &u),
         displacement: u,
         stats: SolveStats {
             relative_residual: residual,
