@@ -270,10 +270,9 @@ fn twice_the_spacing_interpolates_a_linear_field_better_than_algorithm_1_on_cont
     }
 }
 
-#[test]
-fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
-    // A rank of a distributed run keeps the entries at its own nodes only: exactly the whole
-    // row's (column's) entries there, bit for bit, and nothing elsewhere.
+/// 40 sources on an arc and 30 targets on a shifted arc, radii twice the spacing: an
+/// interpolation whose `R` is dense.
+fn arc_interpolation() -> (Interpolation, [usize; 2]) {
     let sources = arc(1.0, &(0..40).map(|k| 0.02 * k as f64).collect::<Vec<_>>());
     let targets = arc(
         1.0,
@@ -283,9 +282,17 @@ fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
     );
     let radii = interpolation_radii(&sources, 2.0).unwrap();
     let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+    (r, [sources.len(), targets.len()])
+}
+
+#[test]
+fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
+    // A rank of a distributed run keeps the entries at its own nodes only: exactly the whole
+    // row's (column's) entries there, bit for bit, and nothing elsewhere.
+    let (r, [num_sources, num_targets]) = arc_interpolation();
     let mine = |i: usize| i % 3 != 1;
-    let all_targets: Vec<usize> = (0..targets.len()).collect();
-    let all_sources: Vec<usize> = (0..sources.len()).collect();
+    let all_targets: Vec<usize> = (0..num_targets).collect();
+    let all_sources: Vec<usize> = (0..num_sources).collect();
     let pairs = [
         (r.rows(&all_targets, |_| true), r.rows(&all_targets, mine)),
         (
@@ -307,15 +314,7 @@ fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
 fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
     // Sources on an arc, targets on a shifted arc: R is dense, its rows and columns computed by
     // transposed and plain solves must match it to round-off, dropping only entries <= DROP_TOL.
-    let sources = arc(1.0, &(0..40).map(|k| 0.02 * k as f64).collect::<Vec<_>>());
-    let targets = arc(
-        1.0,
-        &(0..30)
-            .map(|k| 0.011 + 0.025 * k as f64)
-            .collect::<Vec<_>>(),
-    );
-    let radii = interpolation_radii(&sources, 2.0).unwrap();
-    let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+    let (r, [num_sources, num_targets]) = arc_interpolation();
     let dense = r.matrix();
     let dense_of = |entries: &[(usize, f64)], len: usize| {
         let mut v = vec![0.0; len];
@@ -324,9 +323,9 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         }
         v
     };
-    let all_targets: Vec<usize> = (0..targets.len()).collect();
+    let all_targets: Vec<usize> = (0..num_targets).collect();
     for (t, row) in r.rows(&all_targets, |_| true).iter().enumerate() {
-        let row = dense_of(row, sources.len());
+        let row = dense_of(row, num_sources);
         for (j, value) in row.iter().enumerate() {
             assert!(
                 (value - dense[(t, j)]).abs() <= 1e-12 + DROP_TOL,
@@ -338,9 +337,9 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
             "row {t} sums to one"
         );
     }
-    let all_sources: Vec<usize> = (0..sources.len()).collect();
+    let all_sources: Vec<usize> = (0..num_sources).collect();
     for (j, column) in r.columns(&all_sources, |_| true).iter().enumerate() {
-        let column = dense_of(column, targets.len());
+        let column = dense_of(column, num_targets);
         for (t, value) in column.iter().enumerate() {
             assert!(
                 (value - dense[(t, j)]).abs() <= 1e-12 + DROP_TOL,
