@@ -18,9 +18,10 @@ runs are not used by the fit: they test it (the 4-rank run at 217k and the 31k r
 against the model). The fit reads each part at each rank's peak, and the moment of that peak moves
 between runs: since the ranks keep only their rows of the Krylov vectors and of the coupling
 blocks, the 4-rank run at 217k peaked where its GMRES basis held 0.4 MB (23 MB on 2 ranks), so
-the 2-rank runs took its place in the fit; and rank 0, which computes the strain and stress
-fields it writes, peaked at 1M in the post-processing while the other ranks peaked in the
-contact loop (the report marks whether the GMRES basis is live at a run's peak). One process is another program (it keeps the whole stiffness for the body
+the 2-rank runs took its place in the fit. (Rank 0 also peaked at 1M in the post-processing,
+while it held the strain and stress fields and a gathered copy of the grid to write them; since
+the output is written a chunk at a time, every rank peaks in the contact loop: the report marks
+whether the GMRES basis is live at a run's peak.) One process is another program (it keeps the whole stiffness for the body
 solves, and several threads run dense products), so the serial runs are shown, not fitted. The
 contact surface grows like ``n^(2/3)`` under uniform refinement and the half-space blocks like
 its square: the exponents are measured, not assumed (but the one of ``FIXED_EXPONENTS``, whose
