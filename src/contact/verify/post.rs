@@ -166,9 +166,9 @@ fn max_tangential(traction: &[[f64; 3]], normals: &[[f64; 3]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// One body's part of the answer: displacement `u`, the reactions of its Dirichlet groups
-/// (with the interface's `contact_force` on it); the coupled
-/// system's `residual` replaces the body's own.
+/// One body's part of the answer: displacement `u` and the reactions of its Dirichlet groups
+/// (with the interface's `contact_force` on it); the coupled system's `residual` replaces the
+/// body's own.
 fn body_solution(
     problem: &ElasticProblem,
     (body, stats): (&AssembledBody, &SolveStats),
