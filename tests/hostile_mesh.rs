@@ -28,7 +28,7 @@ fn cells_by_tag(mesh: &Mesh) -> HashMap<u64, Vec<u64>> {
         .flat_map(|b| {
             (0..b.num_cells()).map(move |c| {
                 (
-                    b.cell_tags[c],
+                    b.cell_tags.get(c),
                     b.cell(c).iter().map(|&n| b.node_tags[n]).collect(),
                 )
             })

@@ -365,6 +365,14 @@ fn two_pairs_sharing_a_block_on_three_ranks_give_the_serial_answer() {
 }
 
 #[test]
+fn a_hemisphere_pressed_by_a_force_on_three_ranks_gives_the_serial_answer() {
+    // Force control: the approach is an unknown of the coupled solve, its column `k` and row
+    // held whole by every rank (the rigid block), the sphere's rows shared among three ranks;
+    // four load steps.
+    ranks_give_the_serial_answer(3, "hemisphere_pressed_by_force", "", 1);
+}
+
+#[test]
 fn a_coulomb_pair_sheared_on_two_ranks_gives_the_serial_answer() {
     // Friction: a sticking node's tangential rows read the interpolation R12, whose entries
     // each rank keeps at its own nodes only; a 2D half-disc pressed, then sheared in steps.

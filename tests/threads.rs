@@ -67,7 +67,7 @@ fn jittered_cube(n: usize) -> BodyMesh {
             for i in 0..n {
                 let corner = |c: usize| index(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
                 for [a, b] in PATHS {
-                    cells.extend([corner(0), corner(a), corner(b), corner(7)]);
+                    cells.extend([corner(0), corner(a), corner(b), corner(7)].map(|n| n as u32));
                 }
             }
         }
@@ -98,8 +98,8 @@ fn stiffness_assembly_is_identical_for_any_thread_count() {
     // The plain sequential scatter, one cell after another.
     let mut sequential = vec![0.0; pattern.nnz()];
     for c in 0..body.num_cells() {
-        let ke = tetrahedron_stiffness(&node_coords(&body.coords, body.cell(c)), &material);
-        pattern.add_element(body.cell(c), ke.as_slice(), &mut sequential);
+        let ke = tetrahedron_stiffness(&node_coords(&body.coords, &body.cell(c)), &material);
+        pattern.add_element(&body.cell(c), ke.as_slice(), &mut sequential);
     }
     for threads in THREADS {
         let k = with_threads(threads, || assemble_stiffness(&body, &material, &pattern));

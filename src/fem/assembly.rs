@@ -7,7 +7,7 @@ use super::kernels::{
     facet_mass, facet_measure_and_normal, tetrahedron_stiffness, triangle_stiffness,
 };
 use super::{Material, NodeGraph, SparsityPattern};
-use crate::mesh::{BodyMesh, FacetGroup};
+use crate::mesh::{BodyMesh, CellNodes, FacetGroup};
 
 /// Coordinates of the `N` nodes of a cell or facet.
 pub fn node_coords<const N: usize>(coords: &[[f64; 3]], nodes: &[usize]) -> [[f64; 3]; N] {
@@ -75,12 +75,14 @@ pub fn assemble_stiffness(
 ) -> SparseColMat<usize, f64> {
     let nodes_per_cell = body.nodes_per_cell();
     let size = (body.dim * nodes_per_cell).pow(2);
-    let batches: Vec<&[usize]> = body.cells.chunks(CELL_BATCH * nodes_per_cell).collect();
-    let element_matrices = |cells: &[usize], out: &mut [f64]| {
+    let batches: Vec<&[u32]> = body.cells.chunks(CELL_BATCH * nodes_per_cell).collect();
+    let element_matrices = |cells: &[u32], out: &mut [f64]| {
         out[..cells.len() / nodes_per_cell * size]
             .par_chunks_exact_mut(size)
             .zip(cells.par_chunks_exact(nodes_per_cell))
-            .for_each(|(element, cell)| element_stiffness(body, material, cell, element));
+            .for_each(|(element, cell)| {
+                element_stiffness(body, material, &CellNodes::of(cell), element)
+            });
     };
     let mut values = vec![0.0; pattern.nnz()];
     let batch_len = CELL_BATCH.min(body.num_cells()) * size;
@@ -96,7 +98,7 @@ pub fn assemble_stiffness(
                     .chunks_exact(nodes_per_cell)
                     .zip(current.chunks_exact(size))
                 {
-                    pattern.add_element(cell, element, &mut values);
+                    pattern.add_element(&CellNodes::of(cell), element, &mut values);
                 }
             },
             || {

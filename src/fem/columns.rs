@@ -61,15 +61,15 @@ impl NodeColumns {
         let nodes_per_cell = body.nodes_per_cell();
         let n = block * nodes_per_cell;
         let mut element = vec![0.0; n * n];
-        for cell in body.cells.chunks_exact(nodes_per_cell) {
+        for cell in body.cells() {
             if cell.iter().all(|&a| position[a] == usize::MAX) {
                 continue;
             }
-            element_stiffness(body, material, cell, &mut element);
+            element_stiffness(body, material, &cell, &mut element);
             for (ja, &a) in cell.iter().enumerate() {
                 let q = position[a];
                 if q != usize::MAX {
-                    graph.add_node_columns(cell, ja, &element, &col_ptr[block * q..], &mut values);
+                    graph.add_node_columns(&cell, ja, &element, &col_ptr[block * q..], &mut values);
                 }
             }
         }
@@ -139,7 +139,7 @@ mod tests {
             node_tags: (1..=5).collect(),
             coords,
             cells: vec![0, 1, 2, 1, 3, 2, 1, 4, 3],
-            cell_tags: vec![1, 2, 3],
+            cell_tags: vec![1, 2, 3].into(),
             boundary_groups: Default::default(),
             point_groups: Default::default(),
         };

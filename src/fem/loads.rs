@@ -73,11 +73,11 @@ pub fn add_body_force(body: &BodyMesh, b: &[f64; 3], f: &mut [f64]) {
     for c in 0..body.num_cells() {
         let cell = body.cell(c);
         let measure = if dim == 2 {
-            triangle_gradients(&node_coords(&body.coords, cell)).1
+            triangle_gradients(&node_coords(&body.coords, &cell)).1
         } else {
-            tetrahedron_gradients(&node_coords(&body.coords, cell)).1
+            tetrahedron_gradients(&node_coords(&body.coords, &cell)).1
         };
-        for &node in cell {
+        for &node in cell.iter() {
             for k in 0..dim {
                 f[dim * node + k] += b[k] * measure / (dim + 1) as f64;
             }

@@ -8,6 +8,8 @@
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
+use crate::mesh::NodeIndex;
+
 /// The node graph of a pattern: which nodes the elements couple, and the unknowns per node.
 /// All a fill-reducing ordering needs (`crate::linalg::ordering`), `block^2` times smaller
 /// than the pattern itself.
@@ -22,25 +24,25 @@ pub struct NodeGraph {
 impl NodeGraph {
     /// The graph of `num_nodes` nodes coupled through `elements` (`nodes_per_element` node
     /// indices each, flat), with `block` unknowns per node.
-    pub fn new(
+    pub fn new<I: NodeIndex>(
         num_nodes: usize,
-        elements: &[usize],
+        elements: &[I],
         nodes_per_element: usize,
         block: usize,
     ) -> Self {
         // node -> elements, then node -> distinct nodes of those elements.
         let mut element_ptr = vec![0usize; num_nodes + 1];
-        for &n in elements {
-            element_ptr[n + 1] += 1;
+        for n in elements {
+            element_ptr[n.index() + 1] += 1;
         }
         for i in 0..num_nodes {
             element_ptr[i + 1] += element_ptr[i];
         }
         let mut next = element_ptr.clone();
         let mut node_elements = vec![0usize; elements.len()];
-        for (k, &n) in elements.iter().enumerate() {
-            node_elements[next[n]] = k / nodes_per_element;
-            next[n] += 1;
+        for (k, n) in elements.iter().enumerate() {
+            node_elements[next[n.index()]] = k / nodes_per_element;
+            next[n.index()] += 1;
         }
 
         let mut neighbour_ptr = Vec::with_capacity(num_nodes + 1);
@@ -51,9 +53,8 @@ impl NodeGraph {
             scratch.clear();
             scratch.push(a);
             for &e in &node_elements[element_ptr[a]..element_ptr[a + 1]] {
-                scratch.extend_from_slice(
-                    &elements[e * nodes_per_element..(e + 1) * nodes_per_element],
-                );
+                let element = &elements[e * nodes_per_element..(e + 1) * nodes_per_element];
+                scratch.extend(element.iter().map(|n| n.index()));
             }
             scratch.sort_unstable();
             scratch.dedup();
@@ -120,9 +121,9 @@ pub struct SparsityPattern {
 impl SparsityPattern {
     /// The pattern of `num_nodes` nodes coupled through `elements` (`nodes_per_element` node
     /// indices each, flat), with `block` unknowns per node.
-    pub fn new(
+    pub fn new<I: NodeIndex>(
         num_nodes: usize,
-        elements: &[usize],
+        elements: &[I],
         nodes_per_element: usize,
         block: usize,
     ) -> Self {
@@ -200,7 +201,7 @@ mod tests {
     #[test]
     fn pattern_of_two_triangles_with_two_unknowns_per_node() {
         // Triangles (0, 1, 2) and (1, 3, 2): nodes 0 and 3 are not coupled.
-        let p = SparsityPattern::new(4, &[0, 1, 2, 1, 3, 2], 3, 2);
+        let p = SparsityPattern::new(4, &[0usize, 1, 2, 1, 3, 2], 3, 2);
         assert_eq!(p.neighbours(0), &[0, 1, 2]);
         assert_eq!(p.neighbours(1), &[0, 1, 2, 3]);
         assert_eq!(p.nnz(), 4 * (3 + 4 + 4 + 3));

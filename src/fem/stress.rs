@@ -68,7 +68,7 @@ pub fn cell_field(
         .collect();
     let (strain, stress) = if dim == 2 {
         let (lambda, _) = material.lame();
-        let (g, _) = triangle_gradients(&node_coords(&body.coords, cell));
+        let (g, _) = triangle_gradients(&node_coords(&body.coords, &cell));
         let eps = strain_matrix_2d(&g) * nalgebra::SVector::<f64, 6>::from_column_slice(&ue);
         let sig = material.plane_strain_matrix() * eps;
         (
@@ -76,7 +76,7 @@ pub fn cell_field(
             [sig[0], sig[1], lambda * (eps[0] + eps[1]), 0.0, 0.0, sig[2]],
         )
     } else {
-        let (g, _) = tetrahedron_gradients(&node_coords(&body.coords, cell));
+        let (g, _) = tetrahedron_gradients(&node_coords(&body.coords, &cell));
         let eps = strain_matrix_3d(&g) * nalgebra::SVector::<f64, 12>::from_column_slice(&ue);
         let sig = material.elasticity_matrix_3d() * eps;
         (

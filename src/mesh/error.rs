@@ -99,4 +99,13 @@ pub enum MeshError {
     Model { path: PathBuf, message: String },
     #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
     EmptyBody { path: PathBuf, body: String },
+    #[error(
+        "{path}: body '{body}' has {nodes} nodes: at most 4,294,967,295 nodes a body are \
+         supported (split it into several bodies)"
+    )]
+    TooManyNodes {
+        path: PathBuf,
+        body: String,
+        nodes: usize,
+    },
 }

@@ -8,6 +8,7 @@
 //! Every boundary facet is stored with the node order that makes its right-hand normal point
 //! out of the body (worked out from the adjacent cell, never from the file's facet order).
 
+mod element_tags;
 mod error;
 mod generate;
 mod gmsh;
@@ -16,6 +17,7 @@ mod msh41;
 mod quality;
 mod summary;
 
+pub use element_tags::ElementTags;
 pub use error::MeshError;
 pub use generate::mesh_geo;
 pub use gmsh::{mesh_from_model, read_msh, read_msh_bytes};
@@ -64,15 +66,65 @@ pub struct BodyMesh {
     pub coords: Vec<[f64; 3]>,
     /// Local node index -> gmsh node tag.
     pub node_tags: Vec<u64>,
-    /// Cell connectivity, `dim + 1` local node indices per cell, flat.
-    pub cells: Vec<usize>,
+    /// Cell connectivity, `dim + 1` local node indices per cell, flat. Stored as `u32`, half
+    /// the bytes of the largest array of a mesh (a body of more than 2^32 nodes is refused when
+    /// read); [`Self::cell`] and [`Self::cells`] give them as `usize`.
+    pub cells: Vec<u32>,
     /// Local cell index -> gmsh element tag.
-    pub cell_tags: Vec<u64>,
+    pub cell_tags: ElementTags,
     /// Boundary groups that have at least one facet on this body, by name.
     pub boundary_groups: BTreeMap<String, FacetGroup>,
     /// Groups of points (gmsh physical points) on this body: sorted local nodes, by name. They
     /// can carry Dirichlet conditions, e.g. to pin a corner against rigid-body motions.
     pub point_groups: BTreeMap<String, Vec<usize>>,
+}
+
+/// The local nodes of one cell (3 in 2D, 4 in 3D) as `usize`, from the `u32` the mesh stores
+/// ([`BodyMesh::cells`]); it reads as a slice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CellNodes {
+    nodes: [usize; 4],
+    len: usize,
+}
+
+impl CellNodes {
+    /// The nodes of a stored cell (at most 4).
+    pub fn of(stored: &[u32]) -> Self {
+        let mut nodes = [0; 4];
+        for (node, &n) in nodes.iter_mut().zip(stored) {
+            *node = n as usize;
+        }
+        Self {
+            nodes,
+            len: stored.len(),
+        }
+    }
+}
+
+impl std::ops::Deref for CellNodes {
+    type Target = [usize];
+
+    fn deref(&self) -> &[usize] {
+        &self.nodes[..self.len]
+    }
+}
+
+/// A local node index as a mesh stores it: `u32` in the cells, `usize` in the facets and
+/// groups (their arrays are small). The graph and pattern of a matrix are built from either.
+pub trait NodeIndex: Copy + Send + Sync {
+    fn index(self) -> usize;
+}
+
+impl NodeIndex for usize {
+    fn index(self) -> usize {
+        self
+    }
+}
+
+impl NodeIndex for u32 {
+    fn index(self) -> usize {
+        self as usize
+    }
 }
 
 /// Facets of one boundary group that lie on one body.
@@ -107,9 +159,16 @@ impl BodyMesh {
     }
 
     /// Local node indices of cell `c`.
-    pub fn cell(&self, c: usize) -> &[usize] {
+    pub fn cell(&self, c: usize) -> CellNodes {
         let n = self.nodes_per_cell();
-        &self.cells[n * c..n * (c + 1)]
+        CellNodes::of(&self.cells[n * c..n * (c + 1)])
+    }
+
+    /// The local node indices of every cell, in order.
+    pub fn cells(&self) -> impl ExactSizeIterator<Item = CellNodes> + '_ {
+        self.cells
+            .chunks_exact(self.nodes_per_cell())
+            .map(CellNodes::of)
     }
 
     /// The boundary group `name`, if it has facets on this body.
@@ -168,6 +227,7 @@ impl FacetGroup {
         let mut nodes = self.facets.clone();
         nodes.sort_unstable();
         nodes.dedup();
+        nodes.shrink_to_fit();
         nodes
     }
 }

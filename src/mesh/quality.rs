@@ -43,15 +43,15 @@ fn longest_edge(coords: &[[f64; 3]], cell: &[usize]) -> f64 {
 pub fn check_cells(path: &Path, body: &BodyMesh) -> Result<(), MeshError> {
     let dim = body.dim;
     let measures: Vec<f64> = (0..body.num_cells())
-        .map(|c| signed_measure(&body.coords, body.cell(c), dim))
+        .map(|c| signed_measure(&body.coords, &body.cell(c), dim))
         .collect();
     for (c, &m) in measures.iter().enumerate() {
-        let relative = m.abs() / longest_edge(&body.coords, body.cell(c)).powi(dim as i32);
+        let relative = m.abs() / longest_edge(&body.coords, &body.cell(c)).powi(dim as i32);
         if relative.is_nan() || relative < DEGENERATE_RELATIVE_MEASURE {
             return Err(MeshError::DegenerateCell {
                 path: path.to_owned(),
                 body: body.name.clone(),
-                element_tag: body.cell_tags[c],
+                element_tag: body.cell_tags.get(c),
                 measure_name: if dim == 2 { "area" } else { "volume" },
                 measure: m.abs(),
                 relative,
@@ -69,7 +69,7 @@ pub fn check_cells(path: &Path, body: &BodyMesh) -> Result<(), MeshError> {
         return Err(MeshError::InvertedCell {
             path: path.to_owned(),
             body: body.name.clone(),
-            element_tag: body.cell_tags[c],
+            element_tag: body.cell_tags.get(c),
             majority: positive.max(negative),
         });
     }

@@ -119,14 +119,18 @@ impl Grid<'_> {
         self.write_by_body(&mesh, "geometry", Width::Columns(3), nodes, geometry)?;
         let topology = |k: usize| {
             let first = first_nodes[k];
-            body(k).mesh.cells.iter().map(move |&n| (n + first) as i64)
+            body(k)
+                .mesh
+                .cells
+                .iter()
+                .map(move |&n| (n as usize + first) as i64)
         };
         self.write_by_body(&mesh, "topology", Width::Columns(dim + 1), cells, topology)?;
         let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|&t| t as i64);
         self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
         let node_body = |k: usize| std::iter::repeat_n(k as i32, nodes[k]);
         self.write_by_body(&mesh, "node_body", Width::Scalar, nodes, node_body)?;
-        let cell_tag = |k: usize| body(k).mesh.cell_tags.iter().map(|&t| t as i64);
+        let cell_tag = |k: usize| body(k).mesh.cell_tags.iter().map(|t| t as i64);
         self.write_by_body(&mesh, "cell_tag", Width::Scalar, cells, cell_tag)?;
         let cell_body = |k: usize| std::iter::repeat_n(k as i32, cells[k]);
         self.write_by_body(&mesh, "cell_body", Width::Scalar, cells, cell_body)?;
@@ -542,7 +546,7 @@ mod tests {
         let coords = (0..=n)
             .flat_map(|i| [[x0 + i as f64, 0.0, 0.0], [x0 + i as f64, 1.0, 0.0]])
             .collect();
-        let cells: Vec<usize> = (0..n)
+        let cells: Vec<u32> = (0..n as u32)
             .flat_map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 1])
             .collect();
         BodyMesh {

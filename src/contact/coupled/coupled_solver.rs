@@ -641,7 +641,7 @@ mod tests {
                     node(i + 1, j + 1),
                     node(i, j + 1),
                 ];
-                cells.extend([a, b, c, a, c, d]);
+                cells.extend([a, b, c, a, c, d].map(|n| n as u32));
             }
         }
         let cell = |i: usize, j: usize, t: usize| 2 * (i + j * nx) + t;
