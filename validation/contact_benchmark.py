@@ -76,7 +76,11 @@ Aims, per path (each figure shown at every size, judged where said):
      them);
   4. at most 8 active-set iterations in every load step (both runs);
   5. each extra load step at most 0.25 of the first, the set-up counted in the first:
-     step 2 / (set-up + step 1) of the load-stepped run.
+     step 2 / (set-up + step 1) of the load-stepped run;
+  6. on MPI ranks (paths mpi2 and mpi4: the default case file under ``mpirun -n 2`` and ``-n 4``),
+     the one-step run's largest rank peak at most 0.6 of the serial (default path) run's peak on
+     2 ranks and 0.35 on 4, and its wall time on 2 ranks at most 0.6 of the serial run's, judged
+     at 1M and 3M DOFs (4 ranks on fewer cores are oversubscribed: their time is not judged).
 
 Results: a table on stdout, the report ``validation/CONTACT_BENCHMARK.md`` and
 the raw numbers ``validation/build/contact_bench/results.json``.
@@ -142,12 +146,15 @@ PATHS = {
              "label": "the default case file under `mpirun -n 2`: each body's rows split between the two ranks "
                       "(METIS), AMG for every body whatever its size, the coupled GMRES on every rank; peak "
                       "memory is the sum of the ranks' peaks (summary.json's rank_peak_memory_mb)"},
+    "mpi4": {"body": "auto", "solver": "auto", "ranks": 4,
+             "label": "the same under `mpirun -n 4` (oversubscribed where the machine has fewer cores: its "
+                      "memory per rank counts, not its time)"},
 }
 
 # A run is killed (and reported as skipped) beyond these limits. An iterative run at 1M DOFs
 # may take 30 to 60 minutes.
 MAX_RSS_GB = 18.0
-MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0, "default": 5400.0, "mpi2": 5400.0}
+MAX_SECONDS_OURS = {"direct": 1200.0, "iterative": 5400.0, "default": 5400.0, "mpi2": 5400.0, "mpi4": 5400.0}
 MAX_SECONDS_DOLFINX = 600.0
 # ... but at the on-request sizes (3M DOFs), where reading and distributing the mesh alone takes minutes.
 MAX_SECONDS_DOLFINX_LARGE = 1800.0
@@ -165,6 +172,12 @@ AIM_MEMORY_MIN_DOFS = 1_000_000  # ... judged at this size and above (1M, 3M)
 AIM_APPLICATIONS = 4.0  # 3. body applications (V-cycles) per body over the whole solve / dolfinx's CG iterations
 AIM_ITERATIONS = 8  # 4. active-set iterations per load step
 AIM_STEP = 0.25  # 5. extra load step / (set-up + first load step)
+# 6. Ranks against one process (one-step runs, judged at >= AIM_MEMORY_MIN_DOFS): the largest rank's
+# peak / the serial (default path) run's peak, per number of ranks; and the wall time on 2 ranks / the
+# serial run's (4 ranks on a 2-core machine are oversubscribed: their time is shown, not judged).
+AIM_RANK_PEAK = {2: 0.6, 4: 0.35}
+AIM_RANK_WALL = {2: 0.6}
+RANK_PATHS = ("mpi2", "mpi4")  # the paths on several ranks, each against "default"
 
 # The largest Cholesky run of BODY_SOLVER_BENCHMARK.md (block_3d, one body, report of 2026-11-26 at
 # commit 5096dde): used if that report's table cannot be read. The direct path's estimate starts from it.
@@ -206,6 +219,8 @@ RUNS = {
     "default_steps": ("default, load steps (0.5, 1.0)", "default", LOAD_STEPS),
     "mpi2_one": ("mpi2, one step (1.0)", "mpi2", ONE_STEP),
     "mpi2_steps": ("mpi2, load steps (0.5, 1.0)", "mpi2", LOAD_STEPS),
+    "mpi4_one": ("mpi4, one step (1.0)", "mpi4", ONE_STEP),
+    "mpi4_steps": ("mpi4, load steps (0.5, 1.0)", "mpi4", LOAD_STEPS),
     "dolfinx_cg": ("dolfinx, CG + GAMG", None, None),
     "dolfinx_mumps": ("dolfinx, MUMPS Cholesky", None, None),
     "dolfinx_cg_mpi": (f"dolfinx, CG + GAMG, {MPI_RANKS} MPI ranks", None, None),
@@ -411,7 +426,8 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
     shutil.rmtree(output, ignore_errors=True)  # never read a stale summary
     log = output.with_suffix(".log")
     ranks = PATHS[path].get("ranks", 1)
-    launcher = [MPIRUN, "-n", str(ranks)] if ranks > 1 else []
+    oversubscribe = ["--oversubscribe"] if ranks > (os.cpu_count() or 1) else []
+    launcher = [MPIRUN, *oversubscribe, "-n", str(ranks)] if ranks > 1 else []
     usage = measure([*launcher, binary, "solve", case, "-vv", "--output", output], log,
                     env=MPI_ENV if ranks > 1 else None, max_seconds=MAX_SECONDS_OURS[path],
                     max_rss_gb=MAX_RSS_GB, check=False)
@@ -500,17 +516,23 @@ def rank_agreement(serial: Path, parallel: Path) -> dict:
 
 
 def agreement_lines(sizes: list[dict]) -> list[str]:
-    """The report's bullets: each size's 2-rank run against the serial one."""
+    """The report's bullets: each size's runs on several ranks against the serial one."""
     lines = []
     for size in sizes:
-        for one in ("one", "steps"):
-            q = size["runs"].get(f"mpi2_{one}", {}).get("vs_serial")
-            if q:
-                lines.append(f"* {size['name']}, {_kind(f'mpi2_{one}')}: displacement {q['displacement']:.1e}, "
-                             f"contact pressure {q['pressure']:.1e}, force {q['force']:.1e} (largest over the "
-                             f"steps); active set {'the same' if q['same_active_set'] else 'DIFFERENT'}, statuses "
-                             f"{'the same' if q['same_statuses'] else 'DIFFERENT'}")
+        for path in RANK_PATHS:
+            for one in ("one", "steps"):
+                q = size["runs"].get(f"{path}_{one}", {}).get("vs_serial")
+                if q:
+                    lines.append(_agreement_line(size, path, one, q))
     return lines or ["* no size has both runs"]
+
+
+def _agreement_line(size: dict, path: str, one: str, q: dict) -> str:
+    """One bullet of ``agreement_lines``."""
+    return (f"* {size['name']}, {PATHS[path]['ranks']} ranks, {_kind(f'{path}_{one}')}: "
+            f"displacement {q['displacement']:.1e}, contact pressure {q['pressure']:.1e}, force {q['force']:.1e} "
+            f"(largest over the steps); active set {'the same' if q['same_active_set'] else 'DIFFERENT'}, "
+            f"statuses {'the same' if q['same_statuses'] else 'DIFFERENT'}")
 
 
 def dolfinx_seconds(count: int) -> float:
@@ -608,10 +630,12 @@ def benchmark_size(size: Size, binary: Path, paths: list[str], earlier: list[dic
     if timed(runs["dolfinx_cg"]) and timed(runs["dolfinx_mumps"]):
         u_cg, u_mumps = (np.load(size.folder / f"{r}.u.npy") for r in ("dolfinx_cg", "dolfinx_mumps"))
         runs["dolfinx_cg"]["l2_vs_mumps"] = float(np.linalg.norm(u_cg - u_mumps) / np.linalg.norm(u_mumps))
-    for one in ("one", "steps"):  # our 2-rank run against the serial one: the same answer?
-        serial_run, parallel_run = runs.get(f"default_{one}", {}), runs.get(f"mpi2_{one}", {})
-        if timed(serial_run) and timed(parallel_run):
-            parallel_run["vs_serial"] = rank_agreement(size.folder / f"default_{one}", size.folder / f"mpi2_{one}")
+    for path in RANK_PATHS:  # our runs on several ranks against the serial one: the same answer?
+        for one in ("one", "steps"):
+            serial_run, parallel_run = runs.get(f"default_{one}", {}), runs.get(f"{path}_{one}", {})
+            if timed(serial_run) and timed(parallel_run):
+                parallel_run["vs_serial"] = rank_agreement(size.folder / f"default_{one}",
+                                                           size.folder / f"{path}_{one}")
     if timed(runs["dolfinx_cg"]) and timed(runs["dolfinx_cg_mpi"]):  # the same solution, other DOF order
         norm = float(np.linalg.norm(np.load(size.folder / "dolfinx_cg.u.npy")))
         runs["dolfinx_cg_mpi"]["norm_vs_serial"] = abs(runs["dolfinx_cg_mpi"]["solution_norm"] - norm) / norm
@@ -880,6 +904,36 @@ def aims_table(sizes: list[dict]) -> list[list[str]]:
                          applications,
                          f"{q['iterations']}: {_iterations_verdict(q['iterations'])}" if "iterations" in q else "-",
                          f"{q['step']:.2f}: {_verdict(q['step'], AIM_STEP)}" if "step" in q else missing[1]])
+    return rows
+
+
+def rank_table(sizes: list[dict]) -> list[list[str]]:
+    """Aim 6: the one-step run on 1, 2 and 4 ranks: wall time and the peak of each rank, against the serial
+    (default path) run's."""
+    rows = [["DOFs", "ranks", "wall s", "wall / serial", "contact total s", "peak MB of each rank",
+             "largest rank / serial peak", "aims (6)"]]
+    for size in sizes:
+        serial = size["runs"]["default_one"]
+        for path in ("default", *RANK_PATHS):
+            run = size["runs"][f"{path}_one"]
+            ranks = PATHS[path].get("ranks", 1)
+            if not timed(run) or not timed(serial):
+                rows.append([f"{dofs(size):,}", f"{ranks}", *["-"] * 5, status(run)])
+                continue
+            peaks = run.get("rank_peak_mb") or [run["peak_mb"]]
+            wall, peak = run["wall"] / serial["wall"], max(peaks) / serial["peak_mb"]
+            judged = dofs(size) >= AIM_MEMORY_MIN_DOFS
+            verdicts = []
+            if ranks in AIM_RANK_PEAK:
+                verdicts.append(f"peak <= {AIM_RANK_PEAK[ranks]:g}: " + (
+                    _verdict(peak, AIM_RANK_PEAK[ranks]) if judged else "not judged below 1M"))
+            if ranks in AIM_RANK_WALL:
+                verdicts.append(f"wall <= {AIM_RANK_WALL[ranks]:g}: " + (
+                    _verdict(wall, AIM_RANK_WALL[ranks]) if judged else "not judged below 1M"))
+            elif ranks > (os.cpu_count() or 1):
+                verdicts.append("wall not judged (oversubscribed)")
+            rows.append([f"{dofs(size):,}", f"{ranks}", fmt(run["wall"]), f"{wall:.2f}", fmt(run["contact_total"]),
+                         " / ".join(f"{p:.0f}" for p in peaks), f"{peak:.2f}", "; ".join(verdicts) or "-"])
     return rows
 
 
@@ -1266,11 +1320,20 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         "(validation/dolfinx_parallel_elastic.py: the mesh read by rank 0 and distributed by dolfinx; each phase "
         "ends with a barrier and is timed on rank 0); its memory is the sum of the ranks' peaks.",
         "",
-        "### Two ranks against one",
+        "### Ranks against one process",
         "",
-        "Path `mpi2` against `default` on the same mesh, from their output files (largest difference over the "
-        "largest value; the serial run's bodies are Cholesky below 30,000 DOFs, CG + AMG above, the 2-rank "
-        "run's always CG + AMG):",
+        markdown(rank_table(sizes)),
+        "",
+        "* Aim 6, the one-step runs: the largest rank's peak resident memory (`summary.json`'s "
+        f"`rank_peak_memory_mb`) at most {AIM_RANK_PEAK[2]:g} of the serial run's peak on 2 ranks and "
+        f"{AIM_RANK_PEAK[4]:g} on 4, and the wall time on 2 ranks at most {AIM_RANK_WALL[2]:g} of the serial "
+        "run's, judged at >= 1M DOFs. 4 ranks on a machine of fewer cores are oversubscribed: their memory "
+        "counts, their time is shown only. What each rank's memory is made of: "
+        "[MEMORY_MODEL.md](MEMORY_MODEL.md).",
+        "",
+        "Paths `mpi2` and `mpi4` against `default` on the same mesh, from their output files (largest "
+        "difference over the largest value; the serial run's bodies are Cholesky below 30,000 DOFs, CG + AMG "
+        "above, the runs on ranks always CG + AMG):",
         "",
         *agreement_lines(sizes),
         "",
@@ -1402,18 +1465,19 @@ def upgrade(size: dict) -> dict:
     for run in OURS:
         runs.setdefault(run, {"not_run": "not in results.json (written before the iterative path was benchmarked)"})
     runs.setdefault("dolfinx_cg_mpi", {"not_run": "not in results.json (written before the MPI run was added)"})
-    for one in ("one", "steps"):  # written before the 2-rank agreement: computed from the kept output folders
-        serial_run, parallel_run = runs.get(f"default_{one}", {}), runs.get(f"mpi2_{one}", {})
-        folders = [BENCH / size["name"] / f"{path}_{one}" for path in ("default", "mpi2")]
-        if (timed(serial_run) and timed(parallel_run) and "vs_serial" not in parallel_run
-                and all((f / "solution.h5").is_file() for f in folders)):
-            parallel_run["vs_serial"] = rank_agreement(*folders)
+    for path in RANK_PATHS:  # written before the agreement: computed from the kept output folders
+        for one in ("one", "steps"):
+            serial_run, parallel_run = runs.get(f"default_{one}", {}), runs.get(f"{path}_{one}", {})
+            folders = [BENCH / size["name"] / f"{p}_{one}" for p in ("default", path)]
+            if (timed(serial_run) and timed(parallel_run) and "vs_serial" not in parallel_run
+                    and all((f / "solution.h5").is_file() for f in folders)):
+                parallel_run["vs_serial"] = rank_agreement(*folders)
     return size
 
 
 def print_results(sizes: list[dict]) -> None:
     """The tables and the reading on stdout."""
-    for table in (contact_table, comparison_table, aims_table, iteration_table):
+    for table in (contact_table, comparison_table, aims_table, rank_table, iteration_table):
         print()
         print(markdown(table(sizes)))
     print()
