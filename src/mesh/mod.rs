@@ -67,7 +67,7 @@ pub struct BodyMesh {
     /// Local node index -> gmsh node tag.
     pub node_tags: Vec<u64>,
     /// Cell connectivity, `dim + 1` local node indices per cell, flat. Stored as `u32`, half
-    /// the bytes of the largest array of a mesh (a body of more than 2^32 nodes is refused when
+    /// the bytes of the largest array of a mesh (a body of 2^32 nodes or more is refused when
     /// read); [`Self::cell`] and [`Self::cells`] give them as `usize`.
     pub cells: Vec<u32>,
     /// Local cell index -> gmsh element tag.
@@ -88,8 +88,9 @@ pub struct CellNodes {
 }
 
 impl CellNodes {
-    /// The nodes of a stored cell (at most 4).
+    /// The nodes of a stored cell (at most 4: P1 triangles and tetrahedra).
     pub fn of(stored: &[u32]) -> Self {
+        debug_assert!(stored.len() <= 4, "a P1 cell has at most 4 nodes");
         let mut nodes = [0; 4];
         for (node, &n) in nodes.iter_mut().zip(stored) {
             *node = n as usize;
