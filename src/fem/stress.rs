@@ -62,14 +62,16 @@ pub fn cell_field(
 ) -> ([f64; 9], [f64; 9], f64) {
     let dim = body.dim;
     let cell = body.cell(c);
-    let ue: Vec<f64> = cell
-        .iter()
-        .flat_map(|&a| u[dim * a..dim * a + dim].iter().copied())
-        .collect();
+    // The cell's displacements, `dim` per node, on the stack: this runs once per cell written.
+    let mut ue = [0.0; 12];
+    for (k, &a) in cell.iter().enumerate() {
+        ue[dim * k..dim * k + dim].copy_from_slice(&u[dim * a..dim * a + dim]);
+    }
+    let ue = &ue[..dim * cell.len()];
     let (strain, stress) = if dim == 2 {
         let (lambda, _) = material.lame();
         let (g, _) = triangle_gradients(&node_coords(&body.coords, &cell));
-        let eps = strain_matrix_2d(&g) * nalgebra::SVector::<f64, 6>::from_column_slice(&ue);
+        let eps = strain_matrix_2d(&g) * nalgebra::SVector::<f64, 6>::from_column_slice(ue);
         let sig = material.plane_strain_matrix() * eps;
         (
             [eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]],
@@ -77,7 +79,7 @@ pub fn cell_field(
         )
     } else {
         let (g, _) = tetrahedron_gradients(&node_coords(&body.coords, &cell));
-        let eps = strain_matrix_3d(&g) * nalgebra::SVector::<f64, 12>::from_column_slice(&ue);
+        let eps = strain_matrix_3d(&g) * nalgebra::SVector::<f64, 12>::from_column_slice(ue);
         let sig = material.elasticity_matrix_3d() * eps;
         (
             [eps[0], eps[1], eps[2], eps[3], eps[4], eps[5]],
