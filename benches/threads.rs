@@ -118,7 +118,7 @@ fn main() {
 
                     let n = system.f_c.len();
                     let (seconds, x) = timed(|| {
-                        let mut x = system.f_c.clone();
+                        let mut x = system.f_c.to_vec();
                         factor.solve_in_place(&mut x, 1);
                         x
                     });

@@ -153,7 +153,7 @@ fn cholesky_solves_are_identical_for_any_thread_count() {
             )
             .unwrap();
             let factor = Cholesky::factorize(symbolic, system.stiffness.whole().unwrap()).unwrap();
-            let mut one = system.f_c.clone();
+            let mut one = system.f_c.to_vec();
             factor.solve_in_place(&mut one, 1);
             let mut many = rhs.clone();
             factor.solve_in_place(&mut many, num_rhs);
@@ -269,7 +269,7 @@ mod v_cycles {
         BodySolver::cg_amg(
             system.stiffness.whole().unwrap(),
             system.dim,
-            &system.coordinates,
+            system.stiffness.coordinates().unwrap(),
             1e-10,
         )
         .expect("set-up")

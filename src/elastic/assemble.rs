@@ -18,7 +18,7 @@ use super::problem::{ElasticProblem, ForcedComponent, constraints, forced_compon
 use super::solution::{SolveStats, timed};
 use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
-use crate::fem::{Constraints, NodeColumns, NodeGraph};
+use crate::fem::{Constraints, LoadVector, NodeColumns, NodeGraph};
 use crate::linalg::{Distribution, LinalgError, RankRows};
 use crate::parallel::ranks::Ranks;
 
@@ -27,9 +27,6 @@ use crate::parallel::ranks::Ranks;
 pub struct AssembledBody {
     /// Dofs per node.
     pub dim: usize,
-    /// Node coordinates, `dim` per node: the rigid-body modes an iterative solver's
-    /// multigrid needs (its near-null space).
-    pub coordinates: Vec<f64>,
     /// The node graph of `K_c`'s pattern, for a Cholesky factor's fill-reducing ordering, with
     /// the whole `K_c`; `None` with a rank's rows, which only the partition needed it for (at
     /// 1M DOFs 60 MB on every rank).
@@ -38,13 +35,15 @@ pub struct AssembledBody {
     /// all the reactions need of it. The whole `K` is not kept: at a million DOFs it is a
     /// gigabyte beside `K_c` and the solver's own copies.
     pub prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
-    pub f: Vec<f64>,
+    /// The loads as assembled.
+    pub f: LoadVector,
     pub constraints: Constraints,
     /// The constrained stiffness `K_c`: whole, or this rank's rows of it.
     pub stiffness: Stiffness,
     /// The largest diagonal entry of `K_c` (the contact system's scale).
     pub k_scale: f64,
-    pub f_c: Vec<f64>,
+    /// The constrained right-hand side.
+    pub f_c: LoadVector,
     /// The force-controlled components of the body, in the order of
     /// [`forced_components`]: their dofs are held at 0 in `K_c` and move by unknowns of the
     /// contact solve.
@@ -63,12 +62,12 @@ pub struct RhsPart {
     /// The path: `None` the default one.
     pub path: Option<String>,
     /// The loads that follow it (with the body force on the default path), assembled.
-    pub f: Vec<f64>,
+    pub f: LoadVector,
     /// Its constrained right-hand side: at a free dof its loads less the pull of the values it
     /// prescribes (`-K_FD g_D`), at a prescribed dof `K_dd g_d` of its own value (0 at the
     /// dofs other paths prescribe), so that `sum_p s_p f_c(p)` is `f_c` of the loads and
     /// values of step factors `s_p`.
-    pub f_c: Vec<f64>,
+    pub f_c: LoadVector,
 }
 
 impl AssembledBody {
@@ -77,12 +76,12 @@ impl AssembledBody {
     /// sum of each part's `f_c` times its path's factor.
     pub fn rhs(&self, factors: &StepFactors) -> Vec<f64> {
         if self.parts.is_empty() {
-            return self.f_c.iter().map(|v| factors.default * v).collect();
+            return self.f_c.scaled(factors.default);
         }
         let mut rhs = vec![0.0; self.f_c.len()];
         for part in &self.parts {
-            let s = factors.of(part.path.as_deref());
-            rhs.iter_mut().zip(&part.f_c).for_each(|(r, v)| *r += s * v);
+            part.f_c
+                .add_scaled_to(factors.of(part.path.as_deref()), &mut rhs);
         }
         rhs
     }
@@ -90,9 +89,9 @@ impl AssembledBody {
     /// The load (the step's `f`) at `dof` at a step of `factors`.
     pub fn load(&self, dof: usize, factors: &StepFactors) -> f64 {
         match self.parts.is_empty() {
-            true => factors.default * self.f[dof],
+            true => factors.default * self.f.get(dof),
             false => (self.parts.iter())
-                .map(|part| factors.of(part.path.as_deref()) * part.f[dof])
+                .map(|part| factors.of(part.path.as_deref()) * part.f.get(dof))
                 .sum(),
         }
     }
@@ -123,7 +122,7 @@ impl AssembledBody {
     /// force-controlled groups at a step of `factors`.
     pub fn resultant(&self, factors: &StepFactors) -> f64 {
         let dim = self.dim;
-        let sum = |f: &[f64], c: usize| -> f64 { f.iter().skip(c).step_by(dim).sum() };
+        let sum = |f: &LoadVector, c: usize| f.component_sum(c, dim);
         let magnitude = |force: &dyn Fn(&RigidColumn) -> f64, loads: &dyn Fn(usize) -> f64| {
             (0..dim)
                 .map(|c| {
@@ -153,8 +152,14 @@ impl AssembledBody {
 
 /// A body's constrained stiffness `K_c` as this process holds it.
 pub enum Stiffness {
-    /// All of it (one process).
-    Whole(SparseColMat<usize, f64>),
+    /// All of it (one process), with the node coordinates (`dim` per node) from which a
+    /// CG + AMG solver builds the rigid-body modes of its multigrid (the near-null space): they
+    /// go with the matrix to that solver, as a rank's go with its rows ([`RankRows`]), and
+    /// no copy of a body's size stays behind once it is taken.
+    Whole {
+        k_c: SparseColMat<usize, f64>,
+        coordinates: Vec<f64>,
+    },
     /// This rank's rows (a distributed run), until its solver takes them.
     Rows(RankRows),
     /// Taken by its CG + AMG solver (PETSc), which makes the products.
@@ -165,16 +170,24 @@ impl Stiffness {
     /// The whole matrix, if this process holds it.
     pub fn whole(&self) -> Option<&SparseColMat<usize, f64>> {
         match self {
-            Self::Whole(k_c) => Some(k_c),
+            Self::Whole { k_c, .. } => Some(k_c),
+            _ => None,
+        }
+    }
+
+    /// The node coordinates that go with the whole matrix, if this process holds it.
+    pub fn coordinates(&self) -> Option<&[f64]> {
+        match self {
+            Self::Whole { coordinates, .. } => Some(coordinates),
             _ => None,
         }
     }
 
     /// The whole matrix, taken for a solver that keeps its own copy (`Released` is left);
     /// `None`, and nothing changed, if this process does not hold it whole.
-    pub fn take_whole(&mut self) -> Option<SparseColMat<usize, f64>> {
+    pub fn take_whole(&mut self) -> Option<(SparseColMat<usize, f64>, Vec<f64>)> {
         match std::mem::replace(self, Self::Released) {
-            Self::Whole(k_c) => Some(k_c),
+            Self::Whole { k_c, coordinates } => Some((k_c, coordinates)),
             other => {
                 *self = other;
                 None
@@ -307,7 +320,8 @@ pub fn assemble(
     stats.num_dofs = body.num_dofs();
     let constraints = constraints(problem)?;
     stats.num_prescribed_dofs = constraints.num_fixed();
-    let coordinates: Vec<f64> = body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect();
+    let coordinates =
+        || -> Vec<f64> { body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect() };
 
     // 1. Load vector f: surface loads and body force.
     let f = timed(stats, verbose, "assemble loads", || {
@@ -327,12 +341,12 @@ pub fn assemble(
     // 2. K_c and f_c, and the rows of K at the prescribed dofs.
     let ranks = crate::parallel::ranks();
     let constrained = match ranks.size {
-        1 => whole_stiffness(problem, &constraints, &f, stats, verbose),
+        1 => whole_stiffness(problem, &constraints, &f, coordinates(), stats, verbose),
         _ => rank_stiffness(
             problem,
             &constraints,
             &f,
-            &coordinates,
+            &coordinates(),
             ranks,
             stats,
             verbose,
@@ -356,14 +370,13 @@ pub fn assemble(
         .collect();
     Ok(AssembledBody {
         dim,
-        coordinates,
         graph: constrained.graph,
         prescribed_rows: constrained.prescribed_rows,
-        f,
+        f: LoadVector::new(f),
         constraints,
         stiffness: constrained.stiffness,
         k_scale: constrained.k_scale,
-        f_c: constrained.f_c,
+        f_c: LoadVector::new(constrained.f_c),
         rigid,
         parts,
     })
@@ -412,8 +425,8 @@ impl PathLoads {
         }
         RhsPart {
             path: self.path,
-            f: self.f,
-            f_c,
+            f: LoadVector::new(self.f),
+            f_c: LoadVector::new(f_c),
         }
     }
 }
@@ -483,6 +496,7 @@ fn whole_stiffness(
     problem: &ElasticProblem,
     constraints: &Constraints,
     f: &[f64],
+    coordinates: Vec<f64>,
     stats: &mut SolveStats,
     verbose: bool,
 ) -> ConstrainedStiffness {
@@ -513,7 +527,7 @@ fn whole_stiffness(
     ConstrainedStiffness {
         graph: Some(graph),
         k_scale: largest_diagonal(&k_c),
-        stiffness: Stiffness::Whole(k_c),
+        stiffness: Stiffness::Whole { k_c, coordinates },
         f_c,
         prescribed_rows,
     }

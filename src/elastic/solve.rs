@@ -234,10 +234,9 @@ pub fn solve(
         (Some(rows), _, _) => timed(&mut stats, verbose, "CG + AMG setup", || {
             BodySolver::cg_amg_rows(rows, settings.rtol)?.set_up()
         }),
-        (None, Some(k_c), _) => timed(&mut stats, verbose, "CG + AMG setup", || {
-            let matrix =
-                BodySolver::cg_amg_matrix(&k_c, system.dim, &system.coordinates, settings.rtol)?;
-            drop(k_c);
+        (None, Some((k_c, coordinates)), _) => timed(&mut stats, verbose, "CG + AMG setup", || {
+            let matrix = BodySolver::cg_amg_matrix(&k_c, system.dim, &coordinates, settings.rtol)?;
+            drop((k_c, coordinates));
             matrix.set_up()
         }),
         (None, None, Some(k_c)) => {
@@ -266,7 +265,7 @@ pub fn solve(
     //    displacements solve `(D_aa - k^T W) a = (force + applied) - k^T u0`, and `u = u0 - W a`.
     let r = system.rigid.len();
     let n = system.f_c.len();
-    let mut columns = system.f_c.clone();
+    let mut columns = system.f_c.to_vec();
     for rigid in &system.rigid {
         let mut k = vec![0.0; n];
         rigid.column.iter().for_each(|&(dof, v)| k[dof] = v);
@@ -288,7 +287,7 @@ pub fn solve(
         0 => Vec::new(),
         _ => rigid_displacements(problem, &system, &u, w)?,
     };
-    let mut rhs = system.f_c.clone();
+    let mut rhs = system.f_c.to_vec();
     for (j, (rigid, a)) in system.rigid.iter().zip(&a).enumerate() {
         u.iter_mut().zip(&w[j * n..]).for_each(|(u, w)| *u -= w * a);
         rigid.column.iter().for_each(|&(dof, v)| rhs[dof] -= v * a);

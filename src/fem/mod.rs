@@ -12,6 +12,7 @@ pub mod assembly;
 mod columns;
 mod dirichlet;
 pub mod kernels;
+mod load_vector;
 pub mod loads;
 mod material;
 pub mod rigid_modes;
@@ -20,5 +21,6 @@ pub mod stress;
 
 pub use columns::NodeColumns;
 pub use dirichlet::Constraints;
+pub use load_vector::LoadVector;
 pub use material::{Material, MaterialError};
 pub use sparsity::{NodeGraph, SparsityPattern};

@@ -22,13 +22,16 @@ use crate::parallel::ranks::Ranks;
 
 #[derive(Debug)]
 pub struct Distribution {
-    /// Our unknown at each of PETSc's rows: `ours[p]`.
-    ours: Vec<usize>,
+    /// Our node at each of PETSc's nodes (PETSc's rows `block p .. block (p + 1)` are our
+    /// node `nodes[p]`'s unknowns): a node, not an unknown, and 32 bits, as the mesh's cells
+    /// hold it, so that this map of the whole body costs every rank `4 / block` bytes per
+    /// unknown (it was 8 per unknown).
+    nodes: Vec<u32>,
     /// The rows of each rank (unknowns), in rank order.
     counts: Vec<usize>,
-    /// PETSc's first row of this rank.
+    /// PETSc's first node of this rank (`block` rows each).
     first: usize,
-    /// This rank's number of rows.
+    /// This rank's number of nodes (`block` rows each).
     local: usize,
     /// Unknowns per node.
     block: usize,
@@ -39,8 +42,8 @@ impl Distribution {
     /// graph `graph`.
     pub fn new(graph: &NodeGraph, ranks: Ranks) -> Result<Self, LinalgError> {
         let block = graph.block();
-        let nodes = graph.num_nodes();
-        let neighbours: Vec<Vec<usize>> = (0..nodes)
+        let num_nodes = graph.num_nodes();
+        let neighbours: Vec<Vec<usize>> = (0..num_nodes)
             .map(|a| {
                 graph
                     .neighbours(a)
@@ -52,23 +55,29 @@ impl Distribution {
             .collect();
         let part = partition(&neighbours, ranks.size)?;
         drop(neighbours);
-        let mut ours = Vec::with_capacity(nodes * block);
+        // The mesh refuses bodies of 2^32 nodes or more (`crate::mesh::MeshError`).
+        let node = |a: usize| u32::try_from(a).expect("a body has fewer than 2^32 nodes");
+        let mut nodes = Vec::with_capacity(num_nodes);
         let mut counts = vec![0; ranks.size];
         for (rank, count) in counts.iter_mut().enumerate() {
-            for node in (0..nodes).filter(|&a| part[a] == rank) {
-                ours.extend((0..block).map(|c| node * block + c));
-                *count += block;
-            }
+            let first = nodes.len();
+            nodes.extend((0..num_nodes).filter(|&a| part[a] == rank).map(node));
+            *count = (nodes.len() - first) * block;
         }
-        let first = counts[..ranks.rank].iter().sum();
-        let local = counts[ranks.rank];
+        let first = counts[..ranks.rank].iter().sum::<usize>() / block;
+        let local = counts[ranks.rank] / block;
         Ok(Self {
-            ours,
+            nodes,
             counts,
             first,
             local,
             block,
         })
+    }
+
+    /// Our unknown at PETSc's row `p`.
+    fn ours(&self, p: usize) -> usize {
+        self.nodes[p / self.block] as usize * self.block + p % self.block
     }
 
     /// Each rank's number of unknowns, in rank order.
@@ -78,28 +87,28 @@ impl Distribution {
 
     /// This rank's number of unknowns.
     pub fn local(&self) -> usize {
-        self.local
+        self.local * self.block
     }
 
     /// This rank's nodes, increasing: the columns ([`NodeColumns`]) it assembles.
     pub fn nodes(&self) -> Vec<usize> {
-        self.own()
-            .iter()
-            .step_by(self.block)
-            .map(|&dof| dof / self.block)
-            .collect()
+        let own = &self.nodes[self.first..self.first + self.local];
+        own.iter().map(|&node| node as usize).collect()
     }
 
     /// This rank's rows for PETSc: `columns` (of this rank's [`Self::nodes`], constrained)
     /// read as rows, with global column indices in PETSc's numbering, sorted in each row, and
     /// `coords` (`block` values per node, in our order) of this rank's nodes.
     pub fn rows(self, columns: &NodeColumns, coords: &[f64]) -> RankRows {
-        let rows = self.own();
+        let block = self.block;
+        let rows: Vec<usize> = self.own().collect();
         debug_assert_eq!(columns.num_columns(), rows.len());
-        let mut petsc_of = vec![0usize; self.ours.len()];
-        for (p, &ours) in self.ours.iter().enumerate() {
-            petsc_of[ours] = p;
+        // PETSc's node of each of our nodes.
+        let mut petsc_node = vec![0u32; self.nodes.len()];
+        for (p, &ours) in self.nodes.iter().enumerate() {
+            petsc_node[ours as usize] = p as u32;
         }
+        let petsc_of = |ours: usize| petsc_node[ours / block] as usize * block + ours % block;
         let mut row_ptr = Vec::with_capacity(rows.len() + 1);
         let mut petsc_columns = Vec::with_capacity(columns.nnz());
         let mut values = Vec::with_capacity(columns.nnz());
@@ -111,7 +120,7 @@ impl Distribution {
             row.clear();
             row.extend(
                 (entries.iter().zip(entry_values))
-                    .map(|(&column, &value)| (petsc_of[column] as i64, value)),
+                    .map(|(&column, &value)| (petsc_of(column) as i64, value)),
             );
             row.sort_unstable_by_key(|&(column, _)| column);
             petsc_columns.extend(row.iter().map(|&(column, _)| column));
@@ -130,20 +139,21 @@ impl Distribution {
 
     /// This rank's rows of `whole` (our numbering), in PETSc's order.
     pub fn local_part(&self, whole: &[f64]) -> Vec<f64> {
-        self.own().iter().map(|&ours| whole[ours]).collect()
+        self.own().map(|ours| whole[ours]).collect()
     }
 
     /// Our unknown at each of this rank's rows, in PETSc's order.
-    pub fn own(&self) -> &[usize] {
-        &self.ours[self.first..self.first + self.local]
+    pub fn own(&self) -> impl Iterator<Item = usize> + '_ {
+        let rows = self.first * self.block..(self.first + self.local) * self.block;
+        rows.map(|p| self.ours(p))
     }
 
     /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank.
     pub fn gather(&self, local: &[f64], whole: &mut [f64]) -> Result<(), LinalgError> {
         let petsc = crate::parallel::all_gather(local, &self.counts)
             .map_err(|e| LinalgError::Mpi(e.to_string()))?;
-        for (&ours, value) in self.ours.iter().zip(petsc) {
-            whole[ours] = value;
+        for (p, value) in petsc.into_iter().enumerate() {
+            whole[self.ours(p)] = value;
         }
         Ok(())
     }

@@ -209,8 +209,7 @@ impl KrylovState {
 pub struct KrylovProblem<'a> {
     pub system: &'a CoupledSystem,
     pub pairs: &'a [Pair<'a>],
-    /// Each body's constrained stiffness (the operator's diagonal blocks) and node
-    /// coordinates (the half-space model's points, on each pair's primary).
+    /// Each body's constrained stiffness (the operator's diagonal blocks).
     pub bodies: &'a [&'a AssembledBody],
     /// Each body's solver, applied once per iteration as its block of the preconditioner.
     pub solvers: &'a [BodySolver],
@@ -235,9 +234,8 @@ pub fn solve(
     let tolerance = tightness.relative();
     let schur = (problem.pairs.iter().enumerate())
         .map(|(p, pair)| {
-            let coordinates = &problem.bodies[pair.primary].coordinates;
             let c0 = problem.compliance[p];
-            HalfSpace::new(system, p, pair.coupling, coordinates, problem.dim, c0)
+            HalfSpace::new(system, p, pair.coupling, problem.dim, c0)
         })
         .collect();
     let num_bodies = system.num_bodies();

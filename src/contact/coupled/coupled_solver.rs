@@ -115,7 +115,8 @@ impl BodyFactors {
         let dim = bodies.first().map_or(3, |body| body.dim);
         let factor = |body: &&AssembledBody| match kind {
             BodySolverKind::CgAmg => {
-                BodySolver::cg_amg(assembled(body)?, body.dim, &body.coordinates, settings.rtol)
+                let coordinates = body.stiffness.coordinates().unwrap_or_default();
+                BodySolver::cg_amg(assembled(body)?, body.dim, coordinates, settings.rtol)
                     .map_err(cg_amg_error)
             }
             _ => cholesky(body, None, settings.ordering),
@@ -416,10 +417,10 @@ pub fn petsc_solvers(
         let matrix = match body.stiffness.take_rows() {
             Some(rows) => BodySolver::cg_amg_rows(rows, settings.rtol),
             None => {
-                let k_c = body.stiffness.take_whole().ok_or_else(|| {
+                let (k_c, coordinates) = body.stiffness.take_whole().ok_or_else(|| {
                     ContactError::Linalg("a body's stiffness was released twice".to_string())
                 })?;
-                BodySolver::cg_amg_matrix(&k_c, body.dim, &body.coordinates, settings.rtol)
+                BodySolver::cg_amg_matrix(&k_c, body.dim, &coordinates, settings.rtol)
             }
         };
         pending.push(matrix.map_err(cg_amg_error)?);
@@ -722,7 +723,14 @@ mod tests {
 
     /// Tied coupling of the column `i1` of `primary` (nx1 squares wide) with the column `i2` of
     /// the secondary, on matching nodes.
-    fn tied(nx1: usize, i1: usize, nx2: usize, i2: usize, normal: f64) -> Coupling {
+    fn tied(
+        primary: &BodyMesh,
+        nx1: usize,
+        i1: usize,
+        nx2: usize,
+        i2: usize,
+        normal: f64,
+    ) -> Coupling {
         let h = 1.0 / NY as f64;
         let area = |j: usize| if j == 0 || j == NY { h / 2.0 } else { h };
         let primary_nodes: Vec<usize> = (0..=NY).map(|j| i1 + j * (nx1 + 1)).collect();
@@ -743,6 +751,7 @@ mod tests {
             interpolated: secondary.iter().map(|&n| vec![(n, 1.0)]).collect(),
             loads2: (0..=NY).map(|j| vec![(secondary[j], area(j))]).collect(),
             gaps: vec![[0.0; 3]; NY + 1],
+            points: primary_nodes.iter().map(|&n| primary.coords[n]).collect(),
             primary_nodes,
         }
     }
@@ -809,7 +818,10 @@ mod tests {
         ];
         let bodies = assembled(&meshes, &[0.01, 0.01, 0.01, 0.02]);
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
-        let couplings = [tied(NX, NX, NX, 0, 1.0), tied(NX, 0, NX, NX, -1.0)];
+        let couplings = [
+            tied(&meshes[0], NX, NX, NX, 0, 1.0),
+            tied(&meshes[2], NX, 0, NX, NX, -1.0),
+        ];
         let pairs = [
             Pair {
                 primary: 0,
@@ -900,7 +912,7 @@ mod tests {
         let bodies = assembled(&meshes, &[0.01, 0.02]);
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
         let compliance = 1e-4;
-        let coupling = turned(tied(NX, NX, NX, 0, 1.0), compliance);
+        let coupling = turned(tied(&meshes[0], NX, NX, NX, 0, 1.0), compliance);
         let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
         let pairs = [Pair {
             primary: 0,
@@ -963,8 +975,8 @@ mod tests {
         let bodies: Vec<&AssembledBody> = bodies.iter().collect();
         let factors = StepFactors::uniform(1.0);
         for coupling in [
-            tied(NX, NX, NX, 0, 1.0),
-            turned(tied(NX, NX, NX, 0, 1.0), 1e-4),
+            tied(&meshes[0], NX, NX, NX, 0, 1.0),
+            turned(tied(&meshes[0], NX, NX, NX, 0, 1.0), 1e-4),
         ] {
             let pairs = [Pair {
                 primary: 0,
@@ -1000,7 +1012,7 @@ mod tests {
                     assert!(system.residual(&bodies, None, &x).is_err());
                     // This rank's rows, in the order of its Krylov vectors.
                     let own: Vec<usize> = (distributions.iter().zip(&whole.offsets))
-                        .flat_map(|(d, &offset)| d.own().iter().map(move |&dof| offset + dof))
+                        .flat_map(|(d, &offset)| d.own().map(move |dof| offset + dof))
                         .collect();
                     let x_rank: Vec<f64> = own.iter().map(|&row| x[row]).collect();
                     let mut c_rank = vec![0.0; m];
@@ -1043,10 +1055,11 @@ mod tests {
         // The tied coupling of the two columns that meet, between their clamped and pushed
         // ends (where a turned multiplier would restate a prescribed component), its two
         // multipliers per node along a basis turned by 30 degrees.
-        let whole = tied(NX, NX, NX, 0, 1.0);
+        let whole = tied(&meshes[0], NX, NX, NX, 0, 1.0);
         let inner = 1..NY;
         let mut coupling = Coupling {
             primary_nodes: whole.primary_nodes[inner.clone()].to_vec(),
+            points: whole.points[inner.clone()].to_vec(),
             normals: whole.normals[inner.clone()].to_vec(),
             areas1: whole.areas1[inner.clone()].to_vec(),
             multipliers: whole.multipliers[inner.clone()].to_vec(),

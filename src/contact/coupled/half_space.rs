@@ -102,19 +102,20 @@ pub fn compliance_factor(materials: [&Material; 2], dim: usize) -> f64 {
 
 impl HalfSpace {
     /// `S~` on the multipliers of pair `pair` of `system`, whose `coupling` has its active
-    /// primary nodes at `coordinates` (the primary body's, `dim` per node), with the
-    /// compliance factor `c0` ([`compliance_factor`]). It acts on the pair's multipliers alone
+    /// primary nodes at its `points`, with the compliance factor `c0` ([`compliance_factor`]). It acts on the pair's multipliers alone
     /// (numbered from 0): the pairs' blocks of the preconditioner are independent.
     pub fn new(
         system: &CoupledSystem,
         pair: usize,
         coupling: &Coupling,
-        coordinates: &[f64],
         dim: usize,
         c0: f64,
     ) -> Self {
         let area: HashMap<usize, f64> = (coupling.primary_nodes.iter().copied())
             .zip(coupling.areas1.iter().copied())
+            .collect();
+        let point: HashMap<usize, [f64; 3]> = (coupling.primary_nodes.iter().copied())
+            .zip(coupling.points.iter().copied())
             .collect();
         let multipliers = system.pair_multipliers(pair);
         let diagonal = system.d[multipliers.clone()].to_vec();
@@ -138,7 +139,8 @@ impl HalfSpace {
             }
             let row = system.rows[system.pair_multipliers(pair).start + k];
             let mut x = [0.0; 3];
-            x[..dim].copy_from_slice(&coordinates[dim * node..dim * node + dim]);
+            let p = point.get(&node).copied().unwrap_or_default();
+            x[..dim].copy_from_slice(&p[..dim]);
             let a = area.get(&node).copied().unwrap_or(0.0);
             coupled.push(k);
             owners.push(node);

@@ -275,6 +275,7 @@ impl InterfaceOperators {
         };
         Coupling {
             primary_nodes: active.iter().map(|&i| primary.nodes[i]).collect(),
+            points: active.iter().map(|&i| primary.coords[i]).collect(),
             normals,
             areas1: active.iter().map(|&i| primary.nodal_area[i]).collect(),
             multipliers,

@@ -43,7 +43,7 @@ impl RowOwnership {
         let mut place = vec![Self::ELSEWHERE; total];
         let (mut first, mut local) = (0, 0);
         for body in bodies {
-            for &ours in body.own() {
+            for ours in body.own() {
                 place[first + ours] = local as u32;
                 local += 1;
             }

@@ -71,6 +71,9 @@ use crate::linalg::{BodySolver, mat_vec};
 pub struct Coupling {
     /// Body-local node of each active primary node.
     pub primary_nodes: Vec<usize>,
+    /// Reference position of each active primary node: the points of the half-space model
+    /// (`crate::contact::coupled::half_space`).
+    pub points: Vec<[f64; 3]>,
     /// Normal at each active node (pointing out of the primary), along which its pressure
     /// `p = -lambda . n` is measured. Frictionless and Coulomb: the normal of the secondary
     /// facet the node is held on, the direction of its normal constraint row (the gradient of
