@@ -1,10 +1,10 @@
 //! Progress lines of long phases, so that a run of minutes never looks hung.
 //!
 //! A [`Heartbeat`] covers one phase (meshing, an assembly, a body solver's set-up, one
-//! active-set iteration, ...): from 5 seconds on, a thread of its own says how long the phase
-//! has been running, every 5 seconds (every 30 seconds after the first minute: an hour-long
-//! phase written to a log file adds about a hundred lines, not seven hundred), until the phase
-//! ends ([`Cadence::DEFAULT`]). A phase shorter than 5 seconds says nothing. Code deep inside
+//! active-set iteration, ...): from 5 seconds on, the process's progress thread says how long
+//! the phase has been running, every 5 seconds (every 30 seconds after the first minute: an
+//! hour-long phase written to a log file adds about a hundred lines, not seven hundred), until
+//! the phase ends ([`Cadence::DEFAULT`]). A phase shorter than 5 seconds says nothing. Code deep inside
 //! a phase that knows how far it is (the coupled GMRES) adds that to the next line with
 //! [`note`].
 //!
@@ -15,8 +15,8 @@
 //! one call (a factorization, PETSc's AMG set-up) that cannot report.
 
 use std::cell::RefCell;
-use std::sync::{Arc, Condvar, Mutex};
-use std::thread::JoinHandle;
+use std::collections::BTreeMap;
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 /// The `log` target of progress lines.
@@ -44,12 +44,9 @@ impl Cadence {
     };
 }
 
-/// What a heartbeat's thread shares with the phase.
+/// What the progress thread and a phase share: the phase's own word on how far it is
+/// ([`note`]), shown with its next line.
 struct Shared {
-    /// Set when the phase ends.
-    done: Mutex<bool>,
-    ended: Condvar,
-    /// The phase's own word on how far it is ([`note`]), shown with the next line.
     note: Mutex<Option<String>>,
 }
 
@@ -58,9 +55,102 @@ thread_local! {
     static CURRENT: RefCell<Option<Arc<Shared>>> = const { RefCell::new(None) };
 }
 
+/// A running phase, as the progress thread sees it.
+struct Beat {
+    what: String,
+    start: Instant,
+    cadence: Cadence,
+    /// When its next line is due, from its start.
+    next: Duration,
+    shared: Arc<Shared>,
+}
+
+/// The running phases of the process, by number, and the one thread that writes their lines.
+///
+/// One thread for the whole process, started with the first heartbeat, rather than one per
+/// phase: with a thread per phase (each active-set iteration, each step of an assembly) a
+/// serial run of a million unknowns peaked 120 to 180 MB above the same run without progress
+/// lines in two of three runs, and with one thread in none of three (`docs/decisions.md`,
+/// where the likely cause, glibc's per-thread malloc arenas, is discussed).
+struct Board {
+    beats: Mutex<(u64, BTreeMap<u64, Beat>)>,
+    changed: Condvar,
+}
+
+impl Board {
+    /// The process's board; its thread starts with the first call. A process forked after
+    /// its parent's thread started (a Python process pool) has a copy of the board but no
+    /// thread, so it starts a board of its own.
+    fn get() -> &'static Board {
+        static BOARD: Mutex<Option<(u32, &'static Board)>> = Mutex::new(None);
+        let pid = std::process::id();
+        let mut slot = BOARD.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((owner, board)) = *slot
+            && owner == pid
+        {
+            return board;
+        }
+        // One per process, for its lifetime: leaked, like the thread that reads it.
+        let board: &'static Board = Box::leak(Box::new(Board {
+            beats: Mutex::new((0, BTreeMap::new())),
+            changed: Condvar::new(),
+        }));
+        // Never joined: it sleeps while no phase runs, and ends with the process.
+        let spawned = std::thread::Builder::new()
+            .name("internodes-progress".into())
+            .spawn(|| board.write_lines());
+        if let Err(e) = spawned {
+            log::debug!("no progress lines: their thread did not start ({e})");
+        }
+        *slot = Some((pid, board));
+        board
+    }
+
+    fn lock(&self) -> MutexGuard<'_, (u64, BTreeMap<u64, Beat>)> {
+        self.beats.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The progress thread: sleeps until the next line is due (or a phase starts or ends),
+    /// then writes the lines due. They are written under the lock, so a phase that ends
+    /// waits for its line being written and none follows its end (a logger's time is the
+    /// phase's, as when each phase joined a thread of its own).
+    fn write_lines(&self) {
+        let mut beats = self.lock();
+        loop {
+            let due = (beats.1.values()).map(|b| b.start + b.next).min();
+            beats = match due {
+                None => (self.changed.wait(beats)).unwrap_or_else(|e| e.into_inner()),
+                Some(due) => {
+                    let wait = due.saturating_duration_since(Instant::now());
+                    (self.changed.wait_timeout(beats, wait))
+                        .unwrap_or_else(|e| e.into_inner())
+                        .0
+                }
+            };
+            for beat in beats.1.values_mut() {
+                let elapsed = beat.start.elapsed();
+                if elapsed < beat.next {
+                    continue;
+                }
+                let note = (beat.shared.note.lock().unwrap_or_else(|e| e.into_inner()))
+                    .as_ref()
+                    .map_or(String::new(), |n| format!(" ({n})"));
+                let what = &beat.what;
+                log::info!(target: TARGET, "{what}: {:.0} s{note}", elapsed.as_secs_f64());
+                beat.next = elapsed
+                    + match elapsed < beat.cadence.slower_after {
+                        true => beat.cadence.every,
+                        false => beat.cadence.slower,
+                    };
+            }
+        }
+    }
+}
+
 /// Progress lines of one phase while it lasts ([module doc](self)); ends with the value.
 pub struct Heartbeat {
-    running: Option<(Arc<Shared>, JoinHandle<()>)>,
+    /// Its number on the [`Board`], and what it shares with the progress thread.
+    running: Option<(u64, Arc<Shared>)>,
     /// The heartbeat this one covers, current again when this one ends.
     outer: Option<Arc<Shared>>,
 }
@@ -68,7 +158,7 @@ pub struct Heartbeat {
 impl Heartbeat {
     /// Starts the progress lines of the phase `what` ("  iteration 3"), unless `verbose` is
     /// false or nothing would print them (`--quiet`, a rank other than 0 of a distributed run,
-    /// a library user without a logger): then it is inert and starts no thread.
+    /// a library user without a logger): then it is inert.
     pub fn start(verbose: bool, what: impl Into<String>) -> Self {
         Self::with_cadence(verbose, what, Cadence::DEFAULT)
     }
@@ -82,46 +172,27 @@ impl Heartbeat {
             };
         }
         let shared = Arc::new(Shared {
-            done: Mutex::new(false),
-            ended: Condvar::new(),
             note: Mutex::new(None),
         });
-        let what = what.into();
-        let beat = Arc::clone(&shared);
-        let start = Instant::now();
-        let thread = std::thread::spawn(move || {
-            let lock = || beat.done.lock().unwrap_or_else(|e| e.into_inner());
-            let mut next = cadence.first;
-            loop {
-                // `done` is read under the lock the wait releases: an end signalled before
-                // the wait began (a phase shorter than the thread's start) is not missed.
-                let mut done = lock();
-                while !*done && start.elapsed() < next {
-                    let wait = next.saturating_sub(start.elapsed());
-                    done = (beat.ended.wait_timeout(done, wait))
-                        .unwrap_or_else(|e| e.into_inner())
-                        .0;
-                }
-                if *done {
-                    return;
-                }
-                // Not logged under the lock: the phase's end does not wait for a logger.
-                drop(done);
-                let elapsed = start.elapsed();
-                let note = (beat.note.lock().unwrap_or_else(|e| e.into_inner()))
-                    .as_ref()
-                    .map_or(String::new(), |n| format!(" ({n})"));
-                log::info!(target: TARGET, "{what}: {:.0} s{note}", elapsed.as_secs_f64());
-                next = elapsed
-                    + match elapsed < cadence.slower_after {
-                        true => cadence.every,
-                        false => cadence.slower,
-                    };
-            }
-        });
+        let board = Board::get();
+        let id = {
+            let mut beats = board.lock();
+            let id = beats.0;
+            beats.0 += 1;
+            let beat = Beat {
+                what: what.into(),
+                start: Instant::now(),
+                cadence,
+                next: cadence.first,
+                shared: Arc::clone(&shared),
+            };
+            beats.1.insert(id, beat);
+            id
+        };
+        board.changed.notify_one();
         let outer = CURRENT.with(|c| c.replace(Some(Arc::clone(&shared))));
         Self {
-            running: Some((shared, thread)),
+            running: Some((id, shared)),
             outer,
         }
     }
@@ -129,12 +200,11 @@ impl Heartbeat {
 
 impl Drop for Heartbeat {
     fn drop(&mut self) {
-        if let Some((shared, thread)) = self.running.take() {
+        if let Some((id, _)) = self.running.take() {
             CURRENT.with(|c| c.replace(self.outer.take()));
-            *shared.done.lock().unwrap_or_else(|e| e.into_inner()) = true;
-            shared.ended.notify_one();
-            // The thread only logs; a panic there (a logger's) is not the phase's.
-            let _ = thread.join();
+            let board = Board::get();
+            board.lock().1.remove(&id);
+            board.changed.notify_one();
         }
     }
 }

@@ -25,7 +25,7 @@ pub struct Distribution {
     /// Our node at each of PETSc's nodes (PETSc's rows `block p .. block (p + 1)` are our
     /// node `nodes[p]`'s unknowns): a node, not an unknown, and 32 bits, as the mesh's cells
     /// hold it, so that this map of the whole body costs every rank `4 / block` bytes per
-    /// unknown (it was 8 per unknown).
+    /// unknown.
     nodes: Vec<u32>,
     /// The rows of each rank (unknowns), in rank order.
     counts: Vec<usize>,
@@ -56,12 +56,20 @@ impl Distribution {
         let part = partition(&neighbours, ranks.size)?;
         drop(neighbours);
         // The mesh refuses bodies of 2^32 nodes or more (`crate::mesh::MeshError`).
-        let node = |a: usize| u32::try_from(a).expect("a body has fewer than 2^32 nodes");
+        if u32::try_from(num_nodes).is_err() {
+            return Err(LinalgError::Sizes(format!(
+                "{num_nodes} nodes: more than a partition numbers (2^32 - 1)"
+            )));
+        }
         let mut nodes = Vec::with_capacity(num_nodes);
         let mut counts = vec![0; ranks.size];
         for (rank, count) in counts.iter_mut().enumerate() {
             let first = nodes.len();
-            nodes.extend((0..num_nodes).filter(|&a| part[a] == rank).map(node));
+            nodes.extend(
+                (0..num_nodes)
+                    .filter(|&a| part[a] == rank)
+                    .map(|a| a as u32),
+            );
             *count = (nodes.len() - first) * block;
         }
         let first = counts[..ranks.rank].iter().sum::<usize>() / block;
