@@ -69,8 +69,8 @@ struct Beat {
 ///
 /// One thread for the whole process, started with the first heartbeat, rather than one per
 /// phase: with a thread per phase (each active-set iteration, each step of an assembly) a
-/// serial run of a million unknowns peaked 120 to 180 MB above the same run without progress
-/// lines in two of three runs, and with one thread in none of three (`docs/decisions.md`,
+/// serial run of a million unknowns peaked 120 to 180 MB above its runs with one thread in two
+/// of three runs, where those three peaked within 6 MB of each other (`docs/decisions.md`,
 /// where the likely cause, glibc's per-thread malloc arenas, is discussed).
 struct Board {
     beats: Mutex<(u64, BTreeMap<u64, Beat>)>,
