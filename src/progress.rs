@@ -4,9 +4,9 @@
 //! active-set iteration, ...): from 5 seconds on, the process's progress thread says how long
 //! the phase has been running, every 5 seconds (every 30 seconds after the first minute: an
 //! hour-long phase written to a log file adds about a hundred lines, not seven hundred), until
-//! the phase ends ([`Cadence::DEFAULT`]). A phase shorter than 5 seconds says nothing. Code deep inside
-//! a phase that knows how far it is (the coupled GMRES) adds that to the next line with
-//! [`note`].
+//! the phase ends ([`Cadence::DEFAULT`]). A phase shorter than 5 seconds says nothing. Code
+//! deep inside a phase that knows how far it is (the coupled GMRES) adds that to the next line
+//! with [`note`].
 //!
 //! The lines are `log` records at level info with the target [`TARGET`]: the command line
 //! rewrites one line in place on a terminal and prints plain lines elsewhere (a log file, a

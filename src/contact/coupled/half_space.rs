@@ -102,8 +102,9 @@ pub fn compliance_factor(materials: [&Material; 2], dim: usize) -> f64 {
 
 impl HalfSpace {
     /// `S~` on the multipliers of pair `pair` of `system`, whose `coupling` has its active
-    /// primary nodes at its `points`, with the compliance factor `c0` ([`compliance_factor`]). It acts on the pair's multipliers alone
-    /// (numbered from 0): the pairs' blocks of the preconditioner are independent.
+    /// primary nodes at its `points`, with the compliance factor `c0` ([`compliance_factor`]).
+    /// It acts on the pair's multipliers alone (numbered from 0): the pairs' blocks of the
+    /// preconditioner are independent.
     pub fn new(
         system: &CoupledSystem,
         pair: usize,
