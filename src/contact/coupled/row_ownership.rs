@@ -13,8 +13,8 @@ use crate::linalg::{BodySolver, Distribution};
 /// what `CoupledSystem::assemble_on` numbers the coupling blocks' entries by.
 pub struct RowOwnership {
     /// For each unknown of the bodies (the system's numbering), its place among this rank's
-    /// rows, or [`Self::ELSEWHERE`]: four bytes an unknown, half of what the partition itself
-    /// (`Distribution`) takes.
+    /// rows, or [`Self::ELSEWHERE`]: four bytes an unknown on every rank (the partition itself,
+    /// `Distribution`, takes four bytes a node).
     place: Vec<u32>,
 }
 
