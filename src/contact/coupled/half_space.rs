@@ -112,11 +112,10 @@ impl HalfSpace {
         dim: usize,
         c0: f64,
     ) -> Self {
-        let area: HashMap<usize, f64> = (coupling.primary_nodes.iter().copied())
-            .zip(coupling.areas1.iter().copied())
-            .collect();
-        let point: HashMap<usize, [f64; 3]> = (coupling.primary_nodes.iter().copied())
-            .zip(coupling.points.iter().copied())
+        // Each active node's place in the coupling, for its area and point.
+        let place: HashMap<usize, usize> = (coupling.primary_nodes.iter().copied())
+            .enumerate()
+            .map(|(i, node)| (node, i))
             .collect();
         let multipliers = system.pair_multipliers(pair);
         let diagonal = system.d[multipliers.clone()].to_vec();
@@ -139,10 +138,11 @@ impl HalfSpace {
                 }
             }
             let row = system.rows[system.pair_multipliers(pair).start + k];
-            let mut x = [0.0; 3];
-            let p = point.get(&node).copied().unwrap_or_default();
-            x[..dim].copy_from_slice(&p[..dim]);
-            let a = area.get(&node).copied().unwrap_or(0.0);
+            let (mut x, mut a) = ([0.0; 3], 0.0);
+            if let Some(&i) = place.get(&node) {
+                x[..dim].copy_from_slice(&coupling.points[i][..dim]);
+                a = coupling.areas1[i];
+            }
             coupled.push(k);
             owners.push(node);
             points.push((x, row, e, a));
