@@ -52,6 +52,10 @@ PARTS = [
     ("GMRES basis and vectors", "gmres::"),
     ("coupled Krylov solve (other)", "coupled_krylov::"),
     ("mesh", "internodes::mesh::"),
+    # The interface forces on the bodies are kept as fem::LoadVector's entries: the loop's.
+    ("contact (other)", "CoupledSystem::solution"),
+    ("contact (other)", "CoupledSolution::of_pair"),
+    ("contact (other)", "row_ownership::complete_forces"),
     ("assembly: graph, partition, rows, loads", "internodes::elastic::"),
     ("assembly: graph, partition, rows, loads", "internodes::fem::"),
     ("assembly: graph, partition, rows, loads", "Distribution::"),

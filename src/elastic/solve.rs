@@ -8,6 +8,7 @@ use super::error::SolveError;
 use super::problem::ElasticProblem;
 use super::solution::{ElasticSolution, SolveStats, timed};
 use crate::cancel::Cancel;
+use crate::fem::LoadVector;
 use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
     relative_difference, relative_residual,
@@ -88,7 +89,7 @@ pub fn reactions(
     system: &AssembledBody,
     u: &[f64],
     factors: &StepFactors,
-    f_other: &[f64],
+    f_other: Option<&LoadVector>,
 ) -> Vec<(String, Vec<f64>)> {
     let body = problem.body;
     let dim = body.dim;
@@ -114,8 +115,7 @@ pub fn reactions(
             for node in nodes {
                 for c in (0..dim).filter(|&c| mask[c]) {
                     let d = dim * node + c;
-                    total[c] +=
-                        r[d] - system.load(d, factors) - f_other.get(d).copied().unwrap_or(0.0);
+                    total[c] += r[d] - system.load(d, factors) - f_other.map_or(0.0, |f| f.get(d));
                 }
             }
             (group.clone(), total)
@@ -320,7 +320,7 @@ pub fn solve(
     full.paths = (problem.paths().into_iter())
         .map(|path| (path.to_string(), 1.0))
         .collect();
-    let reactions = reactions(problem, &system, &u, &full, &[]);
+    let reactions = reactions(problem, &system, &u, &full, None);
     Ok(ElasticSolution {
         displacement: u,
         reactions,

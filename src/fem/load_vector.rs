@@ -1,16 +1,18 @@
-//! A body's load vector as it is kept after assembly: `f`, or the constrained right-hand side
-//! `f_c`.
+//! A vector of nodal forces on a body as it is kept beyond the moment it is made: the load
+//! vector `f` and the constrained right-hand side `f_c` after assembly, and the forces the
+//! contact interfaces put on a body (`crate::contact::coupled::system::CoupledSolution`).
 //!
 //! Most contact cases load a body through its supports and its contacts, not through loads:
-//! `f` is then zero, and `f_c` is nonzero only at the prescribed dofs and their neighbours.
-//! Kept whole, each would cost every rank 8 bytes per unknown of the body for the whole run
-//! (at 1M unknowns 8 MB a vector, at 100M 800 MB). So a vector with few nonzero entries keeps
-//! only those; one that most dofs load (a body force) is kept whole.
+//! `f` is then zero, `f_c` is nonzero only at the prescribed dofs and their neighbours, and the
+//! contact forces only at the interface's nodes. Kept whole, each would cost every rank 8 bytes
+//! per unknown of the body (at 1M unknowns 8 MB a vector, at 100M 800 MB). So a vector with
+//! few nonzero entries keeps only those; one that most dofs load (a body force) is kept whole.
 //!
 //! Every value read from it is the one the whole vector gives, to the bit: a missing entry
 //! reads as `0.0`, and [`LoadVector::scaled`] writes `s * 0.0` there as the whole vector's
-//! product would (`-0.0` for a negative `s`). Only the sign of a zero can differ, where a sum
-//! skips the zeros ([`LoadVector::add_scaled_to`], [`LoadVector::component_sum`]).
+//! product would (`-0.0` for a negative `s`); [`LoadVector::component_sum`] adds the entries
+//! in the whole vector's order, and its zeros change no partial sum. Only the sign of a zero
+//! can differ, where [`LoadVector::add_scaled_to`] skips the zeros.
 
 /// A load vector ([module doc](self)).
 #[derive(Debug, Clone, PartialEq)]
@@ -95,15 +97,19 @@ impl LoadVector {
         }
     }
 
-    /// The sum of the entries of component `c` (`dim` components per node), in dof order (of
-    /// no entry: `-0.0`, where the whole vector's zeros sum to `+0.0`).
+    /// The sum of the entries of component `c` (`dim` components per node), in dof order: the
+    /// whole vector's sum to the bit (`+ 0.0` turns the empty sum's `-0.0` into the `+0.0`
+    /// that the whole vector's zeros sum to, and changes no other sum).
     pub fn component_sum(&self, c: usize, dim: usize) -> f64 {
         match self {
             Self::Whole(whole) => whole.iter().skip(c).step_by(dim).sum(),
-            Self::Sparse { entries, .. } => (entries.iter())
-                .filter(|&&(d, _)| d % dim == c)
-                .map(|&(_, v)| v)
-                .sum(),
+            Self::Sparse { entries, .. } => {
+                let sum: f64 = (entries.iter())
+                    .filter(|&&(d, _)| d % dim == c)
+                    .map(|&(_, v)| v)
+                    .sum();
+                sum + 0.0
+            }
         }
     }
 }
@@ -138,7 +144,7 @@ mod tests {
             }
             for c in 0..3 {
                 let expected: f64 = whole.iter().skip(c).step_by(3).sum();
-                assert_eq!(kept.component_sum(c, 3), expected);
+                assert_eq!(kept.component_sum(c, 3).to_bits(), expected.to_bits());
             }
         }
     }

@@ -98,6 +98,16 @@ impl Distribution {
         self.local * self.block
     }
 
+    /// This rank's nodes, increasing, as the partition keeps them.
+    pub fn own_nodes(&self) -> &[u32] {
+        &self.nodes[self.first..self.first + self.local]
+    }
+
+    /// Unknowns per node.
+    pub fn block(&self) -> usize {
+        self.block
+    }
+
     /// This rank's nodes, increasing: the columns ([`NodeColumns`]) it assembles.
     pub fn nodes(&self) -> Vec<usize> {
         let own = &self.nodes[self.first..self.first + self.local];

@@ -181,8 +181,8 @@ pub struct KrylovStats {
 /// What the Krylov path keeps between active-set iterations and load steps.
 #[derive(Default)]
 pub struct KrylovState {
-    /// The bodies' displacements of the last solve and the load step's factors it was solved
-    /// at.
+    /// The bodies' displacements of the last solve (this rank's rows of them in a distributed
+    /// run) and the load step's factors it was solved at.
     displacements: Option<(StepFactors, Vec<f64>)>,
     /// Traction of the last solve per (pair, primary node, component), unscaled.
     tractions: HashMap<MultiplierKey, f64>,
@@ -229,8 +229,6 @@ pub fn solve(
 ) -> Result<Vec<f64>, ContactError> {
     let system = problem.system;
     let rhs = system.rhs();
-    let x = starting_guess(system, state);
-    let rhs_norm = gmres::norm(&rhs);
     let tolerance = tightness.relative();
     let schur = (problem.pairs.iter().enumerate())
         .map(|(p, pair)| {
@@ -240,7 +238,10 @@ pub fn solve(
         .collect();
     let num_bodies = system.num_bodies();
     let product = CoupledProduct::new(problem)?;
-    let local_scratch = vec![0.0; product.layout.num_rows(system)];
+    let rows = product.layout.num_rows(system);
+    let rhs_norm = product.layout.dot(&rhs, &rhs)?.sqrt();
+    let mut local_x = starting_guess(system, state, rows);
+    let local_scratch = vec![0.0; rows];
     let mut operators = Blocks {
         product,
         schur,
@@ -257,8 +258,6 @@ pub fn solve(
         max_iterations,
         restart: RESTART,
     };
-    let rhs = operators.product.layout.local_part(rhs);
-    let mut local_x = operators.product.layout.local_part(x);
     let outcome = gmres::solve(&mut operators, &rhs, &mut local_x, settings);
     state.body_applications.resize(num_bodies, 0);
     for (total, new) in state
@@ -285,22 +284,31 @@ pub fn solve(
             tolerance,
         }));
     }
-    let x = operators.product.layout.whole(local_x)?;
-    keep(system, &x, state);
-    Ok(x)
+    keep(
+        system,
+        &local_x,
+        rows,
+        &mut state.displacements,
+        &mut state.tractions,
+    );
+    operators.product.layout.whole(local_x)
 }
 
 /// The last solve's displacements (scaled to this load step's factors:
 /// `StepFactors::scale_from`) and tractions, along each multiplier's direction; an uncoupled
-/// multiplier's exact value.
-fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
-    let n = system.num_displacements();
-    let mut x = match &state.displacements {
+/// multiplier's exact value. A vector of the solve's layout, whose displacement rows are the
+/// first `rows` (`crate::contact::coupled::krylov_layout`).
+fn starting_guess(system: &CoupledSystem, state: &KrylovState, rows: usize) -> Vec<f64> {
+    let n = rows;
+    // Allocated to its length (the multipliers appended to a vector of the displacements'
+    // length would double its room): GMRES holds it through the solve.
+    let mut x = Vec::with_capacity(n + system.m);
+    match &state.displacements {
         Some((factors, u)) if u.len() == n => match system.factors.scale_from(factors) {
-            Some(scale) => u.iter().map(|u| scale * u).collect(),
-            None => vec![0.0; n],
+            Some(scale) => x.extend(u.iter().map(|u| scale * u)),
+            None => x.resize(n, 0.0),
         },
-        _ => vec![0.0; n],
+        _ => x.resize(n, 0.0),
     };
     x.resize(n + system.m, 0.0);
     for (k, column) in system.columns.iter().enumerate() {
@@ -320,14 +328,22 @@ fn starting_guess(system: &CoupledSystem, state: &KrylovState) -> Vec<f64> {
     x
 }
 
-/// Keeps the displacements and tractions of `x` for the next solve's start.
-fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
-    let n = system.num_displacements();
-    state.displacements = Some((system.factors.clone(), x[..n].to_vec()));
-    state.tractions.clear();
+/// Keeps the displacements and tractions of `x`, a vector of the solve's layout whose first
+/// `rows` are displacements, for the next solve's start: in a distributed run this rank's rows
+/// alone.
+fn keep(
+    system: &CoupledSystem,
+    x: &[f64],
+    rows: usize,
+    displacements: &mut Option<(StepFactors, Vec<f64>)>,
+    tractions: &mut HashMap<MultiplierKey, f64>,
+) {
+    let n = rows;
+    *displacements = Some((system.factors.clone(), x[..n].to_vec()));
+    tractions.clear();
     for (k, column) in system.columns.iter().enumerate() {
         for (key, weight) in column {
-            *state.tractions.entry(*key).or_insert(0.0) += system.s * x[n + k] * weight;
+            *tractions.entry(*key).or_insert(0.0) += system.s * x[n + k] * weight;
         }
     }
 }
@@ -340,8 +356,8 @@ fn keep(system: &CoupledSystem, x: &[f64], state: &mut KrylovState) {
 pub fn relative_residual(problem: &KrylovProblem, x: Vec<f64>) -> Result<f64, ContactError> {
     let mut product = CoupledProduct::new(problem)?;
     let rhs = problem.system.rhs();
-    let rhs_norm = gmres::norm(&rhs);
-    let (rhs, x) = (product.layout.local_part(rhs), product.layout.local_part(x));
+    let rhs_norm = product.layout.dot(&rhs, &rhs)?.sqrt();
+    let x = product.layout.local_part(x);
     let mut residual = vec![0.0; x.len()];
     product.apply(&x, &mut residual)?;
     residual.iter_mut().zip(&rhs).for_each(|(r, b)| *r = b - *r);

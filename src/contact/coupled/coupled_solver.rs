@@ -44,6 +44,7 @@ use crate::contact::coupled::system::{CoupledSystem, Pair, Unknowns, assembled};
 use crate::contact::settings::{ContactSettings, CoupledSolver};
 use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
+use crate::fem::LoadVector;
 use crate::linalg::{
     BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Distribution, LinalgError, Ordering,
 };
@@ -196,7 +197,7 @@ impl BodyFactors {
     pub fn complete_forces(
         &self,
         which: &[usize],
-        forces: &mut [&mut Vec<f64>],
+        forces: &mut [&mut LoadVector],
     ) -> Result<(), ContactError> {
         match shared_bodies(&self.solvers)? {
             None => Ok(()),
@@ -1000,7 +1001,7 @@ mod tests {
                         .map(|mesh| Distribution::new(&stiffness_graph(mesh), ranks).unwrap())
                         .collect();
                     let shared: Vec<&Distribution> = distributions.iter().collect();
-                    let ownership = RowOwnership::from_distributions(&shared).unwrap();
+                    let ownership = RowOwnership::from_distributions(&shared);
                     let system =
                         CoupledSystem::assemble_on(&bodies, &pairs, 2, &factors, Some(&ownership))
                             .unwrap();
@@ -1014,6 +1015,17 @@ mod tests {
                     let own: Vec<usize> = (distributions.iter().zip(&whole.offsets))
                         .flat_map(|(d, &offset)| d.own().map(move |dof| offset + dof))
                         .collect();
+                    // Every unknown placed at its row among this rank's, or nowhere; the
+                    // right-hand side held at those rows alone.
+                    let mut places = vec![None; n];
+                    own.iter()
+                        .enumerate()
+                        .for_each(|(k, &row)| places[row] = Some(k));
+                    let placed: Vec<Option<usize>> = (0..n).map(|i| ownership.place(i)).collect();
+                    assert_eq!(placed, places);
+                    assert_eq!(ownership.num_local(), own.len());
+                    let f_rank: Vec<f64> = own.iter().map(|&row| whole.f[row]).collect();
+                    assert_eq!(system.f, f_rank);
                     let x_rank: Vec<f64> = own.iter().map(|&row| x[row]).collect();
                     let mut c_rank = vec![0.0; m];
                     system.add_c_product(&x_rank, &mut c_rank);

@@ -63,6 +63,7 @@ use crate::contact::law::{Multiplier, Reads, Restates};
 use rayon::prelude::*;
 
 use crate::elastic::{AssembledBody, StepFactors};
+use crate::fem::LoadVector;
 use crate::linalg::{BodySolver, mat_vec};
 
 /// The interface operators of one pair in one iteration, on its active primary nodes I (built
@@ -118,8 +119,10 @@ pub struct CoupledSolution {
     /// frictionless, `lambda_n n`).
     pub traction: Vec<Vec<[f64; 3]>>,
     /// Forces the interfaces apply to each body's dofs: `M_a lambda` on a primary, `-M_b R_ba
-    /// lambda` on a secondary, summed over the body's pairs.
-    pub contact_force: Vec<Vec<f64>>,
+    /// lambda` on a secondary, summed over the body's pairs. Nonzero at the interface nodes
+    /// alone, so kept as those entries (`LoadVector::new`), not a vector of the body's size
+    /// that every rank would hold for the loop's life.
+    pub contact_force: Vec<LoadVector>,
     /// Each body's force-controlled displacements, one per `RigidColumn` of the body (they
     /// are also in `u`, at the group's dofs).
     pub rigid: Vec<Vec<f64>>,
@@ -157,7 +160,7 @@ impl CoupledSolution {
         CoupledSolution {
             u: vec![self.u[a].clone(), self.u[b].clone()],
             traction: vec![self.traction[p].clone()],
-            contact_force: forces.into(),
+            contact_force: forces.map(LoadVector::new).into(),
             rigid: vec![self.rigid[a].clone(), self.rigid[b].clone()],
             relative_residual: self.relative_residual,
         }
@@ -165,13 +168,13 @@ impl CoupledSolution {
 
     /// The total contact force on each body (components beyond `dim` are 0).
     pub fn total_forces(&self, dim: usize) -> Vec<[f64; 3]> {
-        let total = |force: &[f64]| -> [f64; 3] {
+        let total = |force: &LoadVector| -> [f64; 3] {
             std::array::from_fn(|c| match c < dim {
-                true => force.iter().skip(c).step_by(dim).sum(),
+                true => force.component_sum(c, dim),
                 false => 0.0,
             })
         };
-        self.contact_force.iter().map(|f| total(f)).collect()
+        self.contact_force.iter().map(total).collect()
     }
 }
 
@@ -280,7 +283,10 @@ pub struct CoupledSystem {
     /// `RigidColumn` is multiplier `rigid_offsets[k] + r`; they follow every pair's
     /// multipliers.
     pub rigid_offsets: Vec<usize>,
-    /// The bodies' `f_k` (constrained), one after another, and `g`.
+    /// The bodies' `f_k` (constrained), one after another, numbered as [`Self::unknowns`]
+    /// says: whole, or in a distributed run this rank's rows alone, in the order of its Krylov
+    /// vectors (`crate::contact::coupled::krylov_layout`), so that no rank holds the whole
+    /// right-hand side through the solve.
     pub f: Vec<f64>,
     /// The load step's factors `f` and `g` are scaled by (each body's `f_k` by
     /// `AssembledBody::rhs`).
@@ -362,7 +368,20 @@ impl CoupledSystem {
             blocks.add_rigid(k, body, first, offsets[k], s, factors);
         }
         // Loads and prescribed displacements scale the constrained right-hand side linearly.
-        let f: Vec<f64> = (bodies.iter()).flat_map(|body| body.rhs(factors)).collect();
+        let f = match ownership {
+            None => (bodies.iter()).flat_map(|body| body.rhs(factors)).collect(),
+            Some(ownership) => {
+                let mut f = vec![0.0; ownership.num_local()];
+                for (k, body) in bodies.iter().enumerate() {
+                    for (dof, value) in body.rhs(factors).into_iter().enumerate() {
+                        if let Some(place) = ownership.place(offsets[k] + dof) {
+                            f[place] = value;
+                        }
+                    }
+                }
+                f
+            }
+        };
         Ok(Self {
             offsets,
             unknowns: match ownership {
@@ -576,9 +595,12 @@ impl CoupledSystem {
         }
     }
 
-    /// `[f; g]`.
+    /// `[f; g]`, `f` numbered as [`Self::f`] is. Allocated to its length: a copy of `f`
+    /// extended by `g` would double its room, a second right-hand side's worth held through
+    /// the solve.
     pub fn rhs(&self) -> Vec<f64> {
-        let mut rhs = self.f.clone();
+        let mut rhs = Vec::with_capacity(self.f.len() + self.g.len());
+        rhs.extend_from_slice(&self.f);
         rhs.extend_from_slice(&self.g);
         rhs
     }
@@ -640,7 +662,7 @@ impl CoupledSystem {
         CoupledSolution {
             u,
             traction,
-            contact_force,
+            contact_force: contact_force.into_iter().map(LoadVector::new).collect(),
             rigid,
             relative_residual,
         }

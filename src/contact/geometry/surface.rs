@@ -19,6 +19,7 @@ use thiserror::Error;
 use crate::contact::geometry::boundary::BodyBoundary;
 use crate::contact::geometry::projection::SurfaceIndex;
 use crate::contact::geometry::rbf::nearest_distances;
+use crate::fem::LoadVector;
 use crate::fem::kernels::facet_measure_and_normal;
 use crate::mesh::BodyMesh;
 
@@ -138,10 +139,10 @@ impl ContactSurface {
     /// The contact pressure averaged over the patch of node `s` with its hat function as
     /// weight, `int p phi_s ds / int phi_s ds`, from the nodal contact forces `force` that the
     /// interface exerts on this body (body dofs, `dim` per node).
-    pub fn mean_pressure(&self, force: &[f64], s: usize) -> f64 {
+    pub fn mean_pressure(&self, force: &LoadVector, s: usize) -> f64 {
         let node = self.nodes[s];
         let normal_force: f64 = (0..self.dim)
-            .map(|k| force[self.dim * node + k] * self.normals[s][k])
+            .map(|k| force.get(self.dim * node + k) * self.normals[s][k])
             .sum();
         -normal_force / self.nodal_area[s]
     }

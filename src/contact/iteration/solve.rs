@@ -95,6 +95,7 @@ use crate::contact::verify::post::{self, LastIterate};
 use crate::elastic::{
     AssembledBody, ElasticProblem, SolveStats, SolverSettings, StepFactors, assemble,
 };
+use crate::fem::LoadVector;
 use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::BodySolverKind;
 use crate::progress::Heartbeat;
@@ -1471,7 +1472,7 @@ impl ContactSolver<'_> {
             };
             let mut view = solution.of_pair(p, &pair, dim);
             if let Some(factors) = self.factors.as_ref() {
-                let mut forces: Vec<&mut Vec<f64>> = view.contact_force.iter_mut().collect();
+                let mut forces: Vec<&mut LoadVector> = view.contact_force.iter_mut().collect();
                 factors.complete_forces(&[a, b], &mut forces)?;
             }
             let (mut certificate, gaps) = certify(problem, &view, [&nodes, &solved]);
@@ -1592,7 +1593,7 @@ impl ContactSolver<'_> {
         let mut solution = system.solution(&x, &bodies, &pairs, dim, residual);
         if let Some(factors) = self.factors.as_ref() {
             let all: Vec<usize> = (0..bodies.len()).collect();
-            let mut forces: Vec<&mut Vec<f64>> = solution.contact_force.iter_mut().collect();
+            let mut forces: Vec<&mut LoadVector> = solution.contact_force.iter_mut().collect();
             factors.complete_forces(&all, &mut forces)?;
         }
         Ok(solution)

@@ -70,6 +70,7 @@ use crate::contact::law::{ContactLaw, Tangential};
 use crate::contact::method::Enforcement;
 use crate::contact::problem::ContactProblem;
 use crate::contact::solution::ContactStatus;
+use crate::fem::LoadVector;
 
 /// How the loop's ending and the residual checks make the status: the one place that decides
 /// it. A loop that stopped converged has solved the discrete problem only if every residual,
@@ -101,8 +102,8 @@ pub fn certify(
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
     let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
     let sides: [Side; 2] = [
-        (s1, s2, u1, u2, &solution.contact_force[0][..]),
-        (s2, s1, u2, u1, &solution.contact_force[1][..]),
+        (s1, s2, u1, u2, &solution.contact_force[0]),
+        (s2, s1, u2, u1, &solution.contact_force[1]),
     ];
     let gaps = sides.map(|(own, other, u_own, u_other, _)| {
         geometric_gaps(own, other, Some(u_own), Some(u_other))
@@ -408,7 +409,7 @@ type Side<'a> = (
     &'a ContactSurface,
     &'a [f64],
     &'a [f64],
-    &'a [f64],
+    &'a LoadVector,
 );
 
 fn force_centres(sides: &[Side; 2], mean: &[Vec<f64>]) -> ForceCentres {

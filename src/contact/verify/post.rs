@@ -15,6 +15,7 @@ use crate::contact::verify::hertz;
 use crate::elastic::{
     AssembledBody, ElasticProblem, ElasticSolution, SolveStats, StepFactors, reactions,
 };
+use crate::fem::LoadVector;
 
 /// What an active-set loop hands over: the problem with its assembled bodies, and how the loop
 /// ended with its last iterate and that iterate's certificate.
@@ -24,7 +25,7 @@ pub(in crate::contact) struct LastIterate<'a> {
     pub bodies: [(&'a AssembledBody, &'a SolveStats); 2],
     /// The forces every pair puts on each of the two bodies (the reactions balance them);
     /// `solution` has this pair's alone.
-    pub body_contact_force: [&'a [f64]; 2],
+    pub body_contact_force: [&'a LoadVector; 2],
     pub linear_solvers: LinearSolvers,
     pub factors: &'a StepFactors,
     pub status: ContactStatus,
@@ -173,12 +174,12 @@ fn body_solution(
     problem: &ElasticProblem,
     (body, stats): (&AssembledBody, &SolveStats),
     u: Vec<f64>,
-    contact_force: &[f64],
+    contact_force: &LoadVector,
     factors: &StepFactors,
     residual: f64,
 ) -> ElasticSolution {
     ElasticSolution {
-        reactions: reactions(problem, body, &u, factors, contact_force),
+        reactions: reactions(problem, body, &u, factors, Some(contact_force)),
         displacement: u,
         stats: SolveStats {
             relative_residual: residual,
@@ -191,7 +192,7 @@ fn body_solution(
 /// with the lumped interface mass the traction of node `s` is its force over its area.
 fn surface_fields(
     surface: &ContactSurface,
-    force: &[f64],
+    force: &LoadVector,
     gaps: Vec<f64>,
     active: impl Fn(usize) -> bool,
 ) -> SurfaceFields {
@@ -201,7 +202,7 @@ fn surface_fields(
             let node = surface.nodes[s];
             std::array::from_fn(|c| {
                 if c < dim {
-                    force[dim * node + c] / surface.nodal_area[s]
+                    force.get(dim * node + c) / surface.nodal_area[s]
                 } else {
                     0.0
                 }
