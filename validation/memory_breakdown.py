@@ -52,10 +52,12 @@ PARTS = [
     ("GMRES basis and vectors", "gmres::"),
     ("coupled Krylov solve (other)", "coupled_krylov::"),
     ("mesh", "internodes::mesh::"),
-    # The interface forces on the bodies are kept as fem::LoadVector's entries: the loop's.
+    # The loop's, through functions of fem and Distribution: the interface forces kept as
+    # fem::LoadVector's entries, the last iterate's displacements kept at a rank's rows.
     ("contact (other)", "CoupledSystem::solution"),
     ("contact (other)", "CoupledSolution::of_pair"),
     ("contact (other)", "row_ownership::complete_forces"),
+    ("contact (other)", "BodyFactors::own_rows"),
     ("assembly: graph, partition, rows, loads", "internodes::elastic::"),
     ("assembly: graph, partition, rows, loads", "internodes::fem::"),
     ("assembly: graph, partition, rows, loads", "Distribution::"),

@@ -208,6 +208,33 @@ impl BodyFactors {
         }
     }
 
+    /// Each body's displacements `u` (whole, every body) reduced to this rank's rows of it in a
+    /// distributed run, in PETSc's order; unchanged on one process. The loop keeps its last
+    /// iterate so between solves ([`Self::whole_rows`] undoes it), so that no rank holds a
+    /// whole body's vector through the next solve.
+    pub fn own_rows(&self, u: &mut [Vec<f64>]) -> Result<(), ContactError> {
+        if let Some(shared) = shared_bodies(&self.solvers)? {
+            for (distribution, u) in shared.iter().zip(u.iter_mut()) {
+                *u = distribution.local_part(u);
+            }
+        }
+        Ok(())
+    }
+
+    /// Each body's displacements whole again from every rank's rows of them
+    /// ([`Self::own_rows`]; collective, the same values to the bit); unchanged on one process.
+    pub fn whole_rows(&self, u: &mut [Vec<f64>]) -> Result<(), ContactError> {
+        if let Some(shared) = shared_bodies(&self.solvers)? {
+            for (distribution, u) in shared.iter().zip(u.iter_mut()) {
+                let mut whole = vec![0.0; distribution.counts().iter().sum()];
+                (distribution.gather(u, &mut whole))
+                    .map_err(|e| ContactError::Linalg(format!("gathering a body's vector: {e}")))?;
+                *u = whole;
+            }
+        }
+        Ok(())
+    }
+
     /// `|[f; g] - A x| / |[f; g]|` of the answer `x` of [`Self::solve`]: by the system's blocks,
     /// or on several ranks, whose systems hold only their entries, by the coupled GMRES's
     /// product (collective).

@@ -633,8 +633,8 @@ struct LoopState {
     corrections: Vec<Vec<f64>>,
     safeguard: Safeguard,
     history: Vec<IterationRecord>,
-    /// The last iterate: each pair's coupling, and the solution.
-    last: Option<(Vec<Coupling>, CoupledSolution)>,
+    /// The last iterate.
+    last: Option<KeptIterate>,
     /// The node states `last` was solved on (`active` moves on to the next one).
     solved: NodeStates,
     /// Whether the solve started without an active set from an earlier one.
@@ -649,6 +649,51 @@ struct LoopState {
     /// the last iteration that the loop went on for (over the settling margin).
     slides: Vec<Option<[f64; 3]>>,
     slide_change: Option<f64>,
+}
+
+/// The last iterate as the loop keeps it between solves: each pair's coupling and the solution,
+/// whose displacements are, in a distributed run, this rank's rows alone
+/// ([`BodyFactors::own_rows`]), so that no rank holds a whole body's vector through the next
+/// solve. Read whole through [`Self::displacements`] and [`Self::into_whole`] (collective).
+struct KeptIterate {
+    couplings: Vec<Coupling>,
+    solution: CoupledSolution,
+}
+
+impl KeptIterate {
+    fn new(
+        couplings: Vec<Coupling>,
+        mut solution: CoupledSolution,
+        factors: Option<&BodyFactors>,
+    ) -> Result<Self, ContactError> {
+        if let Some(factors) = factors {
+            factors.own_rows(&mut solution.u)?;
+        }
+        Ok(Self {
+            couplings,
+            solution,
+        })
+    }
+
+    /// Each body's displacements, whole (collective).
+    fn displacements(&self, factors: Option<&BodyFactors>) -> Result<Vec<Vec<f64>>, ContactError> {
+        let mut u = self.solution.u.clone();
+        if let Some(factors) = factors {
+            factors.whole_rows(&mut u)?;
+        }
+        Ok(u)
+    }
+
+    /// The couplings and the solution with its displacements whole (collective).
+    fn into_whole(
+        mut self,
+        factors: Option<&BodyFactors>,
+    ) -> Result<(Vec<Coupling>, CoupledSolution), ContactError> {
+        if let Some(factors) = factors {
+            factors.whole_rows(&mut self.solution.u)?;
+        }
+        Ok((self.couplings, self.solution))
+    }
 }
 
 impl LoopState {
@@ -668,7 +713,7 @@ impl LoopState {
     fn advance(
         &mut self,
         record: IterationRecord,
-        last: (Vec<Coupling>, CoupledSolution),
+        last: KeptIterate,
         step: Step,
     ) -> Option<ContactStatus> {
         self.history.push(record);
@@ -821,7 +866,8 @@ impl ContactSolver<'_> {
         if self.solver.verbose {
             log::debug!("{}", record.line(log::log_enabled!(log::Level::Trace)));
         }
-        Ok(state.advance(record, (couplings, solution), step))
+        let last = KeptIterate::new(couplings, solution, self.factors.as_ref())?;
+        Ok(state.advance(record, last, step))
     }
 
     /// Where the bodies that nothing but their contacts hold (along a force-controlled
@@ -876,7 +922,10 @@ impl ContactSolver<'_> {
                 continue;
             }
             let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-            let gaps = match state.last.as_ref().map(|(_, solution)| &solution.u) {
+            let last = (state.last.as_ref())
+                .map(|last| last.displacements(self.factors.as_ref()))
+                .transpose()?;
+            let gaps = match last {
                 Some(u) => geometric_gaps(s1, s2, Some(&u[sides[0]]), Some(&u[sides[1]])),
                 None => geometric_gaps(s1, s2, None, None),
             };
@@ -1454,7 +1503,8 @@ impl ContactSolver<'_> {
         loop_end: ContactStatus,
         state: LoopState,
     ) -> Result<Vec<ContactSolution>, ContactError> {
-        let (couplings, solution) = state.last.expect("max_iterations >= 1 is validated");
+        let last = state.last.expect("max_iterations >= 1 is validated");
+        let (couplings, solution) = last.into_whole(self.factors.as_ref())?;
         let dim = self.pairs[0].primary_surface.dim;
         let mut answers = Vec::with_capacity(self.pairs.len());
         // Each Coulomb pair's tangential states the last iterate was solved with.
