@@ -37,7 +37,10 @@ pub struct ActiveSet {
 /// What a Coulomb pair's next load step starts from.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FrictionHistory {
-    /// The primary's and the secondary's displacements (body dofs).
+    /// The primary's and the secondary's displacements at their contact surfaces' nodes alone
+    /// (`crate::contact::geometry::surface::ContactSurface::values`: three components per
+    /// node), all that the next step's jumps read, where the bodies' whole vectors would be
+    /// held on every rank through the next step.
     pub displacements: [Vec<f64>; 2],
     /// The accumulated slip of every primary candidate.
     pub accumulated_slip: Vec<f64>,

@@ -295,21 +295,17 @@ impl InterfaceOperators {
         u1: &[f64],
         u2: &[f64],
     ) -> Vec<[f64; 3]> {
-        let dim = primary.dim;
-        let u2_flat: Vec<f64> = secondary
-            .nodes
-            .iter()
-            .flat_map(|&node| (0..3).map(move |k| if k < dim { u2[dim * node + k] } else { 0.0 }))
-            .collect();
-        let u2_at_1 = self.r12.apply(&u2_flat, 3);
-        (0..primary.len())
-            .map(|i| {
-                let node = primary.nodes[i];
-                std::array::from_fn(|k| {
-                    let u1_k = if k < dim { u1[dim * node + k] } else { 0.0 };
-                    u1_k - u2_at_1[3 * i + k]
-                })
-            })
+        let on_surfaces = [primary.values(u1), secondary.values(u2)];
+        self.jumps_of(&on_surfaces)
+    }
+
+    /// [`Self::jumps`] from the displacements at the two surfaces' nodes alone (`[primary,
+    /// secondary]`, three components per node: `ContactSurface::values`), which is all it
+    /// reads.
+    pub fn jumps_of(&self, [u1, u2]: &[Vec<f64>; 2]) -> Vec<[f64; 3]> {
+        let u2_at_1 = self.r12.apply(u2, 3);
+        (0..u1.len() / 3)
+            .map(|i| std::array::from_fn(|k| u1[3 * i + k] - u2_at_1[3 * i + k]))
             .collect()
     }
 

@@ -136,6 +136,15 @@ impl ContactSurface {
         std::array::from_fn(|k| self.coords[s][k] + if k < dim { u[dim * node + k] } else { 0.0 })
     }
 
+    /// The body vector `u` (body dofs) at this surface's nodes, three components per node in
+    /// the surface's order (the third 0 in 2D).
+    pub fn values(&self, u: &[f64]) -> Vec<f64> {
+        let dim = self.dim;
+        (self.nodes.iter())
+            .flat_map(|&node| (0..3).map(move |k| if k < dim { u[dim * node + k] } else { 0.0 }))
+            .collect()
+    }
+
     /// The contact pressure averaged over the patch of node `s` with its hat function as
     /// weight, `int p phi_s ds / int phi_s ds`, from the nodal contact forces `force` that the
     /// interface exerts on this body (body dofs, `dim` per node).

@@ -826,12 +826,7 @@ impl ContactSolver<'_> {
                     timed(&mut seconds.operators, || self.pair_again(p, pairings[p]))?;
                     state.corrections[p] = self.corrections(p, &solution, &gaps[p]);
                     if let Some(start) = state.friction[p].as_mut() {
-                        let (s1, s2) = (
-                            &self.pairs[p].primary_surface,
-                            &self.pairs[p].secondary_surface,
-                        );
-                        let [u1, u2] = &start.displacements;
-                        start.jumps = self.operators[p].jumps(s1, s2, u1, u2);
+                        start.jumps = self.operators[p].jumps_of(&start.displacements);
                     }
                 }
                 state.safeguard = Safeguard::default();
@@ -1278,17 +1273,12 @@ impl ContactSolver<'_> {
     fn start_of_step(&self, p: usize, history: Option<FrictionHistory>) -> StepStart {
         let problem = &self.pairs[p];
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        let [a, b] = self.pair_bodies[p];
         let history = history.unwrap_or_else(|| FrictionHistory {
-            displacements: [
-                vec![0.0; self.bodies[a].f_c.len()],
-                vec![0.0; self.bodies[b].f_c.len()],
-            ],
+            displacements: [vec![0.0; 3 * s1.len()], vec![0.0; 3 * s2.len()]],
             accumulated_slip: vec![0.0; s1.len()],
         });
-        let [u1, u2] = &history.displacements;
         StepStart {
-            jumps: self.operators[p].jumps(s1, s2, u1, u2),
+            jumps: self.operators[p].jumps_of(&history.displacements),
             displacements: history.displacements,
             accumulated_slip: history.accumulated_slip,
         }
@@ -1557,8 +1547,9 @@ impl ContactSolver<'_> {
                             _ => None,
                         })
                         .collect();
+                    let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
                     let history = FrictionHistory {
-                        displacements: [view.u[0].clone(), view.u[1].clone()],
+                        displacements: [s1.values(&view.u[0]), s2.values(&view.u[1])],
                         accumulated_slip: fields.accumulated_slip.clone(),
                     };
                     (slip, Some(history), Some(fields.into_solution()))
@@ -1728,7 +1719,8 @@ impl PairFriction {
 
 /// Where a Coulomb pair's load step starts ([`ContactSolver::start_of_step`]).
 struct StepStart {
-    /// The primary's and the secondary's displacements at the end of the last step.
+    /// The primary's and the secondary's displacements at the end of the last step, at their
+    /// contact surfaces' nodes (`FrictionHistory::displacements`).
     displacements: [Vec<f64>; 2],
     /// The jump `u1_i - (R12 u2)_i` of every primary candidate there, through the current
     /// operators (computed again when they are paired again).
