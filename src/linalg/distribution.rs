@@ -110,8 +110,7 @@ impl Distribution {
 
     /// This rank's nodes, increasing: the columns ([`NodeColumns`]) it assembles.
     pub fn nodes(&self) -> Vec<usize> {
-        let own = &self.nodes[self.first..self.first + self.local];
-        own.iter().map(|&node| node as usize).collect()
+        self.own_nodes().iter().map(|&node| node as usize).collect()
     }
 
     /// This rank's rows for PETSc: `columns` (of this rank's [`Self::nodes`], constrained)

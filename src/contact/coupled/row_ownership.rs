@@ -103,8 +103,8 @@ pub fn shared_bodies(solvers: &[BodySolver]) -> Result<Option<Vec<&Distribution>
 /// be whole on every rank.
 pub fn kept_nodes(distribution: &Distribution, body: &AssembledBody) -> Vec<bool> {
     let mut kept = vec![false; body.f.len() / body.dim];
-    for node in distribution.nodes() {
-        kept[node] = true;
+    for &node in distribution.own_nodes() {
+        kept[node as usize] = true;
     }
     for dof in body.rigid.iter().flat_map(|rigid| &rigid.dofs) {
         kept[dof / body.dim] = true;
