@@ -300,6 +300,9 @@ mod v_cycles {
         // Without options of PETSc's own, the V-cycles do run at once (else they take turns).
         if std::env::var_os("PETSC_OPTIONS").is_none() {
             assert!(internodes::linalg::petsc::concurrent_v_cycles());
+            // The set-ups left PETSc's options as they found them (the shim sets
+            // -matptap_via around a one-process set-up alone).
+            assert!(internodes::linalg::petsc::options_are_ours().expect("PETSc's options"));
         }
         let sizes = [3 * 13 * 13 * 13, 3 * 10 * 10 * 10];
         // Fresh objects first: their first V-cycles, too, run at once.

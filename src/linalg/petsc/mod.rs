@@ -79,8 +79,8 @@ use super::LinalgError;
 use super::distribution::{Distribution, RankRows};
 use crate::parallel::ranks::Ranks;
 pub use mpi::{abort_world, broadcast_bytes, finalize, gather_values, world_ranks};
-pub use runtime::concurrent_v_cycles;
 use runtime::{MpiFint, PETSC, petsc, petsc_error, text};
+pub use runtime::{concurrent_v_cycles, options_are_ours};
 
 #[repr(C)]
 struct RawCgAmg {

@@ -58,14 +58,8 @@ pub(super) fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
         if code != 0 {
             return Err((text(step), code));
         }
-        let mut ours = 0;
         // SAFETY: PETSc is initialized; the exclusive lock is held.
-        let code = unsafe { internodes_petsc_options_are_ours(&mut ours, &mut step) };
-        if code == 0 {
-            Ok(ours != 0)
-        } else {
-            Err((text(step), code))
-        }
+        unsafe { database_is_ours() }
     });
     match outcome {
         Ok(_) => Ok(guard),
@@ -74,5 +68,33 @@ pub(super) fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
             code: *code,
             message: text(unsafe { internodes_petsc_error_text(*code) }),
         }),
+    }
+}
+
+/// Whether PETSc's options database holds no option but ours now. It is read once at
+/// initialization ([`concurrent_v_cycles`]); an option set for one call (the shim's
+/// `-matptap_via` around a one-process GAMG set-up) must be gone after it, which this tells.
+pub fn options_are_ours() -> Result<bool, LinalgError> {
+    let _guard = petsc()?;
+    // SAFETY: `petsc` initialized PETSc and holds the exclusive lock.
+    unsafe { database_is_ours() }.map_err(|(step, code)| LinalgError::Petsc {
+        step,
+        code,
+        message: text(unsafe { internodes_petsc_error_text(code) }),
+    })
+}
+
+/// The shim's `internodes_petsc_options_are_ours`: the step and code of a failure.
+///
+/// # Safety
+/// PETSc is initialized and the caller holds [`PETSC`] exclusively.
+unsafe fn database_is_ours() -> Result<bool, (String, i32)> {
+    let (mut ours, mut step) = (0, std::ptr::null());
+    // SAFETY: the caller's guarantee.
+    let code = unsafe { internodes_petsc_options_are_ours(&mut ours, &mut step) };
+    if code == 0 {
+        Ok(ours != 0)
+    } else {
+        Err((text(step), code))
     }
 }
