@@ -59,7 +59,7 @@ pub(super) fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
             return Err((text(step), code));
         }
         // SAFETY: PETSc is initialized; the exclusive lock is held.
-        unsafe { database_is_ours() }
+        unsafe { database_is_ours() }.map_err(|(step, code)| (text(step), code))
     });
     match outcome {
         Ok(_) => Ok(guard),
@@ -77,24 +77,20 @@ pub(super) fn petsc() -> Result<RwLockWriteGuard<'static, ()>, LinalgError> {
 pub fn options_are_ours() -> Result<bool, LinalgError> {
     let _guard = petsc()?;
     // SAFETY: `petsc` initialized PETSc and holds the exclusive lock.
-    unsafe { database_is_ours() }.map_err(|(step, code)| LinalgError::Petsc {
-        step,
-        code,
-        message: text(unsafe { internodes_petsc_error_text(code) }),
-    })
+    unsafe { database_is_ours() }.map_err(|(step, code)| petsc_error(step, code))
 }
 
-/// The shim's `internodes_petsc_options_are_ours`: the step and code of a failure.
+/// The shim's `internodes_petsc_options_are_ours`: the shim's step and code of a failure.
 ///
 /// # Safety
 /// PETSc is initialized and the caller holds [`PETSC`] exclusively.
-unsafe fn database_is_ours() -> Result<bool, (String, i32)> {
+unsafe fn database_is_ours() -> Result<bool, (*const c_char, c_int)> {
     let (mut ours, mut step) = (0, std::ptr::null());
     // SAFETY: the caller's guarantee.
     let code = unsafe { internodes_petsc_options_are_ours(&mut ours, &mut step) };
     if code == 0 {
         Ok(ours != 0)
     } else {
-        Err((text(step), code))
+        Err((step, code))
     }
 }
