@@ -151,15 +151,25 @@ fn ranks_give_the_serial_answer(
     contact_settings: &str,
     laterals_from_step: usize,
 ) {
-    ranks_give_the_serial_answer_of(ranks, name, contact_settings, laterals_from_step, &|_| {});
+    ranks_give_the_serial_answer_of(
+        ranks,
+        name,
+        contact_settings,
+        laterals_from_step,
+        0,
+        &|_| {},
+    );
 }
 
-/// [`ranks_give_the_serial_answer`] with `edit` applied to the example's table.
+/// [`ranks_give_the_serial_answer`] with `edit` applied to the example's table, and
+/// `extra_iterations` more active-set iterations allowed to one run than to the other in a
+/// step (0 but where the runs are solved to a tight tolerance: see the Coulomb pair's test).
 fn ranks_give_the_serial_answer_of(
     ranks: usize,
     name: &str,
     contact_settings: &str,
     laterals_from_step: usize,
+    extra_iterations: u64,
     edit: &dyn Fn(&mut toml::Table),
 ) {
     let dir = tempfile::tempdir().unwrap();
@@ -265,9 +275,12 @@ fn ranks_give_the_serial_answer_of(
         assert_eq!(steps_p.len(), steps_q.len());
         for (k, (s, t)) in steps_p.iter().zip(steps_q).enumerate() {
             assert_eq!(s["status"], t["status"], "{name}");
-            assert_eq!(
-                s["iterations"], t["iterations"],
-                "{name}: active-set iterations"
+            let (i, j) = (s["iterations"].as_u64(), t["iterations"].as_u64());
+            assert!(
+                i.zip(j)
+                    .is_some_and(|(i, j)| i.abs_diff(j) <= extra_iterations),
+                "{name}: step {}: active-set iterations {i:?} and {j:?}",
+                k + 1
             );
             assert_eq!(s["accurate"], t["accurate"], "{name}: the accuracy report");
             assert_eq!(s["failed_checks"], t["failed_checks"], "{name}");
@@ -301,7 +314,7 @@ fn a_load_path_on_two_ranks_gives_the_serial_answer() {
     // The demo's sphere pushed down along a load path that presses, then releases part way,
     // its lateral supports on the default path: each path's part of f_c is lifted from the
     // rows of K at the prescribed dofs, which every rank holds whole.
-    ranks_give_the_serial_answer_of(2, "hemisphere_on_block", "", 1, &|case| {
+    ranks_give_the_serial_answer_of(2, "hemisphere_on_block", "", 1, 0, &|case| {
         case["contact"].as_table_mut().unwrap().remove("load_steps");
         let paths: toml::Table = toml::from_str("press = [0.4, 1.0, 0.7]").unwrap();
         case.insert("load_path".into(), paths.into());
@@ -376,7 +389,22 @@ fn a_hemisphere_pressed_by_a_force_on_three_ranks_gives_the_serial_answer() {
 fn a_coulomb_pair_sheared_on_two_ranks_gives_the_serial_answer() {
     // Friction: a sticking node's tangential rows read the interpolation R12, whose entries
     // each rank keeps at its own nodes only; a 2D half-disc pressed, then sheared in steps.
-    ranks_give_the_serial_answer(2, "half_disc_sheared", "", 1);
+    //
+    // Solved to a penetration tolerance of 1e-9 h, as the floating ball: at the default the
+    // loop stops once the gaps settle within 1e-5 h (and the slip directions within their
+    // margin), 1e-5 h / 0.02 = 6e-6 of the press here, and two preconditioners' answers may
+    // differ by that much (measured: stress 1.09e-6 of its largest value apart, displacement
+    // 2e-8, with the serial nodes along a Z curve in PETSc). At 1e-9 h the fields agree to
+    // 6e-11, but the last settling iterations follow the preconditioners' round-off: the
+    // second step took 6 iterations serially and 5 on 2 ranks (so it did before the Z curve).
+    ranks_give_the_serial_answer_of(
+        2,
+        "half_disc_sheared",
+        "penetration_tolerance = 1e-9",
+        1,
+        1,
+        &|_| {},
+    );
 }
 
 #[test]

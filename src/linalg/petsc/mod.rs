@@ -56,7 +56,9 @@
 //!   `PetscFPTrapPush` stack and `PetscCitationsRegister` are reached only in set-up
 //!   (Chebyshev's eigenvalue estimate in `KSPSetUp`); no MPI call is on the path on
 //!   `PETSC_COMM_SELF`.
-//! - A whole matrix ([`CgAmgMatrix::new`]) goes to PETSc on `PETSC_COMM_SELF`; in a
+//! - A whole matrix ([`CgAmgMatrix::new`]) goes to PETSc on `PETSC_COMM_SELF`, its nodes
+//!   along a Z curve (`node_order.rs`: locality for GAMG's products), every vector permuted on
+//!   its way in and out; in a
 //!   distributed run ([`crate::parallel`]) each rank hands PETSc only its own rows of a body
 //!   ([`CgAmgMatrix::distributed`], on `PETSC_COMM_WORLD`; `crate::linalg::Distribution`),
 //!   and a solve, a product or a V-cycle takes and returns whole vectors in our numbering
@@ -67,6 +69,7 @@
 //!   makes them in the same order, and V-cycles never overlap.
 
 mod mpi;
+mod node_order;
 mod runtime;
 
 use std::ffi::{c_char, c_int};
@@ -79,6 +82,7 @@ use super::LinalgError;
 use super::distribution::{Distribution, RankRows};
 use crate::parallel::ranks::Ranks;
 pub use mpi::{abort_world, broadcast_bytes, finalize, gather_values, world_ranks};
+use node_order::NodeOrder;
 use runtime::{MpiFint, PETSC, petsc, petsc_error, text};
 pub use runtime::{concurrent_v_cycles, options_are_ours};
 
@@ -98,6 +102,7 @@ unsafe extern "C" {
         row_ptr: *const i64,
         col_idx: *const i64,
         values: *const f64,
+        petsc_nodes: *const i64,
         coords: *const f64,
         rtol: f64,
         max_iterations: i64,
@@ -176,14 +181,22 @@ pub struct CgStats {
     pub relative_residual: f64,
 }
 
+/// Where a matrix's rows are in PETSc, and in which order.
+enum Layout {
+    /// All on this process, the nodes along a Z curve ([`NodeOrder`]): every vector is
+    /// permuted on its way to PETSc and back, so callers keep our numbering.
+    Whole(NodeOrder),
+    /// Shared among the ranks, each rank's rows in our order.
+    Shared(Distribution),
+}
+
 /// CG + GAMG set up for one matrix.
 pub struct CgAmg {
     raw: NonNull<RawCgAmg>,
     /// The matrix's size.
     n: usize,
-    /// How its rows are shared among the ranks (`None` on one process: PETSc has them all, in
-    /// our numbering).
-    distribution: Option<Distribution>,
+    /// Where PETSc's rows are, and in which order.
+    layout: Layout,
     /// PETSc's own arrays of the matrix, where it is whole on this process: what
     /// [`Self::multiply`] reads and [`Self::matrix`] copies.
     rows: Option<PetscRows>,
@@ -245,14 +258,28 @@ impl CgAmgMatrix {
         // here (checked below), and its values, counts of allocated entries, are below
         // i64::MAX. A converted copy would cost 8 bytes per stored entry at the peak.
         const _: () = assert!(size_of::<usize>() == size_of::<i64>());
+        // The nodes go to PETSc along a Z curve: the shim puts each row at its place, and the
+        // coordinates (one value per dof) are permuted here.
+        let order = NodeOrder::along_z_curve(coords, dim);
+        let petsc_nodes = order.petsc_nodes();
+        let petsc_coords = order.to_petsc(coords);
         let rows = LocalRows {
             num_rows: n,
             row_ptr: symbolic.col_ptr().as_ptr().cast::<i64>(),
             columns: symbolic.row_idx().as_ptr().cast::<i64>(),
             values,
-            coords,
+            petsc_nodes: Some(&petsc_nodes),
+            coords: &petsc_coords,
         };
-        CgAmg::build(Communicator::solo()?, n, dim, rows, None, rtol).map(Self)
+        CgAmg::build(
+            Communicator::solo()?,
+            n,
+            dim,
+            rows,
+            Layout::Whole(order),
+            rtol,
+        )
+        .map(Self)
     }
 
     /// PETSc's copy of a body shared among the ranks of the run, from this rank's `rows`
@@ -274,6 +301,7 @@ impl CgAmgMatrix {
             row_ptr: rows.row_ptr.as_ptr(),
             columns: rows.columns.as_ptr(),
             values: &rows.values,
+            petsc_nodes: None,
             coords: &rows.coords,
         };
         CgAmg::build(
@@ -281,7 +309,7 @@ impl CgAmgMatrix {
             n,
             dim,
             local,
-            Some(rows.distribution),
+            Layout::Shared(rows.distribution),
             rtol,
         )
         .map(Self)
@@ -305,9 +333,9 @@ impl CgAmgMatrix {
 /// writes them after assembly (no nonzero is ever inserted; CG and GAMG only read the
 /// operator), so reading them from any thread beside a V-cycle is a read beside reads. They
 /// let one process hold `K_c` once: the caller may free its own copy
-/// (`crate::elastic::Stiffness::Released`) and still have products at the speed of its own
-/// (the same sums in the same order: `K_c` is symmetric, so PETSc's rows are its columns) and
-/// the matrix back for a Cholesky factor.
+/// (`crate::elastic::Stiffness::Released`) and still have products (the same terms: `K_c` is
+/// symmetric, so PETSc's rows are its columns, summed in PETSc's node order) and the matrix
+/// back for a Cholesky factor.
 struct PetscRows {
     row_ptr: *const std::ffi::c_void,
     columns: *const std::ffi::c_void,
@@ -398,12 +426,13 @@ impl PetscRows {
         }
     }
 
-    /// A copy of the matrix, its rows read as columns (it is symmetric).
-    fn matrix(&self) -> SparseColMat<usize, f64> {
+    /// A copy of the matrix in our numbering (PETSc's is `order`), its rows read as columns
+    /// (it is symmetric).
+    fn matrix(&self, order: &NodeOrder) -> SparseColMat<usize, f64> {
         // SAFETY: the index type matches `index_bytes` (checked in `of`).
         match self.index_bytes {
-            4 => columns_of(unsafe { self.slices::<i32>() }, self.n),
-            _ => columns_of(unsafe { self.slices::<i64>() }, self.n),
+            4 => columns_of(unsafe { self.slices::<i32>() }, order),
+            _ => columns_of(unsafe { self.slices::<i64>() }, order),
         }
     }
 }
@@ -422,45 +451,63 @@ fn product<I: PetscIndex>(
     });
 }
 
-/// The symmetric matrix of compressed rows as compressed columns.
+/// The symmetric matrix of compressed rows in PETSc's `order` as compressed columns in ours:
+/// our column `j` is PETSc's row of `j`, each entry's row ours, sorted.
 fn columns_of<I: PetscIndex>(
     (row_ptr, columns, values): (&[I], &[I], &[f64]),
-    n: usize,
+    order: &NodeOrder,
 ) -> SparseColMat<usize, f64> {
-    let col_ptr = row_ptr.iter().map(|&p| p.index()).collect();
-    let row_idx = columns.iter().map(|&c| c.index()).collect();
+    let n = row_ptr.len() - 1;
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let (mut row_idx, mut entries) = (Vec::with_capacity(values.len()), Vec::new());
+    let mut sorted = Vec::with_capacity(values.len());
+    col_ptr.push(0);
+    for j in 0..n {
+        let p = order.petsc_dof(j);
+        entries.clear();
+        entries.extend(
+            (row_ptr[p].index()..row_ptr[p + 1].index())
+                .map(|k| (order.our_dof(columns[k].index()), values[k])),
+        );
+        entries.sort_unstable_by_key(|&(i, _)| i);
+        row_idx.extend(entries.iter().map(|&(i, _)| i));
+        sorted.extend(entries.iter().map(|&(_, v)| v));
+        col_ptr.push(row_idx.len());
+    }
     let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-    SparseColMat::new(symbolic, values.to_vec())
+    SparseColMat::new(symbolic, sorted)
 }
 
 /// The rows this process hands PETSc, as the shim reads them: `num_rows + 1` row pointers from
-/// 0, each entry's global column and value, and the coordinates of the rows' nodes (`dim` per
-/// node: one value per row).
+/// 0, each entry's global column and value, where each node goes in PETSc's order (one value
+/// per node; `None`: where it is), and the coordinates of the nodes in PETSc's order (`dim`
+/// per node: one value per row).
 struct LocalRows<'a> {
     num_rows: usize,
     row_ptr: *const i64,
     columns: *const i64,
     values: &'a [f64],
+    petsc_nodes: Option<&'a [i64]>,
     coords: &'a [f64],
 }
 
 impl CgAmg {
     /// The PETSc objects of [`CgAmgMatrix`], without the hierarchy: a matrix of `n` unknowns
-    /// (`dim` per node) of which this process holds `rows`, shared as `distribution` says
-    /// (`None`: all on this process, in our numbering).
+    /// (`dim` per node) of which this process holds `rows`, laid out as `layout` says.
     fn build(
         comm: Communicator,
         n: usize,
         dim: usize,
         rows: LocalRows,
-        distribution: Option<Distribution>,
+        layout: Layout,
         rtol: f64,
     ) -> Result<Self, LinalgError> {
         let _lock = petsc()?;
         let mut raw = std::ptr::null_mut();
         let mut step = std::ptr::null();
         // SAFETY: the arrays have the lengths the shim reads (num_rows + 1, nnz, nnz,
-        // num_rows: checked by the callers), it copies them, and the lock is held.
+        // num_rows / dim or none, num_rows: checked by the callers), it copies them, and the
+        // lock is held.
         let code = unsafe {
             internodes_cgamg_create(
                 comm.handle,
@@ -469,6 +516,7 @@ impl CgAmg {
                 rows.row_ptr,
                 rows.columns,
                 rows.values.as_ptr(),
+                rows.petsc_nodes.map_or(std::ptr::null(), <[i64]>::as_ptr),
                 rows.coords.as_ptr(),
                 rtol,
                 MAX_ITERATIONS,
@@ -479,17 +527,17 @@ impl CgAmg {
         if code != 0 {
             return Err(petsc_error(step, code));
         }
-        debug_assert_eq!(comm.ranks.size > 1, distribution.is_some());
+        debug_assert_eq!(comm.ranks.size > 1, matches!(layout, Layout::Shared(_)));
         let raw = NonNull::new(raw).ok_or_else(|| petsc_error(step, 0))?;
-        let rows = match distribution {
-            Some(_) => None,
+        let rows = match layout {
+            Layout::Shared(_) => None,
             // SAFETY: `raw` is alive and built, whole on this process; the lock is held.
-            None => Some(unsafe { PetscRows::of(raw, n) }?),
+            Layout::Whole(_) => Some(unsafe { PetscRows::of(raw, n) }?),
         };
         Ok(Self {
             raw,
             n,
-            distribution,
+            layout,
             rows,
             rtol,
             applying: Mutex::new(()),
@@ -498,22 +546,25 @@ impl CgAmg {
 
     /// Each rank's number of unknowns of this matrix, in rank order (one value on one process).
     pub fn rank_dofs(&self) -> Vec<usize> {
-        match &self.distribution {
-            None => vec![self.n],
-            Some(d) => d.counts().to_vec(),
+        match &self.layout {
+            Layout::Whole(_) => vec![self.n],
+            Layout::Shared(d) => d.counts().to_vec(),
         }
     }
 
     /// A copy of the matrix, where it is whole on this process (`None` on several ranks).
     pub fn matrix(&self) -> Option<SparseColMat<usize, f64>> {
-        self.rows.as_ref().map(PetscRows::matrix)
+        match (&self.rows, &self.layout) {
+            (Some(rows), Layout::Whole(order)) => Some(rows.matrix(order)),
+            _ => None,
+        }
     }
 
     /// This rank's part of `whole` (our numbering), as PETSc's vectors hold it.
-    fn local_part<'a>(&self, whole: &'a [f64]) -> std::borrow::Cow<'a, [f64]> {
-        match &self.distribution {
-            None => whole.into(),
-            Some(d) => d.local_part(whole).into(),
+    fn local_part(&self, whole: &[f64]) -> Vec<f64> {
+        match &self.layout {
+            Layout::Whole(order) => order.to_petsc(whole),
+            Layout::Shared(d) => d.local_part(whole),
         }
     }
 
@@ -524,16 +575,18 @@ impl CgAmg {
 
     /// This rank's number of rows (the whole matrix's on one process).
     fn local_len(&self) -> usize {
-        self.distribution
-            .as_ref()
-            .map_or(self.n, Distribution::local)
+        match &self.layout {
+            Layout::Whole(_) => self.n,
+            Layout::Shared(d) => d.local(),
+        }
     }
 
-    /// Every rank's part of a result (`local`) into `whole`, on every rank.
+    /// Every rank's part of a result (`local`, as PETSc's vectors hold it) into `whole` (our
+    /// numbering), on every rank.
     fn assemble_whole(&self, local: Vec<f64>, whole: &mut [f64]) -> Result<(), LinalgError> {
-        match &self.distribution {
-            None => whole.copy_from_slice(&local),
-            Some(d) => d.gather(&local, whole)?,
+        match &self.layout {
+            Layout::Whole(order) => order.to_ours(&local, whole),
+            Layout::Shared(d) => d.gather(&local, whole)?,
         }
         Ok(())
     }
@@ -611,19 +664,18 @@ impl CgAmg {
     /// every rank receives all of `y`). On one process the product reads PETSc's arrays
     /// from this side, on every thread, without PETSc's lock ([`PetscRows`]).
     pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
-        match self.distribution {
-            None => self.multiply_rows(x, y),
-            Some(_) => self.on_whole("a product", x, y, |x, y| self.multiply_rows(x, y)),
-        }
+        self.on_whole("a product", x, y, |x, y| self.multiply_rows(x, y))
     }
 
-    /// `y = K x` on this rank's rows alone (PETSc's order, [`Self::distribution`]): `x` and `y`
+    /// `y = K x` on this rank's rows alone (in our order, [`Self::distribution`]): `x` and `y`
     /// hold this rank's rows, and PETSc exchanges the rows of `x` the product reads across
     /// ranks (collective). On one process, the whole vectors.
     pub fn multiply_rows(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
-        if let Some(rows) = &self.rows {
+        if let (Some(rows), Layout::Whole(order)) = (&self.rows, &self.layout) {
             self.check_rows("a product", x, y)?;
-            rows.multiply(x, y);
+            let mut petsc_y = vec![0.0; self.n];
+            rows.multiply(&order.to_petsc(x), &mut petsc_y);
+            order.to_ours(&petsc_y, y);
             return Ok(());
         }
         self.call_on_rows("a product", x, y, |x, y, step| {
@@ -644,14 +696,14 @@ impl CgAmg {
         self.on_whole("a V-cycle", rhs, x, |rhs, x| self.precondition_rows(rhs, x))
     }
 
-    /// [`Self::precondition`] on this rank's rows alone (PETSc's order, [`Self::distribution`];
+    /// [`Self::precondition`] on this rank's rows alone (in our order, [`Self::distribution`];
     /// collective). On one process, the whole vectors.
     pub fn precondition_rows(&self, rhs: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
         self.call_on_rows("a V-cycle", rhs, x, |rhs, x, step| {
             // PETSc is initialized (`self` exists). `applying` is taken under the shared lock,
             // never the other way round, and released first (reverse order of declaration).
             // A distributed V-cycle is collective: never beside another call.
-            let concurrent = concurrent_v_cycles() && self.distribution.is_none();
+            let concurrent = concurrent_v_cycles() && matches!(self.layout, Layout::Whole(_));
             let _exclusive = if concurrent { None } else { Some(petsc()?) };
             let _shared = concurrent.then(|| PETSC.read().unwrap_or_else(PoisonError::into_inner));
             let _own =
@@ -664,11 +716,14 @@ impl CgAmg {
 
     /// How the matrix's rows are shared among the ranks (`None` on one process).
     pub fn distribution(&self) -> Option<&Distribution> {
-        self.distribution.as_ref()
+        match &self.layout {
+            Layout::Whole(_) => None,
+            Layout::Shared(d) => Some(d),
+        }
     }
 
-    /// A linear map on this rank's rows (`on_rows`) applied to whole vectors in our numbering:
-    /// every rank receives every rank's rows of `output`.
+    /// A linear map on this rank's rows (`on_rows`, vectors in our numbering) applied to whole
+    /// vectors: every rank receives every rank's rows of `output`.
     fn on_whole(
         &self,
         what: &str,
@@ -684,10 +739,14 @@ impl CgAmg {
                 self.n
             )));
         }
-        let local_input = self.local_part(input);
-        let mut local_output = self.local_buffer();
-        on_rows(&local_input, &mut local_output)?;
-        self.assemble_whole(local_output, output)
+        match &self.layout {
+            Layout::Whole(_) => on_rows(input, output),
+            Layout::Shared(d) => {
+                let mut local_output = self.local_buffer();
+                on_rows(&d.local_part(input), &mut local_output)?;
+                Ok(d.gather(&local_output, output)?)
+            }
+        }
     }
 
     /// `input` and `output` hold this rank's rows.
@@ -703,8 +762,9 @@ impl CgAmg {
         Ok(())
     }
 
-    /// A call of the shim (`call`: this rank's rows of `input` in, of the result out; it
-    /// returns the shim's code and sets `step` on error) on vectors of this rank's rows.
+    /// A call of the shim (`call`: this rank's rows of `input` in, of the result out, as
+    /// PETSc's vectors hold them; it returns the shim's code and sets `step` on error) on
+    /// vectors of this rank's rows in our order.
     fn call_on_rows(
         &self,
         what: &str,
@@ -714,7 +774,16 @@ impl CgAmg {
     ) -> Result<(), LinalgError> {
         self.check_rows(what, input, output)?;
         let mut step = std::ptr::null();
-        match call(input.as_ptr(), output.as_mut_ptr(), &mut step)? {
+        let code = match &self.layout {
+            Layout::Shared(_) => call(input.as_ptr(), output.as_mut_ptr(), &mut step)?,
+            Layout::Whole(order) => {
+                let (petsc_input, mut petsc_output) = (order.to_petsc(input), self.local_buffer());
+                let code = call(petsc_input.as_ptr(), petsc_output.as_mut_ptr(), &mut step)?;
+                order.to_ours(&petsc_output, output);
+                code
+            }
+        };
+        match code {
             0 => Ok(()),
             code => Err(petsc_error(step, code)),
         }

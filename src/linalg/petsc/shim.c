@@ -157,14 +157,71 @@ static int to_petsc_ints(const int64_t *from, size_t len, PetscInt **to, const c
     return 0;
 }
 
-static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, const int64_t *row_ptr,
-                 const int64_t *col_idx, const double *values, const double *coords, double rtol,
-                 int64_t max_it, const char **step)
+/* The rows of a matrix whole on this process (SEQAIJ, created and sized) at their places in
+ * another order of the nodes: our node k is node petsc_node[k] of PETSc's, so our dof
+ * k * block + c is PETSc's petsc_node[k] * block + c, for rows and columns alike. Each row is
+ * inserted with its columns sorted, into exactly the room preallocated for it, so that no
+ * copy of the whole matrix is made besides PETSc's own. */
+static int insert_permuted(Mat a, int64_t n, int64_t block, const int64_t *row_ptr,
+                           const int64_t *col_idx, const double *values, const int64_t *petsc_node,
+                           const char **step)
+{
+    PetscInt *lengths = NULL, *columns = NULL;
+    PetscScalar *entries = NULL;
+    int64_t longest = 0;
+    int code = 0;
+
+#define PETSC_DOF(dof) ((PetscInt)(petsc_node[(dof) / block] * block + (dof) % block))
+    for (int64_t k = 0; k < n / block; k++) {
+        if (petsc_node[k] < 0 || petsc_node[k] >= n / block) {
+            *step = "checking the node order (a node's place beyond the nodes)";
+            return PETSC_ERR_ARG_OUTOFRANGE;
+        }
+    }
+    TRY(PetscMalloc1(n, &lengths));
+    for (int64_t r = 0; r < n; r++) {
+        int64_t length = row_ptr[r + 1] - row_ptr[r];
+        lengths[PETSC_DOF(r)] = (PetscInt)length;
+        if (length > longest) longest = length;
+    }
+    code = MatSeqAIJSetPreallocation(a, 0, lengths);
+    PetscFree(lengths);
+    if (code) {
+        *step = "MatSeqAIJSetPreallocation (the permuted rows' lengths)";
+        return code;
+    }
+    TRY(PetscMalloc2(longest, &columns, longest, &entries));
+    for (int64_t r = 0; r < n && !code; r++) {
+        PetscInt row = PETSC_DOF(r), length = (PetscInt)(row_ptr[r + 1] - row_ptr[r]);
+        for (PetscInt e = 0; e < length; e++) {
+            int64_t column = col_idx[row_ptr[r] + e];
+            if (column < 0 || column >= n) {
+                code = PETSC_ERR_ARG_OUTOFRANGE;
+                *step = "checking the column indices (one beyond the matrix)";
+                break;
+            }
+            columns[e] = PETSC_DOF(column);
+            entries[e] = values[row_ptr[r] + e];
+        }
+        if (!code) code = PetscSortIntWithScalarArray(length, columns, entries);
+        if (!code) code = MatSetValues(a, 1, &row, length, columns, entries, INSERT_VALUES);
+        if (code && !*step) *step = "inserting a permuted row";
+    }
+#undef PETSC_DOF
+    PetscFree2(columns, entries);
+    if (code) return code;
+    TRY(MatAssemblyBegin(a, MAT_FINAL_ASSEMBLY));
+    TRY(MatAssemblyEnd(a, MAT_FINAL_ASSEMBLY));
+    return 0;
+}
+
+/* The rows as they are (AIJ: SEQAIJ on one process, MPIAIJ on several): both preallocation
+ * calls are made, the one that does not match the type is a no-op. They copy i, j, values and
+ * assemble. */
+static int insert_as_they_are(Mat a, int64_t n, const int64_t *row_ptr, const int64_t *col_idx,
+                              const double *values, const char **step)
 {
     PetscInt *i = NULL, *j = NULL;
-    Vec xyz = NULL;
-    MatNullSpace near_null = NULL;
-    PC pc;
     int code;
 
     if ((code = to_petsc_ints(row_ptr, (size_t)n + 1, &i, step))) return code;
@@ -172,23 +229,43 @@ static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, co
         PetscFree(i);
         return code;
     }
-    s->n = (PetscInt)n;
-
-    /* The matrix: AIJ (SEQAIJ on one process, MPIAIJ on several) with the node block size, so
-     * that GAMG aggregates nodes, not single dofs. Both preallocation calls are made: the one
-     * that does not match the type is a no-op. They copy i, j, values and assemble. */
-    code = MatCreate(comm, &s->a);
-    if (!code) code = MatSetSizes(s->a, (PetscInt)n, (PetscInt)n, PETSC_DETERMINE, PETSC_DETERMINE);
-    if (!code) code = MatSetBlockSize(s->a, (PetscInt)block);
-    if (!code) code = MatSetType(s->a, MATAIJ);
-    if (!code) code = MatSeqAIJSetPreallocationCSR(s->a, i, j, values);
-    if (!code) code = MatMPIAIJSetPreallocationCSR(s->a, i, j, values);
+    code = MatSeqAIJSetPreallocationCSR(a, i, j, values);
+    if (!code) code = MatMPIAIJSetPreallocationCSR(a, i, j, values);
     PetscFree(i);
     PetscFree(j);
-    if (code) {
-        *step = "creating the AIJ matrix from CSR arrays";
-        return code;
+    if (code) *step = "creating the AIJ matrix from CSR arrays";
+    return code;
+}
+
+static int build(InternodesCgAmg *s, MPI_Comm comm, int64_t n, int64_t block, const int64_t *row_ptr,
+                 const int64_t *col_idx, const double *values, const int64_t *petsc_node,
+                 const double *coords, double rtol, int64_t max_it, const char **step)
+{
+    Vec xyz = NULL;
+    MatNullSpace near_null = NULL;
+    PC pc;
+    int code;
+
+    s->n = (PetscInt)n;
+
+    /* The matrix: AIJ with the node block size, so that GAMG aggregates nodes, not single
+     * dofs; its rows as they are, or (on one process) at their places in PETSc's node order. */
+    TRY(MatCreate(comm, &s->a));
+    TRY(MatSetSizes(s->a, (PetscInt)n, (PetscInt)n, PETSC_DETERMINE, PETSC_DETERMINE));
+    TRY(MatSetBlockSize(s->a, (PetscInt)block));
+    TRY(MatSetType(s->a, MATAIJ));
+    if (petsc_node) {
+        PetscMPIInt size;
+        TRY(MPI_Comm_size(comm, &size));
+        if (size != 1) {
+            *step = "a node order on several processes";
+            return PETSC_ERR_SUP;
+        }
+        code = insert_permuted(s->a, n, block, row_ptr, col_idx, values, petsc_node, step);
+    } else {
+        code = insert_as_they_are(s->a, n, row_ptr, col_idx, values, step);
     }
+    if (code) return code;
     TRY(MatSetOption(s->a, MAT_SPD, PETSC_TRUE));
 
     /* Near-null space: the rigid-body modes of the nodes (3 in 2D, 6 in 3D). */
@@ -341,11 +418,15 @@ void internodes_cgamg_destroy(InternodesCgAmg *s)
 
 /* Builds the operator (n x n CSR, symmetric positive definite, `block` dofs per node,
  * interleaved: this rank's n rows) and its CG + GAMG solver on the communicator `fcomm`;
- * `coords` holds the node coordinates, `block` per node (n values). The GAMG hierarchy is built
- * by internodes_cgamg_set_up, which must follow before any solve or application. */
+ * `petsc_node` (NULL, or on one process n / block values) puts our node k at place
+ * petsc_node[k] of PETSc's order, in which every vector of a later call is then read and
+ * written; `coords` holds the node coordinates in PETSc's order, `block` per node (n values).
+ * The GAMG hierarchy is built by internodes_cgamg_set_up, which must follow before any solve
+ * or application. */
 int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int64_t *row_ptr,
-                            const int64_t *col_idx, const double *values, const double *coords,
-                            double rtol, int64_t max_it, InternodesCgAmg **out, const char **step)
+                            const int64_t *col_idx, const double *values, const int64_t *petsc_node,
+                            const double *coords, double rtol, int64_t max_it,
+                            InternodesCgAmg **out, const char **step)
 {
     InternodesCgAmg *s = NULL;
     *out = NULL;
@@ -354,7 +435,8 @@ int internodes_cgamg_create(MPI_Fint fcomm, int64_t n, int64_t block, const int6
         return PETSC_ERR_ARG_OUTOFRANGE;
     }
     TRY(PetscCalloc1(1, &s));
-    int code = build(s, MPI_Comm_f2c(fcomm), n, block, row_ptr, col_idx, values, coords, rtol, max_it, step);
+    int code = build(s, MPI_Comm_f2c(fcomm), n, block, row_ptr, col_idx, values, petsc_node, coords,
+                     rtol, max_it, step);
     if (code) {
         internodes_cgamg_destroy(s);
         return code;
