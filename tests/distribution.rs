@@ -52,11 +52,12 @@ fn the_ranks_rows_are_the_whole_constrained_matrix() {
 
         for size in [1, 2, 3] {
             let distributions: Vec<Distribution> = (0..size)
-                .map(|rank| Distribution::new(&graph, Ranks { rank, size }).unwrap())
+                .map(|rank| Distribution::new(&graph, &coords, Ranks { rank, size }).unwrap())
                 .collect();
-            // PETSc's numbering: rank 0's nodes first, each node's unknowns together.
+            // PETSc's numbering: rank 0's nodes first (along a Z curve), each node's unknowns
+            // together.
             let ours: Vec<usize> = (distributions.iter())
-                .flat_map(|d| d.nodes())
+                .flat_map(|d| d.own_nodes().iter().map(|&node| node as usize))
                 .flat_map(|node| (0..dim).map(move |c| dim * node + c))
                 .collect();
             let mut seen = ours.clone();
@@ -72,7 +73,8 @@ fn the_ranks_rows_are_the_whole_constrained_matrix() {
                 assert_eq!(distribution.counts().len(), size);
                 let mut columns =
                     NodeColumns::assemble(body, &material, &graph, distribution.nodes());
-                let local_f_c = constraints.apply_to_columns(&mut columns, &f);
+                let local_f_c =
+                    distribution.in_petsc_order(&constraints.apply_to_columns(&mut columns, &f));
                 let rows = distribution.rows(&columns, &coords);
                 assert_eq!(rows.num_dofs(), n);
                 for (p, &i) in ours[first..first + rows.num_rows()].iter().enumerate() {

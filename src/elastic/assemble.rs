@@ -552,7 +552,7 @@ fn rank_stiffness(
     // The symbolic phase of a rank: the node graph, and which nodes are whose.
     let (graph, distribution) = timed(stats, verbose, "sparsity pattern", || {
         let graph = stiffness_graph(body);
-        Distribution::new(&graph, ranks).map(|distribution| (graph, distribution))
+        Distribution::new(&graph, coordinates, ranks).map(|distribution| (graph, distribution))
     })?;
     let mut columns = timed(stats, verbose, "assemble stiffness", || {
         NodeColumns::assemble(body, &problem.material, &graph, distribution.nodes())
@@ -577,7 +577,7 @@ fn rank_stiffness(
     let mut f_c = vec![0.0; f.len()];
     let local_largest = timed(stats, verbose, "apply Dirichlet conditions", || {
         let local_f_c = constraints.apply_to_columns(&mut columns, f);
-        distribution.gather(&local_f_c, &mut f_c)?;
+        distribution.gather(&distribution.in_petsc_order(&local_f_c), &mut f_c)?;
         Ok::<_, LinalgError>(
             (0..columns.num_columns())
                 .flat_map(|q| {

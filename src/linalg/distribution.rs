@@ -5,17 +5,19 @@
 //! node graph of the stiffness: parts of nearly equal size with few edges between them, so
 //! that a matrix-vector product or a V-cycle exchanges little). PETSc owns its rows by
 //! contiguous ranges, so PETSc's numbering puts the nodes of rank 0 first, then those of rank
-//! 1, and so on, each in our order, each node's `dim` unknowns together (the block structure
-//! GAMG aggregates by). Every rank computes the same partition (METIS is deterministic for a
-//! given graph), assembles the columns of its own nodes only
-//! ([`crate::fem::NodeColumns`]: its rows, `K` being symmetric) and hands them to PETSc as
-//! [`RankRows`].
+//! 1, and so on, each rank's along a Z curve through their coordinates (locality for the
+//! products of GAMG's set-up and V-cycles: `super::node_order`), each node's `dim` unknowns
+//! together (the block structure GAMG aggregates by). Every rank computes the same partition
+//! and order (METIS is deterministic for a given graph), assembles the columns of its own
+//! nodes only ([`crate::fem::NodeColumns`]: its rows, `K` being symmetric; in our order) and
+//! hands them to PETSc, in PETSc's order, as [`RankRows`].
 //!
 //! Vectors cross between the two numberings here: [`Distribution::local_part`] takes this
 //! rank's rows out of a whole vector in our numbering, [`Distribution::gather`] puts every
 //! rank's rows back into one whole vector on every rank (`MPI_Allgatherv`).
 
 use super::LinalgError;
+use super::node_order::z_curve_keys;
 use super::ordering::partition;
 use crate::fem::{NodeColumns, NodeGraph};
 use crate::parallel::ranks::Ranks;
@@ -27,6 +29,9 @@ pub struct Distribution {
     /// hold it, so that this map of the whole body costs every rank `4 / block` bytes per
     /// unknown.
     nodes: Vec<u32>,
+    /// This rank's nodes, increasing, each with its place among this rank's nodes in PETSc's
+    /// order.
+    own_sorted: Vec<(u32, u32)>,
     /// The rows of each rank (unknowns), in rank order.
     counts: Vec<usize>,
     /// PETSc's first node of this rank (`block` rows each).
@@ -39,8 +44,8 @@ pub struct Distribution {
 
 impl Distribution {
     /// The distribution over `ranks` of the unknowns of the body whose stiffness has the node
-    /// graph `graph`.
-    pub fn new(graph: &NodeGraph, ranks: Ranks) -> Result<Self, LinalgError> {
+    /// graph `graph` and whose nodes are at `coords` (one value per unknown: `block` per node).
+    pub fn new(graph: &NodeGraph, coords: &[f64], ranks: Ranks) -> Result<Self, LinalgError> {
         let block = graph.block();
         let num_nodes = graph.num_nodes();
         let neighbours: Vec<Vec<usize>> = (0..num_nodes)
@@ -61,6 +66,13 @@ impl Distribution {
                 "{num_nodes} nodes: more than a partition numbers (2^32 - 1)"
             )));
         }
+        if coords.len() != num_nodes * block {
+            return Err(LinalgError::Sizes(format!(
+                "{} coordinates for {num_nodes} nodes of {block} unknowns",
+                coords.len()
+            )));
+        }
+        let keys = z_curve_keys(coords, block);
         let mut nodes = Vec::with_capacity(num_nodes);
         let mut counts = vec![0; ranks.size];
         for (rank, count) in counts.iter_mut().enumerate() {
@@ -70,12 +82,20 @@ impl Distribution {
                     .filter(|&a| part[a] == rank)
                     .map(|a| a as u32),
             );
+            nodes[first..].sort_by_key(|&a| (keys[a as usize], a));
             *count = (nodes.len() - first) * block;
         }
+        drop(keys);
         let first = counts[..ranks.rank].iter().sum::<usize>() / block;
         let local = counts[ranks.rank] / block;
+        let mut own_sorted: Vec<(u32, u32)> = (nodes[first..first + local].iter())
+            .zip(0..)
+            .map(|(&node, place)| (node, place))
+            .collect();
+        own_sorted.sort_unstable();
         Ok(Self {
             nodes,
+            own_sorted,
             counts,
             first,
             local,
@@ -98,9 +118,14 @@ impl Distribution {
         self.local * self.block
     }
 
-    /// This rank's nodes, increasing, as the partition keeps them.
+    /// This rank's nodes in PETSc's order.
     pub fn own_nodes(&self) -> &[u32] {
         &self.nodes[self.first..self.first + self.local]
+    }
+
+    /// This rank's nodes, increasing, each with its place in [`Self::own_nodes`].
+    pub fn own_places(&self) -> &[(u32, u32)] {
+        &self.own_sorted
     }
 
     /// Unknowns per node.
@@ -110,7 +135,23 @@ impl Distribution {
 
     /// This rank's nodes, increasing: the columns ([`NodeColumns`]) it assembles.
     pub fn nodes(&self) -> Vec<usize> {
-        self.own_nodes().iter().map(|&node| node as usize).collect()
+        self.own_sorted
+            .iter()
+            .map(|&(node, _)| node as usize)
+            .collect()
+    }
+
+    /// Values at this rank's unknowns in the order of its [`NodeColumns`] (its nodes
+    /// increasing) in PETSc's order, as [`Self::gather`] takes them.
+    pub fn in_petsc_order(&self, in_node_order: &[f64]) -> Vec<f64> {
+        let block = self.block;
+        let mut petsc = vec![0.0; in_node_order.len()];
+        for (q, &(_, place)) in self.own_sorted.iter().enumerate() {
+            let p = place as usize;
+            petsc[p * block..(p + 1) * block]
+                .copy_from_slice(&in_node_order[q * block..(q + 1) * block]);
+        }
+        petsc
     }
 
     /// This rank's rows for PETSc: `columns` (of this rank's [`Self::nodes`], constrained)
@@ -120,6 +161,11 @@ impl Distribution {
         let block = self.block;
         let rows: Vec<usize> = self.own().collect();
         debug_assert_eq!(columns.num_columns(), rows.len());
+        // The column of `columns` (its nodes increasing) at each of this rank's places.
+        let mut column_of_place = vec![0; self.local];
+        for (q, &(_, place)) in self.own_sorted.iter().enumerate() {
+            column_of_place[place as usize] = q;
+        }
         // PETSc's node of each of our nodes.
         let mut petsc_node = vec![0u32; self.nodes.len()];
         for (p, &ours) in self.nodes.iter().enumerate() {
@@ -131,7 +177,8 @@ impl Distribution {
         let mut values = Vec::with_capacity(columns.nnz());
         let mut row: Vec<(i64, f64)> = Vec::new();
         row_ptr.push(0i64);
-        for (q, &ours) in rows.iter().enumerate() {
+        for (r, &ours) in rows.iter().enumerate() {
+            let q = column_of_place[r / block] * block + r % block;
             debug_assert_eq!(columns.dof(q), ours);
             let (entries, entry_values) = columns.column(q);
             row.clear();

@@ -7,6 +7,7 @@ mod body_solver;
 mod cholesky;
 mod distribution;
 pub mod gmres;
+mod node_order;
 mod ordering;
 #[cfg(feature = "petsc")]
 pub mod petsc;

@@ -1025,7 +1025,12 @@ mod tests {
                 for rank in 0..size {
                     let ranks = crate::parallel::Ranks { rank, size };
                     let distributions: Vec<Distribution> = (meshes.iter())
-                        .map(|mesh| Distribution::new(&stiffness_graph(mesh), ranks).unwrap())
+                        .map(|mesh| {
+                            let coords: Vec<f64> = (mesh.coords.iter())
+                                .flat_map(|x| x[..mesh.dim].to_vec())
+                                .collect();
+                            Distribution::new(&stiffness_graph(mesh), &coords, ranks).unwrap()
+                        })
                         .collect();
                     let shared: Vec<&Distribution> = distributions.iter().collect();
                     let ownership = RowOwnership::from_distributions(&shared);

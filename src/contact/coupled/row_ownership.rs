@@ -30,9 +30,10 @@ struct OwnRows {
     first: usize,
     /// Unknowns per node.
     block: usize,
-    /// This rank's nodes of the body, increasing (`Distribution::own_nodes`): its rows are
-    /// their unknowns, node by node, in this order (PETSc's).
-    nodes: Vec<u32>,
+    /// This rank's nodes of the body, increasing, each with its place among them in PETSc's
+    /// order (`Distribution::own_places`): its rows are their unknowns, node by node, in
+    /// PETSc's order.
+    nodes: Vec<(u32, u32)>,
     /// Where the body's rows start among this rank's.
     local: usize,
 }
@@ -52,7 +53,7 @@ impl RowOwnership {
             own.push(OwnRows {
                 first,
                 block: body.block(),
-                nodes: body.own_nodes().to_vec(),
+                nodes: body.own_places().to_vec(),
                 local,
             });
             first += body.counts().iter().sum::<usize>();
@@ -75,8 +76,11 @@ impl RowOwnership {
         let body = &self.bodies[self.bodies.partition_point(|b| b.first <= global) - 1];
         let ours = global - body.first;
         let node = u32::try_from(ours / body.block).ok()?;
-        let k = body.nodes.binary_search(&node).ok()?;
-        Some(body.local + k * body.block + ours % body.block)
+        let k = body
+            .nodes
+            .binary_search_by_key(&node, |&(node, _)| node)
+            .ok()?;
+        Some(body.local + body.nodes[k].1 as usize * body.block + ours % body.block)
     }
 }
 

@@ -57,7 +57,7 @@
 //!   (Chebyshev's eigenvalue estimate in `KSPSetUp`); no MPI call is on the path on
 //!   `PETSC_COMM_SELF`.
 //! - A whole matrix ([`CgAmgMatrix::new`]) goes to PETSc on `PETSC_COMM_SELF`, its nodes
-//!   along a Z curve (`node_order.rs`: locality for GAMG's products), every vector permuted on
+//!   along a Z curve (`crate::linalg::node_order`: locality for GAMG's products), every vector permuted on
 //!   its way in and out; in a
 //!   distributed run ([`crate::parallel`]) each rank hands PETSc only its own rows of a body
 //!   ([`CgAmgMatrix::distributed`], on `PETSC_COMM_WORLD`; `crate::linalg::Distribution`),
@@ -69,7 +69,6 @@
 //!   makes them in the same order, and V-cycles never overlap.
 
 mod mpi;
-mod node_order;
 mod runtime;
 
 use std::ffi::{c_char, c_int};
@@ -80,9 +79,9 @@ use faer::sparse::SparseColMat;
 
 use super::LinalgError;
 use super::distribution::{Distribution, RankRows};
+use super::node_order::NodeOrder;
 use crate::parallel::ranks::Ranks;
 pub use mpi::{abort_world, broadcast_bytes, finalize, gather_values, world_ranks};
-use node_order::NodeOrder;
 use runtime::{MpiFint, PETSC, petsc, petsc_error, text};
 pub use runtime::{concurrent_v_cycles, options_are_ours};
 

@@ -1,5 +1,6 @@
-//! The order in which a body's nodes are handed to PETSc on one process: along a Z-order
-//! (Morton) curve through their coordinates.
+//! The order in which a body's nodes are handed to PETSc: along a Z-order (Morton) curve
+//! through their coordinates (on one process the whole body's, in a distributed run each
+//! rank's nodes: `Distribution`).
 //!
 //! Our nodes come in the mesh file's tag order, which for a gmsh 3D mesh is close to random: in
 //! the 217k-DOF hemisphere on block two nodes of one tetrahedron lie a median 10,000 places
@@ -16,12 +17,46 @@
 //! the curve is as good for locality and costs a sort. Hand-written: it is a dozen lines of bit
 //! interleaving, and none of our dependencies orders points along a curve.
 //!
-//! Only PETSc sees this order: its matrix and vectors are permuted on the way in and out, so
-//! every caller keeps our numbering.
+//! On one process only PETSc sees this order ([`NodeOrder`]): its matrix and vectors are
+//! permuted on the way in and out, so every caller keeps our numbering. In a distributed run
+//! PETSc's numbering is the distribution's anyway, and each rank's nodes take their place in
+//! it along the curve.
+
+/// The Z-curve key of each node at `coords` (`dim` values per node, interleaved): the bits of
+/// its coordinates, each scaled to `63 / dim` bits over the nodes' bounding box, interleaved.
+pub(crate) fn z_curve_keys(coords: &[f64], dim: usize) -> Vec<u64> {
+    let num_nodes = coords.len() / dim;
+    let node = |k: usize| &coords[k * dim..(k + 1) * dim];
+    let (mut low, mut high) = (vec![f64::INFINITY; dim], vec![f64::NEG_INFINITY; dim]);
+    for k in 0..num_nodes {
+        for (c, &x) in node(k).iter().enumerate() {
+            low[c] = low[c].min(x);
+            high[c] = high[c].max(x);
+        }
+    }
+    let bits = 63 / dim as u32;
+    let cells = ((1u64 << bits) - 1) as f64;
+    let key = |k: usize| -> u64 {
+        let mut key = 0u64;
+        for (c, &x) in node(k).iter().enumerate() {
+            let extent = high[c] - low[c];
+            let scaled = match extent > 0.0 {
+                true => ((x - low[c]) / extent * cells).clamp(0.0, cells) as u64,
+                false => 0,
+            };
+            for bit in 0..bits {
+                key |= ((scaled >> bit) & 1) << (bit as usize * dim + c);
+            }
+        }
+        key
+    };
+    (0..num_nodes).map(key).collect()
+}
 
 /// A permutation of a body's nodes (`dim` dofs each, interleaved) and of their dofs.
+#[cfg(feature = "petsc")]
 #[derive(Debug, Clone)]
-pub(super) struct NodeOrder {
+pub(crate) struct NodeOrder {
     dim: usize,
     /// `petsc_node[k]`: where our node `k` stands in PETSc's order.
     petsc_node: Vec<usize>,
@@ -29,35 +64,13 @@ pub(super) struct NodeOrder {
     our_node: Vec<usize>,
 }
 
+#[cfg(feature = "petsc")]
 impl NodeOrder {
     /// The nodes at `coords` (`dim` values per node, interleaved) sorted along a Z curve.
-    pub(super) fn along_z_curve(coords: &[f64], dim: usize) -> Self {
-        let num_nodes = coords.len() / dim;
-        let node = |k: usize| &coords[k * dim..(k + 1) * dim];
-        let (mut low, mut high) = (vec![f64::INFINITY; dim], vec![f64::NEG_INFINITY; dim]);
-        for k in 0..num_nodes {
-            for (c, &x) in node(k).iter().enumerate() {
-                low[c] = low[c].min(x);
-                high[c] = high[c].max(x);
-            }
-        }
-        let bits = 63 / dim as u32;
-        let cells = ((1u64 << bits) - 1) as f64;
-        let key = |k: usize| -> u64 {
-            let mut key = 0u64;
-            for (c, &x) in node(k).iter().enumerate() {
-                let extent = high[c] - low[c];
-                let scaled = match extent > 0.0 {
-                    true => ((x - low[c]) / extent * cells).clamp(0.0, cells) as u64,
-                    false => 0,
-                };
-                for bit in 0..bits {
-                    key |= ((scaled >> bit) & 1) << (bit as usize * dim + c);
-                }
-            }
-            key
-        };
-        let mut keyed: Vec<(u64, usize)> = (0..num_nodes).map(|k| (key(k), k)).collect();
+    pub(crate) fn along_z_curve(coords: &[f64], dim: usize) -> Self {
+        let keys = z_curve_keys(coords, dim);
+        let num_nodes = keys.len();
+        let mut keyed: Vec<(u64, usize)> = keys.into_iter().zip(0..).collect();
         keyed.sort_unstable();
         let our_node: Vec<usize> = keyed.into_iter().map(|(_, k)| k).collect();
         let mut petsc_node = vec![0; num_nodes];
@@ -72,17 +85,17 @@ impl NodeOrder {
     }
 
     /// Where each of our nodes stands in PETSc's order, as the shim reads it.
-    pub(super) fn petsc_nodes(&self) -> Vec<i64> {
+    pub(crate) fn petsc_nodes(&self) -> Vec<i64> {
         self.petsc_node.iter().map(|&p| p as i64).collect()
     }
 
     /// Our dof `i`'s place in PETSc's order.
-    pub(super) fn petsc_dof(&self, i: usize) -> usize {
+    pub(crate) fn petsc_dof(&self, i: usize) -> usize {
         self.petsc_node[i / self.dim] * self.dim + i % self.dim
     }
 
     /// `ours` (one value per dof, or per coordinate) in PETSc's order.
-    pub(super) fn to_petsc(&self, ours: &[f64]) -> Vec<f64> {
+    pub(crate) fn to_petsc(&self, ours: &[f64]) -> Vec<f64> {
         let dim = self.dim;
         let mut petsc = Vec::with_capacity(ours.len());
         for &k in &self.our_node {
@@ -92,7 +105,7 @@ impl NodeOrder {
     }
 
     /// `petsc` (in PETSc's order) into `ours`.
-    pub(super) fn to_ours(&self, petsc: &[f64], ours: &mut [f64]) {
+    pub(crate) fn to_ours(&self, petsc: &[f64], ours: &mut [f64]) {
         let dim = self.dim;
         for (p, &k) in self.our_node.iter().enumerate() {
             ours[k * dim..(k + 1) * dim].copy_from_slice(&petsc[p * dim..(p + 1) * dim]);
@@ -100,7 +113,7 @@ impl NodeOrder {
     }
 
     /// Which of our dofs stands at place `p` of PETSc's order.
-    pub(super) fn our_dof(&self, p: usize) -> usize {
+    pub(crate) fn our_dof(&self, p: usize) -> usize {
         self.our_node[p / self.dim] * self.dim + p % self.dim
     }
 }
@@ -116,14 +129,17 @@ mod tests {
         let coords: Vec<f64> = (0..16)
             .flat_map(|k| [(k % 4) as f64, (k / 4) as f64])
             .collect();
-        let order = NodeOrder::along_z_curve(&coords, 2);
+        let keys = z_curve_keys(&coords, 2);
+        let mut order: Vec<usize> = (0..16).collect();
+        order.sort_by_key(|&k| keys[k]);
         assert_eq!(
-            order.our_node,
+            order,
             [0, 1, 4, 5, 2, 3, 6, 7, 8, 9, 12, 13, 10, 11, 14, 15]
         );
     }
 
     #[test]
+    #[cfg(feature = "petsc")]
     fn values_go_to_petsc_and_back_unchanged() {
         let coords = [0.3, 0.1, 0.9, 0.0, 0.5, 0.5, 0.1, 0.8, 0.2, 0.7, 0.4, 0.6];
         let order = NodeOrder::along_z_curve(&coords, 3);
