@@ -46,7 +46,8 @@
 //! approximate inverse of `crate::contact::coupled::two_level_inverse`, which never assembles
 //! `S~`: the dense LU takes `2 m^2` numbers and `m^3 / 3` multiply-adds (by the memory model of
 //! `docs/parallel.md`, 65 GB per rank at 100M DOFs), the two-level inverse about
-//! `m (20 u + dim m / 128)` (`u` multipliers per node).
+//! `m (20 u + 45 dim)` numbers and a coarse factor of `(dim m / 128)^2` (`u` multipliers per
+//! node).
 
 use std::collections::HashMap;
 
@@ -56,7 +57,7 @@ use faer::prelude::*;
 use crate::contact::coupled::compliance::MultiplierKey;
 use crate::contact::coupled::far_field::{LumpedSums, distance};
 use crate::contact::coupled::system::{CoupledSystem, Coupling};
-use crate::contact::coupled::two_level_inverse::{TwoLevelInverse, Unknown};
+use crate::contact::coupled::two_level_inverse::{FarField, TwoLevelInverse, Unknown};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::fem::Material;
 
@@ -74,7 +75,7 @@ enum Inverse {
     /// Assembled and LU-factored: at most [`DENSE_LIMIT`] multipliers.
     Dense(faer::linalg::solvers::PartialPivLu<f64>),
     /// Above: never assembled, `crate::contact::coupled::two_level_inverse`.
-    TwoLevel(TwoLevelInverse),
+    TwoLevel(TwoLevelInverse<Kernel>),
 }
 
 /// The most coupled multipliers whose `S~` is assembled and factored exactly. Why 1000: above,
@@ -175,18 +176,21 @@ impl HalfSpace {
             let mut nodes: Vec<[f64; 3]> = Vec::new();
             let mut node_of: HashMap<usize, usize> = HashMap::new();
             let unknowns: Vec<Unknown> = (points.iter().zip(&owners))
-                .map(|((x, _, e, _), owner)| {
+                .map(|((x, r, e, a), owner)| {
                     let node = *node_of.entry(*owner).or_insert_with(|| {
                         nodes.push(*x);
                         nodes.len() - 1
                     });
+                    // S~_kl = (t s c0 r_k) . (A_l e_l) G_kl between distinct nodes.
                     Unknown {
                         node,
                         direction: *e,
+                        reads: r.map(|v| scale * v),
+                        loads: e.map(|v| a * v),
                     }
                 })
                 .collect();
-            Inverse::TwoLevel(TwoLevelInverse::new(&nodes, &unknowns, dim, entry))
+            Inverse::TwoLevel(TwoLevelInverse::new(&nodes, &unknowns, dim, entry, kernel))
         };
         Self {
             coupled,
@@ -224,6 +228,7 @@ impl HalfSpace {
 
 /// The half-space kernel `G` of the module doc on a set of surface points: `L` from their
 /// bounding box and areas.
+#[derive(Clone, Copy)]
 struct Kernel {
     dim: usize,
     length: f64,
@@ -277,6 +282,18 @@ impl Kernel {
         } else {
             1.0 - (a / self.length).ln()
         }
+    }
+}
+
+impl FarField for Kernel {
+    /// `G(|x - y|)` and its gradient in `y`, `-G'(r) (x - y) / r`.
+    fn field(&self, x: &[f64; 3], y: &[f64; 3]) -> (f64, [f64; 3]) {
+        let r = distance(x, y);
+        let slope = self.slope(r);
+        (
+            self.between(r),
+            std::array::from_fn(|c| -slope * (x[c] - y[c]) / r),
+        )
     }
 }
 
@@ -632,12 +649,7 @@ impl ModelGaps for LumpedGaps<'_> {
                 self.kernel
                     .between(distance(&self.points[i], &self.points[j]))
             },
-            |i, centre| {
-                let (x, d) = (&self.points[i], distance(&self.points[i], centre));
-                let (g, slope) = (self.kernel.between(d), self.kernel.slope(d));
-                // d G(|x - y|) / dy = -G'(d) (x - y) / d.
-                (g, std::array::from_fn(|c| -slope * (x[c] - centre[c]) / d))
-            },
+            |i, centre| self.kernel.field(&self.points[i], centre),
         );
         self.gaps[i] + self.c0 * sum
     }
