@@ -49,6 +49,9 @@ PARTS = [
     ("interface coupling", "InterfaceOperators::coupling"),
     ("interface operators (other)", "InterfaceOperators::"),
     ("half-space preconditioner (S~^-1)", "HalfSpace::new"),
+    # The two-level inverse's rows, computed on rayon's threads, whose stacks do not reach
+    # HalfSpace::new.
+    ("half-space preconditioner (S~^-1)", "two_level_inverse::"),
     ("GMRES basis and vectors", "gmres::"),
     ("coupled Krylov solve (other)", "coupled_krylov::"),
     ("mesh", "internodes::mesh::"),

@@ -75,7 +75,7 @@ enum Inverse {
     /// Assembled and LU-factored: at most [`DENSE_LIMIT`] multipliers.
     Dense(faer::linalg::solvers::PartialPivLu<f64>),
     /// Above: never assembled, `crate::contact::coupled::two_level_inverse`.
-    TwoLevel(TwoLevelInverse<Kernel>),
+    TwoLevel(Box<TwoLevelInverse<Kernel>>),
 }
 
 /// The most coupled multipliers whose `S~` is assembled and factored exactly. Why 1000: above,
@@ -190,7 +190,9 @@ impl HalfSpace {
                     }
                 })
                 .collect();
-            Inverse::TwoLevel(TwoLevelInverse::new(&nodes, &unknowns, dim, entry, kernel))
+            Inverse::TwoLevel(Box::new(TwoLevelInverse::new(
+                &nodes, &unknowns, dim, entry, kernel,
+            )))
         };
         Self {
             coupled,

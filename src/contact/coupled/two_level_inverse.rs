@@ -105,8 +105,10 @@ pub struct TwoLevelInverse<G: FarField> {
 
 /// `P` of the module doc: `S~ V` summed over the near clusters, lumped over the far ones.
 struct LumpedProduct<G: FarField> {
-    /// The near part of each unknown's row, as `(coarse column, value)`.
-    near: Vec<Vec<(u32, f64)>>,
+    /// The near part of each unknown's row: its values at its cluster's `near` columns, from
+    /// `near_offsets[i]` (the rows one after the other, allocated once).
+    near_values: Vec<f64>,
+    near_offsets: Vec<usize>,
     /// Each unknown's node's point, its row vector `p_i` and its node's cluster.
     at: Vec<[f64; 3]>,
     reads: Vec<[f64; 3]>,
@@ -117,12 +119,14 @@ struct LumpedProduct<G: FarField> {
 }
 
 /// A cluster of the coarse level: its centre, its coarse columns with their monopoles and
-/// dipoles (`T_c`, `Q_c` of the module doc), and the clusters far from it (sorted).
+/// dipoles (`T_c`, `Q_c` of the module doc), the clusters far from it (sorted), and the coarse
+/// columns of the others (near it, itself included), which its rows of `P` store.
 struct Cluster {
     centre: [f64; 3],
     columns: Range<usize>,
     moments: Vec<Moments>,
     far: Vec<usize>,
+    near: Vec<u32>,
 }
 
 /// `T_c` and `Q_c` of the module doc (`Q_c[k][l]` the `k` component of `q` times the `l` of the
@@ -213,31 +217,42 @@ impl<G: FarField> TwoLevelInverse<G> {
                 of_node[node].iter().for_each(|&k| cluster_of[k] = b);
             }
         }
-        // The near part of each row of P: each entry of S~ between near clusters once.
-        let near: Vec<Vec<(u32, f64)>> = (0..m)
-            .into_par_iter()
-            .map(|i| {
-                let far = &clusters[cluster_of[i]].far;
-                let mut row = Vec::new();
-                for (b, cluster) in clusters.iter().enumerate() {
-                    if far.binary_search(&b).is_ok() || cluster.columns.is_empty() {
-                        continue;
-                    }
-                    let mut values = vec![0.0; cluster.columns.len()];
-                    for &j in node_clusters[b].iter().flat_map(|&node| &of_node[node]) {
-                        let a = entry(i, j);
-                        for &(c, v) in &basis[j] {
-                            values[c - cluster.columns.start] += a * v;
+        // The near part of each row of P: each entry of S~ between near clusters once, a block
+        // of rows at a time into one allocation.
+        let mut near_offsets = Vec::with_capacity(m + 1);
+        near_offsets.push(0);
+        for &b in &cluster_of {
+            near_offsets.push(near_offsets.last().unwrap_or(&0) + clusters[b].near.len());
+        }
+        let mut near_values = Vec::with_capacity(near_offsets[m]);
+        let all: Vec<usize> = (0..m).collect();
+        for block in all.chunks(ROW_BLOCK) {
+            let rows: Vec<Vec<f64>> = (block.par_iter())
+                .map(|&i| {
+                    let far = &clusters[cluster_of[i]].far;
+                    let mut row = Vec::with_capacity(clusters[cluster_of[i]].near.len());
+                    for (b, cluster) in clusters.iter().enumerate() {
+                        if far.binary_search(&b).is_ok() {
+                            continue;
+                        }
+                        let start = row.len();
+                        row.resize(start + cluster.columns.len(), 0.0);
+                        for &j in node_clusters[b].iter().flat_map(|&node| &of_node[node]) {
+                            let a = entry(i, j);
+                            for &(c, v) in &basis[j] {
+                                row[start + c - cluster.columns.start] += a * v;
+                            }
                         }
                     }
-                    let columns = cluster.columns.clone().map(|c| c as u32);
-                    row.extend(columns.zip(values));
-                }
-                row
-            })
-            .collect();
+                    row
+                })
+                .collect();
+            rows.iter()
+                .for_each(|row| near_values.extend_from_slice(row));
+        }
         let product = LumpedProduct {
-            near,
+            near_values,
+            near_offsets,
             at: unknowns.iter().map(|u| nodes[u.node]).collect(),
             reads: unknowns.iter().map(|u| u.reads).collect(),
             cluster_of,
@@ -247,7 +262,6 @@ impl<G: FarField> TwoLevelInverse<G> {
         };
         // V^T P, a block of rows of P at a time, added in the rows' order.
         let mut coarse = Mat::<f64>::zeros(n0, n0);
-        let all: Vec<usize> = (0..m).collect();
         for block in all.chunks(ROW_BLOCK) {
             let rows: Vec<Vec<f64>> = block.par_iter().map(|&i| product.row(i)).collect();
             for (&i, row) in block.iter().zip(rows) {
@@ -291,10 +305,17 @@ impl<G: FarField> TwoLevelInverse<G> {
 }
 
 impl<G: FarField> LumpedProduct<G> {
+    /// The near part of row `i`: its columns and values.
+    fn near_row(&self, i: usize) -> impl Iterator<Item = (&u32, &f64)> {
+        let columns = &self.clusters[self.cluster_of[i]].near;
+        let values = &self.near_values[self.near_offsets[i]..self.near_offsets[i + 1]];
+        columns.iter().zip(values)
+    }
+
     /// Row `i`, dense over the `n0` coarse columns.
     fn row(&self, i: usize) -> Vec<f64> {
         let mut row = vec![0.0; self.n0];
-        for &(c, v) in &self.near[i] {
+        for (&c, &v) in self.near_row(i) {
             row[c as usize] = v;
         }
         for &b in &self.clusters[self.cluster_of[i]].far {
@@ -322,7 +343,7 @@ impl<G: FarField> LumpedProduct<G> {
         (0..self.at.len())
             .into_par_iter()
             .map(|i| {
-                let near: f64 = (self.near[i].iter()).map(|&(c, v)| v * y[c as usize]).sum();
+                let near: f64 = (self.near_row(i)).map(|(&c, &v)| v * y[c as usize]).sum();
                 let far: f64 = (self.clusters[self.cluster_of[i]].far.iter())
                     .map(|&b| {
                         let (g, grad) = self.kernel.field(&self.at[i], &self.clusters[b].centre);
@@ -408,7 +429,7 @@ fn lumped_clusters(
         centres.push(centre);
         radii.push(radius);
     }
-    (node_clusters.iter().zip(columns).enumerate())
+    let mut clusters = (node_clusters.iter().zip(columns).enumerate())
         .map(|(b, (cluster, columns))| {
             let centre = centres[b];
             let mut moments = vec![Moments::default(); columns.len()];
@@ -420,7 +441,7 @@ fn lumped_clusters(
                     }
                 }
             }
-            let far = (0..node_clusters.len())
+            let far: Vec<usize> = (0..node_clusters.len())
                 .filter(|&a| {
                     a != b
                         && distance(&centres[a], &centre) >= ADMISSIBILITY * (radii[a] + radii[b])
@@ -431,9 +452,18 @@ fn lumped_clusters(
                 columns,
                 moments,
                 far,
+                near: Vec::new(),
             }
         })
-        .collect()
+        .collect::<Vec<Cluster>>();
+    for b in 0..clusters.len() {
+        let near: Vec<u32> = (0..clusters.len())
+            .filter(|a| clusters[b].far.binary_search(a).is_err())
+            .flat_map(|a| clusters[a].columns.clone().map(|c| c as u32))
+            .collect();
+        clusters[b].near = near;
+    }
+    clusters
 }
 
 /// Each unknown's coarse columns and weights: a row of `V`.
@@ -738,11 +768,11 @@ mod tests {
                     }
                 }
                 // The near columns are the exact sums.
-                for &(c, v) in &product.near[i] {
+                for (&c, &v) in product.near_row(i) {
                     assert!((v - exact[c as usize]).abs() <= 1e-12 * largest);
                 }
             }
-            let stored = product.near.iter().map(Vec::len).sum::<usize>() as f64 / m as f64;
+            let stored = product.near_values.len() as f64 / m as f64;
             eprintln!(
                 "dim {dim}, m {m}: {far_entries} far entries, largest error {worst:.1e} of the \
                  row; {stored:.0} near entries stored per row of {} columns",
