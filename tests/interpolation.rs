@@ -1,7 +1,8 @@
 //! Rescaled localized RBF interpolation between non-matching interfaces (`contact::rbf`):
 //! exact reproduction of constants, convergence on smooth fields, radii (Algorithm 1 of
 //! `docs/method.md` 2.2 against twice the spacing), and the sparse rows and columns the contact
-//! operators use. Everything is deterministic.
+//! operators use: solved on patches of a large surface, and with wide supports, against the
+//! whole `Phi_MM` factored here. Everything is deterministic.
 
 use std::f64::consts::PI;
 
@@ -80,7 +81,7 @@ fn check_constants(sources: &[[f64; 3]], targets: &[[f64; 3]]) {
     assert_eq!(interp.num_sources(), sources.len());
     assert_eq!(interp.num_targets(), targets.len());
     assert!(interp.uncovered_targets().is_empty());
-    let r = interp.matrix();
+    let r = interp.matrix().expect("matrix");
     assert_eq!(r.shape(), (targets.len(), sources.len()));
     for (t, row) in r.row_iter().enumerate() {
         let sum: f64 = row.iter().sum();
@@ -89,7 +90,7 @@ fn check_constants(sources: &[[f64; 3]], targets: &[[f64; 3]]) {
     // A constant vector field (3 interleaved components) is reproduced exactly.
     let c = [2.5, -7.0, 1e-3];
     let values: Vec<f64> = (0..sources.len()).flat_map(|_| c).collect();
-    let out = interp.apply(&values, 3);
+    let out = interp.apply(&values, 3).expect("apply");
     for (t, v) in out.chunks_exact(3).enumerate() {
         for k in 0..3 {
             assert!(
@@ -102,7 +103,7 @@ fn check_constants(sources: &[[f64; 3]], targets: &[[f64; 3]]) {
     }
     // apply agrees with the dense matrix.
     let g: Vec<f64> = sources.iter().map(|p| p[0] - 2.0 * p[1] + p[2]).collect();
-    let by_apply = interp.apply(&g, 1);
+    let by_apply = interp.apply(&g, 1).expect("apply");
     let by_matrix = &r * nalgebra::DVector::from_vec(g);
     for (a, b) in by_apply.iter().zip(by_matrix.iter()) {
         assert!((a - b).abs() < 1e-12);
@@ -144,6 +145,7 @@ fn max_error(sources: &[[f64; 3]], targets: &[[f64; 3]], f: impl Fn(&[f64; 3]) -
     let g: Vec<f64> = sources.iter().map(&f).collect();
     interp
         .apply(&g, 1)
+        .expect("apply")
         .iter()
         .zip(targets)
         .map(|(v, p)| (v - f(p)).abs())
@@ -243,6 +245,7 @@ fn twice_the_spacing_interpolates_a_linear_field_better_than_algorithm_1_on_cont
         let x: Vec<f64> = from.coords.iter().map(|p| p[0]).collect();
         interp
             .apply(&x, 1)
+            .expect("apply")
             .iter()
             .zip(&targets)
             .map(|(v, p)| (v - p[0]).abs() / h)
@@ -294,10 +297,13 @@ fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
     let all_targets: Vec<usize> = (0..num_targets).collect();
     let all_sources: Vec<usize> = (0..num_sources).collect();
     let pairs = [
-        (r.rows(&all_targets, |_| true), r.rows(&all_targets, mine)),
         (
-            r.columns(&all_sources, |_| true),
-            r.columns(&all_sources, mine),
+            r.rows(&all_targets, |_| true).unwrap(),
+            r.rows(&all_targets, mine).unwrap(),
+        ),
+        (
+            r.columns(&all_sources, |_| true).unwrap(),
+            r.columns(&all_sources, mine).unwrap(),
         ),
     ];
     for (whole, kept) in pairs {
@@ -315,7 +321,7 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
     // Sources on an arc, targets on a shifted arc: R is dense, its rows and columns computed by
     // transposed and plain solves must match it to round-off, dropping only entries <= DROP_TOL.
     let (r, [num_sources, num_targets]) = arc_interpolation();
-    let dense = r.matrix();
+    let dense = r.matrix().expect("matrix");
     let dense_of = |entries: &[(usize, f64)], len: usize| {
         let mut v = vec![0.0; len];
         for &(k, w) in entries {
@@ -324,7 +330,7 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         v
     };
     let all_targets: Vec<usize> = (0..num_targets).collect();
-    for (t, row) in r.rows(&all_targets, |_| true).iter().enumerate() {
+    for (t, row) in r.rows(&all_targets, |_| true).unwrap().iter().enumerate() {
         let row = dense_of(row, num_sources);
         for (j, value) in row.iter().enumerate() {
             assert!(
@@ -338,7 +344,12 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         );
     }
     let all_sources: Vec<usize> = (0..num_sources).collect();
-    for (j, column) in r.columns(&all_sources, |_| true).iter().enumerate() {
+    for (j, column) in r
+        .columns(&all_sources, |_| true)
+        .unwrap()
+        .iter()
+        .enumerate()
+    {
         let column = dense_of(column, num_targets);
         for (t, value) in column.iter().enumerate() {
             assert!(
@@ -347,4 +358,167 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
             );
         }
     }
+}
+
+/// The rows and columns of `R` from the whole `Phi_MM` factored once (faer's sparse LU): the
+/// reference for the patch solves. `R[t, :] = D_tt^-1 Phi_MM^-T Phi_NM[t, :]^T`, `D_tt` its sum.
+fn whole_solve_rows(
+    sources: &[[f64; 3]],
+    radii: &[f64],
+    targets: &[[f64; 3]],
+    rows: &[usize],
+) -> Vec<Vec<f64>> {
+    use faer::linalg::solvers::Solve;
+    use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+    use faer::sparse::{SparseColMat, Triplet};
+    use internodes::contact::rbf::wendland_c2;
+    let m = sources.len();
+    let phi = |p: &[f64; 3], j: usize| {
+        let d = (0..3).map(|k| (p[k] - sources[j][k]).powi(2)).sum::<f64>();
+        wendland_c2(d.sqrt() / radii[j])
+    };
+    let mut triplets = Vec::new();
+    for (i, p) in sources.iter().enumerate() {
+        for j in 0..m {
+            let v = phi(p, j);
+            if v > 0.0 {
+                triplets.push(Triplet::new(i, j, v));
+            }
+        }
+    }
+    let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets).unwrap();
+    let lu = Lu::try_new_with_symbolic(
+        SymbolicLu::try_new(matrix.symbolic()).unwrap(),
+        matrix.as_ref(),
+    )
+    .unwrap();
+    rows.iter()
+        .map(|&t| {
+            let mut z: Vec<f64> = (0..m).map(|j| phi(&targets[t], j)).collect();
+            lu.solve_transpose_in_place(faer::MatMut::from_column_major_slice_mut(&mut z, m, 1));
+            let sum: f64 = z.iter().sum();
+            z.iter().map(|v| v / sum).collect()
+        })
+        .collect()
+}
+
+#[test]
+fn rows_and_columns_solved_on_patches_are_those_of_the_whole_solve() {
+    // 10,000 sources on a spherical cap (a wobbled grid, the transfer operators' radii: twice
+    // the spacing) and 4,900 targets on another: a surface large enough that the patches
+    // (rbf_patch.rs) hold a small part of it. Rows and columns in the middle of the cap,
+    // computed on patches, against the whole Phi_MM's factor.
+    let sources = patch(99, 0.25, 1.3, sphere_cap);
+    let targets = patch(69, 0.3, 0.7, sphere_cap);
+    let radii = interpolation_radii(&sources, 2.0).unwrap();
+    let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+    assert!(r.uncovered_targets().is_empty());
+    let centre = sphere_cap(0.5, 0.5);
+    let near = |p: &[f64; 3], reach: f64| {
+        (0..3).map(|k| (p[k] - centre[k]).powi(2)).sum::<f64>() < reach * reach
+    };
+    let zone: Vec<usize> = (0..targets.len())
+        .filter(|&t| near(&targets[t], 0.1))
+        .collect();
+    let all_rows: Vec<usize> = (0..targets.len()).collect();
+    let whole = whole_solve_rows(&sources, &radii, &targets, &all_rows);
+    let rows = r.rows(&zone, |_| true).unwrap();
+    // The difference at the entries a row keeps, and the largest entry it drops.
+    let (mut error, mut dropped, mut reach) = (0.0f64, 0.0f64, 0.0f64);
+    for (&t, row) in zone.iter().zip(&rows) {
+        let mut kept = vec![None; sources.len()];
+        for &(j, w) in row {
+            kept[j] = Some(w);
+            let d = (0..3)
+                .map(|k| (sources[j][k] - targets[t][k]).powi(2))
+                .sum::<f64>();
+            reach = reach.max(d.sqrt());
+        }
+        for (a, b) in kept.iter().zip(&whole[t]) {
+            match a {
+                Some(a) => error = error.max((a - b).abs()),
+                None => dropped = dropped.max(b.abs()),
+            }
+        }
+    }
+    let in_zone: Vec<usize> = (0..sources.len())
+        .filter(|&j| near(&sources[j], 0.1))
+        .collect();
+    let columns = r.columns(&in_zone, |_| true).unwrap();
+    let (mut column_error, mut column_dropped) = (0.0f64, 0.0f64);
+    for (&j, column) in in_zone.iter().zip(&columns) {
+        let mut kept = vec![None; targets.len()];
+        for &(t, w) in column {
+            kept[t] = Some(w);
+        }
+        for (t, value) in kept.iter().enumerate() {
+            match value {
+                Some(value) => column_error = column_error.max((value - whole[t][j]).abs()),
+                None => column_dropped = column_dropped.max(whole[t][j].abs()),
+            }
+        }
+    }
+    let h = 0.5 / 99.0;
+    println!(
+        "{} sources, {} rows and {} columns: largest difference from the whole solve {error:.1e} \
+         (rows), {column_error:.1e} (columns); largest entry dropped {dropped:.1e} (rows), \
+         {column_dropped:.1e} (columns); rows reach {:.1} spacings",
+        sources.len(),
+        zone.len(),
+        in_zone.len(),
+        reach / h
+    );
+    // The rows reach a small part of the cap (its extent is 100 spacings), so the patches
+    // are smaller than the surface and this tests their truncation: the entries kept within
+    // round-off of the whole solve's (PATCH_TOL's aim), those dropped at most DROP_TOL (the
+    // whole solve's entries there, up to the same round-off).
+    assert!(reach < 40.0 * h, "rows reach {:.1} spacings", reach / h);
+    assert!(
+        error < 1e-14 && column_error < 1e-14,
+        "{error:e}, {column_error:e}"
+    );
+    assert!(dropped < DROP_TOL + 1e-14, "rows: {dropped:e}");
+    assert!(
+        column_dropped < DROP_TOL + 1e-14,
+        "columns: {column_dropped:e}"
+    );
+}
+
+#[test]
+fn wide_supports_interpolate_as_the_whole_solve_does() {
+    // Supports of ten spacings (the largest rbf_radius a case may set): Phi_MM is ill
+    // conditioned, GMRES on it stops short of its tolerance and the whole matrix is factored
+    // (rbf_patch::WholeFactor), which then serves the rows too. Both against the whole solve.
+    let sources = patch(59, 0.25, 1.3, sphere_cap);
+    let targets = patch(41, 0.3, 0.7, sphere_cap);
+    let radii = interpolation_radii(&sources, 10.0).unwrap();
+    let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+    let all_rows: Vec<usize> = (0..targets.len()).collect();
+    let whole = whole_solve_rows(&sources, &radii, &targets, &all_rows);
+    let g: Vec<f64> = sources
+        .iter()
+        .map(|p| p[0] - 2.0 * p[1] + p[2] * p[2])
+        .collect();
+    let applied = r.apply(&g, 1).unwrap();
+    let mut apply_error = 0.0f64;
+    for (t, value) in applied.iter().enumerate() {
+        let reference: f64 = whole[t].iter().zip(&g).map(|(w, g)| w * g).sum();
+        apply_error = apply_error.max((value - reference).abs());
+    }
+    let rows = r.rows(&all_rows, |_| true).unwrap();
+    let mut row_error = 0.0f64;
+    for (row, whole) in rows.iter().zip(&whole) {
+        let mut kept = vec![0.0; sources.len()];
+        for &(j, w) in row {
+            kept[j] = w;
+        }
+        for (a, b) in kept.iter().zip(whole) {
+            row_error = row_error.max((a - b).abs());
+        }
+    }
+    println!("radius 10: apply {apply_error:.1e}, rows {row_error:.1e} from the whole solve");
+    assert!(
+        apply_error < 1e-12 && row_error < 1e-12,
+        "{apply_error:e}, {row_error:e}"
+    );
 }

@@ -43,8 +43,12 @@ PARTS = [
     ("faer dense-product buffer (reserved; mostly never written)", "private_gemm_x86"),
     ("PETSc: GAMG hierarchy (set-up)", "internodes_cgamg_set_up"),
     ("PETSc: matrix, KSP (create)", "internodes_cgamg_create"),
-    ("RBF interpolation: set-up (sparse LU of Phi_MM)", "Interpolation::new"),
+    # The whole Phi_MM's sparse LU, factored only where a solve needs it (rbf_patch.rs).
+    ("RBF interpolation: whole factor of Phi_MM (where used)", "rbf_patch::whole_factor"),
+    ("RBF interpolation: set-up (Phi_MM, Phi_NM, their graph)", "Interpolation::new"),
     ("RBF interpolation: rows and columns", "rbf::Interpolation::"),
+    # The patches' solves, on rayon's threads.
+    ("RBF interpolation: rows and columns", "rbf_patch::"),
     ("coupled system blocks", "CoupledSystem::assemble"),
     ("interface coupling", "InterfaceOperators::coupling"),
     ("interface operators (other)", "InterfaceOperators::"),

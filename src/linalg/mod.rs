@@ -17,6 +17,7 @@ pub use body_solver::{
 };
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
 pub use distribution::{Distribution, RankRows};
+pub(crate) use node_order::z_curve_keys;
 
 use faer::sparse::SparseColMat;
 use thiserror::Error;

@@ -103,7 +103,7 @@ impl InterfaceOperators {
             )?)
         };
         let n2_flat: Vec<f64> = secondary.normals.iter().flatten().copied().collect();
-        let n2_at_1 = r12.apply(&n2_flat, 3);
+        let n2_at_1 = r12.apply(&n2_flat, 3)?;
         let normals: Vec<[f64; 3]> = (0..primary.len())
             .map(|i| contact_normal(&primary.normals[i], &n2_at_1[3 * i..3 * i + 3], weights))
             .collect();
@@ -169,18 +169,18 @@ impl InterfaceOperators {
         active: &[usize],
         constraint: Constraint,
         kept: Option<&[bool]>,
-    ) -> Coupling {
+    ) -> Result<Coupling, ContactError> {
         let missing: Vec<usize> = active
             .iter()
             .copied()
             .filter(|i| !self.rows12.contains_key(i))
             .collect();
         let keeps = |j: usize| kept.is_none_or(|kept| kept[j]);
-        self.rows12
-            .extend(missing.iter().copied().zip(self.r12.rows(&missing, keeps)));
+        let rows = self.r12.rows(&missing, keeps)?;
+        self.rows12.extend(missing.iter().copied().zip(rows));
         if let Some(r21) = &self.r21 {
             let receiving = &self.receiving;
-            let columns = r21.columns(&missing, |t| keeps(receiving[t]));
+            let columns = r21.columns(&missing, |t| keeps(receiving[t]))?;
             self.columns21.extend(missing.iter().copied().zip(columns));
         }
         let to_body2 = |entries: &[(usize, f64)], weight: &dyn Fn(usize, f64) -> f64| {
@@ -273,7 +273,7 @@ impl InterfaceOperators {
                 )
             }
         };
-        Coupling {
+        Ok(Coupling {
             primary_nodes: active.iter().map(|&i| primary.nodes[i]).collect(),
             points: active.iter().map(|&i| primary.coords[i]).collect(),
             normals,
@@ -283,7 +283,7 @@ impl InterfaceOperators {
             interpolated,
             loads2,
             gaps,
-        }
+        })
     }
 
     /// The displacement jump `u1_i - (R12 u2)_i` of every primary candidate, for the bodies'
@@ -294,7 +294,7 @@ impl InterfaceOperators {
         secondary: &ContactSurface,
         u1: &[f64],
         u2: &[f64],
-    ) -> Vec<[f64; 3]> {
+    ) -> Result<Vec<[f64; 3]>, ContactError> {
         let on_surfaces = [primary.values(u1), secondary.values(u2)];
         self.jumps_of(&on_surfaces)
     }
@@ -302,11 +302,11 @@ impl InterfaceOperators {
     /// [`Self::jumps`] from the displacements at the two surfaces' nodes alone (`[primary,
     /// secondary]`, three components per node: `ContactSurface::values`), which is all it
     /// reads.
-    pub fn jumps_of(&self, [u1, u2]: &[Vec<f64>; 2]) -> Vec<[f64; 3]> {
-        let u2_at_1 = self.r12.apply(u2, 3);
-        (0..u1.len() / 3)
+    pub fn jumps_of(&self, [u1, u2]: &[Vec<f64>; 2]) -> Result<Vec<[f64; 3]>, ContactError> {
+        let u2_at_1 = self.r12.apply(u2, 3)?;
+        Ok((0..u1.len() / 3)
             .map(|i| std::array::from_fn(|k| u1[3 * i + k] - u2_at_1[3 * i + k]))
-            .collect()
+            .collect())
     }
 
     /// The linearized gap of every primary candidate, `g_i(u) = d_i - n_i . (u1_i - (R12

@@ -29,11 +29,11 @@
 
 use std::num::NonZeroUsize;
 
-use faer::MatMut;
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+
+use crate::contact::geometry::rbf_patch::{self as patch, CompressedRows, Graph};
+use crate::linalg::gmres;
 
 /// Starting value of the constant `c` of Algorithm 1 (`r_i = d_i / c`).
 pub const C_START: f64 = 0.5;
@@ -101,7 +101,9 @@ pub enum RbfError {
         /// The offending radius.
         radius: f64,
     },
-    /// `Phi_MM` could not be factored or its factorization gives non-finite values.
+    /// A solve with `Phi_MM` failed: GMRES stopped short and the whole matrix could not be
+    /// factored, a patch's matrix could not be factored although it held every source its
+    /// graph reaches, or a solve gave a non-finite value.
     #[error("the RBF matrix Phi_MM is singular: {detail}")]
     SingularPhi {
         /// What failed.
@@ -110,9 +112,6 @@ pub enum RbfError {
     /// The k-d tree could not be built (more than `u32::MAX` points).
     #[error("k-d tree construction failed: {0}")]
     KdTree(#[from] kiddo::kd_tree::ConstructionError),
-    /// The sparse matrix could not be assembled.
-    #[error("sparse RBF matrix assembly failed: {0}")]
-    Assembly(String),
 }
 
 /// Wendland C2 radial basis function: `phi(delta) = (1 - delta)^4_+ (1 + 4 delta)`
@@ -217,35 +216,75 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
 /// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` from source nodes with
 /// support radii to target points.
 ///
-/// Holds `Phi_NM` (sparse rows), the sparse LU factors of `Phi_MM` and `D_NN^-1`; `R_NM` itself
-/// (dense in general) is never formed, except on request by [`Interpolation::matrix`].
+/// Holds `Phi_MM` and `Phi_NM` (sparse rows), the graph of `Phi_MM` and `D_NN^-1`; `R_NM`
+/// (dense in general) is never formed, except on request by [`Interpolation::matrix`], and
+/// `Phi_MM` is not factored where GMRES serves. Two kinds of solve with `Phi_MM`:
+///
+/// * **Whole fields** ([`Interpolation::apply`], and `D_NN` itself): GMRES on `Phi_MM`, stopped
+///   at a residual of [`SOLVE_TOL`] of the right-hand side. Wendland's matrix with the radii of
+///   [`interpolation_radii`] at their default is well conditioned (`docs/method.md` 2.2), so the
+///   solve costs a few dozen sparse products and keeps nothing but its Krylov vectors while it
+///   runs. Where GMRES stops short (wide supports), the whole `Phi_MM` is factored by sparse LU
+///   and that factor serves every solve after ([`patch::WholeFactor`]).
+/// * **Rows and columns of `R`** ([`Interpolation::rows`], [`Interpolation::columns`]): each
+///   from a solve on a patch of sources around it (`rbf_patch.rs`), since the entries of
+///   `Phi_MM^-1` decay exponentially with the number of steps in `Phi_MM`'s graph.
+///
+/// Why not the whole factor always: its fill is many times `Phi_MM`'s nonzeros and grows
+/// faster than the surface, every rank of a distributed run held it, and each row cost a solve
+/// with all of it; a patch's solve costs the same on any surface.
 #[derive(Debug)]
 pub struct Interpolation {
-    num_sources: usize,
-    /// Row offsets of `Phi_NM` into `phi_cols` / `phi_vals` (length `N + 1`).
-    phi_rows: Vec<usize>,
-    /// Source (column) index of each stored entry of `Phi_NM`.
-    phi_cols: Vec<usize>,
-    /// Value of each stored entry of `Phi_NM`.
-    phi_vals: Vec<f64>,
-    /// Sparse LU factors of `Phi_MM`.
-    lu: Lu<usize, f64>,
+    /// `Phi_MM`, in compressed rows.
+    phi_mm: CompressedRows,
+    /// `Phi_NM`, in compressed rows.
+    phi_nm: CompressedRows,
+    /// Each source's neighbours in `Phi_MM`'s graph (the pattern of `Phi_MM + Phi_MM^T`
+    /// without the diagonal): what a patch grows along.
+    graph: Graph,
+    /// Where the sources and the targets lie: the order in which rows and columns are
+    /// computed in blocks of nearby ones.
+    sources: Vec<[f64; 3]>,
+    targets: Vec<[f64; 3]>,
     /// `1 / D_ii` for covered targets, `0` for uncovered ones.
     inv_d: Vec<f64>,
     /// Targets with `D_ii` not clearly positive (see [`UNCOVERED_TOL`]).
     uncovered: Vec<usize>,
+    /// The whole `Phi_MM`'s sparse LU, factored only where a solve needs it
+    /// ([`patch::WholeFactor`]).
+    whole: patch::WholeFactor,
+}
+
+/// The whole-field solves with `Phi_MM` stop at a residual of this fraction of the right-hand
+/// side's. With `Phi_MM`'s condition number about 6, the solution is then within a few
+/// `1e-15` of the exact one, the round-off of a direct solve.
+pub const SOLVE_TOL: f64 = 1e-15;
+
+/// GMRES on `Phi_MM` with no preconditioner (its diagonal is one).
+struct PhiOperator<'a>(&'a CompressedRows);
+
+impl gmres::Operators for PhiOperator<'_> {
+    type Error = std::convert::Infallible;
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
+        self.0.multiply(x, out);
+        Ok(())
+    }
+    fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
+        out.copy_from_slice(r);
+        Ok(())
+    }
 }
 
 impl Interpolation {
-    /// Assembles `Phi_MM` and `Phi_NM` with a k-d tree radius search, factors `Phi_MM` by sparse
-    /// LU and computes `D_NN = diag(Phi_NM Phi_MM^-1 1)`.
+    /// Assembles `Phi_MM` and `Phi_NM` with a k-d tree radius search and computes
+    /// `D_NN = diag(Phi_NM Phi_MM^-1 1)`.
     ///
     /// Targets whose `D_ii` is not clearly positive (outside every source support; threshold
     /// [`UNCOVERED_TOL`]) do not make `new` fail: their row of `R` is zero and they are listed by
     /// [`Interpolation::uncovered_targets`].
     ///
-    /// Cost: one radius search per source and per target (radius `max_j r_j`), one sparse LU of
-    /// `Phi_MM` and one solve.
+    /// Cost: one radius search per source and per target (radius `max_j r_j`) and one GMRES
+    /// solve with `Phi_MM`.
     pub fn new(
         sources: &[[f64; 3]],
         radii: &[f64],
@@ -272,65 +311,79 @@ impl Interpolation {
         let m = sources.len();
         let tree = ImmutableKdTree::<f64, 3>::new_from_slice(sources)?;
         let r_max = radii.iter().copied().fold(0.0, f64::max);
-
-        let (mm_rows, mm_cols, mm_vals) = rbf_rows(&tree, sources, radii, r_max, sources);
-        let triplets: Vec<Triplet<usize, usize, f64>> = (0..m)
-            .flat_map(|i| (mm_rows[i]..mm_rows[i + 1]).map(move |k| (i, k)))
-            .map(|(i, k)| Triplet::new(i, mm_cols[k], mm_vals[k]))
-            .collect();
-        let phi_mm = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets)
-            .map_err(|e| RbfError::Assembly(format!("{e:?}")))?;
-        let symbolic =
-            SymbolicLu::try_new(phi_mm.symbolic()).map_err(|e| RbfError::SingularPhi {
-                detail: format!("{e:?}"),
-            })?;
-        let lu = Lu::try_new_with_symbolic(symbolic, phi_mm.as_ref()).map_err(|e| {
-            RbfError::SingularPhi {
-                detail: format!("{e:?}"),
-            }
-        })?;
+        let phi_mm = rbf_rows(&tree, sources, radii, r_max, sources);
+        let phi_nm = rbf_rows(&tree, sources, radii, r_max, targets);
+        let graph = Graph::of(&phi_mm);
+        let mut interpolation = Self {
+            phi_mm,
+            phi_nm,
+            graph,
+            sources: sources.to_vec(),
+            targets: targets.to_vec(),
+            inv_d: Vec::new(),
+            uncovered: Vec::new(),
+            whole: patch::WholeFactor::new(),
+        };
 
         // y = Phi_MM^-1 1
-        let mut y = vec![1.0; m];
-        lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut y, m, 1));
-        if let Some(j) = y.iter().position(|v| !v.is_finite()) {
-            return Err(RbfError::SingularPhi {
-                detail: format!("entry {j} of Phi_MM^-1 1 is not finite"),
-            });
-        }
-
-        let (phi_rows, phi_cols, phi_vals) = rbf_rows(&tree, sources, radii, r_max, targets);
-        let mut inv_d = Vec::with_capacity(targets.len());
-        let mut uncovered = Vec::new();
+        let y = interpolation.solve(&vec![1.0; m])?;
         for t in 0..targets.len() {
-            let range = phi_rows[t]..phi_rows[t + 1];
-            let (sum, magnitude) = phi_cols[range.clone()]
-                .iter()
-                .zip(&phi_vals[range])
-                .fold((0.0, 0.0), |(s, a), (&j, &v)| {
+            let (sum, magnitude) = (interpolation.phi_nm.row(t))
+                .fold((0.0, 0.0), |(s, a), (j, v)| {
                     (s + v * y[j], a + v * y[j].abs())
                 });
             if sum > UNCOVERED_TOL * magnitude {
-                inv_d.push(1.0 / sum);
+                interpolation.inv_d.push(1.0 / sum);
             } else {
-                inv_d.push(0.0);
-                uncovered.push(t);
+                interpolation.inv_d.push(0.0);
+                interpolation.uncovered.push(t);
             }
         }
-        Ok(Self {
-            num_sources: m,
-            phi_rows,
-            phi_cols,
-            phi_vals,
-            lu,
-            inv_d,
-            uncovered,
-        })
+        Ok(interpolation)
+    }
+
+    /// `Phi_MM^-1 b`: by GMRES ([`SOLVE_TOL`]), or with the whole factor where it exists or
+    /// GMRES stops short of its tolerance (wide supports make `Phi_MM` ill-conditioned: with
+    /// `rbf_radius = 10` on the 3D hemisphere's surfaces GMRES is still at `3e-6` after 200
+    /// products). A matrix that cannot be factored then is [`RbfError::SingularPhi`], with why
+    /// GMRES stopped.
+    fn solve(&self, b: &[f64]) -> Result<Vec<f64>, RbfError> {
+        let m = b.len();
+        let with_factor = |lu: &faer::sparse::linalg::solvers::Lu<usize, f64>| {
+            let mut x = b.to_vec();
+            lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut x, m, 1));
+            x
+        };
+        if let Some(Ok(lu)) = self.whole.get() {
+            return finite(with_factor(lu));
+        }
+        let mut x = vec![0.0; m];
+        let settings = gmres::GmresSettings {
+            tolerance: SOLVE_TOL * gmres::norm(b),
+            reduction: None,
+            max_iterations: MAX_SOLVE_ITERATIONS,
+            restart: MAX_SOLVE_ITERATIONS,
+        };
+        let Ok(stats) = gmres::solve(&mut PhiOperator(&self.phi_mm), b, &mut x, settings);
+        let Some(failure) = stats.failure else {
+            return Ok(x);
+        };
+        match patch::whole_factor(&self.phi_mm, &self.whole) {
+            Ok(lu) => finite(with_factor(lu)),
+            Err(detail) => Err(RbfError::SingularPhi {
+                detail: format!(
+                    "GMRES {failure} after {} iterations (residual {:.1e} of the right-hand \
+                     side's), and {detail}",
+                    stats.iterations,
+                    stats.residual / stats.initial_residual
+                ),
+            }),
+        }
     }
 
     /// Number of source nodes `M`.
     pub fn num_sources(&self) -> usize {
-        self.num_sources
+        self.sources.len()
     }
 
     /// Number of target points `N`.
@@ -342,122 +395,143 @@ impl Interpolation {
     /// (`values[j * components + k]`), to the targets: returns `R_NM g` in the same interleaved
     /// layout (`N * components` values). Rows of uncovered targets are zero.
     ///
-    /// Cost: one sparse LU solve with `components` right-hand sides and one product with
-    /// `Phi_NM`.
+    /// Cost: one GMRES solve with `Phi_MM` per component and one product with `Phi_NM`.
     ///
     /// # Panics
     /// If `values.len() != num_sources() * components`.
-    pub fn apply(&self, values: &[f64], components: usize) -> Vec<f64> {
-        let m = self.num_sources;
+    pub fn apply(&self, values: &[f64], components: usize) -> Result<Vec<f64>, RbfError> {
+        let m = self.num_sources();
         assert_eq!(
             values.len(),
             m * components,
             "expected {components} values for each of the {m} source nodes"
         );
         let n = self.num_targets();
-        if components == 0 {
-            return Vec::new();
-        }
-        // Column-major M x components copy, solved in place: x = Phi_MM^-1 g.
-        let mut x = vec![0.0; m * components];
-        for (j, node) in values.chunks_exact(components).enumerate() {
-            for (k, &v) in node.iter().enumerate() {
-                x[k * m + j] = v;
-            }
-        }
-        self.lu
-            .solve_in_place(MatMut::from_column_major_slice_mut(&mut x, m, components));
         let mut out = vec![0.0; n * components];
-        for (t, row) in out.chunks_exact_mut(components).enumerate() {
-            let scale = self.inv_d[t];
-            if scale == 0.0 {
-                continue;
+        for k in 0..components {
+            let g: Vec<f64> = values.iter().skip(k).step_by(components).copied().collect();
+            let x = self.solve(&g)?;
+            for (t, row) in out.chunks_exact_mut(components).enumerate() {
+                let value: f64 = self.phi_nm.row(t).map(|(j, v)| v * x[j]).sum();
+                row[k] = self.inv_d[t] * value;
             }
-            for p in self.phi_rows[t]..self.phi_rows[t + 1] {
-                let (j, v) = (self.phi_cols[p], self.phi_vals[p]);
-                for (k, o) in row.iter_mut().enumerate() {
-                    *o += v * x[k * m + j];
-                }
-            }
-            row.iter_mut().for_each(|o| *o *= scale);
         }
-        out
+        Ok(out)
     }
 
-    /// The dense `N x M` interpolation matrix `R_NM`. Costs `M` solves and `N * M`
-    /// memory: meant for small interfaces and tests.
-    pub fn matrix(&self) -> nalgebra::DMatrix<f64> {
-        let m = self.num_sources;
-        let mut identity = vec![0.0; m * m];
-        identity.iter_mut().step_by(m + 1).for_each(|v| *v = 1.0);
-        // With the identity as an M-component field, output row t holds row t of R.
-        nalgebra::DMatrix::from_row_slice(self.num_targets(), m, &self.apply(&identity, m))
+    /// The dense `N x M` interpolation matrix `R_NM`, column by column ([`Self::apply`] of
+    /// each unit vector). Costs `M` solves and `N * M` memory: meant for small interfaces and
+    /// tests.
+    pub fn matrix(&self) -> Result<nalgebra::DMatrix<f64>, RbfError> {
+        let (n, m) = (self.num_targets(), self.num_sources());
+        let mut r = nalgebra::DMatrix::zeros(n, m);
+        let mut unit = vec![0.0; m];
+        for j in 0..m {
+            unit[j] = 1.0;
+            r.set_column(j, &nalgebra::DVector::from_vec(self.apply(&unit, 1)?));
+            unit[j] = 0.0;
+        }
+        Ok(r)
     }
 
     /// Rows `targets` of `R_NM`, each as its entries `(source, weight)` with `|weight| >`
-    /// [`DROP_TOL`] at the sources `keep` accepts: `R[t, :] = D_tt^-1 Phi_NM[t, :] Phi_MM^-1`,
-    /// one transposed solve with `Phi_MM` per row (in blocks). `Phi_MM^-1` is dense but its
-    /// entries decay fast away from the diagonal, so the rows are short.
-    pub fn rows(&self, targets: &[usize], keep: impl Fn(usize) -> bool) -> Vec<Vec<(usize, f64)>> {
-        let m = self.num_sources;
-        let mut rows = Vec::with_capacity(targets.len());
-        for block in targets.chunks(BLOCK) {
-            let mut z = vec![0.0; m * block.len()];
-            for (k, &t) in block.iter().enumerate() {
-                for p in self.phi_rows[t]..self.phi_rows[t + 1] {
-                    z[k * m + self.phi_cols[p]] = self.phi_vals[p];
-                }
-            }
-            self.lu
-                .solve_transpose_in_place(MatMut::from_column_major_slice_mut(
-                    &mut z,
-                    m,
-                    block.len(),
-                ));
-            for (k, &t) in block.iter().enumerate() {
-                let scale = self.inv_d[t];
-                rows.push(sparse(
-                    z[k * m..(k + 1) * m].iter().map(|v| scale * v),
-                    &keep,
-                ));
-            }
-        }
-        rows
+    /// [`DROP_TOL`] at the sources `keep` accepts: `R[t, :] = D_tt^-1 z_t` with `Phi_MM^T z_t =
+    /// Phi_NM[t, :]^T`, solved on a patch around the row's sources (`rbf_patch.rs`), nearby
+    /// rows together. `D_tt` is the sum of `z_t` (`Phi_NM[t, :] Phi_MM^-1 1`), so that each row
+    /// sums to one to round-off. A solve on a patch that fails is [`RbfError::SingularPhi`].
+    pub fn rows(
+        &self,
+        targets: &[usize],
+        keep: impl Fn(usize) -> bool + Sync,
+    ) -> Result<Vec<Vec<(usize, f64)>>, RbfError> {
+        let covered: Vec<usize> = (targets.iter().copied())
+            .filter(|&t| self.inv_d[t] != 0.0)
+            .collect();
+        let solved = patch::in_blocks(&self.targets, &covered, |block| {
+            let seeds: Vec<usize> = (block.iter())
+                .flat_map(|&t| self.phi_nm.row(t).map(|(j, _)| j))
+                .collect();
+            let right_hand_side = |k: usize, set: &mut dyn FnMut(usize, f64)| {
+                self.phi_nm.row(block[k]).for_each(|(j, v)| set(j, v))
+            };
+            let solution = patch::solve(
+                &self.phi_mm,
+                &self.graph,
+                &self.whole,
+                &seeds,
+                block.len(),
+                true,
+                right_hand_side,
+            )
+            .map_err(|detail| RbfError::SingularPhi { detail })?;
+            Ok::<_, RbfError>(
+                (0..block.len())
+                    .map(|k| {
+                        let z = solution.values(k);
+                        let scale = 1.0 / z.iter().sum::<f64>();
+                        let entries =
+                            (solution.nodes.iter().copied()).zip(z.iter().map(|v| scale * v));
+                        sparse(entries, &keep)
+                    })
+                    .collect(),
+            )
+        })?;
+        // The uncovered targets' rows are empty.
+        let mut solved = solved.into_iter();
+        Ok((targets.iter())
+            .map(|&t| match self.inv_d[t] != 0.0 {
+                true => solved.next().unwrap_or_default(),
+                false => Vec::new(),
+            })
+            .collect())
     }
 
     /// Columns `sources` of `R_NM`, each as its entries `(target, weight)` with `|weight| >`
-    /// [`DROP_TOL`] at the targets `keep` accepts: `R[:, j] = D^-1 Phi_NM Phi_MM^-1 e_j`, one
-    /// solve with `Phi_MM` per column (in blocks).
+    /// [`DROP_TOL`] at the targets `keep` accepts: `R[:, j] = D^-1 Phi_NM x_j` with `Phi_MM x_j
+    /// = e_j`, solved on a patch around source `j` (`rbf_patch.rs`), nearby columns together.
+    /// A solve on a patch that fails is [`RbfError::SingularPhi`].
     pub fn columns(
         &self,
         sources: &[usize],
-        keep: impl Fn(usize) -> bool,
-    ) -> Vec<Vec<(usize, f64)>> {
-        let m = self.num_sources;
-        let mut columns = Vec::with_capacity(sources.len());
-        for block in sources.chunks(BLOCK) {
-            let mut x = vec![0.0; m * block.len()];
-            for (k, &j) in block.iter().enumerate() {
-                x[k * m + j] = 1.0;
-            }
-            self.lu
-                .solve_in_place(MatMut::from_column_major_slice_mut(&mut x, m, block.len()));
-            for k in 0..block.len() {
-                let x = &x[k * m..(k + 1) * m];
-                let column = (0..self.num_targets()).map(|t| match keep(t) {
-                    // A target left out reads as zero, which the drop tolerance leaves out.
-                    false => 0.0,
-                    true => {
-                        let value: f64 = (self.phi_rows[t]..self.phi_rows[t + 1])
-                            .map(|p| self.phi_vals[p] * x[self.phi_cols[p]])
-                            .sum();
-                        self.inv_d[t] * value
-                    }
-                });
-                columns.push(sparse(column, &|_| true));
+        keep: impl Fn(usize) -> bool + Sync,
+    ) -> Result<Vec<Vec<(usize, f64)>>, RbfError> {
+        // The targets each source's support holds: those a patch's solution reaches.
+        let mut reached = vec![Vec::new(); self.num_sources()];
+        for t in 0..self.num_targets() {
+            if self.inv_d[t] != 0.0 {
+                self.phi_nm.row(t).for_each(|(j, _)| reached[j].push(t));
             }
         }
-        columns
+        patch::in_blocks(&self.sources, sources, |block| {
+            let right_hand_side = |k: usize, set: &mut dyn FnMut(usize, f64)| set(block[k], 1.0);
+            let solution = patch::solve(
+                &self.phi_mm,
+                &self.graph,
+                &self.whole,
+                block,
+                block.len(),
+                false,
+                right_hand_side,
+            )
+            .map_err(|detail| RbfError::SingularPhi { detail })?;
+            let mut candidates: Vec<usize> = (solution.nodes.iter())
+                .flat_map(|&j| reached[j].iter().copied())
+                .filter(|&t| keep(t))
+                .collect();
+            candidates.sort_unstable();
+            candidates.dedup();
+            Ok((0..block.len())
+                .map(|k| {
+                    let column = candidates.iter().map(|&t| {
+                        let value: f64 = (self.phi_nm.row(t))
+                            .map(|(j, v)| v * solution.at(k, j))
+                            .sum();
+                        (t, self.inv_d[t] * value)
+                    });
+                    sparse(column, &|_| true)
+                })
+                .collect())
+        })
     }
 
     /// Targets outside every source support: `D_ii` not clearly positive (see
@@ -473,16 +547,32 @@ impl Interpolation {
 /// `M * DROP_TOL` of the field's size.
 pub const DROP_TOL: f64 = 1e-13;
 
-/// Right-hand sides per block of the row and column solves.
-const BLOCK: usize = 64;
+/// GMRES products a whole-field solve with `Phi_MM` may take before the whole factor is used
+/// instead (its Krylov vectors are kept without restart, so this bounds them to 100 values
+/// per source): about 35 reach [`SOLVE_TOL`] on the 3D contact surfaces with the default radius.
+const MAX_SOLVE_ITERATIONS: usize = 100;
 
-/// The entries of a dense vector above [`DROP_TOL`] at the positions `keep` accepts, with
-/// their positions.
-fn sparse(values: impl Iterator<Item = f64>, keep: &impl Fn(usize) -> bool) -> Vec<(usize, f64)> {
-    values
-        .enumerate()
+/// `x`, or [`RbfError::SingularPhi`] naming its first non-finite entry.
+fn finite(x: Vec<f64>) -> Result<Vec<f64>, RbfError> {
+    match x.iter().position(|v| !v.is_finite()) {
+        None => Ok(x),
+        Some(j) => Err(RbfError::SingularPhi {
+            detail: format!("entry {j} of a solve with Phi_MM is not finite"),
+        }),
+    }
+}
+
+/// The entries `(position, value)` above [`DROP_TOL`] at the positions `keep` accepts, sorted
+/// by position.
+fn sparse(
+    entries: impl Iterator<Item = (usize, f64)>,
+    keep: &impl Fn(usize) -> bool,
+) -> Vec<(usize, f64)> {
+    let mut kept: Vec<(usize, f64)> = entries
         .filter(|&(i, v)| v.abs() > DROP_TOL && keep(i))
-        .collect()
+        .collect();
+    kept.sort_unstable_by_key(|&(i, _)| i);
+    kept
 }
 
 /// Euclidean distance.
@@ -558,7 +648,7 @@ fn rbf_rows(
     radii: &[f64],
     r_max: f64,
     points: &[[f64; 3]],
-) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+) -> CompressedRows {
     let mut offsets = Vec::with_capacity(points.len() + 1);
     offsets.push(0);
     let mut cols = Vec::new();
@@ -583,7 +673,11 @@ fn rbf_rows(
         vals.extend(row.iter().map(|&(_, v)| v));
         offsets.push(cols.len());
     }
-    (offsets, cols, vals)
+    CompressedRows {
+        offsets,
+        columns: cols,
+        values: vals,
+    }
 }
 
 #[cfg(test)]
@@ -699,12 +793,12 @@ mod tests {
         let radii = support_radii(&points).expect("radii");
         let tree = ImmutableKdTree::<f64, 3>::new_from_slice(&points).expect("tree");
         let r_max = radii.iter().copied().fold(0.0, f64::max);
-        let (rows, cols, vals) = rbf_rows(&tree, &points, &radii, r_max, &points);
+        let phi = rbf_rows(&tree, &points, &radii, r_max, &points);
         let m = points.len();
         let mut sparse = vec![0.0; m * m];
         for i in 0..m {
-            for k in rows[i]..rows[i + 1] {
-                sparse[i * m + cols[k]] = vals[k];
+            for (j, v) in phi.row(i) {
+                sparse[i * m + j] = v;
             }
         }
         let mut off_diagonal = 0;
@@ -732,12 +826,12 @@ mod tests {
         let targets = [[0.3, 0.0, 0.0], [10.0, 0.0, 0.0], [0.9, 0.01, 0.0]];
         let interp = Interpolation::new(&sources, &radii, &targets).expect("interpolation");
         assert_eq!(interp.uncovered_targets(), &[1]);
-        let r = interp.matrix();
+        let r = interp.matrix().expect("matrix");
         assert!(r.row(1).iter().all(|&v| v == 0.0));
         for t in [0, 2] {
             assert!((r.row(t).sum() - 1.0).abs() < 1e-14);
         }
-        let out = interp.apply(&[2.0; 5], 1);
+        let out = interp.apply(&[2.0; 5], 1).expect("apply");
         assert_eq!(out[1], 0.0);
         assert!((out[0] - 2.0).abs() < 1e-14 && (out[2] - 2.0).abs() < 1e-14);
     }

@@ -555,10 +555,11 @@ impl<'a> ContactSolver<'a> {
             active.contact.extend(set.nodes.iter().map(|&i| offset + i));
             active.slip.extend(set.slip.keys().map(|&i| offset + i));
             directions.extend(set.slip.iter().map(|(&i, &d)| (offset + i, d)));
+            let start = self.laws[p].has_friction();
             friction.push(
-                self.laws[p]
-                    .has_friction()
-                    .then(|| self.start_of_step(p, set.history)),
+                start
+                    .then(|| self.start_of_step(p, set.history))
+                    .transpose()?,
             );
             rows.push(set.rows);
             corrections.push(set.corrections);
@@ -747,7 +748,7 @@ impl ContactSolver<'_> {
         let tangential = self.tangential_states(&state.active, &state.directions, &state.turnings);
         let couplings = timed(&mut seconds.operators, || {
             self.couplings(&nodes, state, &tangential)
-        });
+        })?;
         self.check_held(&couplings, &nodes, &tangential)?;
         // 2-4. The coupled solve, the gaps at the iterate, the node states' update.
         let iterate = self.iterate(&couplings, state, &tangential, factors, &mut seconds);
@@ -824,9 +825,9 @@ impl ContactSolver<'_> {
                     let left = (self.operators[p].slid, state.active.clone());
                     state.pairings[p].push(left);
                     timed(&mut seconds.operators, || self.pair_again(p, pairings[p]))?;
-                    state.corrections[p] = self.corrections(p, &solution, &gaps[p]);
+                    state.corrections[p] = self.corrections(p, &solution, &gaps[p])?;
                     if let Some(start) = state.friction[p].as_mut() {
-                        start.jumps = self.operators[p].jumps_of(&start.displacements);
+                        start.jumps = self.operators[p].jumps_of(&start.displacements)?;
                     }
                 }
                 state.safeguard = Safeguard::default();
@@ -1159,13 +1160,18 @@ impl ContactSolver<'_> {
 
     /// Pair `p`'s tied corrections of its current operators at `solution`, whose geometric
     /// gaps are `gaps`: each gap less its linearization.
-    fn corrections(&self, p: usize, solution: &CoupledSolution, gaps: &[f64]) -> Vec<f64> {
+    fn corrections(
+        &self,
+        p: usize,
+        solution: &CoupledSolution,
+        gaps: &[f64],
+    ) -> Result<Vec<f64>, ContactError> {
         let problem = &self.pairs[p];
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
         let [a, b] = self.pair_bodies[p];
-        let jumps = self.operators[p].jumps(s1, s2, &solution.u[a], &solution.u[b]);
+        let jumps = self.operators[p].jumps(s1, s2, &solution.u[a], &solution.u[b])?;
         let linear = self.operators[p].linearized_gaps(&jumps);
-        gaps.iter().zip(&linear).map(|(g, l)| g - l).collect()
+        Ok(gaps.iter().zip(&linear).map(|(g, l)| g - l).collect())
     }
 }
 
@@ -1180,7 +1186,7 @@ impl ContactSolver<'_> {
         nodes: &[Vec<usize>],
         state: &LoopState,
         tangential: &[Option<Vec<Tangential>>],
-    ) -> Vec<Coupling> {
+    ) -> Result<Vec<Coupling>, ContactError> {
         let mut couplings = Vec::with_capacity(self.pairs.len());
         for (p, problem) in self.pairs.iter().enumerate() {
             let law = self.laws[p];
@@ -1198,9 +1204,9 @@ impl ContactSolver<'_> {
             let operators = &mut self.operators[p];
             let enforced = (law, self.methods[p]);
             let kept = self.kept[p].as_deref();
-            couplings.push(operators.coupling(s1, s2, enforced, &nodes[p], constraint, kept));
+            couplings.push(operators.coupling(s1, s2, enforced, &nodes[p], constraint, kept)?);
         }
-        couplings
+        Ok(couplings)
     }
 
     /// Each Coulomb pair's tangential state of every primary candidate in `states` (a
@@ -1239,10 +1245,10 @@ impl ContactSolver<'_> {
         coupling: &Coupling,
         start: &StepStart,
         tangential: &[Tangential],
-    ) -> PairFriction {
+    ) -> Result<PairFriction, ContactError> {
         let problem = &self.pairs[p];
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        let jumps = self.operators[p].jumps(s1, s2, &view.u[0], &view.u[1]);
+        let jumps = self.operators[p].jumps(s1, s2, &view.u[0], &view.u[1])?;
         let len = s1.len();
         let mut answer = PairFriction {
             state: vec![None; len],
@@ -1265,23 +1271,27 @@ impl ContactSolver<'_> {
             answer.slip_increment[i] = slip;
             answer.accumulated_slip[i] += coulomb::norm(slip);
         }
-        answer
+        Ok(answer)
     }
 
     /// Where a Coulomb pair `p`'s load step starts: the displacements the last step ended
     /// with (`history`; none: at rest), and the jumps there through the current operators.
-    fn start_of_step(&self, p: usize, history: Option<FrictionHistory>) -> StepStart {
+    fn start_of_step(
+        &self,
+        p: usize,
+        history: Option<FrictionHistory>,
+    ) -> Result<StepStart, ContactError> {
         let problem = &self.pairs[p];
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
         let history = history.unwrap_or_else(|| FrictionHistory {
             displacements: [vec![0.0; 3 * s1.len()], vec![0.0; 3 * s2.len()]],
             accumulated_slip: vec![0.0; s1.len()],
         });
-        StepStart {
-            jumps: self.operators[p].jumps_of(&history.displacements),
+        Ok(StepStart {
+            jumps: self.operators[p].jumps_of(&history.displacements)?,
             displacements: history.displacements,
             accumulated_slip: history.accumulated_slip,
-        }
+        })
     }
 
     /// The tangential part of the update (`crate::contact::law::coulomb`) of Coulomb pair `p`'s
@@ -1403,10 +1413,10 @@ impl ContactSolver<'_> {
                 let (pair_gaps, jumps, pair_slid) = timed(&mut seconds.search, || {
                     let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
                     *rows = gap_rows(s1, s2, Some(u1), Some(u2), row_normal);
-                    let jumps = operators.jumps(s1, s2, u1, u2);
+                    let jumps = operators.jumps(s1, s2, u1, u2)?;
                     let slid = operators.slide(s1, &jumps, &nodes);
-                    (gaps, jumps, slid)
-                });
+                    Ok::<_, ContactError>((gaps, jumps, slid))
+                })?;
                 let pair_linear = operators.linearized_gaps(&jumps);
                 // The gap each active node's constraint holds: the gap of its linearization (under
                 // the penalty method, less the overlap its pressure allows).
@@ -1530,7 +1540,7 @@ impl ContactSolver<'_> {
                         &couplings[p],
                         start,
                         tangential[p].as_deref().unwrap_or(&[]),
-                    );
+                    )?;
                     for check in checks::friction(
                         problem,
                         friction_coefficient,
