@@ -402,21 +402,30 @@ fn whole_solve_rows(
         .collect()
 }
 
+/// An interpolation between two caps ([`on_caps`]), and every row of its `R` by the whole
+/// solve.
+struct Caps {
+    sources: Vec<[f64; 3]>,
+    targets: Vec<[f64; 3]>,
+    r: Interpolation,
+    whole: Vec<Vec<f64>>,
+}
+
 /// Sources on a wobbled grid of `(n_sources + 1)^2` points on a spherical cap and targets on
-/// another of `(n_targets + 1)^2`, radii `radius` times the spacing: the sources, the targets,
-/// the interpolation and every row of `R` by the whole solve.
-fn on_caps(
-    n_sources: usize,
-    n_targets: usize,
-    radius: f64,
-) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Interpolation, Vec<Vec<f64>>) {
+/// another of `(n_targets + 1)^2`, radii `radius` times the spacing.
+fn on_caps(n_sources: usize, n_targets: usize, radius: f64) -> Caps {
     let sources = patch(n_sources, 0.25, 1.3, sphere_cap);
     let targets = patch(n_targets, 0.3, 0.7, sphere_cap);
     let radii = interpolation_radii(&sources, radius).unwrap();
     let r = Interpolation::new(&sources, &radii, &targets).unwrap();
     let all_rows: Vec<usize> = (0..targets.len()).collect();
     let whole = whole_solve_rows(&sources, &radii, &targets, &all_rows);
-    (sources, targets, r, whole)
+    Caps {
+        sources,
+        targets,
+        r,
+        whole,
+    }
 }
 
 #[test]
@@ -425,7 +434,12 @@ fn rows_and_columns_solved_on_patches_are_those_of_the_whole_solve() {
     // the spacing) and 4,900 targets on another: a surface large enough that the patches
     // (rbf_patch.rs) hold a small part of it. Rows and columns in the middle of the cap,
     // computed on patches, against the whole Phi_MM's factor.
-    let (sources, targets, r, whole) = on_caps(99, 69, 2.0);
+    let Caps {
+        sources,
+        targets,
+        r,
+        whole,
+    } = on_caps(99, 69, 2.0);
     assert!(r.uncovered_targets().is_empty());
     let centre = sphere_cap(0.5, 0.5);
     let near = |p: &[f64; 3], reach: f64| {
@@ -501,7 +515,12 @@ fn wide_supports_interpolate_as_the_whole_solve_does() {
     // Supports of ten spacings (the largest rbf_radius a case may set): Phi_MM is ill
     // conditioned, GMRES on it stops short of its tolerance and the whole matrix is factored
     // (rbf_patch::WholeFactor), which then serves the rows too. Both against the whole solve.
-    let (sources, targets, r, whole) = on_caps(59, 41, 10.0);
+    let Caps {
+        sources,
+        targets,
+        r,
+        whole,
+    } = on_caps(59, 41, 10.0);
     let all_rows: Vec<usize> = (0..targets.len()).collect();
     let g: Vec<f64> = sources
         .iter()
