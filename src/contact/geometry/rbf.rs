@@ -30,9 +30,10 @@
 use std::num::NonZeroUsize;
 
 use faer::linalg::solvers::Solve;
+use faer::sparse::SymbolicSparseRowMat;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::contact::geometry::rbf_patch::{self as patch, CompressedRows, Graph};
+use crate::contact::geometry::rbf_patch::{self as patch, CompressedRows, Graph, row_entries};
 use crate::linalg::gmres;
 
 /// Starting value of the constant `c` of Algorithm 1 (`r_i = d_i / c`).
@@ -266,7 +267,9 @@ struct PhiOperator<'a>(&'a CompressedRows);
 impl gmres::Operators for PhiOperator<'_> {
     type Error = std::convert::Infallible;
     fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
-        self.0.multiply(x, out);
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = row_entries(self.0, i).map(|(j, v)| v * x[j]).sum();
+        }
         Ok(())
     }
     fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
@@ -328,7 +331,7 @@ impl Interpolation {
         // y = Phi_MM^-1 1
         let y = interpolation.solve(&vec![1.0; m])?;
         for t in 0..targets.len() {
-            let (sum, magnitude) = (interpolation.phi_nm.row(t))
+            let (sum, magnitude) = row_entries(&interpolation.phi_nm, t)
                 .fold((0.0, 0.0), |(s, a), (j, v)| {
                     (s + v * y[j], a + v * y[j].abs())
                 });
@@ -412,7 +415,7 @@ impl Interpolation {
             let g: Vec<f64> = values.iter().skip(k).step_by(components).copied().collect();
             let x = self.solve(&g)?;
             for (t, row) in out.chunks_exact_mut(components).enumerate() {
-                let value: f64 = self.phi_nm.row(t).map(|(j, v)| v * x[j]).sum();
+                let value: f64 = row_entries(&self.phi_nm, t).map(|(j, v)| v * x[j]).sum();
                 row[k] = self.inv_d[t] * value;
             }
         }
@@ -449,10 +452,10 @@ impl Interpolation {
             .collect();
         let solved = patch::in_blocks(&self.targets, &covered, |block| {
             let seeds: Vec<usize> = (block.iter())
-                .flat_map(|&t| self.phi_nm.row(t).map(|(j, _)| j))
+                .flat_map(|&t| row_entries(&self.phi_nm, t).map(|(j, _)| j))
                 .collect();
             let right_hand_side = |k: usize, set: &mut dyn FnMut(usize, f64)| {
-                self.phi_nm.row(block[k]).for_each(|(j, v)| set(j, v))
+                row_entries(&self.phi_nm, block[k]).for_each(|(j, v)| set(j, v))
             };
             let solution = patch::solve(
                 &self.phi_mm,
@@ -499,7 +502,7 @@ impl Interpolation {
         let mut reached = vec![Vec::new(); self.num_sources()];
         for t in 0..self.num_targets() {
             if self.inv_d[t] != 0.0 {
-                self.phi_nm.row(t).for_each(|(j, _)| reached[j].push(t));
+                row_entries(&self.phi_nm, t).for_each(|(j, _)| reached[j].push(t));
             }
         }
         patch::in_blocks(&self.sources, sources, |block| {
@@ -523,7 +526,7 @@ impl Interpolation {
             Ok((0..block.len())
                 .map(|k| {
                     let column = candidates.iter().map(|&t| {
-                        let value: f64 = (self.phi_nm.row(t))
+                        let value: f64 = row_entries(&self.phi_nm, t)
                             .map(|(j, v)| v * solution.at(k, j))
                             .sum();
                         (t, self.inv_d[t] * value)
@@ -640,7 +643,7 @@ fn search_radius_squared(radius: f64) -> f64 {
 }
 
 /// Rows of the RBF matrix `(Phi)_tj = phi(|x_t - xi_j| / r_j)` for the given points against the
-/// sources in `tree` (`Phi_MM` or `Phi_NM`), in compressed-row form `(offsets, columns, values)`
+/// sources in `tree` (`Phi_MM` or `Phi_NM`), in compressed rows
 /// with the columns of each row sorted.
 fn rbf_rows(
     tree: &ImmutableKdTree<f64, 3>,
@@ -673,11 +676,9 @@ fn rbf_rows(
         vals.extend(row.iter().map(|&(_, v)| v));
         offsets.push(cols.len());
     }
-    CompressedRows {
-        offsets,
-        columns: cols,
-        values: vals,
-    }
+    let symbolic =
+        SymbolicSparseRowMat::new_checked(points.len(), sources.len(), offsets, None, cols);
+    CompressedRows::new(symbolic, vals)
 }
 
 #[cfg(test)]
@@ -797,7 +798,7 @@ mod tests {
         let m = points.len();
         let mut sparse = vec![0.0; m * m];
         for i in 0..m {
-            for (j, v) in phi.row(i) {
+            for (j, v) in row_entries(&phi, i) {
                 sparse[i * m + j] = v;
             }
         }

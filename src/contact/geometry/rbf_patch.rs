@@ -35,7 +35,7 @@ use std::sync::OnceLock;
 use faer::MatMut;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMat, SparseRowMat, Triplet};
 use rayon::prelude::*;
 
 use crate::linalg::z_curve_keys;
@@ -55,28 +55,12 @@ pub const PATCH_TOL: f64 = 1e-14;
 /// Rows (columns) solved together on one patch.
 pub const BLOCK: usize = 64;
 
-/// A sparse matrix in compressed rows, the columns of each row sorted.
-#[derive(Debug)]
-pub struct CompressedRows {
-    /// Start of each row's entries (length: rows + 1).
-    pub offsets: Vec<usize>,
-    pub columns: Vec<usize>,
-    pub values: Vec<f64>,
-}
+/// A sparse matrix in compressed rows (faer's), the columns of each row sorted.
+pub type CompressedRows = SparseRowMat<usize, f64>;
 
-impl CompressedRows {
-    /// The entries `(column, value)` of row `i`.
-    pub fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let range = self.offsets[i]..self.offsets[i + 1];
-        (self.columns[range.clone()].iter().copied()).zip(self.values[range].iter().copied())
-    }
-
-    /// `out = A x`.
-    pub fn multiply(&self, x: &[f64], out: &mut [f64]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = self.row(i).map(|(j, v)| v * x[j]).sum();
-        }
-    }
+/// The entries `(column, value)` of row `i` of `a`.
+pub fn row_entries(a: &CompressedRows, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+    (a.col_idx_of_row_raw(i).iter().copied()).zip(a.val_of_row(i).iter().copied())
 }
 
 /// The neighbours of each node of a square sparse matrix's graph (its pattern made symmetric,
@@ -90,10 +74,10 @@ pub struct Graph {
 impl Graph {
     /// The graph of the square matrix `a`.
     pub fn of(a: &CompressedRows) -> Self {
-        let n = a.offsets.len() - 1;
+        let n = a.nrows();
         let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n];
         for i in 0..n {
-            for (j, _) in a.row(i).filter(|&(j, _)| j != i) {
+            for (j, _) in row_entries(a, i).filter(|&(j, _)| j != i) {
                 lists[i].push(j as u32);
                 lists[j].push(i as u32);
             }
@@ -163,8 +147,7 @@ pub fn whole_factor<'w>(
     a: &CompressedRows,
     whole: &'w WholeFactor,
 ) -> Result<&'w Lu<usize, f64>, String> {
-    let n = a.offsets.len() - 1;
-    let nodes: Vec<usize> = (0..n).collect();
+    let nodes: Vec<usize> = (0..a.nrows()).collect();
     (whole.get_or_init(|| factor(a, &nodes, Some)).as_ref()).map_err(|e| e.clone())
 }
 
@@ -361,7 +344,7 @@ fn factor(
     let n = nodes.len();
     let mut triplets = Vec::new();
     for (p, &i) in nodes.iter().enumerate() {
-        for (j, value) in a.row(i) {
+        for (j, value) in row_entries(a, i) {
             if let Some(q) = local(j) {
                 triplets.push(Triplet::new(p, q, value));
             }
