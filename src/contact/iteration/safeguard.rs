@@ -81,6 +81,25 @@ pub(super) const CONTRACTION: f64 = 0.5;
 const STALLED_AFTER: usize = 2;
 
 impl Safeguard {
+    /// Whether [`Safeguard::next`] would answer `update` by solving the same `active` set
+    /// again with its counters of slow and fruitless iterations back at zero, far from any
+    /// stop: the set kept, no slip direction turning, the gap error far from settled
+    /// (`Update::far_from_settled`) yet within a spacing, contracted against the smallest on
+    /// this set, and the violation a new best or the no-progress count short of its limit.
+    /// Such an iterate only feeds the next linearization, so the loop may take it from a loose
+    /// solve: nothing it would decide rests on the solve's accuracy.
+    pub(super) fn only_linearizes(&self, active: &NodeStates, update: &Update) -> bool {
+        let error = update.max_gap_error_over_h;
+        let progress = (self.best_violation).is_none_or(|best| violation(update) < best)
+            || self.since_best + 1 < NO_PROGRESS_AFTER;
+        update.next == *active
+            && update.max_direction_change <= DIRECTION_SETTLED
+            && update.far_from_settled
+            && error <= UNSTABLE_GAP_OVER_H
+            && (self.best_error).is_none_or(|best| error <= CONTRACTION * best)
+            && progress
+    }
+
     pub(super) fn next(&mut self, active: &NodeStates, update: &Update) -> Step {
         let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
         let added_back = nodes(&update.penetrating);
@@ -193,6 +212,7 @@ mod tests {
             tension: Vec::new(),
             penetrating: Vec::new(),
             settled,
+            far_from_settled: !settled,
             within_tolerance: error <= 1e-3,
             active: active.contact.len(),
             max_gap_error_over_h: error,
@@ -230,6 +250,38 @@ mod tests {
                 "turn {turn}"
             );
         }
+    }
+
+    #[test]
+    fn an_iterate_that_only_linearizes_is_one_the_loop_solves_again() {
+        let active = NodeStates::in_contact([1, 2, 3].into());
+        let mut safeguard = Safeguard::default();
+        // (gap error over h, far from settled, expected): Newton contracting from far off; an
+        // error that did not halve (the slow count would grow); one near settling (a tight
+        // solve might stop the loop); one a spacing off (the unstable test reads it).
+        let steps = [
+            (1e-2, true, true),
+            (4e-3, true, true),
+            (3e-3, true, false),
+            (1e-3, true, true),
+            (5e-5, false, false),
+            (1e-6, false, false),
+        ];
+        for (error, far, expected) in steps {
+            let mut update = unchanged(&active, error, false);
+            update.far_from_settled = far;
+            let linearizes = safeguard.only_linearizes(&active, &update);
+            assert_eq!(linearizes, expected, "error {error}");
+            let step = safeguard.next(&active, &update);
+            if linearizes {
+                assert!(matches!(step, Step::Solve(ref same) if *same == active));
+            }
+        }
+        let far_off = unchanged(&active, 1.4, false);
+        assert!(!Safeguard::default().only_linearizes(&active, &far_off));
+        let mut grows = unchanged(&active, 1e-2, false);
+        grows.next = NodeStates::in_contact([1, 2, 3, 4].into());
+        assert!(!Safeguard::default().only_linearizes(&active, &grows));
     }
 
     #[test]
