@@ -257,8 +257,9 @@ mod tests {
         let active = NodeStates::in_contact([1, 2, 3].into());
         let mut safeguard = Safeguard::default();
         // (gap error over h, far from settled, expected): Newton contracting from far off; an
-        // error that did not halve (the slow count would grow); one near settling (a tight
-        // solve might stop the loop); one a spacing off (the unstable test reads it).
+        // error that did not halve (the slow count would grow); errors near settling (a tight
+        // solve might stop the loop). After them: one a spacing off (the unstable test reads
+        // it) and a set that changes.
         let steps = [
             (1e-2, true, true),
             (4e-3, true, true),

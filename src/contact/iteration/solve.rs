@@ -1374,8 +1374,9 @@ impl ContactSolver<'_> {
     /// slid; the primal-dual active set update. On the Krylov path the solve is first loose
     /// ([`Tightness::Loose`]; [`Tightness::Reduced`] where a Coulomb pair's slip directions are
     /// iterated on) and solved again tightly when its update would keep the node
-    /// states (and no slipping direction still turns) or return to states seen before: no
-    /// answer, status or check rests on a loose solve.
+    /// states (and no slipping direction still turns) or return to states seen before, unless
+    /// it only feeds the next linearization (`Safeguard::only_linearizes`): no answer, status
+    /// or check rests on a loose solve.
     /// The time of each phase is added to `seconds`.
     fn iterate(
         &mut self,
