@@ -28,24 +28,44 @@ pub(super) enum Step {
 }
 
 /// The loop's memory against repeats (module doc): the sets seen, the nodes removed for
-/// tension, those of them added back for penetration, and those kept active for good.
+/// tension, those of them added back for penetration, and those kept active for good, beside
+/// the [`Counters`] of the iterations.
 #[derive(Default)]
 pub(super) struct Safeguard {
     pub(super) seen: HashSet<NodeStates>,
     released: HashSet<usize>,
     readded: HashSet<usize>,
     pub(super) pinned: HashSet<usize>,
+    counters: Counters,
+}
+
+/// What the safeguard counts from one iteration to the next: small and `Copy`, so that what an
+/// update would make of them can be asked without recording it ([`Safeguard::only_linearizes`]).
+#[derive(Clone, Copy, Default)]
+struct Counters {
     /// The smallest active nodes' gap error of the iterations on the current active set.
     best_error: Option<f64>,
     /// The active nodes' gap error (over h) of the last iteration, when beyond
     /// [`UNSTABLE_GAP_OVER_H`].
-    pub(super) off_surface: Option<f64>,
+    off_surface: Option<f64>,
     /// How many iterations in a row on one active set failed to contract the gap error.
     slow: usize,
     /// The smallest violation of the contact conditions so far ([`violation`]), and how many
     /// iterations have passed without going below it.
     best_violation: Option<f64>,
     since_best: usize,
+}
+
+/// What the counters make of an update, before the sets seen are asked.
+enum Verdict {
+    Stop(ContactStatus),
+    /// The same node states solved again: Newton's next step on the gap, or (`turning`) on a
+    /// slipping node's direction.
+    SameSet {
+        turning: bool,
+    },
+    /// The update changes the node states; the sets seen decide ([`Safeguard::next`]).
+    NewSet,
 }
 
 /// The largest violation of the nodal contact conditions an update found: penetration of an
@@ -80,40 +100,18 @@ pub(super) const CONTRACTION: f64 = 0.5;
 /// See [`CONTRACTION`].
 const STALLED_AFTER: usize = 2;
 
-impl Safeguard {
-    /// Whether [`Safeguard::next`] would answer `update` by solving the same `active` set
-    /// again with its counters of slow and fruitless iterations back at zero, far from any
-    /// stop: the set kept, no slip direction turning, the gap error far from settled
-    /// (`Update::far_from_settled`) yet within a spacing, contracted against the smallest on
-    /// this set, and the violation a new best or the no-progress count short of its limit.
-    /// Such an iterate only feeds the next linearization, so the loop may take it from a loose
-    /// solve: nothing it would decide rests on the solve's accuracy.
-    pub(super) fn only_linearizes(&self, active: &NodeStates, update: &Update) -> bool {
-        let error = update.max_gap_error_over_h;
-        let progress = (self.best_violation).is_none_or(|best| violation(update) < best)
-            || self.since_best + 1 < NO_PROGRESS_AFTER;
-        update.next == *active
-            && update.max_direction_change <= DIRECTION_SETTLED
-            && update.far_from_settled
-            && error <= UNSTABLE_GAP_OVER_H
-            && (self.best_error).is_none_or(|best| error <= CONTRACTION * best)
-            && progress
-    }
-
-    pub(super) fn next(&mut self, active: &NodeStates, update: &Update) -> Step {
-        let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
-        let added_back = nodes(&update.penetrating);
-        let released = &self.released;
-        self.readded
-            .extend(added_back.into_iter().filter(|i| released.contains(i)));
-        self.released.extend(nodes(&update.tension));
+impl Counters {
+    /// The counters after `update` on the `active` states, and what they call for: a stop
+    /// (unstable, no progress, converged or stalled on one set), the same states again, or a
+    /// new set for the sets seen to judge.
+    fn after(mut self, active: &NodeStates, update: &Update) -> (Self, Verdict) {
         let off = update.max_gap_error_over_h;
         if off > UNSTABLE_GAP_OVER_H {
             if self
                 .off_surface
                 .is_some_and(|last| off > CONTRACTION * last)
             {
-                return Step::Stop(ContactStatus::Unstable);
+                return (self, Verdict::Stop(ContactStatus::Unstable));
             }
             self.off_surface = Some(off);
         } else {
@@ -125,39 +123,78 @@ impl Safeguard {
         } else {
             self.since_best += 1;
             if self.since_best >= NO_PROGRESS_AFTER && !update.settled {
-                return Step::Stop(ContactStatus::Stalled);
+                return (self, Verdict::Stop(ContactStatus::Stalled));
             }
         }
-        if update.next == *active {
-            // A slipping node's direction (3D Coulomb) is iterated on by Newton's method: the
-            // loop goes on with the same states until it stops moving
-            // (`crate::contact::law::coulomb`).
-            let directions_settled = update.max_direction_change <= DIRECTION_SETTLED;
-            if update.settled && directions_settled {
-                return Step::Stop(ContactStatus::Converged);
-            }
-            if !directions_settled {
-                return Step::Solve(active.clone());
-            }
-            let error = update.max_gap_error_over_h;
-            let contracted = (self.best_error).is_none_or(|best| error <= CONTRACTION * best);
-            self.slow = if contracted { 0 } else { self.slow + 1 };
-            self.best_error = Some(self.best_error.map_or(error, |best| best.min(error)));
-            return if self.slow >= STALLED_AFTER {
-                // Newton's method on a piecewise linear gap stops contracting where a node sits
-                // on an edge of the other surface, its closest facet changing from one
-                // iteration to the next; within the complementarity tolerance that is an
-                // answer, beyond it a failure.
-                Step::Stop(if update.within_tolerance {
-                    ContactStatus::Converged
-                } else {
-                    ContactStatus::Stalled
-                })
+        if update.next != *active {
+            (self.best_error, self.slow) = (None, 0);
+            return (self, Verdict::NewSet);
+        }
+        // A slipping node's direction (3D Coulomb) is iterated on by Newton's method: the loop
+        // goes on with the same states until it stops moving (`crate::contact::law::coulomb`).
+        let directions_settled = update.max_direction_change <= DIRECTION_SETTLED;
+        if update.settled && directions_settled {
+            return (self, Verdict::Stop(ContactStatus::Converged));
+        }
+        if !directions_settled {
+            return (self, Verdict::SameSet { turning: true });
+        }
+        let error = update.max_gap_error_over_h;
+        let contracted = (self.best_error).is_none_or(|best| error <= CONTRACTION * best);
+        self.slow = if contracted { 0 } else { self.slow + 1 };
+        self.best_error = Some(self.best_error.map_or(error, |best| best.min(error)));
+        if self.slow >= STALLED_AFTER {
+            // Newton's method on a piecewise linear gap stops contracting where a node sits on
+            // an edge of the other surface, its closest facet changing from one iteration to
+            // the next; within the complementarity tolerance that is an answer, beyond it a
+            // failure.
+            let status = if update.within_tolerance {
+                ContactStatus::Converged
             } else {
-                Step::Solve(active.clone())
+                ContactStatus::Stalled
             };
+            return (self, Verdict::Stop(status));
         }
-        (self.best_error, self.slow) = (None, 0);
+        (self, Verdict::SameSet { turning: false })
+    }
+}
+
+impl Safeguard {
+    /// Whether the last iteration left active nodes more than [`UNSTABLE_GAP_OVER_H`] spacings
+    /// off the other surface.
+    pub(super) fn off_surface(&self) -> bool {
+        self.counters.off_surface.is_some()
+    }
+
+    /// Whether [`Safeguard::next`] would answer `update` by Newton's next step on the gap of
+    /// the same `active` set, with nothing that could stop the loop at the next iteration
+    /// resting on this one: the counters' verdict is the same set again (no slip direction
+    /// turning), the error contracted (the slow count back at zero) and within a spacing (the
+    /// unstable test cleared), and the gap error far from settled (`Update::far_from_settled`).
+    /// Such an iterate only feeds the next linearization, so the loop may take it from a loose
+    /// solve: nothing it would decide rests on the solve's accuracy.
+    pub(super) fn only_linearizes(&self, active: &NodeStates, update: &Update) -> bool {
+        let (after, verdict) = self.counters.after(active, update);
+        matches!(verdict, Verdict::SameSet { turning: false })
+            && after.slow == 0
+            && after.off_surface.is_none()
+            && update.far_from_settled
+    }
+
+    pub(super) fn next(&mut self, active: &NodeStates, update: &Update) -> Step {
+        let nodes = |v: &[(usize, f64)]| v.iter().map(|&(i, _)| i).collect::<Vec<_>>();
+        let added_back = nodes(&update.penetrating);
+        let released = &self.released;
+        self.readded
+            .extend(added_back.into_iter().filter(|i| released.contains(i)));
+        self.released.extend(nodes(&update.tension));
+        let verdict;
+        (self.counters, verdict) = self.counters.after(active, update);
+        match verdict {
+            Verdict::Stop(status) => return Step::Stop(status),
+            Verdict::SameSet { .. } => return Step::Solve(active.clone()),
+            Verdict::NewSet => {}
+        }
         self.seen.insert(active.clone());
         let mut next = update.next.clone();
         // In 3D the loop's state is the partition and the slipping nodes' directions: a
@@ -283,6 +320,17 @@ mod tests {
         let mut grows = unchanged(&active, 1e-2, false);
         grows.next = NodeStates::in_contact([1, 2, 3, 4].into());
         assert!(!Safeguard::default().only_linearizes(&active, &grows));
+        // The no-progress count one short of its limit: an iterate without a new smallest
+        // violation stops the loop, so it is solved tightly first.
+        let mut tired = Safeguard::default();
+        (tired.counters.best_violation, tired.counters.since_best) =
+            (Some(0.0), NO_PROGRESS_AFTER - 1);
+        let no_progress = unchanged(&active, 1e-2, false);
+        assert!(!tired.only_linearizes(&active, &no_progress));
+        assert_eq!(
+            status(tired.next(&active, &no_progress)),
+            Some(ContactStatus::Stalled)
+        );
     }
 
     #[test]

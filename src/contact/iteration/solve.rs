@@ -765,7 +765,7 @@ impl ContactSolver<'_> {
             // the constraint does not control the geometry. The last iterate is the
             // answer, its certificate says what fails.
             Err(ContactError::Inaccurate { .. })
-                if state.safeguard.off_surface.is_some() && state.last.is_some() =>
+                if state.safeguard.off_surface() && state.last.is_some() =>
             {
                 state.active = std::mem::take(&mut state.solved);
                 return Ok(Some(ContactStatus::Unstable));
