@@ -19,9 +19,15 @@ use internodes::mesh::mesh_geo;
 /// `geo/tilted_square_2d.geo` meshed by gmsh into `folder`: the square's corner at 0.004, the
 /// block's top at 0.0056 there.
 fn mesh(folder: &Path) -> PathBuf {
+    mesh_at(folder, 0.004)
+}
+
+/// `geo/tilted_square_2d.geo` meshed by gmsh into `folder`: the square's corner at `h`, the
+/// block's top at `1.4 h` there.
+fn mesh_at(folder: &Path, h: f64) -> PathBuf {
     let geo = Path::new(env!("CARGO_MANIFEST_DIR")).join("geo/tilted_square_2d.geo");
     let msh = folder.join("tilted_square_2d.msh");
-    let parameters = [("h_c".to_string(), 0.004), ("h_b".to_string(), 0.0056)];
+    let parameters = [("h_c".to_string(), h), ("h_b".to_string(), 1.4 * h)];
     mesh_geo(&geo, &msh, &parameters).expect("gmsh meshes");
     msh
 }
@@ -111,4 +117,26 @@ fn a_corner_on_an_equal_block_refused_by_a_residual_bound_alone_is_wrong() {
             );
         }
     }
+}
+
+/// Refined eight times (the corner at 0.0005), the same corner pressed by 2% of its side into an
+/// equal block, the block primary: the block's surface slides along the crater's two walls, in
+/// opposite directions, by more spacings than the pairing follows before any set settles. The
+/// run ends refused, and its explanation names the slide, not a stiff primary (both bodies
+/// are of one material).
+#[test]
+fn a_corner_whose_surfaces_slide_off_their_pairing_is_refused_and_says_so() {
+    let folder = tempfile::tempdir().unwrap();
+    let msh = mesh_at(folder.path(), 0.0005);
+    let case = corner_on_block(&msh, 0.008, 1000.0).primary("block");
+    let solution = solve_with(&case, false).unwrap();
+    assert!(!solution.status.is_solution(), "{}", solution.status.name());
+    let slid = solution.history.last().unwrap().pairing_drift_over_h;
+    assert!(slid >= 1.0, "slid {slid} spacings");
+    let summary = solution.summary();
+    assert!(
+        summary.contains(&format!("had slid {slid:.1} spacings")),
+        "{summary}"
+    );
+    assert!(!summary.contains("stiffer"), "{summary}");
 }

@@ -74,6 +74,11 @@ pub struct PhaseSeconds {
     pub checks: f64,
 }
 
+/// A failed solve's surfaces slid this many spacings or more from the pairing are named in its
+/// explanation ([`ContactSolution::summary`]): the RBF supports reach about two spacings, and a
+/// pairing a spacing off reads the other body's displacement at the wrong nodes.
+const SLID_OFF_PAIRING: f64 = 1.0;
+
 /// One line of the iteration history.
 #[derive(Debug, Clone, Serialize)]
 pub struct IterationRecord {
@@ -359,25 +364,54 @@ impl ContactSolution {
                 "NOT solved: the active set settled in {iterations} iterations but a residual check failed: {}",
                 self.certificate.failures()
             ),
-            ContactStatus::IterationLimit => {
-                format!("NOT converged: the iteration cap ({iterations}) was reached")
-            }
-            ContactStatus::Unstable => format!(
-                "NOT converged: at iteration {iterations} an active node is {:.1e} spacings off the other body's surface: the interpolated constraint does not control the geometry, typically a primary much stiffer than the secondary with as fine a contact surface (inf-sup); use primary = \"auto\"",
-                self.history
-                    .last()
-                    .map_or(f64::NAN, |r| r.max_gap_error_over_h)
+            ContactStatus::IterationLimit => format!(
+                "NOT converged: the iteration cap ({iterations}) was reached{}",
+                self.slid_off_pairing()
             ),
+            ContactStatus::Unstable => match self.slid_off_pairing() {
+                slid if slid.is_empty() => format!(
+                    "NOT converged: at iteration {iterations} an active node is {:.1e} spacings off the other body's surface: the interpolated constraint does not control the geometry, typically a primary much stiffer than the secondary with as fine a contact surface (inf-sup; primary = \"auto\" takes the compliant body)",
+                    self.last_gap_error()
+                ),
+                slid => format!(
+                    "NOT converged: at iteration {iterations} an active node is {:.1e} spacings off the other body's surface{slid}",
+                    self.last_gap_error()
+                ),
+            },
             ContactStatus::Cycling => format!(
-                "NOT converged: the active set cycles (an earlier set came back at iteration {iterations})"
+                "NOT converged: the active set cycles (an earlier set came back at iteration {iterations}){}",
+                self.slid_off_pairing()
             ),
             ContactStatus::Stalled => format!(
-                "NOT converged: on an unchanged active set the active nodes' distance to the other surface stopped shrinking ({:.1e} spacings at iteration {iterations})",
-                self.history
-                    .last()
-                    .map_or(f64::NAN, |r| r.max_gap_error_over_h)
+                "NOT converged: on an unchanged active set the active nodes' distance to the other surface stopped shrinking ({:.1e} spacings at iteration {iterations}){}",
+                self.last_gap_error(),
+                self.slid_off_pairing()
             ),
         }
+    }
+
+    /// The active nodes' largest distance to the other surface at the last iteration, in
+    /// spacings.
+    fn last_gap_error(&self) -> f64 {
+        (self.history.last()).map_or(f64::NAN, |r| r.max_gap_error_over_h)
+    }
+
+    /// Where a solve ended with the surfaces slid a spacing or more from where its operators
+    /// were paired, what that means (empty otherwise): the pairing follows the slide only once
+    /// an active set settles (`docs/method.md` 3.5), so a loop whose surfaces keep sliding
+    /// reads the other body's displacement and sends its force where the contact is no longer.
+    /// The equal-material corner ends so (its two sides slide apart by up to ten spacings on
+    /// refined meshes), a body pushed sideways whose set settles does not.
+    fn slid_off_pairing(&self) -> String {
+        let slid = (self.history.last()).map_or(0.0, |r| r.pairing_drift_over_h);
+        if !(slid >= SLID_OFF_PAIRING) {
+            return String::new();
+        }
+        format!(
+            "; the surfaces had slid {slid:.1} spacings from where the interface was paired, which \
+             follows them only once an active set settles: contact that slides this far before \
+             it settles (a corner pressed into a body as compliant as itself) is beyond it"
+        )
     }
 
     /// How the solve ended, in a few words (for the primary choice's reason): the status, and
