@@ -404,7 +404,7 @@ impl ContactSolution {
     /// refined meshes), a body pushed sideways whose set settles does not.
     fn slid_off_pairing(&self) -> String {
         let slid = (self.history.last()).map_or(0.0, |r| r.pairing_drift_over_h);
-        if !(slid >= SLID_OFF_PAIRING) {
+        if slid.is_nan() || slid < SLID_OFF_PAIRING {
             return String::new();
         }
         format!(
