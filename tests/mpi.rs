@@ -441,6 +441,37 @@ fn a_stack_of_three_2d_bodies_on_two_ranks_gives_the_serial_answer() {
 }
 
 #[test]
+fn a_body_force_on_three_ranks_gives_the_serial_answer() {
+    // The hemisphere pressed by a force, each body under its weight (the block's 3.2, which
+    // its base carries, the sphere's 0.04 against the force of 0.8). Each rank keeps only the cells around its own and the
+    // prescribed nodes, so its body force is right at its own and the prescribed nodes only
+    // until the load vector is made whole from the owners' entries (the answer reads it
+    // there alone, but for the resultant that places a force-controlled body's first contact
+    // zone, which must be the same on every rank). Solved to 1e-9 h as the test without
+    // weight.
+    ranks_give_the_serial_answer_of(
+        3,
+        "hemisphere_pressed_by_force",
+        "penetration_tolerance = 1e-9",
+        1,
+        0,
+        &|case| {
+            for (body, weight) in case["body"]
+                .as_array_mut()
+                .unwrap()
+                .iter_mut()
+                .zip([0.02, 0.1])
+            {
+                let force = toml::Value::Array(vec![0.0.into(), 0.0.into(), (-weight).into()]);
+                body.as_table_mut()
+                    .unwrap()
+                    .insert("body_force".into(), force);
+            }
+        },
+    );
+}
+
+#[test]
 fn a_single_body_on_two_ranks_gives_the_serial_answer() {
     let dir = tempfile::tempdir().unwrap();
     let case = example_case(dir.path(), "block_3d", "\n[solver]\nbody = \"cg-amg\"\n");
@@ -457,6 +488,9 @@ fn a_single_body_on_two_ranks_gives_the_serial_answer() {
     );
     // One CG solve to the case's rtol (1e-10 by default) with either preconditioner.
     assert!(d <= 1e-8, "displacement differs by {d:.2e}");
+    // Each rank kept only its part of the cells; the counts are the whole body's.
+    let cells = |dir: &Path| summary(dir)["bodies"][0]["num_cells"].as_u64();
+    assert_eq!(cells(&one), cells(&two));
 }
 
 #[test]

@@ -83,6 +83,7 @@ fn jittered_cube(n: usize) -> BodyMesh {
         cell_tags: (1..=num_cells as u64).collect(),
         boundary_groups: BTreeMap::new(),
         point_groups: BTreeMap::from([("base".to_string(), (0..(n + 1) * (n + 1)).collect())]),
+        part: None,
     }
 }
 

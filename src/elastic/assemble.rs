@@ -324,7 +324,7 @@ pub fn assemble(
         || -> Vec<f64> { body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect() };
 
     // 1. Load vector f: surface loads and body force.
-    let f = timed(stats, verbose, "assemble loads", || {
+    let mut f = timed(stats, verbose, "assemble loads", || {
         let mut f = vec![0.0; body.num_dofs()];
         for load in &problem.loads {
             let group = body
@@ -338,6 +338,9 @@ pub fn assemble(
         f
     });
 
+    // With named load paths, f split by path (its parts' constrained `f_c` follow below).
+    let mut path_loads = path_loads(problem);
+
     // 2. K_c and f_c, and the rows of K at the prescribed dofs.
     let ranks = crate::parallel::ranks();
     let constrained = match ranks.size {
@@ -345,7 +348,8 @@ pub fn assemble(
         _ => rank_stiffness(
             problem,
             &constraints,
-            &f,
+            &mut f,
+            &mut path_loads,
             &coordinates(),
             ranks,
             stats,
@@ -356,8 +360,7 @@ pub fn assemble(
             source,
         })?,
     };
-    // 3. With named load paths, f and f_c split by path.
-    let path_loads = path_loads(problem);
+    // 3. The force-controlled components, and with named load paths f_c split by path.
     let rigid = rigid_columns(
         forced_components(problem),
         &constrained.prescribed_rows,
@@ -533,15 +536,20 @@ fn whole_stiffness(
     }
 }
 
-/// This rank's rows of `K_c` in a distributed run: the body's nodes are partitioned, the
+/// This rank's rows of `K_c` in a distributed run: the body's nodes are partitioned (as the
+/// mesh's [`crate::mesh::RankPart`] says, where the run kept only this rank's cells), the
 /// columns of this rank's nodes assembled and constrained (its rows: `K` is symmetric), and
 /// its rows of `f_c` computed and gathered whole on every rank. Every rank assembles the
 /// columns at the prescribed dofs too (the cells along the Dirichlet groups), for the
-/// reactions. Collective: every rank calls it for every body, in the same order.
+/// reactions. Where the rank kept only its cells, a body force in `f` and in the `parts` is
+/// right at its own nodes only: those vectors are made whole from their owners' entries.
+/// Collective: every rank calls it for every body, in the same order.
+#[allow(clippy::too_many_arguments)]
 fn rank_stiffness(
     problem: &ElasticProblem,
     constraints: &Constraints,
-    f: &[f64],
+    f: &mut Vec<f64>,
+    parts: &mut [PathLoads],
     coordinates: &[f64],
     ranks: Ranks,
     stats: &mut SolveStats,
@@ -552,8 +560,18 @@ fn rank_stiffness(
     // The symbolic phase of a rank: the node graph, and which nodes are whose.
     let (graph, distribution) = timed(stats, verbose, "sparsity pattern", || {
         let graph = stiffness_graph(body);
-        Distribution::new(&graph, coordinates, ranks).map(|distribution| (graph, distribution))
+        let distribution = match &body.part {
+            Some(part) => Distribution::with_owners(&part.owner, coordinates, dim, ranks),
+            None => Distribution::new(&graph, coordinates, ranks),
+        };
+        distribution.map(|distribution| (graph, distribution))
     })?;
+    if body.part.is_some() && problem.body_force.is_some() {
+        for loads in std::iter::once(&mut *f).chain(parts.iter_mut().map(|part| &mut part.f)) {
+            let local = distribution.local_part(loads);
+            distribution.gather(&local, loads)?;
+        }
+    }
     let mut columns = timed(stats, verbose, "assemble stiffness", || {
         NodeColumns::assemble(body, &problem.material, &graph, distribution.nodes())
     });

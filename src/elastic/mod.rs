@@ -10,6 +10,7 @@ mod solve;
 pub use assemble::{AssembledBody, RhsPart, RigidColumn, Stiffness, assemble};
 pub use error::SolveError;
 pub use factors::StepFactors;
+pub(crate) use problem::far_apart_nodes;
 pub use problem::{
     DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, ProblemError,
 };

@@ -142,6 +142,7 @@ mod tests {
             cell_tags: vec![1, 2, 3].into(),
             boundary_groups: Default::default(),
             point_groups: Default::default(),
+            part: None,
         };
         let material = Material::new(1000.0, 0.3).unwrap();
         let whole = assemble_stiffness(&body, &material, &stiffness_pattern(&body)).to_dense();

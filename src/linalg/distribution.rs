@@ -42,30 +42,48 @@ pub struct Distribution {
     block: usize,
 }
 
+/// The rank that owns each node of a body whose stiffness has the node graph `graph`: a METIS
+/// partition into `ranks.size` parts, the same on every rank (METIS is deterministic for a
+/// given graph).
+pub fn node_owners(graph: &NodeGraph, ranks: Ranks) -> Result<Vec<u32>, LinalgError> {
+    let num_nodes = graph.num_nodes();
+    let neighbours: Vec<Vec<usize>> = (0..num_nodes)
+        .map(|a| {
+            graph
+                .neighbours(a)
+                .iter()
+                .copied()
+                .filter(|&b| b != a)
+                .collect()
+        })
+        .collect();
+    let part = partition(&neighbours, ranks.size)?;
+    drop(neighbours);
+    // The mesh refuses bodies of 2^32 nodes or more (`crate::mesh::MeshError`).
+    if u32::try_from(num_nodes).is_err() {
+        return Err(LinalgError::Sizes(format!(
+            "{num_nodes} nodes: more than a partition numbers (2^32 - 1)"
+        )));
+    }
+    Ok(part.into_iter().map(|rank| rank as u32).collect())
+}
+
 impl Distribution {
     /// The distribution over `ranks` of the unknowns of the body whose stiffness has the node
     /// graph `graph` and whose nodes are at `coords` (one value per unknown: `block` per node).
     pub fn new(graph: &NodeGraph, coords: &[f64], ranks: Ranks) -> Result<Self, LinalgError> {
-        let block = graph.block();
-        let num_nodes = graph.num_nodes();
-        let neighbours: Vec<Vec<usize>> = (0..num_nodes)
-            .map(|a| {
-                graph
-                    .neighbours(a)
-                    .iter()
-                    .copied()
-                    .filter(|&b| b != a)
-                    .collect()
-            })
-            .collect();
-        let part = partition(&neighbours, ranks.size)?;
-        drop(neighbours);
-        // The mesh refuses bodies of 2^32 nodes or more (`crate::mesh::MeshError`).
-        if u32::try_from(num_nodes).is_err() {
-            return Err(LinalgError::Sizes(format!(
-                "{num_nodes} nodes: more than a partition numbers (2^32 - 1)"
-            )));
-        }
+        Self::with_owners(&node_owners(graph, ranks)?, coords, graph.block(), ranks)
+    }
+
+    /// The distribution over `ranks` of the unknowns of a body whose nodes `owner` assigns to
+    /// the ranks ([`node_owners`]) and are at `coords` (`block` values per node, its unknowns).
+    pub fn with_owners(
+        owner: &[u32],
+        coords: &[f64],
+        block: usize,
+        ranks: Ranks,
+    ) -> Result<Self, LinalgError> {
+        let num_nodes = owner.len();
         if coords.len() != num_nodes * block {
             return Err(LinalgError::Sizes(format!(
                 "{} coordinates for {num_nodes} nodes of {block} unknowns",
@@ -79,7 +97,7 @@ impl Distribution {
             let first = nodes.len();
             nodes.extend(
                 (0..num_nodes)
-                    .filter(|&a| part[a] == rank)
+                    .filter(|&a| owner[a] as usize == rank)
                     .map(|a| a as u32),
             );
             nodes[first..].sort_by_key(|&a| (keys[a as usize], a));

@@ -97,6 +97,13 @@ pub enum MeshError {
     /// A mesh handed over in memory ([`super::GmshModel`]) whose parts do not fit together.
     #[error("{path}: {message}")]
     Model { path: PathBuf, message: String },
+    /// Read again for the output of a distributed run (whose ranks kept only their cells), the
+    /// file no longer holds what the run solved on.
+    #[error(
+        "{path} changed while the run was solving: body '{body}' no longer has the nodes and \
+         cells the run read at its start, so its results cannot be written on it (run again)"
+    )]
+    Changed { path: PathBuf, body: String },
     #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
     EmptyBody { path: PathBuf, body: String },
     #[error(

@@ -250,6 +250,7 @@ impl FileContents {
             node_tags,
             boundary_groups: BTreeMap::new(),
             point_groups: BTreeMap::new(),
+            part: None,
         })
     }
 

@@ -14,6 +14,7 @@ mod generate;
 mod gmsh;
 mod model;
 mod msh41;
+mod part;
 mod quality;
 mod summary;
 
@@ -22,6 +23,7 @@ pub use error::MeshError;
 pub use generate::mesh_geo;
 pub use gmsh::{mesh_from_model, read_msh, read_msh_bytes};
 pub use model::{GmshModel, ModelElements, ModelGroup};
+pub use part::RankPart;
 pub use quality::{check_cells, signed_measure};
 pub use summary::MeshSummary;
 
@@ -77,6 +79,10 @@ pub struct BodyMesh {
     /// Groups of points (gmsh physical points) on this body: sorted local nodes, by name. They
     /// can carry Dirichlet conditions, e.g. to pin a corner against rigid-body motions.
     pub point_groups: BTreeMap<String, Vec<usize>>,
+    /// On a rank of a distributed run, once the body's nodes are partitioned: `cells` and
+    /// `cell_tags` hold only the cells this rank assembles, and this what it keeps of the
+    /// whole body besides ([`RankPart`]). `None`: every cell is here.
+    pub part: Option<RankPart>,
 }
 
 /// The local nodes of one cell (3 in 2D, 4 in 3D) as `usize`, from the `u32` the mesh stores

@@ -559,6 +559,7 @@ mod tests {
             cells,
             boundary_groups: BTreeMap::new(),
             point_groups: BTreeMap::new(),
+            part: None,
         }
     }
 

@@ -6,6 +6,7 @@
 //! the default log, `-v` and `-vv` of docs/output.md, "The log"), warnings at level warn: the
 //! command line prints them on stderr, the Python module hands them to Python's `logging`.
 
+mod partition;
 mod solve;
 mod write;
 
@@ -221,6 +222,8 @@ fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunErro
         }
         false => read_case_mesh(&case)?,
     };
+    let mut mesh = mesh;
+    partition::keep_rank_cells(&mut mesh, &case)?;
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     solution.rank_peak_memory_mb = gather_peak_memory()?;
     let summary = solution.summary_with(&case, &mesh, &solution.timings);
@@ -283,11 +286,24 @@ fn solve_into(
         mesh.bodies.len(),
     );
 
-    // 2. Every body solved: the two in contact together, the others alone.
+    // 2. Every body solved: the two in contact together, the others alone. The ranks of a
+    //    distributed run keep only the cells they assemble.
+    let mut mesh = mesh;
+    if parallel::distributed() {
+        partition::keep_rank_cells(&mut mesh, &case)?;
+    }
     let mut solution = solve_case_on(&case, &mesh, timings)?;
+    // Read before the ranks' peaks are gathered, so that rank 0's counts it.
+    let phase = Instant::now();
+    let mesh = partition::whole_mesh(mesh, &case)?;
+    if parallel::distributed() {
+        solution
+            .timings
+            .record("read the whole mesh for the output", phase);
+    }
     solution.rank_peak_memory_mb = gather_peak_memory()?;
 
-    // 3. The result files, into the staging folder.
+    // 3. The result files, into the staging folder, on the whole mesh.
     let beat = Heartbeat::start(verbose, "  writing the results");
     let summary = write_results(&solution, &case, &mesh, results.staging())?;
     drop(beat);

@@ -257,7 +257,7 @@ fn solve_alone(
         "body '{}': {} nodes, {} cells, {} dofs",
         body.name,
         body.num_nodes(),
-        body.num_cells(),
+        body.total_cells(),
         body.num_dofs()
     );
     let phase = Instant::now();
@@ -297,7 +297,7 @@ impl CaseSolution {
                     youngs_modulus: spec.youngs_modulus,
                     poisson_ratio: spec.poisson_ratio,
                     num_nodes: body.num_nodes(),
-                    num_cells: body.num_cells(),
+                    num_cells: body.total_cells(),
                     num_dofs: body.num_dofs(),
                     node_offset,
                     cell_offset,
@@ -305,7 +305,7 @@ impl CaseSolution {
                     solve: s.stats.clone(),
                 };
                 node_offset += body.num_nodes();
-                cell_offset += body.num_cells();
+                cell_offset += body.total_cells();
                 summary
             })
             .collect();

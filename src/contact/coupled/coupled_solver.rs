@@ -731,6 +731,7 @@ mod tests {
             cells,
             boundary_groups: groups,
             point_groups: BTreeMap::new(),
+            part: None,
         }
     }
 

@@ -28,34 +28,11 @@ pub struct BodyBoundary {
 impl BodyBoundary {
     pub fn new(body: &BodyMesh) -> Self {
         let dim = body.dim;
-        // Each facet of each cell, keyed by its sorted nodes; a boundary facet appears once.
-        let mut count: HashMap<Vec<usize>, (usize, Vec<usize>, usize)> = HashMap::new();
-        for c in 0..body.num_cells() {
-            let cell = body.cell(c);
-            for opposite in 0..cell.len() {
-                let facet: Vec<usize> = (0..cell.len())
-                    .filter(|&k| k != opposite)
-                    .map(|k| cell[k])
-                    .collect();
-                let mut key = facet.clone();
-                key.sort_unstable();
-                count
-                    .entry(key)
-                    .and_modify(|e| e.0 += 1)
-                    .or_insert((1, facet, cell[opposite]));
-            }
-        }
         let mut index: HashMap<usize, usize> = HashMap::new();
         let mut nodes = Vec::new();
         let mut facets = Vec::new();
-        let mut boundary: Vec<(Vec<usize>, usize)> = count
-            .into_values()
-            .filter(|(n, ..)| *n == 1)
-            .map(|(_, facet, opposite)| (facet, opposite))
-            .collect();
-        // A deterministic order (the hash map's is not).
-        boundary.sort_unstable();
-        for (mut facet, opposite) in boundary {
+        for entry in body.boundary_facets().chunks_exact(dim + 1) {
+            let (mut facet, opposite) = (entry[..dim].to_vec(), entry[dim]);
             let x: Vec<[f64; 3]> = facet.iter().map(|&n| body.coords[n]).collect();
             let (_, normal) = facet_measure_and_normal(&x, dim);
             let inward: f64 = (0..3)
