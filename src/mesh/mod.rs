@@ -80,7 +80,7 @@ pub struct BodyMesh {
     /// can carry Dirichlet conditions, e.g. to pin a corner against rigid-body motions.
     pub point_groups: BTreeMap<String, Vec<usize>>,
     /// On a rank of a distributed run, once the body's nodes are partitioned: `cells` and
-    /// `cell_tags` hold only the cells this rank assembles, and this what it keeps of the
+    /// `cell_tags` hold only the cells this rank assembles, and this is what it keeps of the
     /// whole body besides ([`RankPart`]). `None`: every cell is here.
     pub part: Option<RankPart>,
 }

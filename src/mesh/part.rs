@@ -25,18 +25,21 @@ pub struct RankPart {
 }
 
 impl BodyMesh {
-    /// Keeps the cells that hold a node `keep` accepts (in their order, with their tags) and
-    /// records `owner` and what the whole body's cells gave ([`RankPart`]).
+    /// Keeps the cells of the whole body that hold a node `keep` accepts (in their order, with
+    /// their tags) and records `owner` and what the whole body's cells gave ([`RankPart`]).
     pub fn keep_cells(&mut self, owner: Vec<u32>, keep: impl Fn(usize) -> bool) {
+        debug_assert!(self.part.is_none(), "the cells of a whole body");
         let boundary_facets = self.boundary_facets();
         let total_cells = self.num_cells();
         let kept: Vec<usize> = (0..total_cells)
             .filter(|&c| self.cell(c).iter().any(|&a| keep(a)))
             .collect();
         let n = self.nodes_per_cell();
-        self.cells = (kept.iter())
-            .flat_map(|&c| self.cells[n * c..n * (c + 1)].to_vec())
-            .collect();
+        let mut cells = Vec::with_capacity(n * kept.len());
+        for &c in &kept {
+            cells.extend_from_slice(&self.cells[n * c..n * (c + 1)]);
+        }
+        self.cells = cells;
         let tags: Vec<u64> = kept.iter().map(|&c| self.cell_tags.get(c)).collect();
         self.cell_tags = ElementTags::from(tags);
         self.part = Some(RankPart {
