@@ -79,9 +79,9 @@ pub struct BodyMesh {
     /// Groups of points (gmsh physical points) on this body: sorted local nodes, by name. They
     /// can carry Dirichlet conditions, e.g. to pin a corner against rigid-body motions.
     pub point_groups: BTreeMap<String, Vec<usize>>,
-    /// On a rank of a distributed run, once the body's nodes are partitioned: `cells` and
-    /// `cell_tags` hold only the cells this rank assembles, and this is what it keeps of the
-    /// whole body besides ([`RankPart`]). `None`: every cell is here.
+    /// On a rank of a distributed run, once the body's nodes are partitioned: `cells` holds
+    /// only the cells this rank assembles and `cell_tags` none, and this is what it keeps of
+    /// the whole body besides ([`RankPart`]). `None`: every cell and tag is here.
     pub part: Option<RankPart>,
 }
 

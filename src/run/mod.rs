@@ -295,7 +295,7 @@ fn solve_into(
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     // Read before the ranks' peaks are gathered, so that rank 0's counts it.
     let phase = Instant::now();
-    let mesh = partition::whole_mesh(mesh, &case)?;
+    let mesh = partition::whole_mesh(mesh, &case.path)?;
     if parallel::distributed() {
         solution
             .timings

@@ -4,6 +4,8 @@
 //! this is the assembly of a rank's own columns and of the prescribed ones, the only cells it
 //! keeps; rank 0 writes the output from the mesh file read again ([`whole_mesh`]).
 
+use std::path::Path;
+
 use crate::case::{Case, CaseError};
 use crate::elastic::{SolveError, far_apart_nodes};
 use crate::fem::assembly::stiffness_graph;
@@ -56,12 +58,12 @@ pub(super) fn keep_rank_cells(mesh: &mut Mesh, case: &Case) -> Result<(), RunErr
 /// `mesh`, or where this rank kept only part of its cells, the whole mesh read again from its
 /// file, for the output; refused if the file no longer holds the nodes and cells the run
 /// solved on.
-pub(super) fn whole_mesh(mesh: Mesh, case: &Case) -> Result<Mesh, RunError> {
+pub(super) fn whole_mesh(mesh: Mesh, case_path: &Path) -> Result<Mesh, RunError> {
     if mesh.bodies.iter().all(|b| b.part.is_none()) {
         return Ok(mesh);
     }
     let mesh_error = |source| CaseError::Mesh {
-        path: case.path.clone(),
+        path: case_path.to_owned(),
         source,
     };
     // The solve's memory, freed, goes back to the system first: glibc keeps freed blocks
@@ -89,4 +91,40 @@ pub(super) fn whole_mesh(mesh: Mesh, case: &Case) -> Result<Mesh, RunError> {
         }
     }
     Ok(whole)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture(name: &str) -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures")
+            .join(name)
+    }
+
+    #[test]
+    fn the_mesh_read_again_is_the_whole_one_and_refused_once_its_file_changed() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("mesh.msh");
+        std::fs::copy(fixture("block_2d.msh"), &file).unwrap();
+        let mut mesh = read_msh(&file).unwrap();
+        let cells = mesh.bodies[0].num_cells();
+        let owner = vec![0; mesh.bodies[0].num_nodes()];
+        mesh.bodies[0].keep_cells(owner, |node| node == 0);
+        assert!(mesh.bodies[0].num_cells() < cells);
+
+        let whole = whole_mesh(mesh.clone(), Path::new("case.toml")).unwrap();
+        assert_eq!(whole.bodies[0].num_cells(), cells);
+        assert!(whole.bodies[0].part.is_none());
+
+        std::fs::copy(fixture("flat_blocks_narrow_2d.msh"), &file).unwrap();
+        let error = whole_mesh(mesh, Path::new("case.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("changed while the run was solving"),
+            "{error}"
+        );
+    }
 }
