@@ -105,7 +105,7 @@ mod tests {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/block_3d.msh");
         let whole = read_msh(&path).unwrap().bodies.remove(0);
-        let keep = |node: usize| node % 7 == 0;
+        let keep = |node: usize| node.is_multiple_of(7);
         let mut part = whole.clone();
         part.keep_cells(vec![1; whole.num_nodes()], keep);
 
