@@ -290,7 +290,9 @@ fn solve_into(
     //    distributed run keep only the cells they assemble.
     let mut mesh = mesh;
     if parallel::distributed() {
+        let phase = Instant::now();
         partition::keep_rank_cells(&mut mesh, &case)?;
+        timings.record("partition the mesh", phase);
     }
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     // Read before the ranks' peaks are gathered, so that rank 0's counts it.
