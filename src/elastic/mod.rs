@@ -10,7 +10,7 @@ mod solve;
 pub use assemble::{AssembledBody, RhsPart, RigidColumn, Stiffness, assemble};
 pub use error::SolveError;
 pub use factors::StepFactors;
-pub(crate) use problem::far_apart_nodes;
+pub(crate) use problem::constraints as prescribed_dofs;
 pub use problem::{
     DirichletCondition, ElasticProblem, ForceCondition, LoadCondition, ProblemError,
 };

@@ -330,7 +330,7 @@ impl<'m> ElasticProblem<'m> {
 
 /// Three nodes far apart, for pins: the farthest from the centroid, the farthest from that
 /// one, and (3D) the farthest from the line through both.
-pub(crate) fn far_apart_nodes(coords: &[[f64; 3]], dim: usize) -> Vec<usize> {
+fn far_apart_nodes(coords: &[[f64; 3]], dim: usize) -> Vec<usize> {
     let distance =
         |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
     let n = coords.len() as f64;

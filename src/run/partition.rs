@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use crate::case::{Case, CaseError};
-use crate::elastic::{SolveError, far_apart_nodes};
+use crate::elastic::{SolveError, prescribed_dofs};
 use crate::fem::assembly::stiffness_graph;
 use crate::linalg::node_owners;
 use crate::mesh::{Mesh, MeshError, read_msh};
@@ -15,34 +15,39 @@ use crate::mesh::{Mesh, MeshError, read_msh};
 use super::RunError;
 
 /// Partitions the nodes of every body of `case` among the ranks and keeps, on this rank, the
-/// cells that hold one of its own nodes or a node whose columns every rank assembles: a node
-/// of a group with a prescribed displacement or a force (the case's groups), or one a
-/// floating body may be pinned at (`crate::elastic::ElasticProblem::floating`). Bodies the
-/// case does not name are left whole (nothing assembles them). Collective.
+/// cells that hold one of its own nodes or a node with a prescribed dof in the body's problem
+/// (`crate::elastic::prescribed_dofs`: its Dirichlet and force-controlled groups, a floating
+/// body's pins), whose columns every rank assembles. Bodies the case does not name are left
+/// whole (nothing assembles them). Collective.
 pub(super) fn keep_rank_cells(mesh: &mut Mesh, case: &Case) -> Result<(), RunError> {
+    // The problems below read the case's groups, which its checks vouch for first.
+    case.check_bodies(mesh)?;
     let ranks = crate::parallel::ranks();
     for spec in &case.bodies {
-        let Some(body) = mesh.bodies.iter_mut().find(|b| b.name == spec.name) else {
-            continue; // named in the error of the case's own checks, which come next
+        let index = (mesh.bodies.iter().position(|b| b.name == spec.name))
+            .expect("the checks found every body of the case");
+        let body = &mesh.bodies[index];
+        let linalg_error = |source| RunError::Solve {
+            path: case.path.clone(),
+            source: SolveError::Linalg {
+                body: body.name.clone(),
+                source,
+            },
         };
-        let owner =
-            node_owners(&stiffness_graph(body), ranks).map_err(|source| RunError::Solve {
+        let owner = node_owners(&stiffness_graph(body), ranks).map_err(linalg_error)?;
+        let prescribed =
+            prescribed_dofs(&case.elastic_problem(body, spec)?).map_err(|e| RunError::Solve {
                 path: case.path.clone(),
-                source: SolveError::Linalg {
-                    body: body.name.clone(),
-                    source,
-                },
+                source: e.into(),
             })?;
-        let mut keep: Vec<bool> = (owner.iter())
-            .map(|&rank| rank as usize == ranks.rank)
+        let dim = body.dim;
+        let keep: Vec<bool> = (0..body.num_nodes())
+            .map(|a| {
+                owner[a] as usize == ranks.rank
+                    || (0..dim).any(|c| prescribed.is_fixed(dim * a + c))
+            })
             .collect();
-        let held = (spec.dirichlet.iter().map(|d| &d.group))
-            .chain(spec.forces.iter().map(|f| &f.group))
-            .filter_map(|group| body.group_nodes(group))
-            .flatten();
-        for node in held.chain(far_apart_nodes(&body.coords, body.dim)) {
-            keep[node] = true;
-        }
+        let body = &mut mesh.bodies[index];
         body.keep_cells(owner, |node| keep[node]);
         log::debug!(
             "body '{}': rank {} keeps {} of its {} cells",
