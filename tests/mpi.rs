@@ -520,6 +520,33 @@ fn a_rank_that_fails_alone_ends_every_rank_with_its_error() {
 }
 
 #[test]
+fn a_case_that_does_not_fit_its_mesh_is_refused_once_by_the_rank_that_reads_the_mesh() {
+    // Rank 0 alone reads the mesh and checks the case against it; rank 1 waits for its part,
+    // and is ended with rank 0's error.
+    let dir = tempfile::tempdir().unwrap();
+    let case = example_case(dir.path(), "block_3d", "");
+    let original = std::fs::read_to_string(&case).unwrap();
+    let edited = original.replace("\"block_base\"", "\"no_such_group\"");
+    std::fs::write(&case, edited).unwrap();
+    let out = dir.path().join("out");
+    let run = mpirun(
+        2,
+        &[
+            "solve",
+            case.to_str().unwrap(),
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(!run.status.success(), "{}", text(&run));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("error (rank 0 of 2)"), "{}", text(&run));
+    assert!(stderr.contains("no_such_group"), "{}", text(&run));
+    assert!(!stderr.contains("error (rank 1 of 2)"), "{}", text(&run));
+}
+
+#[test]
 fn what_runs_on_one_process_only_is_refused_on_two_ranks() {
     let dir = tempfile::tempdir().unwrap();
     let cases = [

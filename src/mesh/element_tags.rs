@@ -6,14 +6,16 @@
 //! instead of 8 a cell (16 MB at 1M DOFs, on every rank of a distributed run). Tags in any
 //! other order are kept one by one, so no file costs more than 8 bytes a cell.
 
+use serde::{Deserialize, Serialize};
+
 /// The tag of each cell of a body, in cell order.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ElementTags {
     len: usize,
     storage: Storage,
 }
 
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 enum Storage {
     /// `(first cell, its tag)` of each run, first cells increasing from 0: run `r` holds the
     /// cells up to the next run's first, tags increasing by one.

@@ -23,18 +23,20 @@ pub use error::MeshError;
 pub use generate::mesh_geo;
 pub use gmsh::{mesh_from_model, read_msh, read_msh_bytes};
 pub use model::{GmshModel, ModelElements, ModelGroup};
-pub use part::RankPart;
+pub use part::{CellsByRank, RankPart};
 pub use quality::{check_cells, signed_measure};
 pub use summary::MeshSummary;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use serde::{Deserialize, Serialize};
+
 /// Spatial dimension of a mesh: 2 (triangles, plane strain) or 3 (tetrahedra).
 pub type Dim = usize;
 
 /// Everything read from one mesh file.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Mesh {
     /// The file it was read from, for error messages.
     pub path: PathBuf,
@@ -47,7 +49,7 @@ pub struct Mesh {
 }
 
 /// A physical group as declared in the file (`$PhysicalNames`).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PhysicalGroup {
     pub dim: Dim,
     pub tag: i32,
@@ -59,7 +61,7 @@ pub struct PhysicalGroup {
 }
 
 /// One body: P1 simplices, numbered locally.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BodyMesh {
     pub name: String,
     pub physical_tag: i32,
@@ -135,7 +137,7 @@ impl NodeIndex for u32 {
 }
 
 /// Facets of one boundary group that lie on one body.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct FacetGroup {
     pub physical_tag: i32,
     /// `dim` local node indices per facet, flat, ordered so the right-hand normal points outward.

@@ -4,16 +4,20 @@
 //! Once a body's nodes are partitioned among the ranks, a rank assembles the columns of its
 //! own nodes and of the prescribed ones (`crate::elastic`), and nothing after the assembly
 //! reads a cell: the contact loop works on surfaces, and the output is written by rank 0 from
-//! the mesh file read again. So a rank keeps only the cells around those nodes (every cell
+//! the mesh file read again. So a rank holds only the cells around those nodes (every cell
 //! that holds one: their columns are then complete, bit for bit), and the two facts of the
 //! whole body the run still needs, the partition and the body's boundary
-//! ([`BodyMesh::boundary_facets`]). Every node stays: the coordinates are 24 bytes a node
+//! ([`BodyMesh::boundary_facets`]). Rank 0, which reads the mesh, divides the cells
+//! ([`BodyMesh::cells_by_rank`]) and sends each rank its own (`crate::run`'s partition); the
+//! others never hold the whole body. Every node stays: the coordinates are 24 bytes a node
 //! against the cells' 16 bytes a cell and about 5.5 cells a node in 3D.
+
+use serde::{Deserialize, Serialize};
 
 use super::{BodyMesh, ElementTags};
 
 /// What a rank keeps of a body's mesh beside the cells ([`BodyMesh::part`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RankPart {
     /// The rank that owns each node: the partition of the whole body's node graph that the
     /// distribution of its unknowns follows (`crate::linalg::Distribution`).
@@ -24,31 +28,88 @@ pub struct RankPart {
     pub boundary_facets: Vec<usize>,
 }
 
+/// Every rank's cells of a body, one rank after the other, each rank's in the body's order:
+/// what rank 0 of a distributed run sends the ranks ([`BodyMesh::cells_by_rank`]).
+#[derive(Debug, Clone, Default)]
+pub struct CellsByRank {
+    /// The cells of rank 0, then of rank 1, ..., flat (`dim + 1` nodes a cell).
+    pub cells: Vec<u32>,
+    /// The number of cells of each rank.
+    pub counts: Vec<usize>,
+}
+
 impl BodyMesh {
-    /// Keeps the cells of the whole body that hold a node `keep` accepts (in their order), and
-    /// none of their tags (only the output reads them, on the whole mesh read again: kept for
-    /// a rank's cells, which break gmsh's runs of consecutive tags, they took 8 bytes a cell
-    /// beside the cell's 16), and records `owner` and what the whole body's cells gave
-    /// ([`RankPart`]).
-    pub fn keep_cells(&mut self, owner: Vec<u32>, keep: impl Fn(usize) -> bool) {
+    /// The cells each of `ranks` ranks assembles: a cell goes to every rank that owns one of
+    /// its nodes (`owner`), and to every rank where one of its nodes is `everywhere` (a node
+    /// whose columns every rank assembles). One pass counts, one places: no cell is held
+    /// twice for a rank.
+    pub fn cells_by_rank(
+        &self,
+        owner: &[u32],
+        ranks: usize,
+        everywhere: impl Fn(usize) -> bool,
+    ) -> CellsByRank {
+        // The ranks of one cell, in increasing order, into `into` (cleared first).
+        let ranks_of = |cell: &[u32], into: &mut Vec<usize>| {
+            into.clear();
+            if cell.iter().any(|&a| everywhere(a as usize)) {
+                into.extend(0..ranks);
+            } else {
+                into.extend(cell.iter().map(|&a| owner[a as usize] as usize));
+                into.sort_unstable();
+                into.dedup();
+            }
+        };
+        let n = self.nodes_per_cell();
+        let mut counts = vec![0; ranks];
+        let mut of_cell = Vec::with_capacity(ranks.max(n));
+        for cell in self.cells.chunks_exact(n) {
+            ranks_of(cell, &mut of_cell);
+            for &r in &of_cell {
+                counts[r] += 1;
+            }
+        }
+        let mut next: Vec<usize> = (counts.iter())
+            .scan(0, |at, &count| {
+                let start = *at;
+                *at += count;
+                Some(n * start)
+            })
+            .collect();
+        let mut cells = vec![0; n * counts.iter().sum::<usize>()];
+        for cell in self.cells.chunks_exact(n) {
+            ranks_of(cell, &mut of_cell);
+            for &r in &of_cell {
+                cells[next[r]..next[r] + n].copy_from_slice(cell);
+                next[r] += n;
+            }
+        }
+        CellsByRank { cells, counts }
+    }
+
+    /// Makes the body what every rank keeps of it before its own cells come
+    /// ([`Self::receive_cells`]): no cells and no tags (only the output reads them, on the
+    /// whole mesh read again: kept for a rank's cells, which break gmsh's runs of consecutive
+    /// tags, they took 8 bytes a cell beside the cell's 16), the partition `owner`, and what
+    /// the whole body's cells gave ([`RankPart`]).
+    pub fn drop_cells(&mut self, owner: Vec<u32>) {
         debug_assert!(self.part.is_none(), "the cells of a whole body");
         let boundary_facets = self.boundary_facets();
         let total_cells = self.num_cells();
-        let kept: Vec<usize> = (0..total_cells)
-            .filter(|&c| self.cell(c).iter().any(|&a| keep(a)))
-            .collect();
-        let n = self.nodes_per_cell();
-        let mut cells = Vec::with_capacity(n * kept.len());
-        for &c in &kept {
-            cells.extend_from_slice(&self.cells[n * c..n * (c + 1)]);
-        }
-        self.cells = cells;
+        self.cells = Vec::new();
         self.cell_tags = ElementTags::from(Vec::new());
         self.part = Some(RankPart {
             owner,
             total_cells,
             boundary_facets,
         });
+    }
+
+    /// This rank's cells of a body whose cells were dropped ([`Self::drop_cells`]), in the
+    /// whole body's order.
+    pub fn receive_cells(&mut self, cells: Vec<u32>) {
+        debug_assert!(self.part.is_some() && self.cells.is_empty());
+        self.cells = cells;
     }
 
     /// The number of cells of the whole body (of which a rank's part keeps some).
@@ -105,23 +166,36 @@ mod tests {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/block_3d.msh");
         let whole = read_msh(&path).unwrap().bodies.remove(0);
-        let keep = |node: usize| node.is_multiple_of(7);
-        let mut part = whole.clone();
-        part.keep_cells(vec![1; whole.num_nodes()], keep);
+        // Three ranks: nodes dealt round the ranks, every rank assembling the columns of the
+        // nodes that are multiples of 7.
+        let owner: Vec<u32> = (0..whole.num_nodes()).map(|a| (a % 3) as u32).collect();
+        let everywhere = |node: usize| node.is_multiple_of(7);
+        let split = whole.cells_by_rank(&owner, 3, everywhere);
+        assert_eq!(split.counts.len(), 3);
 
-        let expected: Vec<Vec<usize>> = (whole.cells())
-            .filter(|cell| cell.iter().any(|&a| keep(a)))
-            .map(|cell| cell.to_vec())
-            .collect();
-        let kept: Vec<Vec<usize>> = part.cells().map(|cell| cell.to_vec()).collect();
-        assert_eq!(kept, expected);
-        assert!(kept.len() < whole.num_cells());
-        assert!(part.cell_tags.is_empty());
-        assert_eq!(part.total_cells(), whole.num_cells());
-        assert_eq!(part.boundary_facets(), whole.boundary_facets());
-        assert_eq!(
-            part.part.as_ref().unwrap().owner,
-            vec![1; whole.num_nodes()]
-        );
+        let mut at = 0;
+        for (rank, &count) in split.counts.iter().enumerate() {
+            let expected: Vec<u32> = (whole.cells())
+                .filter(|cell| {
+                    cell.iter()
+                        .any(|&a| owner[a] as usize == rank || everywhere(a))
+                })
+                .flat_map(|cell| cell.iter().map(|&a| a as u32).collect::<Vec<_>>())
+                .collect();
+            let kept = split.cells[at..at + 4 * count].to_vec();
+            at += 4 * count;
+            assert_eq!(kept, expected, "rank {rank}");
+            assert!(count < whole.num_cells());
+
+            let mut part = whole.clone();
+            part.drop_cells(owner.clone());
+            part.receive_cells(kept);
+            assert_eq!(part.num_cells(), count);
+            assert!(part.cell_tags.is_empty());
+            assert_eq!(part.total_cells(), whole.num_cells());
+            assert_eq!(part.boundary_facets(), whole.boundary_facets());
+            assert_eq!(part.part.as_ref().unwrap().owner, owner);
+        }
+        assert_eq!(at, split.cells.len());
     }
 }

@@ -1,9 +1,11 @@
 //! The MPI ranks of a run: `mpirun -n N internodes solve CASE` runs the same program on `N`
 //! processes (`docs/parallel.md`).
 //!
-//! Every rank reads the case and the mesh and runs the contact loop; what is distributed is
-//! each body's stiffness and linear algebra: each rank assembles the rows of its own nodes (a
-//! METIS partition, `crate::linalg::Distribution`) and hands them to PETSc, which builds the
+//! Every rank reads the case and runs the contact loop; rank 0 reads the mesh, partitions each
+//! body's nodes (METIS) and sends every rank the nodes, groups and partition and the cells it
+//! assembles (`crate::run`'s partition). What is distributed is each body's stiffness and
+//! linear algebra: each rank assembles the rows of its own nodes
+//! (`crate::linalg::Distribution`) and hands them to PETSc, which builds the
 //! GAMG hierarchy and runs the V-cycles, CG solves and products on them
 //! (`crate::linalg::petsc`), and the coupled GMRES, whose vectors hold each rank's rows of the
 //! bodies (`crate::contact::coupled::krylov_layout`). The answers every rank then receives whole,
@@ -31,6 +33,9 @@ pub enum ParallelError {
     NoPetsc(usize),
     #[error("MPI: {0}")]
     Mpi(String),
+    /// What rank 0 sent could not be encoded or read back (a bug, not an input's fault).
+    #[error("a message between the ranks: {0}")]
+    Message(String),
     #[error("the rayon thread pool of a rank: {0}")]
     Threads(String),
 }
@@ -86,6 +91,26 @@ pub fn share_from_root(bytes: Vec<u8>) -> Result<Vec<u8>, ParallelError> {
     }
     #[cfg(not(feature = "petsc"))]
     unreachable!("a run without PETSc is never distributed (`start`)")
+}
+
+/// This rank's cells of what rank 0 divides among the ranks (`MPI_Scatterv`): on rank 0,
+/// `all` holds every rank's cells one rank after the other, `counts[r]` cells of `width`
+/// values for rank r; on the others both are empty (not read). Serial: `all` itself.
+pub fn scatter_cells(
+    all: Vec<u32>,
+    counts: &[usize],
+    width: usize,
+) -> Result<Vec<u32>, ParallelError> {
+    if !distributed() {
+        return Ok(all);
+    }
+    #[cfg(feature = "petsc")]
+    {
+        crate::linalg::petsc::scatter_cells(&all, counts, width)
+            .map_err(|e| ParallelError::Mpi(e.to_string()))
+    }
+    #[cfg(not(feature = "petsc"))]
+    unreachable!("a run without PETSc is never distributed (`start`): {counts:?} {width}")
 }
 
 /// Every rank's `value`, in rank order, on every rank. Serial: `[value]`.

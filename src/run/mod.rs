@@ -205,25 +205,12 @@ fn check_distributable(case: &Case) -> Result<(), CaseError> {
     Ok(())
 }
 
-/// A rank other than 0 of a distributed run: the same solve, in step with rank 0 (which
-/// meshes a `.geo` and hands the mesh over), writing nothing.
+/// A rank other than 0 of a distributed run: the same solve, in step with rank 0 (which reads
+/// or meshes the mesh and sends this rank its part), writing nothing.
 fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunError> {
     let timings = Timings::start();
     case.solver.verbose = false;
-    let mesh = match case.generates_mesh() {
-        true => {
-            let bytes = parallel::share_from_root(Vec::new()).map_err(RunError::Parallel)?;
-            read_msh_bytes(&output.join(GENERATED_MESH), &bytes).map_err(|source| {
-                CaseError::Mesh {
-                    path: case.path.clone(),
-                    source,
-                }
-            })?
-        }
-        false => read_case_mesh(&case)?,
-    };
-    let mut mesh = mesh;
-    partition::keep_rank_cells(&mut mesh, &case)?;
+    let mesh = partition::scatter_mesh(None, &case)?;
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     solution.rank_peak_memory_mb = gather_peak_memory()?;
     let summary = solution.summary_with(&case, &mesh, &solution.timings);
@@ -286,14 +273,17 @@ fn solve_into(
         mesh.bodies.len(),
     );
 
-    // 2. Every body solved: the two in contact together, the others alone. The ranks of a
-    //    distributed run keep only the cells they assemble.
-    let mut mesh = mesh;
-    if parallel::distributed() {
-        let phase = Instant::now();
-        partition::keep_rank_cells(&mut mesh, &case)?;
-        timings.record("partition the mesh", phase);
-    }
+    // 2. Every body solved: the two in contact together, the others alone. Rank 0 of a
+    //    distributed run sends each rank the mesh with only the cells it assembles.
+    let mesh = match parallel::distributed() {
+        true => {
+            let phase = Instant::now();
+            let mesh = partition::scatter_mesh(Some(mesh), &case)?;
+            timings.record("partition the mesh", phase);
+            mesh
+        }
+        false => mesh,
+    };
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     // Read before the ranks' peaks are gathered, so that rank 0's counts it.
     let phase = Instant::now();
@@ -342,8 +332,6 @@ fn generate_mesh(case: &Case, results: &ResultFolder) -> Result<Mesh, RunError> 
             source,
         })
     })?;
-    // The other ranks of a distributed run read the same mesh.
-    let bytes = parallel::share_from_root(bytes).map_err(RunError::Parallel)?;
     let msh = results.publish(GENERATED_MESH)?;
     Ok(read_msh_bytes(&msh, &bytes).map_err(mesh_error)?)
 }

@@ -1,8 +1,10 @@
-//! The mesh of a distributed run divided among the ranks, before anything is assembled: each
-//! body's nodes partitioned once (METIS on the node graph of its whole mesh), and each rank
-//! keeping only the cells it assembles ([`crate::mesh::RankPart`]). What reads a cell after
-//! this is the assembly of a rank's own columns and of the prescribed ones, the only cells it
-//! keeps; rank 0 writes the output from the mesh file read again ([`whole_mesh`]).
+//! The mesh of a distributed run divided among the ranks, before anything is assembled: rank 0
+//! reads the whole mesh, partitions each body's nodes once (METIS on the node graph of its
+//! whole mesh) and sends every rank what it keeps ([`crate::mesh::RankPart`]): the nodes, groups,
+//! partition and boundary of every body, and only the cells it assembles. No other rank ever
+//! holds a whole body's cells or the file's bytes. What reads a cell after this is the
+//! assembly of a rank's own columns and of the prescribed ones, the only cells it keeps; rank 0
+//! writes the output from the mesh file read again ([`whole_mesh`]).
 
 use std::path::Path;
 
@@ -10,23 +12,62 @@ use crate::case::{Case, CaseError};
 use crate::elastic::{SolveError, prescribed_dofs};
 use crate::fem::assembly::stiffness_graph;
 use crate::linalg::node_owners;
-use crate::mesh::{Mesh, MeshError, read_msh};
+use crate::mesh::{CellsByRank, Mesh, MeshError, read_msh};
+use crate::parallel::{self, ParallelError};
 
 use super::RunError;
 
-/// Partitions the nodes of every body of `case` among the ranks and keeps, on this rank, the
-/// cells that hold one of its own nodes or a node with a prescribed dof in the body's problem
-/// (`crate::elastic::prescribed_dofs`: its Dirichlet and force-controlled groups, a floating
-/// body's pins), whose columns every rank assembles. Bodies the case does not name are left
-/// whole (nothing assembles them). Collective.
-pub(super) fn keep_rank_cells(mesh: &mut Mesh, case: &Case) -> Result<(), RunError> {
+/// This rank's part of the mesh of a distributed run; `whole` is the mesh on rank 0 and `None`
+/// on the others. Rank 0 checks the case against the mesh, partitions the nodes of every body
+/// of the case among the ranks, and gives each rank the cells that hold one of its own nodes
+/// or a node with a prescribed dof in the body's problem (`crate::elastic::prescribed_dofs`:
+/// its Dirichlet and force-controlled groups, a floating body's pins), whose columns every rank
+/// assembles. Bodies the case does not name go whole (nothing assembles them). Collective: an
+/// error of rank 0 ends the run on every rank (`crate::parallel::abort`).
+pub(super) fn scatter_mesh(whole: Option<Mesh>, case: &Case) -> Result<Mesh, RunError> {
+    let message = |e: postcard::Error| RunError::Parallel(ParallelError::Message(e.to_string()));
+    // 1. On rank 0: the partition, each body's cells divided, and the mesh without them.
+    let (skeleton, divided) = match whole {
+        Some(mut mesh) => {
+            let divided = divide_cells(&mut mesh, case)?;
+            (postcard::to_allocvec(&mesh).map_err(message)?, divided)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    // 2. The mesh without the cells on every rank, then each rank's cells, body by body.
+    let bytes = parallel::share_from_root(skeleton).map_err(RunError::Parallel)?;
+    let mut mesh: Mesh = postcard::from_bytes(&bytes).map_err(message)?;
+    drop(bytes);
+    let mut divided = divided.into_iter();
+    for spec in &case.bodies {
+        let body = (mesh.bodies.iter_mut().find(|b| b.name == spec.name))
+            .expect("rank 0's checks found every body of the case");
+        let CellsByRank { cells, counts } = divided.next().unwrap_or_default();
+        let width = body.nodes_per_cell();
+        let cells = parallel::scatter_cells(cells, &counts, width).map_err(RunError::Parallel)?;
+        body.receive_cells(cells);
+        log::debug!(
+            "body '{}': rank {} keeps {} of its {} cells",
+            body.name,
+            parallel::ranks().rank,
+            body.num_cells(),
+            body.total_cells()
+        );
+    }
+    Ok(mesh)
+}
+
+/// Rank 0's division of the cells of every body of `case` among the ranks, in the case's
+/// order of bodies; each of those bodies of `mesh` is left without its cells
+/// ([`crate::mesh::BodyMesh::drop_cells`]).
+fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<CellsByRank>, RunError> {
     // The problems below read the case's groups, which its checks vouch for first.
     case.check_bodies(mesh)?;
-    let ranks = crate::parallel::ranks();
+    let ranks = parallel::ranks();
+    let mut divided = Vec::with_capacity(case.bodies.len());
     for spec in &case.bodies {
-        let index = (mesh.bodies.iter().position(|b| b.name == spec.name))
+        let body = (mesh.bodies.iter_mut().find(|b| b.name == spec.name))
             .expect("the checks found every body of the case");
-        let body = &mesh.bodies[index];
         let linalg_error = |source| RunError::Solve {
             path: case.path.clone(),
             source: SolveError::Linalg {
@@ -41,23 +82,11 @@ pub(super) fn keep_rank_cells(mesh: &mut Mesh, case: &Case) -> Result<(), RunErr
                 source: e.into(),
             })?;
         let dim = body.dim;
-        let keep: Vec<bool> = (0..body.num_nodes())
-            .map(|a| {
-                owner[a] as usize == ranks.rank
-                    || (0..dim).any(|c| prescribed.is_fixed(dim * a + c))
-            })
-            .collect();
-        let body = &mut mesh.bodies[index];
-        body.keep_cells(owner, |node| keep[node]);
-        log::debug!(
-            "body '{}': rank {} keeps {} of its {} cells",
-            body.name,
-            ranks.rank,
-            body.num_cells(),
-            body.total_cells()
-        );
+        let everywhere = |a: usize| (0..dim).any(|c| prescribed.is_fixed(dim * a + c));
+        divided.push(body.cells_by_rank(&owner, ranks.size, everywhere));
+        body.drop_cells(owner);
     }
-    Ok(())
+    Ok(divided)
 }
 
 /// `mesh`, or where this rank kept only part of its cells, the whole mesh read again from its
@@ -116,7 +145,9 @@ mod tests {
         let mut mesh = read_msh(&file).unwrap();
         let cells = mesh.bodies[0].num_cells();
         let owner = vec![0; mesh.bodies[0].num_nodes()];
-        mesh.bodies[0].keep_cells(owner, |node| node == 0);
+        let kept = mesh.bodies[0].cells_by_rank(&owner, 2, |_| false);
+        mesh.bodies[0].drop_cells(owner);
+        mesh.bodies[0].receive_cells(kept.cells[..3].to_vec());
         assert!(mesh.bodies[0].num_cells() < cells);
 
         let whole = whole_mesh(mesh.clone(), Path::new("case.toml")).unwrap();

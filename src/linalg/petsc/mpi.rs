@@ -24,6 +24,20 @@ unsafe extern "C" {
     ) -> c_int;
     fn internodes_mpi_broadcast_length(len: *mut i64, step: *mut *const c_char) -> c_int;
     fn internodes_mpi_broadcast(data: *mut u8, len: i64, step: *mut *const c_char) -> c_int;
+    fn internodes_mpi_scatter_count(
+        counts: *const i64,
+        mine: *mut i64,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_scatter_cells(
+        all: *const u32,
+        counts: *const c_int,
+        displs: *const c_int,
+        mine: *mut u32,
+        count: c_int,
+        width: c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
     fn internodes_mpi_abort(code: c_int);
     fn internodes_petsc_finalize(step: *mut *const c_char) -> c_int;
 }
@@ -102,6 +116,50 @@ pub fn broadcast_bytes(bytes: Vec<u8>) -> Result<Vec<u8>, LinalgError> {
     let code = unsafe { internodes_mpi_broadcast(data.as_mut_ptr(), len, &mut step) };
     match code {
         0 => Ok(data),
+        _ => Err(petsc_error(step, code)),
+    }
+}
+
+/// Each rank's cells from rank 0 (collective over `PETSC_COMM_WORLD`): on rank 0, `all` holds
+/// every rank's cells one rank after the other, `counts[r]` cells of `width` values for rank
+/// r; on the others both are empty. Returns this rank's `width * counts[rank]` values.
+pub fn scatter_cells(all: &[u32], counts: &[usize], width: usize) -> Result<Vec<u32>, LinalgError> {
+    let mut step = std::ptr::null();
+    let counts64: Vec<i64> = counts.iter().map(|&c| c as i64).collect();
+    let mut mine = 0i64;
+    let _lock = petsc()?;
+    // SAFETY: on rank 0 `counts64` holds a value per rank (the caller's contract), read there
+    // only; `mine` is one value; the lock is held.
+    let code = unsafe { internodes_mpi_scatter_count(counts64.as_ptr(), &mut mine, &mut step) };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    let mut displs = Vec::with_capacity(counts.len());
+    let mut at = 0;
+    for &count in counts {
+        displs.push(mpi_count(at)?);
+        at += count;
+    }
+    let counts = counts
+        .iter()
+        .map(|&c| mpi_count(c))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut cells = vec![0u32; width * mine as usize];
+    // SAFETY: on rank 0 `all` holds `width` values for each of the counts' cells, `counts` and
+    // `displs` one value per rank; `cells` holds this rank's count of cells; the lock is held.
+    let code = unsafe {
+        internodes_mpi_scatter_cells(
+            all.as_ptr(),
+            counts.as_ptr(),
+            displs.as_ptr(),
+            cells.as_mut_ptr(),
+            mpi_count(mine as usize)?,
+            mpi_count(width)?,
+            &mut step,
+        )
+    };
+    match code {
+        0 => Ok(cells),
         _ => Err(petsc_error(step, code)),
     }
 }

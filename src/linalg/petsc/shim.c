@@ -112,6 +112,29 @@ int internodes_mpi_broadcast_length(int64_t *len, const char **step)
     return 0;
 }
 
+/* Rank r's count of what rank 0 scatters next: counts[r] of rank 0's `counts` (one value a
+ * rank, read on rank 0 only) into `mine` on every rank (MPI_Scatter over PETSC_COMM_WORLD). */
+int internodes_mpi_scatter_count(const int64_t *counts, int64_t *mine, const char **step)
+{
+    TRY(MPI_Scatter(counts, 1, MPI_INT64_T, mine, 1, MPI_INT64_T, 0, PETSC_COMM_WORLD));
+    return 0;
+}
+
+/* Each rank's cells from rank 0: counts[r] cells of `width` values starting at cell displs[r]
+ * of rank 0's `all` into `mine` (`count` cells) on rank r (MPI_Scatterv over PETSC_COMM_WORLD;
+ * `all`, `counts` and `displs` are read on rank 0 only). Counted in cells, each an MPI type of
+ * `width` uint32 values, so that the ints of MPI count up to 2^31 cells rather than values. */
+int internodes_mpi_scatter_cells(const uint32_t *all, const int *counts, const int *displs,
+                                 uint32_t *mine, int count, int width, const char **step)
+{
+    MPI_Datatype cell;
+    TRY(MPI_Type_contiguous(width, MPI_UINT32_T, &cell));
+    TRY(MPI_Type_commit(&cell));
+    TRY(MPI_Scatterv(all, counts, displs, cell, mine, count, cell, 0, PETSC_COMM_WORLD));
+    TRY(MPI_Type_free(&cell));
+    return 0;
+}
+
 /* Ends every rank of the run with `code` (a rank that failed alone: the others may be waiting
  * for it in a collective call, and would wait for ever). */
 void internodes_mpi_abort(int code)
