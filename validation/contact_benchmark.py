@@ -470,7 +470,9 @@ def run_ours(binary: Path, case: Path, output: Path, path: str) -> dict:
                       "compliance_estimate": compliance_estimate(its) if path == "direct" else None,
                       "active_primary": last["active_primary"],
                       "force": record["force_primary"][-1], "hertz_a": record["hertz_a"]})
-    set_up = phases["contact set-up"]
+    # The pairs' surfaces, a phase of their own since the binary of this line (outside every
+    # phase before).
+    set_up = phases["contact set-up"] + phases.get("contact surfaces", 0.0)
     linear = contact.get("linear_solvers") or {}
     # How many times each body's block was applied over the whole solve (coupled solve only: an AMG
     # V-cycle per application on cg-amg bodies, a pair of triangular solves on Cholesky; absent before).
@@ -1296,10 +1298,11 @@ def write_report(env: dict, sizes: list[dict], argv: list[str]) -> None:
         *_resolved(sizes),
         "* *active nodes*: at the end of the last step; the frictionless multipliers are one per active primary "
         "node. *status*: how the last step ended (`cycling`: the active set came back to an earlier set).",
-        "* *set-up* = `contact set-up` of `summary.json`: *asm* (sparsity, stiffness, Dirichlet rows of both "
-        "bodies) + *solvers* (the run log's `... of both bodies` line: direct, ordering + Cholesky; iterative, "
-        "PETSc initialization + GAMG hierarchies) + *other* (interpolation operators between the candidate "
-        "surfaces).",
+        "* *set-up* = `contact surfaces` + `contact set-up` of `summary.json`: *asm* (sparsity, stiffness, "
+        "Dirichlet rows of both bodies) + *solvers* (the run log's `... of both bodies` line: direct, ordering + "
+        "Cholesky; iterative, PETSc initialization + GAMG hierarchies) + *other* (the candidate surfaces with "
+        "their bodies' boundaries, and the interpolation operators between them; the surfaces were outside "
+        "every phase of binaries before 2026-12-05).",
         "* *step k* = the active-set loop of load step k with its post-processing (iterations); "
         "*per iteration* over the iterations of all steps; *compliance (est.)*, direct path only: per step, the "
         "iteration times above the step's median iteration, summed (the cost of new interface-compliance "

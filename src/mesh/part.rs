@@ -12,6 +12,7 @@
 //! others never hold the whole body. Every node stays: the coordinates are 24 bytes a node
 //! against the cells' 16 bytes a cell and about 5.5 cells a node in 3D.
 
+use rayon::slice::ParallelSliceMut;
 use serde::{Deserialize, Serialize};
 
 use super::{BodyMesh, ElementTags};
@@ -127,29 +128,34 @@ impl BodyMesh {
         if let Some(part) = &self.part {
             return part.boundary_facets.clone();
         }
-        // Each facet of each cell, keyed by its sorted nodes; a boundary facet appears once.
-        let mut count: std::collections::HashMap<Vec<usize>, (usize, Vec<usize>, usize)> =
-            std::collections::HashMap::new();
-        for cell in self.cells() {
-            for opposite in 0..cell.len() {
-                let facet: Vec<usize> = (0..cell.len())
-                    .filter(|&k| k != opposite)
-                    .map(|k| cell[k])
-                    .collect();
-                let mut key = facet.clone();
-                key.sort_unstable();
-                count
-                    .entry(key)
-                    .and_modify(|e| e.0 += 1)
-                    .or_insert((1, facet, cell[opposite]));
+        // Each facet of each cell, keyed by its sorted nodes (padded for a 2D edge), with its
+        // cell and the cell's node opposite it; sorted by key, a boundary facet is a key that
+        // appears once. A sort of fixed-size keys rather than a hash map of their vectors: 0.3
+        // s against 4.9 s a body at 1M DOFs (2.9M tetrahedra; one run each).
+        let n = self.nodes_per_cell();
+        let mut facets: Vec<([u32; 3], usize, u8)> = Vec::with_capacity(n * self.num_cells());
+        for (c, cell) in self.cells.chunks_exact(n).enumerate() {
+            for opposite in 0..n {
+                let mut key = [u32::MAX; 3];
+                let others = (0..n).filter(|&k| k != opposite).map(|k| cell[k]);
+                for (slot, node) in key.iter_mut().zip(others) {
+                    *slot = node;
+                }
+                key[..n - 1].sort_unstable();
+                facets.push((key, c, opposite as u8));
             }
         }
-        let mut boundary: Vec<(Vec<usize>, usize)> = count
-            .into_values()
-            .filter(|(n, ..)| *n == 1)
-            .map(|(_, facet, opposite)| (facet, opposite))
-            .collect();
-        // A deterministic order (the hash map's is not).
+        facets.par_sort_unstable_by_key(|&(key, ..)| key);
+        let mut boundary: Vec<(Vec<usize>, usize)> = Vec::new();
+        for run in facets.chunk_by(|a, b| a.0 == b.0) {
+            if let [(_, c, opposite)] = run {
+                let cell = self.cell(*c);
+                let opposite = *opposite as usize;
+                let facet = (0..n).filter(|&k| k != opposite).map(|k| cell[k]).collect();
+                boundary.push((facet, cell[opposite]));
+            }
+        }
+        // A deterministic order, whatever the sort left among equal keys.
         boundary.sort_unstable();
         (boundary.into_iter())
             .flat_map(|(facet, opposite)| facet.into_iter().chain([opposite]))
@@ -197,5 +203,39 @@ mod tests {
             assert_eq!(part.part.as_ref().unwrap().owner, owner);
         }
         assert_eq!(at, split.cells.len());
+    }
+
+    #[test]
+    fn the_boundary_is_every_facet_that_no_other_cell_shares_in_a_fixed_order() {
+        for name in ["block_3d.msh", "block_2d.msh"] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/fixtures")
+                .join(name);
+            let body = read_msh(&path).unwrap().bodies.remove(0);
+            // The oracle: each facet counted by its node set in a hash map.
+            let mut count = std::collections::HashMap::new();
+            for cell in body.cells() {
+                for opposite in 0..cell.len() {
+                    let facet: Vec<usize> = (0..cell.len())
+                        .filter(|&k| k != opposite)
+                        .map(|k| cell[k])
+                        .collect();
+                    let mut key = facet.clone();
+                    key.sort_unstable();
+                    let entry = count.entry(key).or_insert((0, facet, cell[opposite]));
+                    entry.0 += 1;
+                }
+            }
+            let mut expected: Vec<(Vec<usize>, usize)> = (count.into_values())
+                .filter(|(n, ..)| *n == 1)
+                .map(|(_, facet, opposite)| (facet, opposite))
+                .collect();
+            expected.sort_unstable();
+            let expected: Vec<usize> = (expected.into_iter())
+                .flat_map(|(facet, opposite)| facet.into_iter().chain([opposite]))
+                .collect();
+            assert!(!expected.is_empty());
+            assert_eq!(body.boundary_facets(), expected, "{name}");
+        }
     }
 }

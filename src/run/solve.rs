@@ -109,8 +109,11 @@ pub fn solve_case_on(
     let mut bodies = Vec::new();
     let mut contacts = Vec::new();
     let mut earlier_steps = Vec::new();
+    // The pairs' surfaces (each with its body's whole boundary) before any contact phase.
+    let phase = Instant::now();
     let problems = case.contact_problems(mesh)?;
     if !problems.is_empty() {
+        timings.record("contact surfaces", phase);
         let (solved, in_contact, earlier) = solve_contact_pairs(case, problems, &mut timings)?;
         contacts = solved;
         bodies.extend(in_contact);
