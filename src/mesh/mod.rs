@@ -39,6 +39,7 @@ pub type Dim = usize;
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Mesh {
     /// The file it was read from, for error messages.
+    #[serde(with = "path_bytes")]
     pub path: PathBuf,
     /// 2 or 3.
     pub dim: Dim,
@@ -46,6 +47,32 @@ pub struct Mesh {
     pub bodies: Vec<BodyMesh>,
     /// Every physical group of the file, including the ones no body uses.
     pub physical_groups: Vec<PhysicalGroup>,
+}
+
+/// A path as its bytes in what rank 0 sends the ranks (`crate::run`'s partition): serde's own
+/// form of a path refuses one that is not UTF-8, which a folder's name may be.
+mod path_bytes {
+    use std::path::{Path, PathBuf};
+
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(path: &Path, serializer: S) -> Result<S::Ok, S::Error> {
+        #[cfg(unix)]
+        let bytes = std::os::unix::ffi::OsStrExt::as_bytes(path.as_os_str()).to_vec();
+        #[cfg(not(unix))]
+        let bytes = path.to_string_lossy().into_owned().into_bytes();
+        bytes.serialize(serializer)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<PathBuf, D::Error> {
+        let bytes = Vec::<u8>::deserialize(deserializer)?;
+        #[cfg(unix)]
+        let path =
+            PathBuf::from(<std::ffi::OsString as std::os::unix::ffi::OsStringExt>::from_vec(bytes));
+        #[cfg(not(unix))]
+        let path = PathBuf::from(String::from_utf8_lossy(&bytes).into_owned());
+        Ok(path)
+    }
 }
 
 /// A physical group as declared in the file (`$PhysicalNames`).

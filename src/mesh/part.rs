@@ -206,6 +206,43 @@ mod tests {
     }
 
     #[test]
+    fn a_mesh_sent_between_ranks_arrives_whole_even_from_a_folder_whose_name_is_not_utf8() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/block_3d.msh");
+        let mut mesh = read_msh(&path).unwrap();
+        #[cfg(unix)]
+        {
+            use std::os::unix::ffi::OsStrExt;
+            let folder = std::ffi::OsStr::from_bytes(b"/tmp/bad\xffdir");
+            mesh.path = std::path::Path::new(folder).join("mesh.msh");
+        }
+        let owner = vec![0; mesh.bodies[0].num_nodes()];
+        mesh.bodies[0].drop_cells(owner);
+
+        let bytes = postcard::to_allocvec(&mesh).unwrap();
+        let sent: crate::mesh::Mesh = postcard::from_bytes(&bytes).unwrap();
+        assert_eq!(sent.path, mesh.path);
+        assert_eq!(sent.dim, mesh.dim);
+        assert_eq!(sent.physical_groups, mesh.physical_groups);
+        let (body, arrived) = (&mesh.bodies[0], &sent.bodies[0]);
+        assert_eq!(arrived.coords, body.coords);
+        assert_eq!(arrived.node_tags, body.node_tags);
+        assert_eq!(arrived.total_cells(), body.total_cells());
+        assert_eq!(arrived.boundary_facets(), body.boundary_facets());
+        assert_eq!(
+            arrived.part.as_ref().unwrap().owner,
+            body.part.as_ref().unwrap().owner
+        );
+        assert_eq!(arrived.point_groups, body.point_groups);
+        let names: Vec<_> = arrived.boundary_groups.keys().collect();
+        assert_eq!(names, body.boundary_groups.keys().collect::<Vec<_>>());
+        for (name, group) in &body.boundary_groups {
+            assert_eq!(arrived.boundary_groups[name].facets, group.facets, "{name}");
+            assert_eq!(arrived.boundary_groups[name].facet_cells, group.facet_cells);
+        }
+    }
+
+    #[test]
     fn the_boundary_is_every_facet_that_no_other_cell_shares_in_a_fixed_order() {
         for name in ["block_3d.msh", "block_2d.msh"] {
             let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
