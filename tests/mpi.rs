@@ -501,6 +501,13 @@ fn a_rank_that_fails_alone_ends_every_rank_with_its_error() {
     let case = example_case(dir.path(), "block_3d", "\n[solver]\nbody = \"cg-amg\"\n");
     let out = dir.path().join("a_file");
     std::fs::write(&out, "not a folder").unwrap();
+    fails_on_rank_0_alone(&case, &out, "a_file");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "not a folder");
+}
+
+/// Solves `case` into `out` on 2 ranks, which must fail with rank 0's error alone, naming
+/// `named`.
+fn fails_on_rank_0_alone(case: &Path, out: &Path, named: &str) {
     let run = mpirun(
         2,
         &[
@@ -514,9 +521,8 @@ fn a_rank_that_fails_alone_ends_every_rank_with_its_error() {
     assert!(!run.status.success(), "{}", text(&run));
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.contains("error (rank 0 of 2)"), "{}", text(&run));
-    assert!(stderr.contains("a_file"), "{}", text(&run));
+    assert!(stderr.contains(named), "{}", text(&run));
     assert!(!stderr.contains("error (rank 1 of 2)"), "{}", text(&run));
-    assert_eq!(std::fs::read_to_string(&out).unwrap(), "not a folder");
 }
 
 #[test]
@@ -528,22 +534,7 @@ fn a_case_that_does_not_fit_its_mesh_is_refused_once_by_the_rank_that_reads_the_
     let original = std::fs::read_to_string(&case).unwrap();
     let edited = original.replace("\"block_base\"", "\"no_such_group\"");
     std::fs::write(&case, edited).unwrap();
-    let out = dir.path().join("out");
-    let run = mpirun(
-        2,
-        &[
-            "solve",
-            case.to_str().unwrap(),
-            "-q",
-            "-o",
-            out.to_str().unwrap(),
-        ],
-    );
-    assert!(!run.status.success(), "{}", text(&run));
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(stderr.contains("error (rank 0 of 2)"), "{}", text(&run));
-    assert!(stderr.contains("no_such_group"), "{}", text(&run));
-    assert!(!stderr.contains("error (rank 1 of 2)"), "{}", text(&run));
+    fails_on_rank_0_alone(&case, &dir.path().join("out"), "no_such_group");
 }
 
 #[test]

@@ -64,10 +64,9 @@ fn mpi_count(n: usize) -> Result<c_int, LinalgError> {
     c_int::try_from(n).map_err(|_| LinalgError::Sizes(format!("{n} values in one MPI message")))
 }
 
-/// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
-/// order, on every rank (collective over `PETSC_COMM_WORLD`).
-pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
-    let total = counts.iter().sum();
+/// `counts` as MPI counts, and where each rank's part starts (`MPI_Allgatherv`'s and
+/// `MPI_Scatterv`'s `displs`).
+fn counts_and_displacements(counts: &[usize]) -> Result<(Vec<c_int>, Vec<c_int>), LinalgError> {
     let mut displs = Vec::with_capacity(counts.len());
     let mut at = 0;
     for &count in counts {
@@ -78,6 +77,14 @@ pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, Linalg
         .iter()
         .map(|&c| mpi_count(c))
         .collect::<Result<Vec<_>, _>>()?;
+    Ok((counts, displs))
+}
+
+/// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
+/// order, on every rank (collective over `PETSC_COMM_WORLD`).
+pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
+    let total = counts.iter().sum();
+    let (counts, displs) = counts_and_displacements(counts)?;
     let mut global = vec![0.0; total];
     let mut step = std::ptr::null();
     let _lock = petsc()?;
@@ -134,16 +141,7 @@ pub fn scatter_cells(all: &[u32], counts: &[usize], width: usize) -> Result<Vec<
     if code != 0 {
         return Err(petsc_error(step, code));
     }
-    let mut displs = Vec::with_capacity(counts.len());
-    let mut at = 0;
-    for &count in counts {
-        displs.push(mpi_count(at)?);
-        at += count;
-    }
-    let counts = counts
-        .iter()
-        .map(|&c| mpi_count(c))
-        .collect::<Result<Vec<_>, _>>()?;
+    let (counts, displs) = counts_and_displacements(counts)?;
     let mut cells = vec![0u32; width * mine as usize];
     // SAFETY: on rank 0 `all` holds `width` values for each of the counts' cells, `counts` and
     // `displs` one value per rank; `cells` holds this rank's count of cells; the lock is held.
