@@ -134,6 +134,21 @@ fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
     if scale > 0.0 { diff / scale } else { diff }
 }
 
+/// The mesh datasets of two runs' `solution.h5` are the same: on ranks, rank 0 holds only
+/// its part of the cells and the others send it the rows of theirs, which must land in the
+/// serial run's order.
+fn same_mesh_written(one: &Path, two: &Path, name: &str) {
+    for dataset in [
+        "mesh/geometry",
+        "mesh/node_tag",
+        "mesh/topology",
+        "mesh/cell_tag",
+        "mesh/cell_body",
+    ] {
+        assert_eq!(read(one, dataset), read(two, dataset), "{name}: {dataset}");
+    }
+}
+
 fn files(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
@@ -219,10 +234,13 @@ fn ranks_give_the_serial_answer_of(
         files(&two),
         "{name}: the output folders' files"
     );
+    same_mesh_written(&one, &two, name);
     for field in [
         "fields/displacement",
         "fields/contact_pressure",
+        "fields/strain",
         "fields/stress",
+        "fields/von_mises",
     ] {
         let d = relative_difference(&read(&one, field), &read(&two, field));
         assert!(d <= AGREEMENT, "{name}: {field} differs by {d:.2e}");
@@ -477,17 +495,29 @@ fn a_single_body_on_two_ranks_gives_the_serial_answer() {
     let case = example_case(dir.path(), "block_3d", "\n[solver]\nbody = \"cg-amg\"\n");
     let case = case.to_str().unwrap();
     let (one, two) = (dir.path().join("one"), dir.path().join("two"));
-    let serial_run = serial(&["solve", case, "-q", "-o", one.to_str().unwrap()]);
-    let parallel_run = mpirun(2, &["solve", case, "-q", "-o", two.to_str().unwrap()]);
+    let export = "--export-matrices";
+    let serial_run = serial(&["solve", case, "-q", export, "-o", one.to_str().unwrap()]);
+    let parallel_run = mpirun(
+        2,
+        &["solve", case, "-q", export, "-o", two.to_str().unwrap()],
+    );
     assert!(serial_run.status.success(), "{}", text(&serial_run));
     assert!(parallel_run.status.success(), "{}", text(&parallel_run));
     assert_eq!(files(&one), files(&two));
-    let d = relative_difference(
-        &read(&one, "fields/displacement"),
-        &read(&two, "fields/displacement"),
-    );
+    same_mesh_written(&one, &two, "block_3d");
     // One CG solve to the case's rtol (1e-10 by default) with either preconditioner.
-    assert!(d <= 1e-8, "displacement differs by {d:.2e}");
+    for field in ["fields/displacement", "fields/stress"] {
+        let d = relative_difference(&read(&one, field), &read(&two, field));
+        assert!(d <= 1e-8, "{field} differs by {d:.2e}");
+    }
+    // The whole body's matrices, which rank 0 assembles from the mesh file read again.
+    let matrices = |dir: &Path| files(&dir.join("matrices"));
+    assert!(!matrices(&one).is_empty());
+    assert_eq!(matrices(&one), matrices(&two));
+    for file in matrices(&one) {
+        let bytes = |dir: &Path| std::fs::read(dir.join("matrices").join(&file)).unwrap();
+        assert!(bytes(&one) == bytes(&two), "matrices/{file} differs");
+    }
     // Each rank kept only its part of the cells; the counts are the whole body's.
     let cells = |dir: &Path| summary(dir)["bodies"][0]["num_cells"].as_u64();
     assert_eq!(cells(&one), cells(&two));

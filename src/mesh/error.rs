@@ -104,6 +104,17 @@ pub enum MeshError {
          cells the run read at its start, so its results cannot be written on it (run again)"
     )]
     Changed { path: PathBuf, body: String },
+    /// A body a distributed run cannot divide: the ranks number its cells in 32 bits
+    /// (`crate::mesh::RankPart::cell_indices`).
+    #[error(
+        "{path}: body '{body}' has {cells} cells: a distributed run numbers a body's cells in 32 \
+         bits, at most 4,294,967,295 (split it into several bodies)"
+    )]
+    TooManyCells {
+        path: PathBuf,
+        body: String,
+        cells: usize,
+    },
     #[error("{path}: body '{body}' has no cells (its element blocks are empty)")]
     EmptyBody { path: PathBuf, body: String },
     #[error(

@@ -2,11 +2,12 @@
 //! the rest of the run needs of the cells it dropped.
 //!
 //! Once a body's nodes are partitioned among the ranks, a rank assembles the columns of its
-//! own nodes and of the prescribed ones (`crate::elastic`), and nothing after the assembly
-//! reads a cell: the contact loop works on surfaces, and the output is written by rank 0 from
-//! the mesh file read again. So a rank holds only the cells around those nodes (every cell
-//! that holds one: their columns are then complete, bit for bit), and the two facts of the
-//! whole body the run still needs, the partition and the body's boundary
+//! own nodes and of the prescribed ones (`crate::elastic`), and after the assembly only the
+//! output reads a cell: the contact loop works on surfaces. So a rank holds only the cells
+//! around those nodes (every cell that holds one: their columns are then complete, bit for
+//! bit), each with its index in the whole body (the output's row of the cell, which the rank
+//! that writes it sends to rank 0: `crate::run`'s output), and the two facts of the whole
+//! body the run still needs, the partition and the body's boundary
 //! ([`BodyMesh::boundary_facets`]). Rank 0, which reads the mesh, divides the cells
 //! ([`BodyMesh::cells_by_rank`]) and sends each rank its own (`crate::run`'s partition); the
 //! others never hold the whole body. Every node stays: the coordinates are 24 bytes a node
@@ -27,6 +28,14 @@ pub struct RankPart {
     pub total_cells: usize,
     /// [`BodyMesh::boundary_facets`] of the whole body.
     pub boundary_facets: Vec<usize>,
+    /// The whole body's index of each cell this rank keeps, increasing ([`BodyMesh::cells`]
+    /// holds them in this order): the row the output writes it in.
+    pub cell_indices: Vec<u32>,
+    /// The whole body's element tags on rank 0, which writes the output (gmsh numbers a
+    /// body's elements in a few runs of consecutive tags: [`ElementTags`]); `None` on the
+    /// other ranks. Never sent between ranks.
+    #[serde(skip)]
+    pub whole_cell_tags: Option<ElementTags>,
 }
 
 /// Every rank's cells of a body, one rank after the other, each rank's in the body's order:
@@ -35,6 +44,8 @@ pub struct RankPart {
 pub struct CellsByRank {
     /// The cells of rank 0, then of rank 1, ..., flat (`dim + 1` nodes a cell).
     pub cells: Vec<u32>,
+    /// The whole body's index of each of those cells ([`RankPart::cell_indices`]).
+    pub indices: Vec<u32>,
     /// The number of cells of each rank.
     pub counts: Vec<usize>,
 }
@@ -77,40 +88,53 @@ impl BodyMesh {
                 Some(n * start)
             })
             .collect();
-        let mut cells = vec![0; n * counts.iter().sum::<usize>()];
-        for cell in self.cells.chunks_exact(n) {
+        let total = counts.iter().sum::<usize>();
+        let (mut cells, mut indices) = (vec![0; n * total], vec![0; total]);
+        for (c, cell) in self.cells.chunks_exact(n).enumerate() {
             ranks_of(cell, &mut of_cell);
             for &r in &of_cell {
                 cells[next[r]..next[r] + n].copy_from_slice(cell);
+                // Bodies of 2^32 cells or more are refused before they are divided.
+                indices[next[r] / n] = c as u32;
                 next[r] += n;
             }
         }
-        CellsByRank { cells, counts }
+        CellsByRank {
+            cells,
+            indices,
+            counts,
+        }
     }
 
     /// Makes the body what every rank keeps of it before its own cells come
-    /// ([`Self::receive_cells`]): no cells and no tags (only the output reads them, on the
-    /// whole mesh read again: kept for a rank's cells, which break gmsh's runs of consecutive
-    /// tags, they took 8 bytes a cell beside the cell's 16), the partition `owner`, and what
-    /// the whole body's cells gave ([`RankPart`]).
-    pub fn drop_cells(&mut self, owner: Vec<u32>) {
+    /// ([`Self::receive_cells`]): no cells and no tags (only the output reads them, on rank
+    /// 0: kept for a rank's cells, which break gmsh's runs of consecutive tags, they would
+    /// take 8 bytes a cell beside the cell's 16), the partition `owner`, and what the whole
+    /// body's cells gave ([`RankPart`]). Returns the tags, which rank 0 keeps
+    /// ([`RankPart::whole_cell_tags`]).
+    pub fn drop_cells(&mut self, owner: Vec<u32>) -> ElementTags {
         debug_assert!(self.part.is_none(), "the cells of a whole body");
         let boundary_facets = self.boundary_facets();
         let total_cells = self.num_cells();
         self.cells = Vec::new();
-        self.cell_tags = ElementTags::from(Vec::new());
         self.part = Some(RankPart {
             owner,
             total_cells,
             boundary_facets,
+            cell_indices: Vec::new(),
+            whole_cell_tags: None,
         });
+        std::mem::replace(&mut self.cell_tags, ElementTags::from(Vec::new()))
     }
 
     /// This rank's cells of a body whose cells were dropped ([`Self::drop_cells`]), in the
-    /// whole body's order.
-    pub fn receive_cells(&mut self, cells: Vec<u32>) {
-        debug_assert!(self.part.is_some() && self.cells.is_empty());
+    /// whole body's order, with their indices in the whole body.
+    pub fn receive_cells(&mut self, cells: Vec<u32>, indices: Vec<u32>) {
+        debug_assert!(self.cells.is_empty());
+        debug_assert_eq!(cells.len(), self.nodes_per_cell() * indices.len());
+        let part = self.part.as_mut().expect("a body whose cells were dropped");
         self.cells = cells;
+        part.cell_indices = indices;
     }
 
     /// The number of cells of the whole body (of which a rank's part keeps some).
@@ -181,23 +205,30 @@ mod tests {
 
         let mut at = 0;
         for (rank, &count) in split.counts.iter().enumerate() {
+            let held =
+                |cell: &[usize]| (cell.iter()).any(|&a| owner[a] as usize == rank || everywhere(a));
             let expected: Vec<u32> = (whole.cells())
-                .filter(|cell| {
-                    cell.iter()
-                        .any(|&a| owner[a] as usize == rank || everywhere(a))
-                })
+                .filter(|cell| held(cell))
                 .flat_map(|cell| cell.iter().map(|&a| a as u32).collect::<Vec<_>>())
                 .collect();
+            let expected_indices: Vec<u32> = (whole.cells().enumerate())
+                .filter(|(_, cell)| held(cell))
+                .map(|(c, _)| c as u32)
+                .collect();
             let kept = split.cells[at..at + 4 * count].to_vec();
+            let indices = split.indices[at / 4..at / 4 + count].to_vec();
             at += 4 * count;
             assert_eq!(kept, expected, "rank {rank}");
+            assert_eq!(indices, expected_indices, "rank {rank}");
             assert!(count < whole.num_cells());
 
             let mut part = whole.clone();
-            part.drop_cells(owner.clone());
-            part.receive_cells(kept);
+            let tags = part.drop_cells(owner.clone());
+            assert_eq!(tags, whole.cell_tags);
+            part.receive_cells(kept, indices.clone());
             assert_eq!(part.num_cells(), count);
             assert!(part.cell_tags.is_empty());
+            assert_eq!(part.part.as_ref().unwrap().cell_indices, indices);
             assert_eq!(part.total_cells(), whole.num_cells());
             assert_eq!(part.boundary_facets(), whole.boundary_facets());
             assert_eq!(part.part.as_ref().unwrap().owner, owner);

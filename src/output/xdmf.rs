@@ -13,6 +13,7 @@
 //! (N, 3), `/fields/slip_increment` (N, 3: over the last load step) and
 //! `/fields/accumulated_slip` (N: the slip path's length over all steps).
 
+use std::ops::Range;
 use std::path::Path;
 
 use super::OutputError;
@@ -34,17 +35,75 @@ pub struct BodyFields<'a> {
     pub surfaces: Vec<&'a SurfaceFields>,
 }
 
-/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`.
+/// The rows of the cell datasets for some cells of one body: each cell's nodes (the body's
+/// node indices), its strain and stress (9 values each, row-major 3 x 3) and its von Mises
+/// stress ([`cell_field`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CellRows {
+    pub topology: Vec<u32>,
+    pub strain: Vec<f64>,
+    pub stress: Vec<f64>,
+    pub von_mises: Vec<f64>,
+}
+
+impl CellRows {
+    /// The rows of `body`'s cells `cells` (indices of the cells its mesh holds).
+    pub fn of(body: &BodyFields, cells: impl Iterator<Item = usize>) -> Self {
+        let mut rows = Self::default();
+        for c in cells {
+            let (strain, stress, von_mises) =
+                cell_field(body.mesh, body.material, body.displacement, c);
+            let n = body.mesh.nodes_per_cell();
+            rows.topology
+                .extend_from_slice(&body.mesh.cells[n * c..n * c + n]);
+            rows.strain.extend(strain);
+            rows.stress.extend(stress);
+            rows.von_mises.push(von_mises);
+        }
+        rows
+    }
+
+    /// The number of cells.
+    pub fn len(&self) -> usize {
+        self.von_mises.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.von_mises.is_empty()
+    }
+}
+
+/// What gives the cell rows of body `k`'s cells `cells` (indices in the whole body), one
+/// chunk at a time ([`cell_chunks`]); an error is a message.
+pub type CellRowsOf<'a> = dyn FnMut(usize, Range<usize>) -> Result<CellRows, String> + 'a;
+
+/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf` from the bodies' own cells (every body's
+/// mesh holds all of its cells).
+pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
+    write_xdmf_with(dir, stem, bodies, &mut |k, cells| {
+        Ok(CellRows::of(&bodies[k], cells))
+    })
+}
+
+/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`, the cell datasets from `cell_rows`:
+/// where the bodies' meshes hold only some of their cells (rank 0 of a distributed run), the
+/// rows of the others come from the ranks that hold them. The node datasets are written from
+/// the bodies' own arrays, which hold every node.
 ///
 /// Each dataset is written body by body, a bounded chunk of rows at a time
 /// ([`CHUNK_ROWS`]), straight from the bodies' own arrays: the writer never holds a copy of
 /// the whole grid (at 1M DOFs that copy was 470 MB beside the fields themselves, on the
 /// process that writes).
-pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
+pub fn write_xdmf_with(
+    dir: &Path,
+    stem: &str,
+    bodies: &[BodyFields],
+    cell_rows: &mut CellRowsOf,
+) -> Result<(), OutputError> {
     let h5_path = dir.join(format!("{stem}.h5"));
     let dim = bodies.first().map_or(3, |b| b.mesh.dim);
     let nodes: Vec<usize> = bodies.iter().map(|b| b.mesh.num_nodes()).collect();
-    let cells: Vec<usize> = bodies.iter().map(|b| b.mesh.num_cells()).collect();
+    let cells: Vec<usize> = bodies.iter().map(|b| b.mesh.total_cells()).collect();
     let contact = bodies.iter().any(|b| !b.surfaces.is_empty());
     let friction = (bodies.iter().flat_map(|b| &b.surfaces)).any(|s| s.friction.is_some());
     let grid = Grid {
@@ -56,7 +115,7 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
         friction,
         chunk_rows: CHUNK_ROWS,
     };
-    grid.write_h5(&h5_path)
+    grid.write_h5(&h5_path, cell_rows)
         .map_err(|source| OutputError::Hdf5 {
             path: h5_path.clone(),
             source,
@@ -77,6 +136,22 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
 /// Rows of a dataset written at a time: what the writer holds of a field beyond the bodies'
 /// own arrays (at most 4.7 MB, for the 9 values of a strain or stress row).
 const CHUNK_ROWS: usize = 1 << 16;
+
+/// The chunks the cell datasets are written in, for bodies of `cells[k]` cells: (body,
+/// its cells), the bodies in order. Every rank of a distributed run sends its rows in these.
+pub fn cell_chunks(cells: &[usize]) -> Vec<(usize, Range<usize>)> {
+    chunks(cells, CHUNK_ROWS)
+}
+
+fn chunks(cells: &[usize], chunk_rows: usize) -> Vec<(usize, Range<usize>)> {
+    (cells.iter().enumerate())
+        .flat_map(|(k, &count)| {
+            (0..count)
+                .step_by(chunk_rows)
+                .map(move |start| (k, start..count.min(start + chunk_rows)))
+        })
+        .collect()
+}
 
 /// Every body's nodes and cells one after the other, as the datasets of the module doc.
 struct Grid<'a> {
@@ -101,7 +176,7 @@ enum Width {
 }
 
 impl Grid<'_> {
-    fn write_h5(&self, path: &Path) -> hdf5::Result<()> {
+    fn write_h5(&self, path: &Path, cell_rows: &mut CellRowsOf) -> hdf5::Result<()> {
         let (bodies, dim) = (self.bodies, self.dim);
         let file = hdf5::File::create(path)?;
         let mesh = file.create_group("mesh")?;
@@ -117,20 +192,20 @@ impl Grid<'_> {
             .collect();
         let geometry = |k: usize| body(k).mesh.coords.iter().flatten().copied();
         self.write_by_body(&mesh, "geometry", Width::Columns(3), nodes, geometry)?;
-        let topology = |k: usize| {
-            let first = first_nodes[k];
-            body(k)
-                .mesh
-                .cells
-                .iter()
-                .map(move |&n| (n as usize + first) as i64)
-        };
-        self.write_by_body(&mesh, "topology", Width::Columns(dim + 1), cells, topology)?;
         let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|&t| t as i64);
         self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
         let node_body = |k: usize| std::iter::repeat_n(k as i32, nodes[k]);
         self.write_by_body(&mesh, "node_body", Width::Scalar, nodes, node_body)?;
-        let cell_tag = |k: usize| body(k).mesh.cell_tags.iter().map(|t| t as i64);
+        let mut tags = Vec::with_capacity(bodies.len());
+        for (k, b) in bodies.iter().enumerate() {
+            tags.push(match &b.mesh.part {
+                None => &b.mesh.cell_tags,
+                Some(part) => part.whole_cell_tags.as_ref().ok_or_else(|| {
+                    hdf5::Error::from(format!("body {k}: its element tags are not on this rank"))
+                })?,
+            });
+        }
+        let cell_tag = |k: usize| tags[k].iter().map(|t| t as i64);
         self.write_by_body(&mesh, "cell_tag", Width::Scalar, cells, cell_tag)?;
         let cell_body = |k: usize| std::iter::repeat_n(k as i32, cells[k]);
         self.write_by_body(&mesh, "cell_body", Width::Scalar, cells, cell_body)?;
@@ -148,7 +223,7 @@ impl Grid<'_> {
             nodes,
             displacement,
         )?;
-        self.write_cell_fields(&fields)?;
+        self.write_cells(&mesh, &fields, &first_nodes, cell_rows)?;
         if self.contact {
             let traction = |k: usize| {
                 on_surfaces(body(k), 3, 0.0, |f, s, v| v.copy_from_slice(&f.traction[s]))
@@ -266,48 +341,65 @@ impl Grid<'_> {
         Ok(())
     }
 
-    /// The datasets `strain`, `stress` (9 values a cell) and `von_mises` of the bodies' `cells`,
-    /// each cell computed once from its body's displacement ([`cell_field`]), [`Self::chunk_rows`]
-    /// cells at a time.
-    fn write_cell_fields(&self, group: &hdf5::Group) -> hdf5::Result<()> {
-        let (bodies, cells, chunk_rows) = (self.bodies, self.cells, self.chunk_rows);
-        let total: usize = cells.iter().sum();
-        let strain = group
+    /// The datasets `topology` (in `mesh`), `strain`, `stress` (9 values a cell) and
+    /// `von_mises` (in `fields`) of the bodies' cells, from `cell_rows`, [`Self::chunk_rows`]
+    /// cells at a time; `first_nodes[k]`: the grid's index of body `k`'s first node.
+    fn write_cells(
+        &self,
+        mesh: &hdf5::Group,
+        fields: &hdf5::Group,
+        first_nodes: &[usize],
+        cell_rows: &mut CellRowsOf,
+    ) -> hdf5::Result<()> {
+        let total: usize = self.cells.iter().sum();
+        let width = self.dim + 1;
+        let topology = mesh
+            .new_dataset::<i64>()
+            .shape((total, width))
+            .create("topology")?;
+        let strain = fields
             .new_dataset::<f64>()
             .shape((total, 9))
             .create("strain")?;
-        let stress = group
+        let stress = fields
             .new_dataset::<f64>()
             .shape((total, 9))
             .create("stress")?;
-        let von_mises = group
+        let von_mises = fields
             .new_dataset::<f64>()
             .shape(total)
             .create("von_mises")?;
-        let chunk = chunk_rows.min(total);
-        let mut values = [Vec::with_capacity(9 * chunk), Vec::with_capacity(9 * chunk)];
-        let mut equivalent = Vec::with_capacity(chunk);
-        let mut first = 0;
-        for (body, &count) in bodies.iter().zip(cells) {
-            for start in (0..count).step_by(chunk_rows) {
-                let end = count.min(start + chunk_rows);
-                values.iter_mut().for_each(Vec::clear);
-                equivalent.clear();
-                for c in start..end {
-                    let (e, s, v) = cell_field(body.mesh, body.material, body.displacement, c);
-                    values[0].extend(e);
-                    values[1].extend(s);
-                    equivalent.push(v);
-                }
-                let rows = first + start..first + end;
-                for (dataset, values) in [&strain, &stress].into_iter().zip(&values) {
-                    let table = ndarray::ArrayView2::from_shape((end - start, 9), &values[..])
-                        .expect("9 values a cell");
-                    dataset.write_slice(table, ndarray::s![rows.clone(), ..])?;
-                }
-                von_mises.write_slice(&equivalent[..], rows)?;
+        let first_cells: Vec<usize> = (self.cells.iter())
+            .scan(0, |first, &n| {
+                let this = *first;
+                *first += n;
+                Some(this)
+            })
+            .collect();
+        let mut nodes = Vec::new();
+        for (k, cells) in chunks(self.cells, self.chunk_rows) {
+            let n = cells.len();
+            let chunk = cell_rows(k, cells.clone()).map_err(hdf5::Error::from)?;
+            if chunk.len() != n
+                || chunk.topology.len() != width * n
+                || chunk.strain.len() != 9 * n
+                || chunk.stress.len() != 9 * n
+            {
+                return Err(hdf5::Error::from(format!(
+                    "body {k}: {} cell rows for its cells {cells:?}",
+                    chunk.len()
+                )));
             }
-            first += count;
+            let rows = first_cells[k] + cells.start..first_cells[k] + cells.end;
+            nodes.clear();
+            nodes.extend((chunk.topology.iter()).map(|&a| (a as usize + first_nodes[k]) as i64));
+            let table = |values| ndarray::ArrayView2::from_shape((n, 9), values).expect("9 a cell");
+            let cell_nodes = ndarray::ArrayView2::from_shape((n, width), &nodes[..])
+                .expect("dim + 1 nodes a cell");
+            topology.write_slice(cell_nodes, ndarray::s![rows.clone(), ..])?;
+            strain.write_slice(table(&chunk.strain[..]), ndarray::s![rows.clone(), ..])?;
+            stress.write_slice(table(&chunk.stress[..]), ndarray::s![rows.clone(), ..])?;
+            von_mises.write_slice(&chunk.von_mises[..], rows)?;
         }
         Ok(())
     }
@@ -595,7 +687,8 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("grid.h5");
-        grid.write_h5(&path).unwrap();
+        let mut rows = |k: usize, cells| Ok(CellRows::of(&bodies[k], cells));
+        grid.write_h5(&path, &mut rows).unwrap();
 
         let file = hdf5::File::open(&path).unwrap();
         let read = |name: &str| file.dataset(name).unwrap().read_raw::<f64>().unwrap();

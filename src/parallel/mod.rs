@@ -133,6 +133,21 @@ pub fn all_gather(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelE
     Err(ParallelError::NoPetsc(counts.len()))
 }
 
+/// [`all_gather`] onto rank 0 alone (`MPI_Gatherv`): the other ranks receive an empty
+/// vector. With one count: `local` itself.
+pub fn gather_to_root(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelError> {
+    if counts.len() <= 1 {
+        return Ok(local.to_vec());
+    }
+    #[cfg(feature = "petsc")]
+    {
+        crate::linalg::petsc::gather_values_to_root(local, counts)
+            .map_err(|e| ParallelError::Mpi(e.to_string()))
+    }
+    #[cfg(not(feature = "petsc"))]
+    Err(ParallelError::NoPetsc(counts.len()))
+}
+
 /// Ends the run: on several ranks, every rank with `code` (`MPI_Abort`), since the others may
 /// be waiting for this one in a collective call; on one, this process.
 pub fn abort(code: u8) -> ! {

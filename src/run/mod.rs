@@ -6,6 +6,7 @@
 //! the default log, `-v` and `-vv` of docs/output.md, "The log"), warnings at level warn: the
 //! command line prints them on stderr, the Python module hands them to Python's `logging`.
 
+mod gathered_cells;
 mod partition;
 mod solve;
 mod write;
@@ -206,7 +207,8 @@ fn check_distributable(case: &Case) -> Result<(), CaseError> {
 }
 
 /// A rank other than 0 of a distributed run: the same solve, in step with rank 0 (which reads
-/// or meshes the mesh and sends this rank its part), writing nothing.
+/// or meshes the mesh and sends this rank its part), writing nothing but sending rank 0 the
+/// output's rows of the cells it writes.
 fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunError> {
     let timings = Timings::start();
     case.solver.verbose = false;
@@ -214,6 +216,8 @@ fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunErro
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     solution.rank_peak_memory_mb = gather_peak_memory()?;
     let summary = solution.summary_with(&case, &mesh, &solution.timings);
+    gathered_cells::send_cell_rows(&write::body_fields(&solution, &mesh))
+        .map_err(RunError::Parallel)?;
     Ok(SolvedRun {
         report: RunReport {
             output_dir: output.to_owned(),
@@ -285,17 +289,10 @@ fn solve_into(
         false => mesh,
     };
     let mut solution = solve_case_on(&case, &mesh, timings)?;
-    // Read before the ranks' peaks are gathered, so that rank 0's counts it.
-    let phase = Instant::now();
-    let mesh = partition::whole_mesh(mesh, &case.path)?;
-    if parallel::distributed() {
-        solution
-            .timings
-            .record("read the whole mesh for the output", phase);
-    }
     solution.rank_peak_memory_mb = gather_peak_memory()?;
 
-    // 3. The result files, into the staging folder, on the whole mesh.
+    // 3. The result files, into the staging folder (the other ranks of a distributed run send
+    //    the rows of the cells rank 0 does not hold).
     let beat = Heartbeat::start(verbose, "  writing the results");
     let summary = write_results(&solution, &case, &mesh, results.staging())?;
     drop(beat);

@@ -1,6 +1,7 @@
 //! The result files of a solved case: `solution.xdmf` and `solution.h5` (every body's fields),
 //! `summary.json`, and in contact runs `force_displacement.csv` and `.png`; `matrices/` when the
-//! case asks for them.
+//! case asks for them. Rank 0 of a distributed run writes them, with the rows of the cells it
+//! does not hold sent by the other ranks (`super::gathered_cells`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -8,12 +9,14 @@ use std::time::Instant;
 use crate::case::Case;
 use crate::contact::StepRecord;
 use crate::fem::assembly::{assemble_stiffness, assemble_surface_mass, stiffness_pattern};
-use crate::mesh::{BodyMesh, Mesh};
+use crate::mesh::Mesh;
 use crate::output::{
     BodyFields, CaseSummary, OutputError, force_displacement_csv, write_force_displacement_png,
-    write_matrix_market, write_xdmf,
+    write_matrix_market, write_xdmf, write_xdmf_with,
 };
 
+use super::gathered_cells::gather_cell_rows;
+use super::partition::whole_mesh;
 use super::solve::case_name;
 use super::{CaseSolution, RunError};
 
@@ -47,26 +50,36 @@ pub fn write_results(
             log::warn!("{} not written: {e}", png.display());
         }
     }
-    let meshes: Vec<&BodyMesh> = (solution.bodies.iter())
-        .map(|s| mesh.body(&s.name).expect("solved bodies are mesh bodies"))
-        .collect();
-    let fields: Vec<BodyFields> = (solution.bodies.iter().zip(&meshes))
-        .map(|(s, body)| BodyFields {
-            mesh: body,
-            displacement: &s.solution.displacement,
-            material: &s.material,
-            surfaces: s.surfaces.iter().map(|s| &s.fields).collect(),
-        })
-        .collect();
-    write_xdmf(dir, "solution", &fields)?;
+    let fields = body_fields(solution, mesh);
+    if fields.iter().any(|b| b.mesh.part.is_some()) {
+        // A distributed run: the ranks send the rows of their cells as they are written.
+        write_xdmf_with(dir, "solution", &fields, &mut |k, cells| {
+            gather_cell_rows(&fields, k, cells).map_err(|e| e.to_string())
+        })?;
+    } else {
+        write_xdmf(dir, "solution", &fields)?;
+    }
     if case.export_matrices {
-        export_matrices(case, mesh, dir)?;
+        export_matrices(case, whole_mesh(mesh, &case.path)?.as_ref(), dir)?;
     }
     let mut timings = solution.timings.clone();
     timings.record("write output", phase);
     let summary = solution.summary_with(case, mesh, &timings);
     summary.write(&dir.join("summary.json"))?;
     Ok(summary)
+}
+
+/// What the output writes of each solved body: its mesh (on a rank of a distributed run, the
+/// part it keeps), displacement, material and interface fields.
+pub(super) fn body_fields<'a>(solution: &'a CaseSolution, mesh: &'a Mesh) -> Vec<BodyFields<'a>> {
+    (solution.bodies.iter())
+        .map(|s| BodyFields {
+            mesh: mesh.body(&s.name).expect("solved bodies are mesh bodies"),
+            displacement: &s.solution.displacement,
+            material: &s.material,
+            surfaces: s.surfaces.iter().map(|s| &s.fields).collect(),
+        })
+        .collect()
 }
 
 /// Writes `matrices/<body>_stiffness.mtx` (unconstrained `K`) and

@@ -14,12 +14,13 @@ unsafe extern "C" {
         size: *mut c_int,
         step: *mut *const c_char,
     ) -> c_int;
-    fn internodes_mpi_allgather(
+    fn internodes_mpi_gather(
         local: *const f64,
         count: c_int,
         global: *mut f64,
         counts: *const c_int,
         displs: *const c_int,
+        root_only: c_int,
         step: *mut *const c_char,
     ) -> c_int;
     fn internodes_mpi_broadcast_length(len: *mut i64, step: *mut *const c_char) -> c_int;
@@ -83,20 +84,31 @@ fn counts_and_displacements(counts: &[usize]) -> Result<(Vec<c_int>, Vec<c_int>)
 /// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
 /// order, on every rank (collective over `PETSC_COMM_WORLD`).
 pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
-    let total = counts.iter().sum();
+    gather(local, counts, false)
+}
+
+/// [`gather_values`] onto rank 0 alone: the other ranks receive nothing (an empty vector).
+pub fn gather_values_to_root(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
+    gather(local, counts, true)
+}
+
+fn gather(local: &[f64], counts: &[usize], root_only: bool) -> Result<Vec<f64>, LinalgError> {
+    let receives = !root_only || world_ranks()?.rank == 0;
+    let total = if receives { counts.iter().sum() } else { 0 };
     let (counts, displs) = counts_and_displacements(counts)?;
     let mut global = vec![0.0; total];
     let mut step = std::ptr::null();
     let _lock = petsc()?;
-    // SAFETY: `global` holds the sum of `counts`, `counts` and `displs` one value per rank,
-    // `local` this rank's count; the lock is held.
+    // SAFETY: where it receives, `global` holds the sum of `counts`; `counts` and `displs`
+    // hold one value per rank, `local` this rank's count; the lock is held.
     let code = unsafe {
-        internodes_mpi_allgather(
+        internodes_mpi_gather(
             local.as_ptr(),
             mpi_count(local.len())?,
             global.as_mut_ptr(),
             counts.as_ptr(),
             displs.as_ptr(),
+            c_int::from(root_only),
             &mut step,
         )
     };

@@ -85,11 +85,18 @@ int internodes_mpi_rank_size(int *rank, int *size, const char **step)
 }
 
 /* Every rank's `local` (counts[r] values from rank r) into `global`, in rank order, on every
- * rank (MPI_Allgatherv over PETSC_COMM_WORLD; displs[r] is where rank r's values start). */
-int internodes_mpi_allgather(const double *local, int count, double *global, const int *counts,
-                             const int *displs, const char **step)
+ * rank (MPI_Allgatherv over PETSC_COMM_WORLD; displs[r] is where rank r's values start), or
+ * with `root_only` on rank 0 alone (MPI_Gatherv: `global`, `counts` and `displs` are read on
+ * rank 0 only). */
+int internodes_mpi_gather(const double *local, int count, double *global, const int *counts,
+                          const int *displs, int root_only, const char **step)
 {
-    TRY(MPI_Allgatherv(local, count, MPI_DOUBLE, global, counts, displs, MPI_DOUBLE, PETSC_COMM_WORLD));
+    if (root_only)
+        TRY(MPI_Gatherv(local, count, MPI_DOUBLE, global, counts, displs, MPI_DOUBLE, 0,
+                        PETSC_COMM_WORLD));
+    else
+        TRY(MPI_Allgatherv(local, count, MPI_DOUBLE, global, counts, displs, MPI_DOUBLE,
+                           PETSC_COMM_WORLD));
     return 0;
 }
 

@@ -1,0 +1,121 @@
+//! The cell rows of a distributed run's output, gathered onto rank 0 a chunk at a time.
+//!
+//! After the partition no rank holds a whole body's cells (`super::partition`), so rank 0,
+//! which writes `solution.h5`, receives the rows of the cell datasets (each cell's nodes,
+//! strain, stress and von Mises stress) from the ranks that hold the cells, in the chunks it
+//! writes them in (`crate::output::cell_chunks`). A cell is sent by one rank, the lowest that
+//! owns one of its nodes: that rank holds it (a rank keeps every cell around its own nodes),
+//! and no other sends it. Each rank computes the strain and stress of the cells it sends from
+//! the displacement, which every rank holds whole once the solve has ended. So rank 0 holds at
+//! most one chunk of rows beyond its own part of the mesh, and nobody reads the mesh file again.
+
+use std::ops::Range;
+
+use crate::output::{BodyFields, CellRows, cell_chunks};
+use crate::parallel::{self, ParallelError};
+
+/// The rows of body `k`'s cells `cells` (indices in the whole body), on rank 0; an empty
+/// [`CellRows`] on the other ranks. Collective: every rank calls it with the same `k` and
+/// `cells`, in the same order, and sends the rows of the cells it writes.
+pub(super) fn gather_cell_rows(
+    bodies: &[BodyFields],
+    k: usize,
+    cells: Range<usize>,
+) -> Result<CellRows, ParallelError> {
+    let body = &bodies[k];
+    let width = body.mesh.nodes_per_cell();
+    let (local, indices): (Vec<usize>, Vec<usize>) = sent_cells(body, cells.clone()).unzip();
+    let sent = CellRows::of(body, local.into_iter());
+    // A cell as values: its index in the whole body, its nodes, strain, stress, von Mises.
+    let values_per_cell = 1 + width + 9 + 9 + 1;
+    let mut values = Vec::with_capacity(values_per_cell * sent.len());
+    for (s, &index) in indices.iter().enumerate() {
+        values.push(index as f64);
+        values.extend(
+            sent.topology[width * s..width * (s + 1)]
+                .iter()
+                .map(|&a| a as f64),
+        );
+        values.extend_from_slice(&sent.strain[9 * s..9 * (s + 1)]);
+        values.extend_from_slice(&sent.stress[9 * s..9 * (s + 1)]);
+        values.push(sent.von_mises[s]);
+    }
+    let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
+        .map(|&count| count as usize)
+        .collect();
+    let all = parallel::gather_to_root(&values, &counts)?;
+    if !parallel::is_root() {
+        return Ok(CellRows::default());
+    }
+    // Rank 0: each cell's rows in its place in the chunk.
+    let n = cells.len();
+    let mut rows = CellRows {
+        topology: vec![0; width * n],
+        strain: vec![0.0; 9 * n],
+        stress: vec![0.0; 9 * n],
+        von_mises: vec![f64::NAN; n],
+    };
+    let mut placed = vec![false; n];
+    for cell in all.chunks_exact(values_per_cell) {
+        let index = cell[0] as usize;
+        let at = index.wrapping_sub(cells.start);
+        if at >= n || placed[at] {
+            return Err(ParallelError::Message(format!(
+                "the output's cell {index} of body '{}' was sent twice or is not in {cells:?}",
+                body.mesh.name
+            )));
+        }
+        placed[at] = true;
+        let (nodes, fields) = cell[1..].split_at(width);
+        (rows.topology[width * at..width * (at + 1)]
+            .iter_mut()
+            .zip(nodes))
+        .for_each(|(a, &node)| *a = node as u32);
+        rows.strain[9 * at..9 * (at + 1)].copy_from_slice(&fields[..9]);
+        rows.stress[9 * at..9 * (at + 1)].copy_from_slice(&fields[9..18]);
+        rows.von_mises[at] = fields[18];
+    }
+    if let Some(at) = placed.iter().position(|&p| !p) {
+        return Err(ParallelError::Message(format!(
+            "no rank sent the output's cell {} of body '{}'",
+            cells.start + at,
+            body.mesh.name
+        )));
+    }
+    Ok(rows)
+}
+
+/// On a rank other than 0: sends the rows of every cell this rank writes, chunk by chunk, as
+/// rank 0 gathers them while it writes (`gather_cell_rows`).
+pub(super) fn send_cell_rows(bodies: &[BodyFields]) -> Result<(), ParallelError> {
+    let cells: Vec<usize> = bodies.iter().map(|b| b.mesh.total_cells()).collect();
+    for (k, range) in cell_chunks(&cells) {
+        gather_cell_rows(bodies, k, range)?;
+    }
+    Ok(())
+}
+
+/// This rank's cells among the whole body's `cells` that it sends, as (index in its mesh,
+/// index in the whole body): those whose lowest owning rank is this one. A body held whole
+/// (one process) sends them all.
+fn sent_cells<'a>(
+    body: &'a BodyFields,
+    cells: Range<usize>,
+) -> Box<dyn Iterator<Item = (usize, usize)> + 'a> {
+    let Some(part) = &body.mesh.part else {
+        return Box::new(cells.map(|c| (c, c)));
+    };
+    let rank = parallel::ranks().rank as u32;
+    let width = body.mesh.nodes_per_cell();
+    let first = part
+        .cell_indices
+        .partition_point(|&c| (c as usize) < cells.start);
+    let end = part
+        .cell_indices
+        .partition_point(|&c| (c as usize) < cells.end);
+    Box::new((first..end).filter_map(move |c| {
+        let nodes = &body.mesh.cells[width * c..width * (c + 1)];
+        let writer = nodes.iter().map(|&a| part.owner[a as usize]).min();
+        (writer == Some(rank)).then_some((c, part.cell_indices[c] as usize))
+    }))
+}
