@@ -121,31 +121,33 @@ pub fn gather(value: f64) -> Result<Vec<f64>, ParallelError> {
 /// Every rank's `local` values (`counts[r]` of them from rank r, in rank order) on every
 /// rank (`MPI_Allgatherv`). With one count: `local` itself.
 pub fn all_gather(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelError> {
-    if counts.len() <= 1 {
-        return Ok(local.to_vec());
-    }
-    #[cfg(feature = "petsc")]
-    {
-        crate::linalg::petsc::gather_values(local, counts)
-            .map_err(|e| ParallelError::Mpi(e.to_string()))
-    }
-    #[cfg(not(feature = "petsc"))]
-    Err(ParallelError::NoPetsc(counts.len()))
+    gather_values(local, counts, false)
 }
 
 /// [`all_gather`] onto rank 0 alone (`MPI_Gatherv`): the other ranks receive an empty
 /// vector. With one count: `local` itself.
 pub fn gather_to_root(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelError> {
+    gather_values(local, counts, true)
+}
+
+fn gather_values(
+    local: &[f64],
+    counts: &[usize],
+    root_only: bool,
+) -> Result<Vec<f64>, ParallelError> {
     if counts.len() <= 1 {
         return Ok(local.to_vec());
     }
     #[cfg(feature = "petsc")]
     {
-        crate::linalg::petsc::gather_values_to_root(local, counts)
+        crate::linalg::petsc::gather_values(local, counts, root_only)
             .map_err(|e| ParallelError::Mpi(e.to_string()))
     }
     #[cfg(not(feature = "petsc"))]
-    Err(ParallelError::NoPetsc(counts.len()))
+    {
+        let _ = root_only;
+        Err(ParallelError::NoPetsc(counts.len()))
+    }
 }
 
 /// Ends the run: on several ranks, every rank with `code` (`MPI_Abort`), since the others may

@@ -82,17 +82,13 @@ fn counts_and_displacements(counts: &[usize]) -> Result<(Vec<c_int>, Vec<c_int>)
 }
 
 /// Every rank's `local` values (`counts[r]` from rank r, this rank's being `local`), in rank
-/// order, on every rank (collective over `PETSC_COMM_WORLD`).
-pub fn gather_values(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
-    gather(local, counts, false)
-}
-
-/// [`gather_values`] onto rank 0 alone: the other ranks receive nothing (an empty vector).
-pub fn gather_values_to_root(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, LinalgError> {
-    gather(local, counts, true)
-}
-
-fn gather(local: &[f64], counts: &[usize], root_only: bool) -> Result<Vec<f64>, LinalgError> {
+/// order, on every rank, or with `root_only` on rank 0 alone (the others receive an empty
+/// vector); collective over `PETSC_COMM_WORLD`.
+pub fn gather_values(
+    local: &[f64],
+    counts: &[usize],
+    root_only: bool,
+) -> Result<Vec<f64>, LinalgError> {
     let receives = !root_only || world_ranks()?.rank == 0;
     let total = if receives { counts.iter().sum() } else { 0 };
     let (counts, displs) = counts_and_displacements(counts)?;
