@@ -29,44 +29,47 @@ use super::RunError;
 pub(super) fn scatter_mesh(whole: Option<Mesh>, case: &Case) -> Result<Mesh, RunError> {
     let message = |e: postcard::Error| RunError::Parallel(ParallelError::Message(e.to_string()));
     // 1. On rank 0: the partition, each body's cells divided, and the mesh without them.
-    let (skeleton, divided, mut tags) = match whole {
+    let (skeleton, divided) = match whole {
         Some(mut mesh) => {
-            let (divided, tags) = divide_cells(&mut mesh, case)?.into_iter().unzip();
-            (
-                postcard::to_allocvec(&mesh).map_err(message)?,
-                divided,
-                tags,
-            )
+            let divided = divide_cells(&mut mesh, case)?;
+            (postcard::to_allocvec(&mesh).map_err(message)?, divided)
         }
-        None => (Vec::new(), Vec::new(), Vec::new()),
+        None => (Vec::new(), Vec::new()),
     };
     // 2. The mesh without the cells on every rank, then each rank's cells, body by body.
-    // The bytes are freed only once the cells are here: glibc raises its mmap threshold to the
-    // size of the largest mapped block freed, so cells and indices received after the free
-    // would come from the main heap, where a long-lived block can keep freed memory resident
-    // (the indices received after it: rank 1's peak at 1M DOFs on 2 ranks 1,394 to 1,407 MB
-    // in three runs of four, against 1,335 to 1,339 in every run without them or with this
-    // order).
+    // The bytes are freed only once the cells are here, so that the cells and indices are
+    // allocated beside them rather than in the room they leave: with glibc's default (a
+    // threshold that rises to the largest mapped block freed) the indices received after the
+    // free raised rank 1's peak at 1M DOFs on 2 ranks to 1,394 to 1,407 MB in three runs of
+    // four, against 1,335 to 1,339 in this order. Since `crate::parallel::start` fixes the
+    // threshold, the order matters only for blocks under 4 MiB; that fix was measured with it
+    // (1,336 to 1,343 MB).
     let bytes = parallel::share_from_root(skeleton).map_err(RunError::Parallel)?;
     let mut mesh: Mesh = postcard::from_bytes(&bytes).map_err(message)?;
     let mut divided = divided.into_iter();
-    tags.reverse();
     for spec in &case.bodies {
         let body = (mesh.bodies.iter_mut().find(|b| b.name == spec.name))
             .expect("rank 0's checks found every body of the case");
-        let CellsByRank {
-            cells,
-            indices,
-            counts,
-        } = divided.next().unwrap_or_default();
+        // Rank 0 keeps the body's element tags, for the output; the others receive none.
+        let (
+            CellsByRank {
+                cells,
+                indices,
+                counts,
+            },
+            tags,
+        ) = match divided.next() {
+            Some((cells, tags)) => (cells, Some(tags)),
+            None => (CellsByRank::default(), None),
+        };
         let width = body.nodes_per_cell();
         let scatter = |values, width| {
             parallel::scatter_cells(values, &counts, width).map_err(RunError::Parallel)
         };
         let (cells, indices) = (scatter(cells, width)?, scatter(indices, 1)?);
         body.receive_cells(cells, indices);
-        if let (Some(part), Some(tags)) = (body.part.as_mut(), tags.pop()) {
-            part.whole_cell_tags = Some(tags);
+        if let Some(part) = body.part.as_mut() {
+            part.whole_cell_tags = tags;
         }
         log::debug!(
             "body '{}': rank {} keeps {} of its {} cells",
