@@ -184,6 +184,7 @@ fn ranks_give_the_serial_answer(
 /// [`ranks_give_the_serial_answer`] with `edit` applied to the example's table, and
 /// `extra_iterations` more active-set iterations allowed to one run than to the other in a
 /// step (0 but where the runs are solved to a tight tolerance: see the Coulomb pair's test).
+/// Returns the folder of the runs (the serial run's output in `one`).
 fn ranks_give_the_serial_answer_of(
     ranks: usize,
     name: &str,
@@ -191,7 +192,7 @@ fn ranks_give_the_serial_answer_of(
     laterals_from_step: usize,
     extra_iterations: u64,
     edit: &dyn Fn(&mut toml::Table),
-) {
+) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     let cg_amg = "\n[solver]\nbody = \"cg-amg\"\n";
     let case = edited_example_case(dir.path(), name, cg_amg, edit);
@@ -324,6 +325,7 @@ fn ranks_give_the_serial_answer_of(
             );
         }
     }
+    dir
 }
 
 #[test]
@@ -357,6 +359,38 @@ fn a_load_path_on_two_ranks_gives_the_serial_answer() {
 fn the_penalty_method_on_two_ranks_gives_the_serial_answer() {
     // The demo under the penalty method: the rows' own term 1 / eps on the distributed path.
     ranks_give_the_serial_answer(2, "hemisphere_on_block", "method = \"penalty\"", 1);
+}
+
+#[test]
+fn the_demo_refined_on_two_ranks_shares_its_contact_surfaces_and_gives_the_serial_answer() {
+    // Refined (level 0.9, 108k DOFs, one load step) until each body has more than
+    // `BALANCED_INTERFACE_PER_RANK` contact-surface nodes a rank: the partition then shares
+    // those nodes out evenly as a second METIS constraint, which the coarser cases above never
+    // reach, and the answer stays the serial one.
+    let dir = ranks_give_the_serial_answer_of(2, "hemisphere_on_block", "", 1, 0, &|case| {
+        case["contact"]["load_steps"] = toml::Value::Array(vec![1.0.into()]);
+        let geo = case["geo_parameters"].as_table_mut().unwrap();
+        geo.insert("level".into(), 0.9.into());
+    });
+    let mesh = dir.path().join("one/mesh.msh");
+    let info = serial(&["info", mesh.to_str().unwrap()]);
+    let info = String::from_utf8_lossy(&info.stdout).into_owned();
+    for surface in ["sphere_contact", "block_contact"] {
+        let nodes: usize = (info.lines())
+            .find_map(|l| l.trim().strip_prefix(&format!("boundary '{surface}': ")))
+            .and_then(|rest| {
+                rest.split(", ")
+                    .nth(1)?
+                    .strip_suffix(" nodes")?
+                    .parse()
+                    .ok()
+            })
+            .unwrap_or_else(|| panic!("{surface} in:\n{info}"));
+        assert!(
+            nodes >= 2 * internodes::linalg::BALANCED_INTERFACE_PER_RANK,
+            "{surface}: {nodes} nodes"
+        );
+    }
 }
 
 #[test]

@@ -3,9 +3,10 @@
 //!
 //! The body's nodes are split into one part per rank by METIS (`METIS_PartGraphKway` on the
 //! node graph of the stiffness: parts of nearly equal size with few edges between them, so
-//! that a matrix-vector product or a V-cycle exchanges little). PETSc owns its rows by
-//! contiguous ranges, so PETSc's numbering puts the nodes of rank 0 first, then those of rank
-//! 1, and so on, each rank's along a Z curve through their coordinates (locality for the
+//! that a matrix-vector product or a V-cycle exchanges little; and, for a body with many
+//! contact-surface nodes, a nearly equal share of those: [`node_owners`]). PETSc owns its
+//! rows by contiguous ranges, so PETSc's numbering puts the nodes of rank 0 first, then those
+//! of rank 1, and so on, each rank's along a Z curve through their coordinates (locality for the
 //! products of GAMG's set-up and V-cycles: `super::node_order`), each node's `dim` unknowns
 //! together (the block structure GAMG aggregates by). Every rank computes the same partition
 //! and order (METIS is deterministic for a given graph), assembles the columns of its own
@@ -42,10 +43,24 @@ pub struct Distribution {
     block: usize,
 }
 
+/// Contact-surface nodes per rank from which a partition shares them out evenly
+/// ([`node_owners`]). The contact loop's rows cost about 23 kB a contact-surface node (the
+/// coupling blocks, the interpolation's rows and columns and the interface coupling: 491 MB
+/// over 4 ranks for the 21,470 of the hemisphere on a block at 1M DOFs), so below a thousand
+/// a rank they weigh tens of MB at most, while a second constraint on a few hundred nodes costs METIS the
+/// balance of the sizes (a 2D body of 51 nodes split 28 / 23, 10% over an even half).
+pub const BALANCED_INTERFACE_PER_RANK: usize = 1_000;
+
 /// The rank that owns each node of a body whose stiffness has the node graph `graph`: a METIS
 /// partition into `ranks.size` parts, the same on every rank (METIS is deterministic for a
-/// given graph).
-pub fn node_owners(graph: &NodeGraph, ranks: Ranks) -> Result<Vec<u32>, LinalgError> {
+/// given graph). Where `interface` marks the body's contact-surface nodes and they number at
+/// least [`BALANCED_INTERFACE_PER_RANK`] a rank, each rank also gets a nearly equal share of
+/// them (`super::ordering::partition`); `interface` may be empty.
+pub fn node_owners(
+    graph: &NodeGraph,
+    ranks: Ranks,
+    interface: &[bool],
+) -> Result<Vec<u32>, LinalgError> {
     let num_nodes = graph.num_nodes();
     let neighbours: Vec<Vec<usize>> = (0..num_nodes)
         .map(|a| {
@@ -57,7 +72,12 @@ pub fn node_owners(graph: &NodeGraph, ranks: Ranks) -> Result<Vec<u32>, LinalgEr
                 .collect()
         })
         .collect();
-    let part = partition(&neighbours, ranks.size)?;
+    let marked = interface.iter().filter(|&&m| m).count();
+    let balanced = match marked >= BALANCED_INTERFACE_PER_RANK * ranks.size {
+        true => interface,
+        false => &[],
+    };
+    let part = partition(&neighbours, ranks.size, balanced)?;
     drop(neighbours);
     // The mesh refuses bodies of 2^32 nodes or more (`crate::mesh::MeshError`).
     if u32::try_from(num_nodes).is_err() {
@@ -72,7 +92,12 @@ impl Distribution {
     /// The distribution over `ranks` of the unknowns of the body whose stiffness has the node
     /// graph `graph` and whose nodes are at `coords` (one value per unknown: `block` per node).
     pub fn new(graph: &NodeGraph, coords: &[f64], ranks: Ranks) -> Result<Self, LinalgError> {
-        Self::with_owners(&node_owners(graph, ranks)?, coords, graph.block(), ranks)
+        Self::with_owners(
+            &node_owners(graph, ranks, &[])?,
+            coords,
+            graph.block(),
+            ranks,
+        )
     }
 
     /// The distribution over `ranks` of the unknowns of a body whose nodes `owner` assigns to

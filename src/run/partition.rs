@@ -14,7 +14,7 @@ use crate::case::{Case, CaseError};
 use crate::elastic::{SolveError, prescribed_dofs};
 use crate::fem::assembly::stiffness_graph;
 use crate::linalg::node_owners;
-use crate::mesh::{CellsByRank, ElementTags, Mesh, MeshError, read_msh};
+use crate::mesh::{BodyMesh, CellsByRank, ElementTags, Mesh, MeshError, read_msh};
 use crate::parallel::{self, ParallelError};
 
 use super::RunError;
@@ -125,7 +125,8 @@ fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, Elemen
                 source,
             },
         };
-        let owner = node_owners(&stiffness_graph(body), ranks).map_err(linalg_error)?;
+        let owner = node_owners(&stiffness_graph(body), ranks, &contact_nodes(body, case))
+            .map_err(linalg_error)?;
         let prescribed =
             prescribed_dofs(&case.elastic_problem(body, spec)?).map_err(|e| RunError::Solve {
                 path: case.path.clone(),
@@ -137,6 +138,23 @@ fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, Elemen
         divided.push((cells, body.drop_cells(owner)));
     }
     Ok(divided)
+}
+
+/// The nodes of `body` on a contact surface of `case` (any pair's, either side), marked: the
+/// nodes whose rows the contact loop's operators hold, which the partition shares among the
+/// ranks besides the body's nodes (`crate::linalg::node_owners`).
+fn contact_nodes(body: &BodyMesh, case: &Case) -> Vec<bool> {
+    let mut marked = vec![false; body.num_nodes()];
+    for pair in &case.contacts {
+        for (name, surface) in pair.bodies.iter().zip(&pair.surfaces) {
+            if *name == body.name {
+                for node in body.group_nodes(surface).unwrap_or_default() {
+                    marked[node] = true;
+                }
+            }
+        }
+    }
+    marked
 }
 
 /// `mesh`, or where this rank kept only part of its cells, the whole mesh read again from its
