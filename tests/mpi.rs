@@ -363,7 +363,7 @@ fn the_penalty_method_on_two_ranks_gives_the_serial_answer() {
 
 #[test]
 fn the_demo_refined_on_two_ranks_shares_its_contact_surfaces_and_gives_the_serial_answer() {
-    // Refined (level 0.9, 108k DOFs, one load step) until each body has more than
+    // Refined (level 0.9, 108k DOFs, one load step) until each body has at least
     // `BALANCED_INTERFACE_PER_RANK` contact-surface nodes a rank: the partition then shares
     // those nodes out evenly as a second METIS constraint, which the coarser cases above never
     // reach, and the answer stays the serial one.

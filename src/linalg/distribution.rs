@@ -47,8 +47,9 @@ pub struct Distribution {
 /// ([`node_owners`]). The contact loop's rows cost about 23 kB a contact-surface node (the
 /// coupling blocks, the interpolation's rows and columns and the interface coupling: 491 MB
 /// over 4 ranks for the 21,470 of the hemisphere on a block at 1M DOFs), so below a thousand
-/// a rank they weigh tens of MB at most, while a second constraint on a few hundred nodes costs METIS the
-/// balance of the sizes (a 2D body of 51 nodes split 28 / 23, 10% over an even half).
+/// a rank they weigh tens of MB at most, while a second constraint on a few hundred nodes
+/// costs METIS the balance of the sizes (a 2D body of 51 nodes split 28 / 23, 10% over an
+/// even half).
 pub const BALANCED_INTERFACE_PER_RANK: usize = 1_000;
 
 /// The rank that owns each node of a body whose stiffness has the node graph `graph`: a METIS
