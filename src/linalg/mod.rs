@@ -16,7 +16,9 @@ pub use body_solver::{
     AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE, PendingCgAmg,
 };
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
-pub use distribution::{BALANCED_INTERFACE_PER_RANK, Distribution, RankRows, node_owners};
+pub use distribution::{
+    BALANCED_INTERFACE_PER_RANK, Distribution, RankRows, node_owners, spread_parts,
+};
 pub(crate) use node_order::z_curve_keys;
 
 use faer::sparse::SparseColMat;

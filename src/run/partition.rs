@@ -13,7 +13,7 @@ use std::path::Path;
 use crate::case::{Case, CaseError};
 use crate::elastic::{SolveError, prescribed_dofs};
 use crate::fem::assembly::stiffness_graph;
-use crate::linalg::node_owners;
+use crate::linalg::{node_owners, spread_parts};
 use crate::mesh::{BodyMesh, CellsByRank, ElementTags, Mesh, MeshError, read_msh};
 use crate::parallel::{self, ParallelError};
 
@@ -105,6 +105,9 @@ fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, Elemen
     case.check_bodies(mesh)?;
     let ranks = parallel::ranks();
     let mut divided = Vec::with_capacity(case.bodies.len());
+    // The nodes each rank owns of the bodies divided so far: each body's parts go where they
+    // even out the ranks' totals (`crate::linalg::spread_parts`).
+    let mut nodes_on_rank = vec![0; ranks.size];
     for spec in &case.bodies {
         let body = (mesh.bodies.iter_mut().find(|b| b.name == spec.name))
             .expect("the checks found every body of the case");
@@ -125,8 +128,15 @@ fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, Elemen
                 source,
             },
         };
-        let owner = node_owners(&stiffness_graph(body), ranks, &contact_nodes(body, case))
+        let mut owner = node_owners(&stiffness_graph(body), ranks, &contact_nodes(body, case))
             .map_err(linalg_error)?;
+        let rank_of_part = spread_parts(&mut owner, &mut nodes_on_rank);
+        log::debug!(
+            "body '{}': its {} parts on ranks {rank_of_part:?}, the ranks' nodes so far \
+             {nodes_on_rank:?}",
+            body.name,
+            ranks.size
+        );
         let prescribed =
             prescribed_dofs(&case.elastic_problem(body, spec)?).map_err(|e| RunError::Solve {
                 path: case.path.clone(),
