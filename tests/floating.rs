@@ -43,7 +43,7 @@ fn corner_tag() -> i64 {
     let mesh = read_fixture("two_blocks_2d.msh");
     let upper = mesh.bodies.iter().find(|b| b.name == "upper").unwrap();
     let nodes = upper.group_nodes("upper_corner").unwrap();
-    upper.node_tags[nodes[0]] as i64
+    upper.node_tags.get(nodes[0]) as i64
 }
 
 #[test]

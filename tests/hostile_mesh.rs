@@ -17,7 +17,7 @@ use internodes::mesh::{Mesh, MeshError, MeshSummary, read_msh, read_msh_bytes};
 fn coords_by_tag(mesh: &Mesh) -> HashMap<u64, [f64; 3]> {
     mesh.bodies
         .iter()
-        .flat_map(|b| b.node_tags.iter().copied().zip(b.coords.iter().copied()))
+        .flat_map(|b| b.node_tags.iter().zip(b.coords.iter().copied()))
         .collect()
 }
 
@@ -29,7 +29,7 @@ fn cells_by_tag(mesh: &Mesh) -> HashMap<u64, Vec<u64>> {
             (0..b.num_cells()).map(move |c| {
                 (
                     b.cell_tags.get(c),
-                    b.cell(c).iter().map(|&n| b.node_tags[n]).collect(),
+                    b.cell(c).iter().map(|&n| b.node_tags.get(n)).collect(),
                 )
             })
         })
@@ -430,7 +430,7 @@ fn two_2d_bodies_on_different_planes_are_rejected() {
         .clone();
     let (_dir, path) = edited_fixture("two_blocks_2d.msh", |text| {
         edit_nodes(&text, |tag, x| {
-            let z = if upper.binary_search(&tag).is_ok() {
+            let z = if upper.position(tag).is_some() {
                 1.0
             } else {
                 0.0

@@ -58,7 +58,7 @@ fn a_model_is_split_into_bodies_and_groups_as_a_file_is() {
     let mesh = mesh_from_model(Path::new("gmsh model 'm'"), square()).unwrap();
     assert_eq!(mesh.dim, 2);
     let body = mesh.body("square").unwrap();
-    assert_eq!(body.node_tags, vec![10, 20, 30, 40]);
+    assert_eq!(body.node_tags.to_vec(), vec![10, 20, 30, 40]);
     assert_eq!(body.cell_tags.to_vec(), vec![1, 2]);
     let bottom = body.boundary_group("bottom").unwrap();
     // The bottom edge, oriented so that its right-hand normal points out of the square (-y).

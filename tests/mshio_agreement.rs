@@ -70,11 +70,15 @@ fn every_body_node_and_cell_agrees_with_mshio() {
         let mesh = read_msh(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
         let mut cells = 0;
         for body in &mesh.bodies {
-            for (x, tag) in body.coords.iter().zip(&body.node_tags) {
-                assert_eq!(Some(x), coordinates.get(tag), "{name}: node {tag}");
+            for (x, tag) in body.coords.iter().zip(body.node_tags.iter()) {
+                assert_eq!(Some(x), coordinates.get(&tag), "{name}: node {tag}");
             }
             for c in 0..body.num_cells() {
-                let ours: Vec<u64> = body.cell(c).iter().map(|&n| body.node_tags[n]).collect();
+                let ours: Vec<u64> = body
+                    .cell(c)
+                    .iter()
+                    .map(|&n| body.node_tags.get(n))
+                    .collect();
                 let tag = body.cell_tags.get(c);
                 assert_eq!(Some(&ours), elements.get(&tag), "{name}: element {tag}");
                 cells += 1;

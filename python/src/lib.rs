@@ -1579,7 +1579,7 @@ impl BodyResult {
         Ok(BodyResult {
             name: solved.name.clone(),
             coordinates: array(py, coordinates, &[n, dim])?,
-            node_tags: array(py, body.node_tags.clone(), &[n])?,
+            node_tags: array(py, body.node_tags.to_vec(), &[n])?,
             displacement: array(py, solved.solution.displacement.clone(), &[n, dim])?,
             cells: array(
                 py,

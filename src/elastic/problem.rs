@@ -382,7 +382,7 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
                         ProblemError::ConflictingDirichlet {
                             body: body.name.clone(),
                             group: condition.group.clone(),
-                            node_tag: body.node_tags[node],
+                            node_tag: body.node_tags.get(node),
                             component,
                             first,
                             second: value,
@@ -400,7 +400,7 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
                                 };
                                 return Err(ProblemError::ConflictingPath {
                                     body: body.name.clone(),
-                                    node_tag: body.node_tags[node],
+                                    node_tag: body.node_tags.get(node),
                                     component,
                                     value,
                                     paths: format!("{} and {}", name(first), name(on)),
@@ -429,7 +429,7 @@ pub(crate) fn constraints(problem: &ElasticProblem) -> Result<Constraints, Probl
                 return Err(ProblemError::ForcedTwice {
                     body: body.name.clone(),
                     group: forced.group.clone(),
-                    node_tag: body.node_tags[dof / dim],
+                    node_tag: body.node_tags.get(dof / dim),
                     component: forced.component,
                     other,
                 });
@@ -479,7 +479,7 @@ pub(crate) fn forced_components(problem: &ElasticProblem) -> Vec<ForcedComponent
     }
     for &(node, component) in &problem.pins {
         out.push(ForcedComponent {
-            group: format!("rigid-mode pin at node {}", body.node_tags[node]),
+            group: format!("rigid-mode pin at node {}", body.node_tags.get(node)),
             component,
             force: 0.0,
             dofs: vec![dim * node + component],

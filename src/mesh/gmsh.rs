@@ -247,7 +247,7 @@ impl FileContents {
             coords,
             cells: cells.node_tags.iter().map(|t| local[t]).collect(),
             cell_tags: cells.element_tags.clone().into(),
-            node_tags,
+            node_tags: node_tags.into(),
             boundary_groups: BTreeMap::new(),
             point_groups: BTreeMap::new(),
             part: None,
@@ -259,7 +259,7 @@ impl FileContents {
         let mut nodes: Vec<usize> = points
             .node_tags
             .iter()
-            .filter_map(|tag| body.node_tags.binary_search(tag).ok())
+            .filter_map(|&tag| body.node_tags.position(tag))
             .collect();
         nodes.sort_unstable();
         nodes.dedup();
@@ -273,7 +273,7 @@ impl FileContents {
             .node_tags
             .iter()
             .enumerate()
-            .map(|(i, &t)| (t, i))
+            .map(|(i, t)| (t, i))
             .collect();
         // Facets of the group that lie on the body, keyed by their sorted local nodes.
         let mut wanted: HashMap<Vec<usize>, usize> = HashMap::new();

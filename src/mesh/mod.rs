@@ -8,20 +8,20 @@
 //! Every boundary facet is stored with the node order that makes its right-hand normal point
 //! out of the body (worked out from the adjacent cell, never from the file's facet order).
 
-mod element_tags;
 mod error;
 mod generate;
 mod gmsh;
+mod gmsh_tags;
 mod model;
 mod msh41;
 mod part;
 mod quality;
 mod summary;
 
-pub use element_tags::ElementTags;
 pub use error::MeshError;
 pub use generate::mesh_geo;
 pub use gmsh::{mesh_from_model, read_msh, read_msh_bytes};
+pub use gmsh_tags::GmshTags;
 pub use model::{GmshModel, ModelElements, ModelGroup};
 pub use part::{CellsByRank, RankPart};
 pub use quality::{check_cells, signed_measure};
@@ -95,14 +95,14 @@ pub struct BodyMesh {
     pub dim: Dim,
     /// Node coordinates; `z = 0` in 2D.
     pub coords: Vec<[f64; 3]>,
-    /// Local node index -> gmsh node tag.
-    pub node_tags: Vec<u64>,
+    /// Local node index -> gmsh node tag, increasing (the nodes are numbered in tag order).
+    pub node_tags: GmshTags,
     /// Cell connectivity, `dim + 1` local node indices per cell, flat. Stored as `u32`, half
     /// the bytes of the largest array of a mesh (a body of 2^32 nodes or more is refused when
     /// read); [`Self::cell`] and [`Self::cells`] give them as `usize`.
     pub cells: Vec<u32>,
     /// Local cell index -> gmsh element tag.
-    pub cell_tags: ElementTags,
+    pub cell_tags: GmshTags,
     /// Boundary groups that have at least one facet on this body, by name.
     pub boundary_groups: BTreeMap<String, FacetGroup>,
     /// Groups of points (gmsh physical points) on this body: sorted local nodes, by name. They

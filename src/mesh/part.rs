@@ -11,12 +11,13 @@
 //! ([`BodyMesh::boundary_facets`]). Rank 0, which reads the mesh, divides the cells
 //! ([`BodyMesh::cells_by_rank`]) and sends each rank its own (`crate::run`'s partition); the
 //! others never hold the whole body. Every node stays: the coordinates are 24 bytes a node
-//! against the cells' 16 bytes a cell and about 5.5 cells a node in 3D.
+//! against the cells' 16 bytes a cell and about 5.5 cells a node in 3D (the node tags are
+//! kept as runs: [`super::GmshTags`]).
 
 use rayon::slice::ParallelSliceMut;
 use serde::{Deserialize, Serialize};
 
-use super::{BodyMesh, ElementTags};
+use super::{BodyMesh, GmshTags};
 
 /// What a rank keeps of a body's mesh beside the cells ([`BodyMesh::part`]).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -32,10 +33,10 @@ pub struct RankPart {
     /// holds them in this order): the row the output writes it in.
     pub cell_indices: Vec<u32>,
     /// The whole body's element tags on rank 0, which writes the output (gmsh numbers a
-    /// body's elements in a few runs of consecutive tags: [`ElementTags`]); `None` on the
+    /// body's elements in a few runs of consecutive tags: [`GmshTags`]); `None` on the
     /// other ranks. Never sent between ranks.
     #[serde(skip)]
-    pub whole_cell_tags: Option<ElementTags>,
+    pub whole_cell_tags: Option<GmshTags>,
 }
 
 /// Every rank's cells of a body, one rank after the other, each rank's in the body's order:
@@ -112,7 +113,7 @@ impl BodyMesh {
     /// take 8 bytes a cell beside the cell's 16), the partition `owner`, and what the whole
     /// body's cells gave ([`RankPart`]). Returns the tags, which rank 0 keeps
     /// ([`RankPart::whole_cell_tags`]).
-    pub fn drop_cells(&mut self, owner: Vec<u32>) -> ElementTags {
+    pub fn drop_cells(&mut self, owner: Vec<u32>) -> GmshTags {
         debug_assert!(self.part.is_none(), "the cells of a whole body");
         let boundary_facets = self.boundary_facets();
         let total_cells = self.num_cells();
@@ -124,7 +125,7 @@ impl BodyMesh {
             cell_indices: Vec::new(),
             whole_cell_tags: None,
         });
-        std::mem::replace(&mut self.cell_tags, ElementTags::from(Vec::new()))
+        std::mem::replace(&mut self.cell_tags, GmshTags::from(Vec::new()))
     }
 
     /// This rank's cells of a body whose cells were dropped ([`Self::drop_cells`]), in the

@@ -192,7 +192,7 @@ impl Grid<'_> {
             .collect();
         let geometry = |k: usize| body(k).mesh.coords.iter().flatten().copied();
         self.write_by_body(&mesh, "geometry", Width::Columns(3), nodes, geometry)?;
-        let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|&t| t as i64);
+        let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|t| t as i64);
         self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
         let node_body = |k: usize| std::iter::repeat_n(k as i32, nodes[k]);
         self.write_by_body(&mesh, "node_body", Width::Scalar, nodes, node_body)?;

@@ -14,7 +14,7 @@ use crate::case::{Case, CaseError};
 use crate::elastic::{SolveError, prescribed_dofs};
 use crate::fem::assembly::stiffness_graph;
 use crate::linalg::{node_owners, spread_parts};
-use crate::mesh::{BodyMesh, CellsByRank, ElementTags, Mesh, MeshError, read_msh};
+use crate::mesh::{BodyMesh, CellsByRank, GmshTags, Mesh, MeshError, read_msh};
 use crate::parallel::{self, ParallelError};
 
 use super::RunError;
@@ -100,7 +100,7 @@ fn return_freed_memory() {
 /// Rank 0's division of the cells of every body of `case` among the ranks, in the case's
 /// order of bodies, each with the body's element tags; each of those bodies of `mesh` is left
 /// without its cells and tags ([`crate::mesh::BodyMesh::drop_cells`]).
-fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, ElementTags)>, RunError> {
+fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, GmshTags)>, RunError> {
     // The problems below read the case's groups, which its checks vouch for first.
     case.check_bodies(mesh)?;
     let ranks = parallel::ranks();

@@ -109,7 +109,7 @@ impl ContactSurface {
             body: body.name.clone(),
             group: group_name.to_string(),
             dim,
-            tags: nodes.iter().map(|&n| body.node_tags[n]).collect(),
+            tags: nodes.iter().map(|&n| body.node_tags.get(n)).collect(),
             nodes,
             coords,
             normals,
