@@ -259,6 +259,8 @@ fn ranks_give_the_serial_answer_of(
         b["rank_peak_memory_mb"].as_array().map(Vec::len),
         Some(ranks)
     );
+    let mut totals = vec![0i64; ranks];
+    let mut largest_difference = 0;
     for body in b["bodies"].as_array().unwrap() {
         let shares: Vec<u64> = (body["solve"]["rank_dofs"].as_array().unwrap().iter())
             .map(|v| v.as_u64().unwrap())
@@ -275,6 +277,20 @@ fn ranks_give_the_serial_answer_of(
                 .iter()
                 .all(|&s| (s as f64 - even).abs() <= 0.03 * even + 3.0),
             "{shares:?}"
+        );
+        for (total, &share) in totals.iter_mut().zip(&shares) {
+            *total += share as i64;
+        }
+        largest_difference =
+            largest_difference.max(shares.iter().max().unwrap() - shares.iter().min().unwrap());
+    }
+    // Each body's parts go to the ranks that even out the totals (`linalg::spread_parts`): on
+    // two ranks the totals then differ by no more than one body's parts do, where labels left
+    // as METIS gives them add up when the bodies' larger parts fall on one rank.
+    if ranks == 2 {
+        assert!(
+            (totals[0] - totals[1]).unsigned_abs() <= largest_difference,
+            "{name}: the ranks' unknowns {totals:?}, a body's parts at most {largest_difference} apart"
         );
     }
     let (pairs_a, pairs_b) = (pairs(&a), pairs(&b));
