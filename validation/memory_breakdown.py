@@ -68,6 +68,9 @@ PARTS = [
     ("assembly: graph, partition, rows, loads", "internodes::elastic::"),
     ("assembly: graph, partition, rows, loads", "internodes::fem::"),
     ("assembly: graph, partition, rows, loads", "Distribution::"),
+    # A rank's cells, received from rank 0 (`crate::parallel::scatter_cells`) into the body:
+    # the partition's own graph and METIS have fem's frames above.
+    ("mesh", "internodes::run::partition::"),
     ("contact (other)", "internodes::contact::"),
     ("output", "internodes::output::"),
     ("PETSc and MPI initialization", "internodes_petsc_initialize"),

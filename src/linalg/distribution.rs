@@ -4,7 +4,8 @@
 //! The body's nodes are split into one part per rank by METIS (`METIS_PartGraphKway` on the
 //! node graph of the stiffness: parts of nearly equal size with few edges between them, so
 //! that a matrix-vector product or a V-cycle exchanges little; and, for a body with many
-//! contact-surface nodes, a nearly equal share of those: [`node_owners`]). PETSc owns its
+//! contact-surface nodes, a nearly equal share of those: [`node_owners`]), each part given to
+//! the rank that keeps the ranks' totals over the bodies even ([`spread_parts`]). PETSc owns its
 //! rows by contiguous ranges, so PETSc's numbering puts the nodes of rank 0 first, then those
 //! of rank 1, and so on, each rank's along a Z curve through their coordinates (locality for the
 //! products of GAMG's set-up and V-cycles: `super::node_order`), each node's `dim` unknowns

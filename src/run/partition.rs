@@ -1,6 +1,7 @@
 //! The mesh of a distributed run divided among the ranks, before anything is assembled: rank 0
 //! reads the whole mesh, partitions each body's nodes once (METIS on the node graph of its
-//! whole mesh) and sends every rank what it keeps ([`crate::mesh::RankPart`]): the nodes, groups,
+//! whole mesh, each part given to the rank that keeps the ranks' totals even) and sends every
+//! rank what it keeps ([`crate::mesh::RankPart`]): the nodes, groups,
 //! partition and boundary of every body, and only the cells it assembles. No other rank ever
 //! holds a whole body's cells or the file's bytes. What reads a cell after this is the
 //! assembly of a rank's own columns and of the prescribed ones, the only cells it keeps, and
