@@ -108,13 +108,6 @@ pub fn spread_parts(owner: &mut [u32], nodes_on_rank: &mut [usize]) -> Vec<usize
     for &part in owner.iter() {
         size[part as usize] += 1;
     }
-    let largest_total = |rank_of_part: &[usize]| {
-        let mut total = nodes_on_rank.to_vec();
-        for (part, &rank) in rank_of_part.iter().enumerate() {
-            total[rank] += size[part];
-        }
-        total.into_iter().max().unwrap_or(0)
-    };
     let mut by_size: Vec<usize> = (0..ranks).collect();
     by_size.sort_by_key(|&part| std::cmp::Reverse(size[part]));
     let mut spread = vec![0; ranks];
@@ -126,10 +119,10 @@ pub fn spread_parts(owner: &mut [u32], nodes_on_rank: &mut [usize]) -> Vec<usize
         spread[part] = rank;
         total[rank] += size[part];
     }
-    let identity: Vec<usize> = (0..ranks).collect();
-    let rank_of_part = match largest_total(&spread) < largest_total(&identity) {
+    let with_metis_labels = (0..ranks).map(|r| nodes_on_rank[r] + size[r]).max();
+    let rank_of_part: Vec<usize> = match total.into_iter().max() < with_metis_labels {
         true => spread,
-        false => identity,
+        false => (0..ranks).collect(),
     };
     for part in owner.iter_mut() {
         *part = rank_of_part[*part as usize] as u32;
