@@ -126,3 +126,58 @@ fn a_punch_whose_footprint_is_off_the_mesh_lines_loads_only_the_nodes_under_it()
         }
     }
 }
+
+/// `geo/tilted_cube_3d.geo` meshed by gmsh into `folder` at the edge sweep's spacings: the
+/// cube 0.01 and the block 0.014 within 0.04 of the cube's lowest edge.
+fn tilted_cube(folder: &std::path::Path) -> std::path::PathBuf {
+    let geo = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("geo/tilted_cube_3d.geo");
+    let msh = folder.join("tilted_cube_3d.msh");
+    let parameters = [("h_c".to_string(), 0.01), ("h_b".to_string(), 0.014)];
+    mesh_geo(&geo, &msh, &parameters).expect("gmsh meshes");
+    msh
+}
+
+#[test]
+fn an_edge_pressed_into_a_body_of_its_own_material_is_one_node_across_and_not_certified() {
+    // The tilted cube's lowest edge pressed by 1% of its side into a block: with the cube as
+    // primary the loop converges on the edge's line of nodes, one node across however long the
+    // line. On a block of the cube's own material the load across the line is what the transfer
+    // spreads: the answer was certified 1.9% off a same-mesh node-to-triangle reference (the
+    // edge sweep's `cube-edge-equal`) while the zone's largest extent, the edge's length,
+    // passed the resolution check. Against a nearly rigid block the same line is held on the
+    // block's plane whatever spreads the load (the edge sweep's `cube-edge`: 0.04% off the
+    // rigid plane), and the check stays as it was.
+    let folder = tempfile::tempdir().unwrap();
+    let msh = tilted_cube(folder.path());
+    for (block_modulus, named) in [(1000.0, true), (1.0e6, false)] {
+        let case = CaseFile::new(&msh)
+            .contact(["cube", "block"], ["cube_contact", "block_contact"])
+            .primary("cube")
+            .body(
+                Body::new("cube", 1000.0, 0.3).dirichlet(
+                    Dirichlet::on("cube_top")
+                        .lateral(3, 0.0)
+                        .vertical(3, -0.004),
+                ),
+            )
+            .body(
+                Body::new("block", block_modulus, 0.3)
+                    .dirichlet(Dirichlet::clamped("block_base", 3)),
+            );
+        let solution = solve_with(&case, false).unwrap();
+        let label = format!("block E = {block_modulus}");
+        assert_eq!(solution.status, ContactStatus::Converged, "{label}");
+        let resolution = (solution.certificate.checks.iter())
+            .find(|c| c.name == internodes::contact::CheckKind::Resolution)
+            .expect("a resolution check");
+        eprintln!(
+            "{label}: resolution {:.3e} at {:?}",
+            resolution.value, resolution.body
+        );
+        assert_eq!(!resolution.passed, named, "{label}: {resolution:?}");
+        if named {
+            // One node across: the figure is the cap of a zone without width.
+            assert!(resolution.value > 100.0, "{label}: {resolution:?}");
+        }
+    }
+}

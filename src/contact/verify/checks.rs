@@ -42,7 +42,10 @@
 //!   check can pass (a stiff, coarse primary under a small zone). The secondary needs more: the
 //!   primary sees it only through the interpolation `R12` of its displacement, whose error over
 //!   a zone of three nodes is of the order of the force's (an explicit stiff primary on a
-//!   compliant secondary three nodes across: 1.3% off dolfinx's rigid flat).
+//!   compliant secondary three nodes across: 1.3% off dolfinx's rigid flat). In 3D against a
+//!   secondary that is not nearly rigid, a zone's width is its width across its longest axis
+//!   ([`aspect`]): along a line of contact (an edge) the load across the line is what the
+//!   transfer spreads, however long the line.
 //! - **Force centre.** The two bodies' contact forces act at the same place ([`ForceCentres`]).
 //! - **Stick zone resolution** (Coulomb pairs in partial slip, [`friction`], which also measures
 //!   the Coulomb law's two residuals, the friction cone and the slip rule): the stick zone
@@ -698,15 +701,23 @@ fn held_by_primary(
 /// checked), as the spacing over the zone's width relative to that minimum; the check fails
 /// above 1. A surface's zone is its nodes in contact: a compressive mean pressure and, on the
 /// secondary, a node the active primary nodes hold ([`Held::Inside`] or [`Held::Rim`]: the
-/// transfer loads a ring of nodes around the zone that do not touch). Its width is twice the largest distance of one of them from
-/// their centroid (2a for a Hertz zone), its spacing their mean [`area_spacing`]. One node in
-/// contact has no width: its figure is capped at 1000 (JSON has no infinity). No node in
-/// contact gives 0 (nothing to resolve).
+/// transfer loads a ring of nodes around the zone that do not touch). Its spacing is their mean
+/// [`area_spacing`]; its width twice the largest distance of one of them from their centroid
+/// (2a for a Hertz zone), and in 3D against a secondary that is not nearly rigid that times
+/// the zone's [`aspect`], its width across its longest axis: the contact of an edge is one
+/// node across however long the edge, and the load across it is the transfer's spreading, not
+/// the solution's (the equal-material cube edge of the edge sweep, one primary node across, was
+/// certified 1.9% off a same-mesh node-to-triangle reference before this). Against a nearly
+/// rigid secondary the primary's nodes are held on its surface whatever spreads the load, and
+/// the largest extent stays (the cube edge on a stiff block, one node across, within 0.04% of
+/// the rigid plane). One node in contact has no width: its figure is capped at 1000 (JSON has
+/// no infinity). No node in contact gives 0 (nothing to resolve).
 fn zone_resolution(
     surfaces: [(&ContactSurface, Option<f64>); 2],
     pressures: &[Vec<f64>],
     held: &[Held],
 ) -> CertificateCheck {
+    let across = surfaces[0].0.dim == 3 && surfaces[1].1.is_some();
     let mut check = Worst::default();
     for (b, ((surface, min_width), pressure)) in surfaces.into_iter().zip(pressures).enumerate() {
         let Some(min_width) = min_width else { continue };
@@ -732,10 +743,33 @@ fn zone_resolution(
             .max_by(|&a, &b| distance(a).total_cmp(&distance(b)));
         let rim = rim.expect("the zone is not empty");
         let spacing = zone.iter().map(|&s| area_spacing(surface, s)).sum::<f64>() / n;
-        let width = (2.0 * distance(rim)).max(spacing / 1000.0);
+        let narrowing = match across {
+            true => aspect(&surface.coords, &zone, centroid),
+            false => 1.0,
+        };
+        let width = (2.0 * distance(rim) * narrowing).max(spacing / 1000.0);
         check.offer(min_width * spacing / width, surface, rim);
     }
     check.check(CheckKind::Resolution, 1.0)
+}
+
+/// How much narrower a 3D zone is across its longest axis than along it: `sqrt(l2 / l1)`, `l1 >=
+/// l2` the two largest eigenvalues of the spread of its nodes' positions about their centroid
+/// (the third is the surface's normal). The zone's ellipse of inertia has this ratio of its
+/// axes, so twice the largest distance from the centroid times it is the width across: a disc's
+/// diameter (a ratio of 1, within the sampling of its nodes), an ellipse's minor axis, a
+/// strip's width, a line's nothing.
+fn aspect(coords: &[[f64; 3]], zone: &[usize], centroid: [f64; 3]) -> f64 {
+    let offset = |s: usize| nalgebra::Vector3::from_fn(|c, _| coords[s][c] - centroid[c]);
+    let spread = zone.iter().fold(nalgebra::Matrix3::zeros(), |m, &s| {
+        m + offset(s) * offset(s).transpose()
+    });
+    let mut eigenvalues: Vec<f64> = spread.symmetric_eigenvalues().iter().copied().collect();
+    eigenvalues.sort_by(|a, b| b.total_cmp(a));
+    if eigenvalues[0] <= 0.0 {
+        return 1.0; // one node: no axis (its width is capped by the caller)
+    }
+    (eigenvalues[1].max(0.0) / eigenvalues[0]).sqrt()
 }
 
 /// The edge length of a regular mesh whose nodes stand for node `s`'s area: the area itself in
@@ -778,5 +812,71 @@ impl Worst {
             node_tag,
             note: None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::aspect;
+
+    fn centroid(points: &[[f64; 3]]) -> [f64; 3] {
+        std::array::from_fn(|c| points.iter().map(|p| p[c]).sum::<f64>() / points.len() as f64)
+    }
+
+    fn aspect_of(points: &[[f64; 3]]) -> f64 {
+        let zone: Vec<usize> = (0..points.len()).collect();
+        aspect(points, &zone, centroid(points))
+    }
+
+    #[test]
+    fn a_zone_narrows_by_its_width_across_over_its_length() {
+        // A line of 41 nodes along a direction in no axis, on a plane tilted by 20 degrees: no
+        // width, however long.
+        let (turn, tilt) = (17f64.to_radians(), 20f64.to_radians());
+        let along = [turn.cos(), turn.sin(), 0.0];
+        let line: Vec<[f64; 3]> = (0..41)
+            .map(|k| {
+                let t = -0.2 + 0.01 * k as f64;
+                [t * along[0], t * along[1], 0.3]
+            })
+            .collect();
+        assert!(aspect_of(&line) < 1e-6, "a line: {}", aspect_of(&line));
+
+        // Two such lines 0.04 apart across, on the tilted plane: a strip 0.4 long whose spread
+        // across is 0.02 against 0.4 / sqrt(12) along it.
+        let across = [
+            -turn.sin() * tilt.cos(),
+            turn.cos() * tilt.cos(),
+            tilt.sin(),
+        ];
+        let strip: Vec<[f64; 3]> = (line.iter())
+            .flat_map(|p| [-0.02, 0.02].map(|d| std::array::from_fn(|c| p[c] + d * across[c])))
+            .collect();
+        let length_spread = (line.iter().map(|p| (p[0] / along[0]).powi(2)).sum::<f64>()
+            / line.len() as f64)
+            .sqrt();
+        let expected = 0.02 / length_spread;
+        let ratio = aspect_of(&strip);
+        assert!(
+            (ratio / expected - 1.0).abs() < 1e-9,
+            "a strip: {ratio} against {expected}"
+        );
+
+        // A disc of radius 0.1 sampled on rings: as wide across as along.
+        let mut disc = vec![[0.0, 0.0, 0.0]];
+        for ring in 1..=5 {
+            let r = 0.02 * ring as f64;
+            for k in 0..6 * ring {
+                let a = 2.0 * std::f64::consts::PI * k as f64 / (6 * ring) as f64;
+                disc.push([r * a.cos(), r * a.sin(), 0.0]);
+            }
+        }
+        assert!(
+            (aspect_of(&disc) - 1.0).abs() < 1e-9,
+            "a disc: {}",
+            aspect_of(&disc)
+        );
+        // One node: no axis, no narrowing.
+        assert_eq!(aspect_of(&[[0.1, 0.2, 0.3]]), 1.0);
     }
 }
