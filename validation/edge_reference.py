@@ -56,7 +56,8 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_reference import GAP_TOLERANCE, RigidFlatContact, obstacle_below, read_body, turned_mesh  # noqa: E402
+from contact_reference import (GAP_TOLERANCE, ReferenceFailure, RigidFlatContact, obstacle_below, read_body,  # noqa: E402
+                               turned_mesh)
 from dolfinx_reference import solve_constrained  # noqa: E402
 
 
@@ -213,6 +214,46 @@ def plane_solve(msh: Path, dim: int, body: str, delta: float, youngs_modulus: fl
     return _record(model, solution, bounded, contact, reaction, delta, start, turned=False)
 
 
+def _pressed_pair(msh: Path, moving: str, delta: float, youngs_modulus: float, poisson_ratio: float,
+                  block_modulus: float | None) -> tuple:
+    """The two elastic bodies of a two-body reference without contact: ``moving`` (groups
+    ``<moving>_contact``, ``<moving>_top``) and the block (``block_contact``, ``block_base``), both
+    stiffness matrices of dolfinx in one block-diagonal matrix (``moving``'s unknowns first), the
+    moving body's top moved down by ``delta`` with its lateral components held, the block's base
+    clamped. Returns (moving body, block, K, the top's nodes, the free unknowns, the displacement of
+    the prescribed motion alone u0, the sparse LU of K on the free unknowns, the moving body's
+    contact nodes off its top and their heights above the block's top, which must be a plane
+    x_v = 0 with none of them below it)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    from dolfinx_reference import Body, ReferenceModel
+
+    body = read_body(msh, moving, [f"{moving}_contact", f"{moving}_top"])
+    block = read_body(msh, "block", ["block_contact", "block_base"])
+    model = ReferenceModel(msh, {moving: body.x, "block": block.x})
+    K = sp.block_diag([model.stiffness(Body(moving, youngs_modulus, poisson_ratio)),
+                       model.stiffness(Body("block", block_modulus or youngs_modulus, poisson_ratio))]).tocsr()
+    dim = model.dim
+    fixed = np.full(K.shape[0], np.nan)
+    top = np.unique(body.facets[f"{moving}_top"])
+    base = np.unique(block.facets["block_base"])
+    for k in range(dim):
+        fixed[dim * top + k] = -delta if k == dim - 1 else 0.0
+        fixed[dim * body.num_nodes + dim * base + k] = 0.0
+    free = np.flatnonzero(np.isnan(fixed))
+    u0 = np.where(np.isnan(fixed), 0.0, fixed)
+    factor = spl.splu(K[free][:, free].tocsc())
+    u0[free] = factor.solve(-(K @ u0)[free])
+    if np.abs(block.x[np.unique(block.facets["block_contact"]), dim - 1]).max() > 1e-12:
+        raise ReferenceFailure(f"{msh}: the block's top is not at x_{dim - 1} = 0")
+    nodes = np.setdiff1d(np.unique(body.facets[f"{moving}_contact"]), top)
+    height = body.x[nodes, dim - 1]
+    if (height < -1e-12).any():
+        raise ReferenceFailure(f"{msh}: {moving} contact nodes below the block's top (overlap)")
+    return body, block, K, top, free, u0, factor, nodes, height
+
+
 def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio: float,
                    reach: float = 2.0, max_iterations: int = 400,
                    block_modulus: float | None = None, update: str = "exact") -> dict:
@@ -251,35 +292,11 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
     configuration (``uncovered_penetration``: the deepest other square contact node below the
     deformed block's top at the answer, over the square's spacing; must be 0).
     """
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spl
-
-    from dolfinx_reference import Body, ReferenceModel
-
     start = time.perf_counter()
-    square = read_body(msh, "square", ["square_contact", "square_top"])
-    block = read_body(msh, "block", ["block_contact", "block_base"])
-    model = ReferenceModel(msh, {"square": square.x, "block": block.x})
-    K = sp.block_diag([model.stiffness(Body("square", youngs_modulus, poisson_ratio)),
-                       model.stiffness(Body("block", block_modulus or youngs_modulus, poisson_ratio))]).tocsr()
+    square, block, K, top, free, u0, factor, nodes, y = _pressed_pair(msh, "square", delta, youngs_modulus,
+                                                                      poisson_ratio, block_modulus)
     ns = square.num_nodes
     size = K.shape[0]
-    fixed = np.full(size, np.nan)
-    top = np.unique(square.facets["square_top"])
-    fixed[2 * top], fixed[2 * top + 1] = 0.0, -delta
-    base = np.unique(block.facets["block_base"])
-    fixed[2 * ns + 2 * base], fixed[2 * ns + 2 * base + 1] = 0.0, 0.0
-    free = np.flatnonzero(np.isnan(fixed))
-    u0 = np.where(np.isnan(fixed), 0.0, fixed)
-    factor = spl.splu(K[free][:, free].tocsc())
-    u0[free] = factor.solve(-(K @ u0)[free])
-
-    if np.abs(block.x[np.unique(block.facets["block_contact"]), 1]).max() > 1e-12:
-        raise ReferenceFailure(f"{msh}: the block's top is not the line y = 0")
-    nodes = np.setdiff1d(np.unique(square.facets["square_contact"]), top)
-    y = square.x[nodes, 1]
-    if (y < -1e-12).any():
-        raise ReferenceFailure(f"{msh}: square contact nodes below the block's top (overlap)")
     candidates = nodes[y <= reach * delta]
     h = float(np.median(np.linalg.norm(np.diff(square.x[candidates[np.argsort(square.x[candidates, 0])], :2],
                                                 axis=0), axis=1)))
@@ -472,38 +489,14 @@ def two_body_solve_3d(msh: Path, delta: float, youngs_modulus: float, poisson_ra
     cube's spacing; must be 0.
     """
     import scipy.sparse as sp
-    import scipy.sparse.linalg as spl
     from scipy.spatial import cKDTree
 
-    from dolfinx_reference import Body, ReferenceModel
-
     start = time.perf_counter()
-    cube = read_body(msh, "cube", ["cube_contact", "cube_top"])
-    block = read_body(msh, "block", ["block_contact", "block_base"])
-    model = ReferenceModel(msh, {"cube": cube.x, "block": block.x})
-    K = sp.block_diag([model.stiffness(Body("cube", youngs_modulus, poisson_ratio)),
-                       model.stiffness(Body("block", block_modulus or youngs_modulus, poisson_ratio))]).tocsr()
+    cube, block, K, top, free, u0, factor, nodes, z = _pressed_pair(msh, "cube", delta, youngs_modulus,
+                                                                    poisson_ratio, block_modulus)
     nc = cube.num_nodes
     size = K.shape[0]
-    fixed = np.full(size, np.nan)
-    top = np.unique(cube.facets["cube_top"])
-    for k, value in enumerate((0.0, 0.0, -delta)):
-        fixed[3 * top + k] = value
-    base = np.unique(block.facets["block_base"])
-    for k in range(3):
-        fixed[3 * nc + 3 * base + k] = 0.0
-    free = np.flatnonzero(np.isnan(fixed))
-    u0 = np.where(np.isnan(fixed), 0.0, fixed)
-    factor = spl.splu(K[free][:, free].tocsc())
-    u0[free] = factor.solve(-(K @ u0)[free])
-
     triangles = block.facets["block_contact"]  # block-local nodes, (m, 3)
-    if np.abs(block.x[np.unique(triangles), 2]).max() > 1e-12:
-        raise ReferenceFailure(f"{msh}: the block's top is not the plane z = 0")
-    nodes = np.setdiff1d(np.unique(cube.facets["cube_contact"]), top)
-    z = cube.x[nodes, 2]
-    if (z < -1e-12).any():
-        raise ReferenceFailure(f"{msh}: cube contact nodes below the block's top (overlap)")
     candidates = nodes[z <= reach * delta]
     faces = cube.facets["cube_contact"]
     near_faces = faces[np.isin(faces, candidates).all(axis=1)]
