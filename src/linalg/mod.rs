@@ -1,9 +1,11 @@
 //! Sparse linear algebra: fill-reducing orderings and the Cholesky factorization of a body's
 //! stiffness, the iterative alternative (PETSc CG + AMG, cargo feature `petsc`), the choice
-//! between them, restarted GMRES for the coupled contact system, plus the residual check every
+//! between them, restarted GMRES for the coupled contact system, a bound-constrained quadratic
+//! program solver for the half-space model of the contact zone, plus the residual check every
 //! solve reports.
 
 mod body_solver;
+pub mod bound_qp;
 mod cholesky;
 mod distribution;
 pub mod gmres;

@@ -132,6 +132,12 @@ impl LumpedSums {
         }
     }
 
+    /// Sets every weight to zero.
+    pub fn clear(&mut self) {
+        self.totals.fill(0.0);
+        self.moments.fill([0.0; 3]);
+    }
+
     /// Adds `change` to the weight of point `j` (whose weights are `weights`, kept by the
     /// caller).
     pub fn add(&mut self, j: usize, change: f64) {

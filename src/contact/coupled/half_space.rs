@@ -53,6 +53,7 @@ use std::collections::HashMap;
 
 use faer::Mat;
 use faer::prelude::*;
+use rayon::prelude::*;
 
 use crate::contact::coupled::compliance::MultiplierKey;
 use crate::contact::coupled::far_field::{LumpedSums, distance};
@@ -60,6 +61,7 @@ use crate::contact::coupled::system::{CoupledSystem, Coupling};
 use crate::contact::coupled::two_level_inverse::{FarField, TwoLevelInverse, Unknown};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::fem::Material;
+use crate::linalg::bound_qp::{self, BoundQpOutcome, SymmetricOperator};
 
 /// The half-space approximation of the Schur complement, inverted exactly or approximately.
 pub struct HalfSpace {
@@ -318,26 +320,28 @@ fn radius(dim: usize, area: f64) -> f64 {
 /// on the `candidates` (surface indices of the primary surface `surface`; `gaps` over every
 /// primary candidate, `p0` the iterate's pressure of each candidate, positive in compression),
 /// with `G` and `c0` of the module doc, widened by the candidates the model leaves within
-/// [`PREDICTION_MARGIN`] of a spacing of touching. Solved by projected Gauss-Seidel (it converges for a
-/// symmetric positive definite `C`), at most [`PREDICTION_SWEEPS`] sweeps: the result is only
-/// where the next active-set iteration starts, which the loop then corrects like any other.
+/// [`PREDICTION_MARGIN`] of a spacing of touching. Solved by MPRGP ([`model_contact`]), at most
+/// [`PREDICTION_PRODUCTS`] products: the result is only where the next active-set iteration
+/// starts, which the loop then corrects like any other.
 ///
 /// Why: the first iterate of a solve started cold has every overlapping node penetrating, about
 /// twice the contact zone for a Hertz contact (the overlap's radius is `sqrt(2)` times the
 /// contact radius), and the primal-dual update then removes one rim of nodes per iteration. The
 /// half-space model spreads the contact pressure over the zone at once.
+/// Returns the set with how the model's solve ended.
 pub fn predicted_set(
     surface: &ContactSurface,
     candidates: &[usize],
     gaps: &[f64],
     p0: &[f64],
     c0: f64,
-) -> Vec<usize> {
-    let (p, r) = half_space_contact(surface, candidates, gaps, p0, c0);
-    (0..candidates.len())
+) -> (Vec<usize>, BoundQpOutcome) {
+    let (p, r, outcome) = half_space_contact(surface, candidates, gaps, p0, c0);
+    let set = (0..candidates.len())
         .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * surface.spacing[candidates[i]])
         .map(|i| candidates[i])
-        .collect()
+        .collect();
+    (set, outcome)
 }
 
 /// The active set the half-space model predicts for a body held only by its contact and
@@ -378,7 +382,7 @@ pub fn force_controlled_set(
     let solve = |delta: f64| {
         let candidates: Vec<usize> = (0..surface.len()).filter(|&i| gaps[i] < delta).collect();
         let shifted: Vec<f64> = gaps.iter().map(|g| g - delta).collect();
-        let (p, r) = half_space_contact(surface, &candidates, &shifted, &no_pressure, c0);
+        let (p, r, _) = half_space_contact(surface, &candidates, &shifted, &no_pressure, c0);
         let carried: f64 = (candidates.iter().zip(&p))
             .map(|(&i, p)| surface.nodal_area[i] * p)
             .sum();
@@ -448,7 +452,7 @@ fn half_space_contact(
     gaps: &[f64],
     p0: &[f64],
     c0: f64,
-) -> (Vec<f64>, Vec<f64>) {
+) -> (Vec<f64>, Vec<f64>, BoundQpOutcome) {
     let points: Vec<[f64; 3]> = candidates.iter().map(|&i| surface.coords[i]).collect();
     let areas: Vec<f64> = candidates.iter().map(|&i| surface.nodal_area[i]).collect();
     let p: Vec<f64> = candidates.iter().map(|&i| p0[i].max(0.0)).collect();
@@ -474,196 +478,125 @@ struct ModelZone<'a> {
 
 /// The pressures `p` and model gaps `r` of the half-space contact problem on `zone` with the
 /// gaps `gaps` at the pressures `p - shifts`, from the pressures `p`: `C` assembled, or its far
-/// part `lumped`.
+/// part `lumped`; and how the solve ended.
+///
+/// In the area-weighted pressures `x = A p` the problem is symmetric, `r = q + c0 G x` with
+/// `q` constant, the complementarity conditions of `min 1/2 x^T c0 G x + q^T x` over `x >= 0`,
+/// solved by MPRGP (`crate::linalg::bound_qp`) until no model gap of a free node and no
+/// negative one of a bound node exceeds [`PREDICTION_TOLERANCE`] of the largest starting gap,
+/// at most [`PREDICTION_PRODUCTS`] products with `G`. Why not projected Gauss-Seidel (used
+/// until 2026-12-06): its error falls by a constant factor a sweep set by `G`'s condition number
+/// rather than its square root, 0.96 on the hemisphere on block at 217k DOFs (151 sweeps, 1.25 s,
+/// to the tolerance) and short of it after its 200 sweeps at 1M (5,309 candidates, 6.1 s), and
+/// each sweep is sequential; MPRGP's products run on every thread.
 fn model_contact(
     zone: &ModelZone,
     gaps: Vec<f64>,
-    mut p: Vec<f64>,
+    p: Vec<f64>,
     shifts: &[f64],
     c0: f64,
     lumped: bool,
-) -> (Vec<f64>, Vec<f64>) {
+) -> (Vec<f64>, Vec<f64>, BoundQpOutcome) {
     let (points, areas) = (zone.points, zone.areas);
+    let m = points.len();
     let kernel = Kernel::new(zone.dim, points.iter().copied().zip(areas.iter().copied()));
-    if lumped {
-        let mut model = LumpedGaps::new(points, areas, &kernel, c0, gaps, shifts, zone.dim);
-        projected_gauss_seidel(&mut model, &mut p);
-        let r = (0..p.len()).map(|i| model.gap(i)).collect();
-        (p, r)
-    } else {
-        let mut model = DenseGaps::new(points, areas, &kernel, c0, &gaps, shifts);
-        projected_gauss_seidel(&mut model, &mut p);
-        (p, model.r)
-    }
-}
-
-/// Solves the half-space contact problem by projected Gauss-Seidel on the `model`'s gaps from
-/// the pressures `p` (it converges for a symmetric positive definite `C`), at most
-/// [`PREDICTION_SWEEPS`] sweeps.
-fn projected_gauss_seidel(model: &mut impl ModelGaps, p: &mut [f64]) {
-    let scale = (0..p.len()).map(|i| model.gap(i).abs()).fold(0.0, f64::max);
-    for _ in 0..PREDICTION_SWEEPS {
-        let mut largest_change = 0.0_f64;
-        for (i, pressure) in p.iter_mut().enumerate() {
-            let diagonal = model.diagonal(i);
-            let new = (*pressure - model.gap(i) / diagonal).max(0.0);
-            let delta = new - *pressure;
-            if delta != 0.0 {
-                *pressure = new;
-                model.change(i, delta);
-                largest_change = largest_change.max((delta * diagonal).abs());
-            }
-        }
-        if largest_change <= PREDICTION_TOLERANCE * scale {
-            break;
-        }
-    }
-}
-
-/// The model gaps `r = g + C (p - p0)` of the half-space contact problem, as projected
-/// Gauss-Seidel reads and updates them.
-trait ModelGaps {
-    /// `r_i` at the current pressures.
-    fn gap(&self, i: usize) -> f64;
-    /// `C_ii`.
-    fn diagonal(&self, i: usize) -> f64;
-    /// The pressure of `i` changed by `delta`.
-    fn change(&mut self, i: usize, delta: f64);
-}
-
-/// `C = c0 G A` assembled (`G` symmetric: row `i` holds both `C`'s row, times `A_j`, and its
-/// column, times `A_i`), and `r` kept up to date.
-struct DenseGaps<'a> {
-    kernel: Vec<f64>,
-    areas: &'a [f64],
-    c0: f64,
-    r: Vec<f64>,
-}
-
-impl<'a> DenseGaps<'a> {
-    /// The model of the points `x` of `areas` with the gaps `gaps` at pressures `p0 + shifts`.
-    fn new(
-        x: &[[f64; 3]],
-        areas: &'a [f64],
-        kernel: &Kernel,
-        c0: f64,
-        gaps: &[f64],
-        shifts: &[f64],
-    ) -> Self {
-        let m = x.len();
-        let g = |i: usize, j: usize| {
-            if i == j {
-                return kernel.own(areas[i]);
-            }
-            kernel.between(distance(&x[i], &x[j]))
-        };
-        let kernel: Vec<f64> = (0..m * m).map(|k| g(k / m, k % m)).collect();
-        let r = (0..m)
-            .map(|i| {
-                let shift: f64 = (kernel[i * m..(i + 1) * m].iter().enumerate())
-                    .map(|(j, g)| c0 * g * areas[j] * shifts[j])
-                    .sum();
-                gaps[i] + shift
-            })
-            .collect();
-        Self {
-            kernel,
-            areas,
-            c0,
-            r,
-        }
-    }
-
-    fn row(&self, i: usize) -> &[f64] {
-        let m = self.r.len();
-        &self.kernel[i * m..(i + 1) * m]
-    }
-}
-
-impl ModelGaps for DenseGaps<'_> {
-    fn gap(&self, i: usize) -> f64 {
-        self.r[i]
-    }
-
-    fn diagonal(&self, i: usize) -> f64 {
-        self.c0 * self.row(i)[i] * self.areas[i]
-    }
-
-    fn change(&mut self, i: usize, delta: f64) {
-        let m = self.r.len();
-        let column = self.c0 * self.areas[i] * delta;
-        let row = &self.kernel[i * m..(i + 1) * m];
-        for (rk, g) in self.r.iter_mut().zip(row) {
-            *rk += g * column;
-        }
-    }
-}
-
-/// `C = c0 G A` never assembled: `r_i` summed afresh at each visit, with the zone's far part
-/// lumped into clusters (`crate::contact::coupled::far_field`).
-struct LumpedGaps<'a> {
-    points: &'a [[f64; 3]],
-    areas: &'a [f64],
-    kernel: &'a Kernel,
-    c0: f64,
-    gaps: Vec<f64>,
-    /// `A_j (p_j - p0_j)`.
-    weights: Vec<f64>,
-    sums: LumpedSums,
-}
-
-impl<'a> LumpedGaps<'a> {
-    /// The model of the points `points` of `areas` with the gaps `gaps` at pressures
-    /// `p0 + shifts`, in `dim` dimensions.
-    fn new(
-        points: &'a [[f64; 3]],
-        areas: &'a [f64],
-        kernel: &'a Kernel,
-        c0: f64,
-        gaps: Vec<f64>,
-        shifts: &[f64],
-        dim: usize,
-    ) -> Self {
-        let mut sums = LumpedSums::new(points, areas, dim);
-        let weights: Vec<f64> = areas.iter().zip(shifts).map(|(a, s)| a * s).collect();
-        for (j, w) in weights.iter().enumerate() {
-            sums.add(j, *w);
-        }
-        Self {
+    let mut compliance = match lumped {
+        true => Compliance::Lumped {
             points,
             areas,
             kernel,
             c0,
-            gaps,
-            weights,
-            sums,
+            sums: LumpedSums::new(points, areas, zone.dim),
+        },
+        false => Compliance::assembled(points, areas, &kernel, c0),
+    };
+    // The gaps at the starting pressures: r = gaps + c0 G A shifts.
+    let mut r = gaps;
+    let weighted_shifts: Vec<f64> = areas.iter().zip(shifts).map(|(a, s)| a * s).collect();
+    let mut product = vec![0.0; m];
+    if weighted_shifts.iter().any(|&w| w != 0.0) {
+        compliance.apply(&weighted_shifts, &mut product);
+        r.iter_mut().zip(&product).for_each(|(r, c)| *r += c);
+    }
+    // G has positive entries, so its largest row sum bounds its norm.
+    compliance.apply(&vec![1.0; m], &mut product);
+    let norm_bound = product.iter().copied().fold(0.0, f64::max);
+    let scale = r.iter().map(|r| r.abs()).fold(0.0, f64::max);
+    let mut x: Vec<f64> = areas.iter().zip(&p).map(|(a, p)| a * p).collect();
+    let settings = bound_qp::BoundQpSettings {
+        tolerance: PREDICTION_TOLERANCE * scale,
+        max_products: PREDICTION_PRODUCTS,
+    };
+    let outcome = bound_qp::solve(&mut compliance, &mut x, &mut r, norm_bound, settings);
+    let p = (x.iter().zip(areas))
+        .map(|(x, &a)| if a > 0.0 { x / a } else { 0.0 })
+        .collect();
+    (p, r, outcome)
+}
+
+/// `c0 G` on a zone's points, as MPRGP multiplies by it.
+enum Compliance<'a> {
+    /// Assembled, row by row (`m^2` numbers).
+    Assembled { kernel: Vec<f64>, c0: f64 },
+    /// Never assembled: each product summed afresh with the zone's far part lumped into
+    /// clusters (`crate::contact::coupled::far_field`).
+    Lumped {
+        points: &'a [[f64; 3]],
+        areas: &'a [f64],
+        kernel: Kernel,
+        c0: f64,
+        sums: LumpedSums,
+    },
+}
+
+impl Compliance<'_> {
+    fn assembled(x: &[[f64; 3]], areas: &[f64], kernel: &Kernel, c0: f64) -> Self {
+        let m = x.len();
+        let g = |i: usize, j: usize| match i == j {
+            true => kernel.own(areas[i]),
+            false => kernel.between(distance(&x[i], &x[j])),
+        };
+        Self::Assembled {
+            kernel: (0..m * m).map(|k| g(k / m, k % m)).collect(),
+            c0,
         }
     }
 }
 
-impl ModelGaps for LumpedGaps<'_> {
-    fn gap(&self, i: usize) -> f64 {
-        let sum = self.sums.sum(
-            i,
-            &self.weights,
-            |i| self.kernel.own(self.areas[i]),
-            |i, j| {
-                self.kernel
-                    .between(distance(&self.points[i], &self.points[j]))
-            },
-            |i, centre| self.kernel.field(&self.points[i], centre),
-        );
-        self.gaps[i] + self.c0 * sum
-    }
-
-    fn diagonal(&self, i: usize) -> f64 {
-        self.c0 * self.kernel.own(self.areas[i]) * self.areas[i]
-    }
-
-    fn change(&mut self, i: usize, delta: f64) {
-        let change = self.areas[i] * delta;
-        self.weights[i] += change;
-        self.sums.add(i, change);
+impl SymmetricOperator for Compliance<'_> {
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) {
+        match self {
+            Self::Assembled { kernel, c0 } => {
+                let m = x.len();
+                (out.par_iter_mut().enumerate()).for_each(|(i, o)| {
+                    let row = &kernel[i * m..(i + 1) * m];
+                    *o = *c0 * row.iter().zip(x).map(|(g, x)| g * x).sum::<f64>();
+                });
+            }
+            Self::Lumped {
+                points,
+                areas,
+                kernel,
+                c0,
+                sums,
+            } => {
+                sums.clear();
+                for (j, &w) in x.iter().enumerate() {
+                    sums.add(j, w);
+                }
+                let (points, areas, kernel, c0, sums) = (*points, *areas, *kernel, *c0, &*sums);
+                (out.par_iter_mut().enumerate()).for_each(|(i, o)| {
+                    *o = c0
+                        * sums.sum(
+                            i,
+                            x,
+                            |i| kernel.own(areas[i]),
+                            |i, j| kernel.between(distance(&points[i], &points[j])),
+                            |i, centre| kernel.field(&points[i], centre),
+                        );
+                });
+            }
+        }
     }
 }
 
@@ -682,10 +615,12 @@ impl ModelGaps for LumpedGaps<'_> {
 /// iteration or two.
 const PREDICTION_MARGIN: f64 = 0.05;
 
-/// Sweeps of [`predicted_set`]'s projected Gauss-Seidel (each `m^2` multiply-adds).
-const PREDICTION_SWEEPS: usize = 200;
+/// Products with `G` of [`predicted_set`]'s model at most (each `m^2` multiply-adds, or the
+/// lumped sums'): the model's answer is only where the loop starts.
+const PREDICTION_PRODUCTS: usize = 200;
 
-/// [`predicted_set`] stops when no sweep moves a gap by more than this fraction of the largest.
+/// [`predicted_set`]'s model is solved when no node's model gap is off its complementarity
+/// condition by more than this fraction of the largest starting gap.
 const PREDICTION_TOLERANCE: f64 = 1e-4;
 
 #[cfg(test)]
@@ -726,8 +661,9 @@ mod tests {
             dim: 3,
         };
         let solve = |lumped| {
-            let (p, r) =
+            let (p, r, outcome) =
                 model_contact(&zone, gaps.clone(), vec![0.0; m], &vec![0.0; m], c0, lumped);
+            assert!(outcome.converged, "{outcome:?}");
             // predicted_set's rule.
             let set = (0..m)
                 .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * h)

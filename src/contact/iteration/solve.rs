@@ -1143,12 +1143,20 @@ impl ContactSolver<'_> {
             let candidates: Vec<usize> = candidates.into_iter().collect();
             let materials = [&problem.primary.material, &problem.secondary.material];
             let c0 = compliance_factor(materials, s1.dim);
-            let predicted = predicted_set(s1, &candidates, &gaps[p], &pressure, c0);
+            let started = std::time::Instant::now();
+            let (predicted, model) = predicted_set(s1, &candidates, &gaps[p], &pressure, c0);
             if self.solver.verbose {
                 log::debug!(
-                    "  half-space prediction: {} nodes active next (the update's {})",
+                    "  half-space prediction: {} nodes active next (the update's {}); its model \
+                     {} in {} products, {:.3} s",
                     predicted.len(),
-                    self.pair_nodes(next, p).len()
+                    self.pair_nodes(next, p).len(),
+                    match model.converged {
+                        true => "solved",
+                        false => "not solved",
+                    },
+                    model.products,
+                    started.elapsed().as_secs_f64()
                 );
             }
             if !predicted.is_empty() {
