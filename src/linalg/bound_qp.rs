@@ -33,8 +33,10 @@
 
 /// `A` of the program, through its products.
 pub trait SymmetricOperator {
+    /// Why a product could not be made (a sum over the ranks of a distributed run).
+    type Error;
     /// `out = A x`.
-    fn apply(&mut self, x: &[f64], out: &mut [f64]);
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Self::Error>;
 }
 
 /// When [`solve`] stops.
@@ -69,14 +71,15 @@ const EXPANSION: f64 = 0.95;
 /// Solves the program from `x` (projected onto `x >= 0` first) with `g = A x + c` at that
 /// start, both overwritten by the last iterate and its gradient; `norm_bound` is an upper bound
 /// of the 2-norm of `A` (for a matrix of positive entries, its largest row sum). Running out
-/// of products is an outcome, not an error: the iterate is the best found.
-pub fn solve(
-    a: &mut impl SymmetricOperator,
+/// of products is an outcome, not an error: the iterate is the best found. The only error is
+/// a product's.
+pub fn solve<A: SymmetricOperator>(
+    a: &mut A,
     x: &mut [f64],
     g: &mut [f64],
     norm_bound: f64,
     settings: BoundQpSettings,
-) -> BoundQpOutcome {
+) -> Result<BoundQpOutcome, A::Error> {
     let n = x.len();
     assert_eq!(g.len(), n, "one gradient entry per unknown");
     let mut outcome = BoundQpOutcome {
@@ -89,7 +92,7 @@ pub fn solve(
     // A start outside the bounds is moved onto them, its gradient with it.
     let shift: Vec<f64> = x.iter().map(|&v| (-v).max(0.0)).collect();
     if shift.iter().any(|&s| s > 0.0) {
-        a.apply(&shift, &mut ap);
+        a.apply(&shift, &mut ap)?;
         outcome.products += 1;
         for i in 0..n {
             x[i] += shift[i];
@@ -110,10 +113,10 @@ pub fn solve(
         outcome.projected_gradient = (0..n).map(|i| (phi[i] + beta[i]).abs()).fold(0.0, f64::max);
         if outcome.projected_gradient <= settings.tolerance {
             outcome.converged = true;
-            return outcome;
+            return Ok(outcome);
         }
         if outcome.products >= settings.max_products || !outcome.projected_gradient.is_finite() {
-            return outcome;
+            return Ok(outcome);
         }
         let chopped: f64 = beta.iter().map(|b| b * b).sum();
         let reduced: f64 = (0..n)
@@ -121,12 +124,12 @@ pub fn solve(
             .map(|i| (x[i] / alpha).min(phi[i]) * phi[i])
             .sum();
         if chopped <= GAMMA * GAMMA * reduced {
-            a.apply(&p, &mut ap);
+            a.apply(&p, &mut ap)?;
             outcome.products += 1;
             let pap = dot(&p, &ap);
             if pap.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 // Not positive definite along p, p = 0, or NaN: nothing more to gain.
-                return outcome;
+                return Ok(outcome);
             }
             let cg_step = dot(g, &p) / pap;
             let feasible_step = (0..n)
@@ -154,7 +157,7 @@ pub fn solve(
                 let step: Vec<f64> = (0..n)
                     .map(|i| (x[i] - alpha * phi[i]).max(0.0) - x[i])
                     .collect();
-                a.apply(&step, &mut ap);
+                a.apply(&step, &mut ap)?;
                 outcome.products += 1;
                 for i in 0..n {
                     x[i] += step[i];
@@ -164,11 +167,11 @@ pub fn solve(
             }
         } else {
             // Proportioning: along -beta, which only raises bound unknowns.
-            a.apply(&beta, &mut ap);
+            a.apply(&beta, &mut ap)?;
             outcome.products += 1;
             let step = chopped / dot(&beta, &ap);
             if !(step > 0.0 && step.is_finite()) {
-                return outcome;
+                return Ok(outcome);
             }
             for i in 0..n {
                 x[i] -= step * beta[i];
@@ -191,10 +194,12 @@ mod tests {
     struct Dense(Vec<Vec<f64>>);
 
     impl SymmetricOperator for Dense {
-        fn apply(&mut self, x: &[f64], out: &mut [f64]) {
+        type Error = std::convert::Infallible;
+        fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
             for (o, row) in out.iter_mut().zip(&self.0) {
                 *o = dot(row, x);
             }
+            Ok(())
         }
     }
 
@@ -227,11 +232,11 @@ mod tests {
             tolerance: 1e-12,
             max_products: 500,
         };
-        let outcome = solve(&mut a, &mut x, &mut g, bound, settings);
+        let Ok(outcome) = solve(&mut a, &mut x, &mut g, bound, settings);
         assert!(outcome.converged, "{outcome:?}");
         // The gradient the solver kept is A x + c, recomputed here.
         let mut ax = vec![0.0; n];
-        a.apply(&x, &mut ax);
+        let Ok(()) = a.apply(&x, &mut ax);
         let (mut free, mut bound_count) = (0, 0);
         for i in 0..n {
             let gi = ax[i] + c[i];
@@ -274,13 +279,13 @@ mod tests {
             .map(|i| if i % 3 == 0 { -1.0 } else { 0.5 })
             .collect();
         let mut g = vec![0.0; n];
-        a.apply(&x, &mut g);
+        let Ok(()) = a.apply(&x, &mut g);
         g.iter_mut().zip(&c).for_each(|(g, c)| *g += c);
         let settings = BoundQpSettings {
             tolerance: 1e-13,
             max_products: 500,
         };
-        let outcome = solve(&mut a, &mut x, &mut g, bound, settings);
+        let Ok(outcome) = solve(&mut a, &mut x, &mut g, bound, settings);
         assert!(outcome.converged, "{outcome:?}");
         for i in 0..n {
             assert!(
@@ -301,7 +306,7 @@ mod tests {
             tolerance: 0.0,
             max_products: 3,
         };
-        let outcome = solve(&mut a, &mut x, &mut g, bound, settings);
+        let Ok(outcome) = solve(&mut a, &mut x, &mut g, bound, settings);
         assert!(!outcome.converged);
         assert!(
             outcome.products >= 3 && outcome.products <= 4,

@@ -50,6 +50,7 @@
 //! node).
 
 use std::collections::HashMap;
+use std::ops::Range;
 
 use faer::Mat;
 use faer::prelude::*;
@@ -62,6 +63,7 @@ use crate::contact::coupled::two_level_inverse::{FarField, TwoLevelInverse, Unkn
 use crate::contact::geometry::surface::ContactSurface;
 use crate::fem::Material;
 use crate::linalg::bound_qp::{self, BoundQpOutcome, SymmetricOperator};
+use crate::parallel::{ParallelError, Ranks};
 
 /// The half-space approximation of the Schur complement, inverted exactly or approximately.
 pub struct HalfSpace {
@@ -328,20 +330,21 @@ fn radius(dim: usize, area: f64) -> f64 {
 /// twice the contact zone for a Hertz contact (the overlap's radius is `sqrt(2)` times the
 /// contact radius), and the primal-dual update then removes one rim of nodes per iteration. The
 /// half-space model spreads the contact pressure over the zone at once.
-/// Returns the set with how the model's solve ended.
+/// Returns the set with how the model's solve ended. Collective in a distributed run (the
+/// ranks share each product, [`Compliance`]); its error is that of a sum over the ranks.
 pub fn predicted_set(
     surface: &ContactSurface,
     candidates: &[usize],
     gaps: &[f64],
     p0: &[f64],
     c0: f64,
-) -> (Vec<usize>, BoundQpOutcome) {
-    let (p, r, outcome) = half_space_contact(surface, candidates, gaps, p0, c0);
+) -> Result<(Vec<usize>, BoundQpOutcome), ParallelError> {
+    let (p, r, outcome) = half_space_contact(surface, candidates, gaps, p0, c0)?;
     let set = (0..candidates.len())
         .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * surface.spacing[candidates[i]])
         .map(|i| candidates[i])
         .collect();
-    (set, outcome)
+    Ok((set, outcome))
 }
 
 /// The active set the half-space model predicts for a body held only by its contact and
@@ -356,13 +359,14 @@ pub fn predicted_set(
 /// concentrates the whole force on them: in 3D a point load sinks the body several times its
 /// final approach (an R/67 hemisphere on a block, 3 times), and the linearized gaps at that
 /// iterate leave the loop unstable. Started from this set, the first iterate is about the
-/// answer (see `tests/force_control.rs`).
+/// answer (see `tests/force_control.rs`). Collective in a distributed run, as
+/// [`predicted_set`] is.
 pub fn force_controlled_set(
     surface: &ContactSurface,
     gaps: &[f64],
     force: f64,
     c0: f64,
-) -> Vec<usize> {
+) -> Result<Vec<usize>, ParallelError> {
     let no_pressure = vec![0.0; surface.len()];
     let first_touch = gaps.iter().copied().fold(f64::INFINITY, f64::min);
     let spacing = surface
@@ -375,26 +379,26 @@ pub fn force_controlled_set(
         || !first_touch.is_finite()
         || spacing.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
     {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     // The model's pressures at the approach `delta`: only candidates that overlap can carry
     // any (the compliance only opens gaps), so the others are left out.
     let solve = |delta: f64| {
         let candidates: Vec<usize> = (0..surface.len()).filter(|&i| gaps[i] < delta).collect();
         let shifted: Vec<f64> = gaps.iter().map(|g| g - delta).collect();
-        let (p, r, _) = half_space_contact(surface, &candidates, &shifted, &no_pressure, c0);
+        let (p, r, _) = half_space_contact(surface, &candidates, &shifted, &no_pressure, c0)?;
         let carried: f64 = (candidates.iter().zip(&p))
             .map(|(&i, p)| surface.nodal_area[i] * p)
             .sum();
-        (candidates, p, r, carried)
+        Ok::<_, ParallelError>((candidates, p, r, carried))
     };
     let (mut low, mut high) = (first_touch, first_touch + spacing);
-    let (mut f_low, mut f_high) = (-force, solve(high).3 - force);
+    let (mut f_low, mut f_high) = (-force, solve(high)?.3 - force);
     let mut doublings = 0;
     while f_high < 0.0 && doublings < FORCE_BRACKETING {
         (low, f_low) = (high, f_high);
         high = first_touch + 2.0 * (high - first_touch);
-        f_high = solve(high).3 - force;
+        f_high = solve(high)?.3 - force;
         doublings += 1;
     }
     // Regula falsi keeping the bracket [low, high]; `high` carries at least the force, and
@@ -407,7 +411,7 @@ pub fn force_controlled_set(
     };
     for _ in 0..steps {
         let delta = (low * f_high - high * f_low) / (f_high - f_low);
-        let f = solve(delta).3 - force;
+        let f = solve(delta)?.3 - force;
         if f.abs() <= FORCE_TOLERANCE * force {
             high = delta;
             break;
@@ -426,11 +430,11 @@ pub fn force_controlled_set(
             side = -1;
         }
     }
-    let (candidates, p, r, _) = solve(high);
-    (0..candidates.len())
+    let (candidates, p, r, _) = solve(high)?;
+    Ok((0..candidates.len())
         .filter(|&i| p[i] > 0.0 || r[i] < PREDICTION_MARGIN * surface.spacing[candidates[i]])
         .map(|i| candidates[i])
-        .collect()
+        .collect())
 }
 
 /// [`force_controlled_set`] finds the force to this fraction.
@@ -452,7 +456,7 @@ fn half_space_contact(
     gaps: &[f64],
     p0: &[f64],
     c0: f64,
-) -> (Vec<f64>, Vec<f64>, BoundQpOutcome) {
+) -> Result<(Vec<f64>, Vec<f64>, BoundQpOutcome), ParallelError> {
     let points: Vec<[f64; 3]> = candidates.iter().map(|&i| surface.coords[i]).collect();
     let areas: Vec<f64> = candidates.iter().map(|&i| surface.nodal_area[i]).collect();
     let p: Vec<f64> = candidates.iter().map(|&i| p0[i].max(0.0)).collect();
@@ -496,30 +500,30 @@ fn model_contact(
     shifts: &[f64],
     c0: f64,
     lumped: bool,
-) -> (Vec<f64>, Vec<f64>, BoundQpOutcome) {
+) -> Result<(Vec<f64>, Vec<f64>, BoundQpOutcome), ParallelError> {
     let (points, areas) = (zone.points, zone.areas);
     let m = points.len();
     let kernel = Kernel::new(zone.dim, points.iter().copied().zip(areas.iter().copied()));
-    let mut compliance = match lumped {
-        true => Compliance::Lumped {
+    let kernel = match lumped {
+        true => CompliancePart::Lumped {
             points,
             areas,
             kernel,
-            c0,
             sums: LumpedSums::new(points, areas, zone.dim),
         },
-        false => Compliance::assembled(points, areas, &kernel, c0),
+        false => CompliancePart::assembled(points, areas, &kernel, ranks_rows(m)),
     };
+    let mut compliance = Compliance { kernel, c0 };
     // The gaps at the starting pressures: r = gaps + c0 G A shifts.
     let mut r = gaps;
     let weighted_shifts: Vec<f64> = areas.iter().zip(shifts).map(|(a, s)| a * s).collect();
     let mut product = vec![0.0; m];
     if weighted_shifts.iter().any(|&w| w != 0.0) {
-        compliance.apply(&weighted_shifts, &mut product);
+        compliance.apply(&weighted_shifts, &mut product)?;
         r.iter_mut().zip(&product).for_each(|(r, c)| *r += c);
     }
     // G has positive entries, so its largest row sum bounds its norm.
-    compliance.apply(&vec![1.0; m], &mut product);
+    compliance.apply(&vec![1.0; m], &mut product)?;
     let norm_bound = product.iter().copied().fold(0.0, f64::max);
     let scale = r.iter().map(|r| r.abs()).fold(0.0, f64::max);
     let mut x: Vec<f64> = areas.iter().zip(&p).map(|(a, p)| a * p).collect();
@@ -527,68 +531,95 @@ fn model_contact(
         tolerance: PREDICTION_TOLERANCE * scale,
         max_products: PREDICTION_PRODUCTS,
     };
-    let outcome = bound_qp::solve(&mut compliance, &mut x, &mut r, norm_bound, settings);
+    let outcome = bound_qp::solve(&mut compliance, &mut x, &mut r, norm_bound, settings)?;
     let p = (x.iter().zip(areas))
         .map(|(x, &a)| if a > 0.0 { x / a } else { 0.0 })
         .collect();
-    (p, r, outcome)
+    Ok((p, r, outcome))
 }
 
-/// `c0 G` on a zone's points, as MPRGP multiplies by it.
-enum Compliance<'a> {
-    /// Assembled, row by row (`m^2` numbers).
-    Assembled { kernel: Vec<f64>, c0: f64 },
+/// `c0 G` on a zone's points, as MPRGP multiplies by it. In a distributed run every rank
+/// holds the same model (the same gaps and pressures, from the same gathered numbers), so each
+/// computes its share of a product's rows ([`ranks_rows`]) and receives the others'
+/// (`MPI_Allgatherv`): a row is summed in the same order wherever it is computed, so a product
+/// is the same bits on any number of ranks, and the model's answer too.
+struct Compliance<'a> {
+    kernel: CompliancePart<'a>,
+    c0: f64,
+}
+
+/// `G`, or what a product with it needs.
+enum CompliancePart<'a> {
+    /// Assembled: this rank's rows of it ([`ranks_rows`]; all of them on one process), row by
+    /// row.
+    Assembled { kernel: Vec<f64> },
     /// Never assembled: each product summed afresh with the zone's far part lumped into
     /// clusters (`crate::contact::coupled::far_field`).
     Lumped {
         points: &'a [[f64; 3]],
         areas: &'a [f64],
         kernel: Kernel,
-        c0: f64,
         sums: LumpedSums,
     },
 }
 
-impl Compliance<'_> {
-    fn assembled(x: &[[f64; 3]], areas: &[f64], kernel: &Kernel, c0: f64) -> Self {
+impl CompliancePart<'_> {
+    /// The `rows` of `G` on the points `x` of `areas`.
+    fn assembled(x: &[[f64; 3]], areas: &[f64], kernel: &Kernel, rows: Range<usize>) -> Self {
         let m = x.len();
         let g = |i: usize, j: usize| match i == j {
             true => kernel.own(areas[i]),
             false => kernel.between(distance(&x[i], &x[j])),
         };
-        Self::Assembled {
-            kernel: (0..m * m).map(|k| g(k / m, k % m)).collect(),
-            c0,
-        }
+        let kernel = rows.flat_map(|i| (0..m).map(move |j| g(i, j))).collect();
+        Self::Assembled { kernel }
     }
 }
 
+/// This rank's share of `m` rows ([`rows_of_rank`]).
+fn ranks_rows(m: usize) -> Range<usize> {
+    let Ranks { rank, size } = crate::parallel::ranks();
+    rows_of_rank(m, rank, size)
+}
+
+/// Rank `rank`'s share of `m` rows among `size` ranks: `m / size` rows each, the first
+/// `m % size` ranks one more, in rank order.
+fn rows_of_rank(m: usize, rank: usize, size: usize) -> Range<usize> {
+    let (share, extra) = (m / size, m % size);
+    let start = rank * share + rank.min(extra);
+    start..start + share + usize::from(rank < extra)
+}
+
 impl SymmetricOperator for Compliance<'_> {
-    fn apply(&mut self, x: &[f64], out: &mut [f64]) {
-        match self {
-            Self::Assembled { kernel, c0 } => {
-                let m = x.len();
-                (out.par_iter_mut().enumerate()).for_each(|(i, o)| {
-                    let row = &kernel[i * m..(i + 1) * m];
-                    *o = *c0 * row.iter().zip(x).map(|(g, x)| g * x).sum::<f64>();
+    type Error = ParallelError;
+
+    fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), ParallelError> {
+        let (m, c0) = (x.len(), self.c0);
+        let rows = ranks_rows(m);
+        let mut local = vec![0.0; rows.len()];
+        match &mut self.kernel {
+            CompliancePart::Assembled { kernel } => {
+                (local.par_iter_mut().enumerate()).for_each(|(k, o)| {
+                    let row = &kernel[k * m..(k + 1) * m];
+                    *o = c0 * row.iter().zip(x).map(|(g, x)| g * x).sum::<f64>();
                 });
             }
-            Self::Lumped {
+            CompliancePart::Lumped {
                 points,
                 areas,
                 kernel,
-                c0,
                 sums,
             } => {
                 sums.clear();
                 for (j, &w) in x.iter().enumerate() {
                     sums.add(j, w);
                 }
-                let (points, areas, kernel, c0, sums) = (*points, *areas, *kernel, *c0, &*sums);
-                (out.par_iter_mut().enumerate()).for_each(|(i, o)| {
+                let (points, areas, kernel, sums) = (*points, *areas, *kernel, &*sums);
+                let start = rows.start;
+                (local.par_iter_mut().enumerate()).for_each(|(k, o)| {
                     *o = c0
                         * sums.sum(
-                            i,
+                            start + k,
                             x,
                             |i| kernel.own(areas[i]),
                             |i, j| kernel.between(distance(&points[i], &points[j])),
@@ -597,6 +628,14 @@ impl SymmetricOperator for Compliance<'_> {
                 });
             }
         }
+        if !crate::parallel::distributed() {
+            out.copy_from_slice(&local);
+            return Ok(());
+        }
+        let size = crate::parallel::ranks().size;
+        let counts: Vec<usize> = (0..size).map(|r| rows_of_rank(m, r, size).len()).collect();
+        out.copy_from_slice(&crate::parallel::all_gather(&local, &counts)?);
+        Ok(())
     }
 }
 
@@ -662,7 +701,8 @@ mod tests {
         };
         let solve = |lumped| {
             let (p, r, outcome) =
-                model_contact(&zone, gaps.clone(), vec![0.0; m], &vec![0.0; m], c0, lumped);
+                model_contact(&zone, gaps.clone(), vec![0.0; m], &vec![0.0; m], c0, lumped)
+                    .expect("one process sums alone");
             assert!(outcome.converged, "{outcome:?}");
             // predicted_set's rule.
             let set = (0..m)
@@ -673,6 +713,17 @@ mod tests {
         let pressures = [solve(false), solve(true)];
         let force = 4.0 * e_star * a.powi(3) / 3.0;
         (zone, pressures, a, force)
+    }
+
+    #[test]
+    fn the_ranks_rows_cover_every_row_once_in_order() {
+        for (m, size) in [(0, 1), (7, 1), (7, 2), (7, 3), (2, 4), (1000, 7)] {
+            let rows: Vec<usize> = (0..size).flat_map(|r| rows_of_rank(m, r, size)).collect();
+            assert_eq!(rows, (0..m).collect::<Vec<_>>(), "{m} rows on {size} ranks");
+            let lengths: Vec<usize> = (0..size).map(|r| rows_of_rank(m, r, size).len()).collect();
+            let (least, most) = (lengths.iter().min(), lengths.iter().max());
+            assert!(most.unwrap() - least.unwrap() <= 1, "{lengths:?}");
+        }
     }
 
     #[test]

@@ -661,6 +661,13 @@ struct KeptIterate {
     solution: CoupledSolution,
 }
 
+/// A sum over the ranks of the half-space model failed (collective: every rank meets it).
+fn prediction_error(e: &crate::parallel::ParallelError) -> ContactError {
+    ContactError::Linalg(format!(
+        "a sum over the ranks in the half-space prediction: {e}"
+    ))
+}
+
 impl KeptIterate {
     fn new(
         couplings: Vec<Coupling>,
@@ -841,7 +848,7 @@ impl ContactSolver<'_> {
             // The first iteration of a solve goes on with the set the half-space model
             // predicts, rather than with every penetrating node.
             Step::Solve(next) if iteration == 1 && !update.penetrating.is_empty() => {
-                Step::Solve(self.predicted(&next, &update, &nodes, &solution, &couplings, &gaps))
+                Step::Solve(self.predicted(&next, &update, &nodes, &solution, &couplings, &gaps)?)
             }
             step => step,
         };
@@ -943,7 +950,8 @@ impl ContactSolver<'_> {
                 .fold(0.0, f64::max);
             let materials = [&problem.primary.material, &problem.secondary.material];
             let c0 = compliance_factor(materials, s1.dim);
-            let mut zone = force_controlled_set(s1, &gaps, force, c0);
+            let mut zone =
+                force_controlled_set(s1, &gaps, force, c0).map_err(|e| prediction_error(&e))?;
             if zone.is_empty() {
                 // No force to place: the nodes that touch already, or the closest one.
                 zone = self.pair_nodes(&state.active.contact, p);
@@ -1118,7 +1126,7 @@ impl ContactSolver<'_> {
         solution: &CoupledSolution,
         couplings: &[Coupling],
         gaps: &[Vec<f64>],
-    ) -> NodeStates {
+    ) -> Result<NodeStates, ContactError> {
         let mut predicted_all = next.contact.clone();
         let next = &next.contact;
         for (p, problem) in self.pairs.iter().enumerate() {
@@ -1144,7 +1152,8 @@ impl ContactSolver<'_> {
             let materials = [&problem.primary.material, &problem.secondary.material];
             let c0 = compliance_factor(materials, s1.dim);
             let started = std::time::Instant::now();
-            let (predicted, model) = predicted_set(s1, &candidates, &gaps[p], &pressure, c0);
+            let (predicted, model) = predicted_set(s1, &candidates, &gaps[p], &pressure, c0)
+                .map_err(|e| prediction_error(&e))?;
             if self.solver.verbose {
                 log::debug!(
                     "  half-space prediction: {} nodes active next (the update's {}); its model \
@@ -1163,7 +1172,7 @@ impl ContactSolver<'_> {
                 predicted_all = self.with_pair_nodes(&predicted_all, p, predicted);
             }
         }
-        NodeStates::in_contact(predicted_all)
+        Ok(NodeStates::in_contact(predicted_all))
     }
 
     /// Pair `p`'s tied corrections of its current operators at `solution`, whose geometric
