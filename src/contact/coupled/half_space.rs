@@ -330,6 +330,7 @@ fn radius(dim: usize, area: f64) -> f64 {
 /// twice the contact zone for a Hertz contact (the overlap's radius is `sqrt(2)` times the
 /// contact radius), and the primal-dual update then removes one rim of nodes per iteration. The
 /// half-space model spreads the contact pressure over the zone at once.
+///
 /// Returns the set with how the model's solve ended. Collective in a distributed run (the
 /// ranks share each product, [`Compliance`]); its error is that of a sum over the ranks.
 pub fn predicted_set(
