@@ -31,6 +31,8 @@
 //! half-space compliance of a contact zone, `crate::contact::coupled::half_space`, whose far part
 //! is lumped); MPRGP needs only products.
 
+use super::gmres::dot;
+
 /// `A` of the program, through its products.
 pub trait SymmetricOperator {
     /// Why a product could not be made (a sum over the ranks of a distributed run).
@@ -180,10 +182,6 @@ pub fn solve<A: SymmetricOperator>(
             p = free(x, g);
         }
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
 #[cfg(test)]
