@@ -43,6 +43,24 @@ impl LoadVector {
         }
     }
 
+    /// The vector of `len` entries whose nonzero entries are `entries` (by increasing dof),
+    /// kept as [`Self::new`] keeps it.
+    pub fn from_entries(len: usize, entries: Vec<(usize, f64)>) -> Self {
+        debug_assert!(
+            entries.windows(2).all(|w| w[0].0 < w[1].0),
+            "dofs increasing"
+        );
+        debug_assert!(entries.iter().all(|&(_, v)| v != 0.0), "nonzero entries");
+        if 4 * entries.len() > len {
+            let mut whole = vec![0.0; len];
+            for (dof, value) in entries {
+                whole[dof] = value;
+            }
+            return Self::Whole(whole);
+        }
+        Self::Sparse { len, entries }
+    }
+
     /// The number of entries (the body's dofs).
     pub fn len(&self) -> usize {
         match self {

@@ -300,6 +300,55 @@ impl Distribution {
         rows.map(|p| self.ours(p))
     }
 
+    /// The row among this rank's rows (PETSc's order) of our unknown `dof`, if this rank owns
+    /// its node.
+    pub fn own_row(&self, dof: usize) -> Option<usize> {
+        let node = u32::try_from(dof / self.block).ok()?;
+        let at = (self.own_sorted)
+            .binary_search_by_key(&node, |&(n, _)| n)
+            .ok()?;
+        Some(self.own_sorted[at].1 as usize * self.block + dof % self.block)
+    }
+
+    /// How every rank receives the values of `nodes` (our numbering, increasing) from their
+    /// owners ([`NodeGather`]). Reads the whole body's map once: `O(n log m)` for `m` nodes.
+    pub fn node_gather(&self, nodes: Vec<u32>) -> NodeGather {
+        debug_assert!(nodes.windows(2).all(|w| w[0] < w[1]), "nodes increasing");
+        let ranks = self.counts.len();
+        // PETSc's node of each gathered node's place, found by one pass over PETSc's nodes.
+        let mut petsc = Vec::with_capacity(nodes.len());
+        for (p, ours) in self.nodes.iter().enumerate() {
+            if let Ok(place) = nodes.binary_search(ours) {
+                petsc.push((p as u32, place as u32));
+            }
+        }
+        // `petsc` is in PETSc's order: rank after rank.
+        let mut counts = vec![0; ranks];
+        let mut starts = Vec::with_capacity(ranks + 1);
+        starts.push(0);
+        for count in &self.counts {
+            starts.push(starts.last().unwrap() + count / self.block);
+        }
+        let mut rank = 0;
+        let mut sends = Vec::new();
+        for &(p, place) in &petsc {
+            while p as usize >= starts[rank + 1] {
+                rank += 1;
+            }
+            counts[rank] += self.block;
+            if p as usize >= self.first && (p as usize) < self.first + self.local {
+                sends.push((p - self.first as u32, place));
+            }
+        }
+        NodeGather {
+            arrival: petsc.iter().map(|&(_, place)| place).collect(),
+            nodes,
+            counts,
+            sends,
+            block: self.block,
+        }
+    }
+
     /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank.
     pub fn gather(&self, local: &[f64], whole: &mut [f64]) -> Result<(), LinalgError> {
         let petsc = crate::parallel::all_gather(local, &self.counts)
@@ -308,6 +357,81 @@ impl Distribution {
             whole[self.ours(p)] = value;
         }
         Ok(())
+    }
+}
+
+/// Some nodes' values gathered from the ranks that own them, onto every rank: what the contact
+/// loop reads of a body (its displacement on the boundary, its contact forces) without a
+/// vector of the body's size on any rank ([`Distribution::node_gather`]). Each rank sends its
+/// own nodes' values among them, in PETSc's order, and every rank receives every rank's
+/// (`MPI_Allgatherv`): the values are the owners' to the bit.
+#[derive(Debug)]
+pub struct NodeGather {
+    /// The nodes (our numbering), increasing.
+    nodes: Vec<u32>,
+    /// The place in `nodes` of each node in the order the values arrive (rank after rank,
+    /// each rank's in PETSc's order).
+    arrival: Vec<u32>,
+    /// The values each rank sends (`block` per node), in rank order.
+    counts: Vec<usize>,
+    /// This rank's nodes among `nodes`, in the order it sends them: each one's row among this
+    /// rank's rows (PETSc's order, `block` values each) and its place in `nodes`.
+    sends: Vec<(u32, u32)>,
+    block: usize,
+}
+
+impl NodeGather {
+    /// The nodes gathered, increasing.
+    pub fn nodes(&self) -> &[u32] {
+        &self.nodes
+    }
+
+    /// The place of `node` among [`Self::nodes`], if it is one of them.
+    pub fn place(&self, node: usize) -> Option<usize> {
+        u32::try_from(node)
+            .ok()
+            .and_then(|node| self.nodes.binary_search(&node).ok())
+    }
+
+    /// Every node's values (`block` each, in the order of [`Self::nodes`]) from `rows`, this
+    /// rank's rows of the body's vector in PETSc's order (collective).
+    pub fn from_rows(&self, rows: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        self.exchange(&self.sent(rows, |(row, _)| row))
+    }
+
+    /// Every node's values (`block` each, in the order of [`Self::nodes`]) as the rank that
+    /// owns it has them in `at_nodes` (the same layout; this rank's values at the other ranks'
+    /// nodes are not read) (collective).
+    pub fn from_owners(&self, at_nodes: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        self.exchange(&self.sent(at_nodes, |(_, place)| place))
+    }
+
+    /// The values this rank sends: `block` of `from` at the position `at` picks of each of its
+    /// nodes (its row, or its place among the nodes).
+    fn sent(&self, from: &[f64], at: impl Fn((u32, u32)) -> u32) -> Vec<f64> {
+        let b = self.block;
+        (self.sends.iter())
+            .flat_map(|&send| {
+                let k = at(send) as usize;
+                from[k * b..(k + 1) * b].iter().copied()
+            })
+            .collect()
+    }
+
+    fn exchange(&self, sent: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        let arrived = crate::parallel::all_gather(sent, &self.counts)
+            .map_err(|e| LinalgError::Mpi(e.to_string()))?;
+        Ok(self.placed(&arrived))
+    }
+
+    /// What every rank sent, in rank order, put in the order of [`Self::nodes`].
+    fn placed(&self, arrived: &[f64]) -> Vec<f64> {
+        let b = self.block;
+        let mut values = vec![0.0; b * self.nodes.len()];
+        for (&place, value) in self.arrival.iter().zip(arrived.chunks_exact(b)) {
+            values[place as usize * b..(place as usize + 1) * b].copy_from_slice(value);
+        }
+        values
     }
 }
 
@@ -371,6 +495,54 @@ mod tests {
         spread_parts(&mut third, &mut nodes_on_rank);
         assert_eq!(third, parts(&[11, 10]));
         assert_eq!(nodes_on_rank, [164, 164]);
+    }
+
+    #[test]
+    fn some_nodes_gathered_from_three_ranks_are_the_whole_vector_s_entries() {
+        // 12 nodes of 2 unknowns on a line, owned by ranks 0, 1, 2 in turn; the whole vector's
+        // entry at unknown `d` is `d`.
+        let (num_nodes, block) = (12, 2);
+        let owner: Vec<u32> = (0..num_nodes).map(|a| (a % 3) as u32).collect();
+        let coords: Vec<f64> = (0..num_nodes).flat_map(|a| [a as f64, 0.0]).collect();
+        let whole: Vec<f64> = (0..num_nodes * block).map(|d| d as f64).collect();
+        let nodes: Vec<u32> = vec![0, 2, 3, 7, 8, 11];
+        let ranks = |rank| Ranks { rank, size: 3 };
+        let distributions: Vec<Distribution> = (0..3)
+            .map(|r| Distribution::with_owners(&owner, &coords, block, ranks(r)).unwrap())
+            .collect();
+        let plans: Vec<NodeGather> = (distributions.iter())
+            .map(|d| d.node_gather(nodes.clone()))
+            .collect();
+        let expected: Vec<f64> = (nodes.iter())
+            .flat_map(|&a| whole[block * a as usize..block * (a as usize + 1)].to_vec())
+            .collect();
+        // From each rank's rows: what every rank sends, in rank order, is what each receives.
+        let arrived: Vec<f64> = (plans.iter().zip(&distributions))
+            .flat_map(|(plan, d)| plan.sent(&d.local_part(&whole), |(row, _)| row))
+            .collect();
+        for plan in &plans {
+            assert_eq!(plan.placed(&arrived), expected);
+        }
+        // From values at the nodes, each node's owner's (the others' are not read).
+        let arrived: Vec<f64> = (plans.iter().enumerate())
+            .flat_map(|(r, plan)| {
+                let mine: Vec<f64> = (nodes.iter())
+                    .flat_map(|&a| {
+                        let d = block * a as usize;
+                        match owner[a as usize] as usize == r {
+                            true => whole[d..d + block].to_vec(),
+                            false => vec![f64::NAN; block],
+                        }
+                    })
+                    .collect();
+                plan.sent(&mine, |(_, place)| place)
+            })
+            .collect();
+        for plan in &plans {
+            assert_eq!(plan.placed(&arrived), expected);
+        }
+        assert_eq!(plans[1].place(7), Some(3));
+        assert_eq!(plans[1].place(5), None);
     }
 
     #[test]

@@ -220,7 +220,8 @@ pub struct KrylovProblem<'a> {
 }
 
 /// Solves the coupled system of `problem` to `tightness` from the last solve kept in `state`;
-/// returns `x = [u_1; ...; u_N; lambda / s]`.
+/// returns `x = [u_1; ...; u_N; lambda / s]` as this process holds it (`KrylovLayout`: whole,
+/// or this rank's rows of each body, then every multiplier).
 pub fn solve(
     problem: &KrylovProblem,
     state: &mut KrylovState,
@@ -291,7 +292,7 @@ pub fn solve(
         &mut state.displacements,
         &mut state.tractions,
     );
-    operators.product.layout.whole(local_x)
+    Ok(local_x)
 }
 
 /// The last solve's displacements (scaled to this load step's factors:
@@ -348,7 +349,7 @@ fn keep(
     }
 }
 
-/// `relative_residual = |[f; g] - A x| / |[f; g]|` of the whole vector `x` by the coupled
+/// `relative_residual = |[f; g] - A x| / |[f; g]|` of `x` (as [`solve`] returns it) by the coupled
 /// GMRES's own product: on several ranks, where a rank's coupled system holds only its entries
 /// of `B` and `C` (`crate::contact::coupled::system::Unknowns::RankRows`), the residual check
 /// of a solve (collective); on one process the same sum as `CoupledSystem::relative_residual`
@@ -357,7 +358,6 @@ pub fn relative_residual(problem: &KrylovProblem, x: Vec<f64>) -> Result<f64, Co
     let mut product = CoupledProduct::new(problem)?;
     let rhs = problem.system.rhs();
     let rhs_norm = product.layout.dot(&rhs, &rhs)?.sqrt();
-    let x = product.layout.local_part(x);
     let mut residual = vec![0.0; x.len()];
     product.apply(&x, &mut residual)?;
     residual.iter_mut().zip(&rhs).for_each(|(r, b)| *r = b - *r);
@@ -376,7 +376,7 @@ struct CoupledProduct<'a> {
     bodies: &'a [&'a AssembledBody],
     solvers: &'a [BodySolver],
     /// How the vectors are held: whole, or this rank's rows of each body.
-    layout: KrylovLayout<'a>,
+    layout: KrylovLayout,
     /// A rank's part of `C u` over its columns (empty on one process).
     partial: Vec<f64>,
 }

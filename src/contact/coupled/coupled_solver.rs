@@ -208,21 +208,15 @@ impl BodyFactors {
         }
     }
 
-    /// Each body's displacements `u` (whole, every body) reduced to this rank's rows of it in a
-    /// distributed run, in PETSc's order; unchanged on one process. The loop keeps its last
-    /// iterate so between solves ([`Self::whole_rows`] undoes it), so that no rank holds a
-    /// whole body's vector through the next solve.
-    pub fn own_rows(&self, u: &mut [Vec<f64>]) -> Result<(), ContactError> {
-        if let Some(shared) = shared_bodies(&self.solvers)? {
-            for (distribution, u) in shared.iter().zip(u.iter_mut()) {
-                *u = distribution.local_part(u);
-            }
-        }
-        Ok(())
+    /// How each body's unknowns are shared among the ranks, in a distributed run; `None` on
+    /// one process.
+    pub fn distributions(&self) -> Result<Option<Vec<&Distribution>>, ContactError> {
+        shared_bodies(&self.solvers)
     }
 
-    /// Each body's displacements whole again from every rank's rows of them
-    /// ([`Self::own_rows`]; collective, the same values to the bit); unchanged on one process.
+    /// Each body's displacements whole from every rank's rows of them (this rank's, PETSc's
+    /// order, in `u`: a distributed run's solve answers so; collective, the same values to the
+    /// bit); unchanged on one process.
     pub fn whole_rows(&self, u: &mut [Vec<f64>]) -> Result<(), ContactError> {
         if let Some(shared) = shared_bodies(&self.solvers)? {
             for (distribution, u) in shared.iter().zip(u.iter_mut()) {
@@ -283,7 +277,8 @@ impl BodyFactors {
     }
 
     /// Solves the coupled system of `pairs` on `bodies`; returns `x = [u_1; ...; u_N; lambda
-    /// / s]`.
+    /// / s]`, in a distributed run this rank's rows of each body (PETSc's order) then every
+    /// multiplier (`crate::contact::coupled::krylov_layout`).
     ///
     /// On the Krylov path a loose solve ([`Tightness`]) stops at a relative residual the
     /// caller's active-set decision needs, not at round-off; the caller then owns the residual

@@ -38,6 +38,7 @@ use std::collections::HashMap;
 
 use crate::contact::ContactError;
 use crate::contact::coupled::system::Coupling;
+use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::GapRow;
 use crate::contact::geometry::rbf::{Interpolation, interpolation_radii};
 use crate::contact::geometry::surface::ContactSurface;
@@ -287,13 +288,13 @@ impl InterfaceOperators {
     }
 
     /// The displacement jump `u1_i - (R12 u2)_i` of every primary candidate, for the bodies'
-    /// displacements `u1`, `u2` (body dofs): what the linearized gaps and the slide read.
+    /// displacements `u1`, `u2`: what the linearized gaps and the slide read.
     pub fn jumps(
         &self,
         primary: &ContactSurface,
         secondary: &ContactSurface,
-        u1: &[f64],
-        u2: &[f64],
+        u1: BodyDisplacement,
+        u2: BodyDisplacement,
     ) -> Result<Vec<[f64; 3]>, ContactError> {
         let on_surfaces = [primary.values(u1), secondary.values(u2)];
         self.jumps_of(&on_surfaces)

@@ -34,31 +34,27 @@ use std::ops::Range;
 use crate::contact::ContactError;
 use crate::contact::coupled::row_ownership::shared_bodies;
 use crate::contact::coupled::system::{CoupledSystem, Unknowns};
-use crate::linalg::{BodySolver, Distribution, gmres};
+use crate::linalg::{BodySolver, gmres};
 
 /// Where the values of a Krylov vector are held (module doc).
-pub enum KrylovLayout<'a> {
+pub enum KrylovLayout {
     /// The whole vector on this process.
     Whole,
     /// This rank's rows of each body, then every multiplier.
-    Shared(SharedLayout<'a>),
+    Shared(SharedLayout),
 }
 
 /// The layout of a distributed run's Krylov vectors.
-pub struct SharedLayout<'a> {
-    /// How each body's unknowns are shared.
-    bodies: Vec<&'a Distribution>,
+pub struct SharedLayout {
     /// Body `k`'s rows of this rank are `local[k]..local[k + 1]` of a Krylov vector.
     local: Vec<usize>,
-    /// Body `k`'s unknowns are `whole[k]..whole[k + 1]` of the whole vector.
-    whole: Vec<usize>,
 }
 
-impl<'a> KrylovLayout<'a> {
+impl KrylovLayout {
     /// The layout of `system`'s vectors given the bodies' `solvers`: shared when they are
     /// shared among ranks, which in a distributed run every body's is (CG + AMG on its rows);
     /// then `system` must hold this rank's entries ([`Unknowns::RankRows`]).
-    pub fn new(system: &CoupledSystem, solvers: &'a [BodySolver]) -> Result<Self, ContactError> {
+    pub fn new(system: &CoupledSystem, solvers: &[BodySolver]) -> Result<Self, ContactError> {
         let shared = match (shared_bodies(solvers)?, system.unknowns) {
             (None, Unknowns::Whole) => return Ok(Self::Whole),
             (Some(shared), Unknowns::RankRows) => shared,
@@ -78,11 +74,7 @@ impl<'a> KrylovLayout<'a> {
         for body in &shared {
             local.push(local.last().unwrap() + body.local());
         }
-        Ok(Self::Shared(SharedLayout {
-            bodies: shared,
-            local,
-            whole: system.offsets.clone(),
-        }))
+        Ok(Self::Shared(SharedLayout { local }))
     }
 
     /// The displacement rows of a vector: where its multipliers start.
@@ -90,35 +82,6 @@ impl<'a> KrylovLayout<'a> {
         match self {
             Self::Whole => system.num_displacements(),
             Self::Shared(layout) => layout.num_local(),
-        }
-    }
-
-    /// This process's part of the whole vector `whole`.
-    pub fn local_part(&self, whole: Vec<f64>) -> Vec<f64> {
-        match self {
-            Self::Whole => whole,
-            Self::Shared(layout) => {
-                let n = layout.num_displacements();
-                let mut local = Vec::with_capacity(layout.num_local() + whole.len() - n);
-                for (k, body) in layout.bodies.iter().enumerate() {
-                    local.extend(body.local_part(&whole[layout.whole_range(k)]));
-                }
-                local.extend_from_slice(&whole[n..]);
-                local
-            }
-        }
-    }
-
-    /// The whole vector of which every rank holds its `local` part (collective).
-    pub fn whole(&self, local: Vec<f64>) -> Result<Vec<f64>, ContactError> {
-        match self {
-            Self::Whole => Ok(local),
-            Self::Shared(layout) => {
-                let mut whole = vec![0.0; layout.num_displacements()];
-                layout.gather_displacements(&local, &mut whole)?;
-                whole.extend_from_slice(&local[layout.num_local()..]);
-                Ok(whole)
-            }
         }
     }
 
@@ -137,38 +100,15 @@ impl<'a> KrylovLayout<'a> {
     }
 }
 
-impl SharedLayout<'_> {
+impl SharedLayout {
     /// This rank's rows of every body: where the multipliers start in a Krylov vector.
     pub fn num_local(&self) -> usize {
         *self.local.last().expect("offsets start with 0")
     }
 
-    /// Every body's unknowns: where the multipliers start in a whole vector.
-    pub fn num_displacements(&self) -> usize {
-        *self.whole.last().expect("offsets start with 0")
-    }
-
     /// Body `k`'s rows of this rank, within a Krylov vector.
     pub fn local_range(&self, k: usize) -> Range<usize> {
         self.local[k]..self.local[k + 1]
-    }
-
-    fn whole_range(&self, k: usize) -> Range<usize> {
-        self.whole[k]..self.whole[k + 1]
-    }
-
-    /// Every body's displacements, whole in our numbering, from every rank's rows of them in
-    /// `local` (collective: one `MPI_Allgatherv` per body).
-    pub fn gather_displacements(
-        &self,
-        local: &[f64],
-        whole: &mut [f64],
-    ) -> Result<(), ContactError> {
-        for (k, body) in self.bodies.iter().enumerate() {
-            body.gather(&local[self.local_range(k)], &mut whole[self.whole_range(k)])
-                .map_err(|e| ContactError::Linalg(format!("gathering a body's vector: {e}")))?;
-        }
-        Ok(())
     }
 
     /// `out += ` the sum over the ranks of every rank's `partial` (of one length on every

@@ -59,12 +59,13 @@ use faer::sparse::{SparseColMat, Triplet};
 use crate::contact::ContactError;
 use crate::contact::coupled::compliance::MultiplierKey;
 use crate::contact::coupled::row_ownership::RowOwnership;
+use crate::contact::geometry::displacement::{BodyDisplacement, NodeValues};
 use crate::contact::law::{Multiplier, Reads, Restates};
 use rayon::prelude::*;
 
 use crate::elastic::{AssembledBody, StepFactors};
 use crate::fem::LoadVector;
-use crate::linalg::{BodySolver, mat_vec};
+use crate::linalg::{BodySolver, Distribution, NodeGather, mat_vec};
 
 /// The interface operators of one pair in one iteration, on its active primary nodes I (built
 /// by `crate::contact::coupled::interface::InterfaceOperators::coupling`, each node's multipliers
@@ -113,8 +114,12 @@ pub struct Pair<'a> {
 
 /// The solution of one iteration.
 pub struct CoupledSolution {
-    /// Displacements of each body.
+    /// Displacements of each body: whole, or in a distributed run's contact loop this rank's
+    /// rows of it (PETSc's order; [`CoupledSystem::solution_on_ranks`]).
     pub u: Vec<Vec<f64>>,
+    /// In a distributed run's contact loop, each body's displacement at the nodes the contact
+    /// geometry reads, from every rank ([`Self::displacement`]); `None` where `u` is whole.
+    pub on_nodes: Option<Vec<NodeValues>>,
     /// Traction on each pair's primary at its active nodes, one vector per node (for
     /// frictionless, `lambda_n n`).
     pub traction: Vec<Vec<[f64; 3]>>,
@@ -129,20 +134,21 @@ pub struct CoupledSolution {
     pub relative_residual: f64,
 }
 
-/// Adds the forces pair `coupling`'s tractions `on_pair` put on its bodies to their nodal
-/// forces: `M_a lambda` on the primary, `-M_b R_ba lambda` on the secondary.
+/// The forces pair `coupling`'s tractions `on_pair` put on its bodies, term by term in a fixed
+/// order: `add(0, dof, f)` adds `f` to the primary's force at `dof` (`M_a lambda`), `add(1, dof,
+/// f)` to the secondary's (`-M_b R_ba lambda`).
 fn add_pair_forces(
     coupling: &Coupling,
     on_pair: &[[f64; 3]],
     dim: usize,
-    [primary, secondary]: [&mut [f64]; 2],
+    mut add: impl FnMut(usize, usize, f64),
 ) {
     for (k, lambda) in on_pair.iter().enumerate() {
         let node = coupling.primary_nodes[k];
-        for c in 0..dim {
-            primary[dim * node + c] += coupling.areas1[k] * lambda[c];
+        for (c, &component) in lambda.iter().enumerate().take(dim) {
+            add(0, dim * node + c, coupling.areas1[k] * component);
             for &(node2, load) in &coupling.loads2[k] {
-                secondary[dim * node2 + c] -= load * lambda[c];
+                add(1, dim * node2 + c, -(load * component));
             }
         }
     }
@@ -155,14 +161,25 @@ impl CoupledSolution {
     pub fn of_pair(&self, p: usize, pair: &Pair, dim: usize) -> CoupledSolution {
         let (a, b) = (pair.primary, pair.secondary);
         let mut forces = [vec![0.0; self.u[a].len()], vec![0.0; self.u[b].len()]];
-        let [primary, secondary] = &mut forces;
-        add_pair_forces(pair.coupling, &self.traction[p], dim, [primary, secondary]);
+        add_pair_forces(pair.coupling, &self.traction[p], dim, |side, dof, value| {
+            forces[side][dof] += value;
+        });
         CoupledSolution {
             u: vec![self.u[a].clone(), self.u[b].clone()],
+            on_nodes: None,
             traction: vec![self.traction[p].clone()],
             contact_force: forces.map(LoadVector::new).into(),
             rigid: vec![self.rigid[a].clone(), self.rigid[b].clone()],
             relative_residual: self.relative_residual,
+        }
+    }
+
+    /// Body `k`'s displacement as the contact geometry reads it: whole, or at the nodes it
+    /// reads ([`Self::on_nodes`]).
+    pub fn displacement(&self, k: usize) -> BodyDisplacement<'_> {
+        match &self.on_nodes {
+            Some(on_nodes) => BodyDisplacement::OnNodes(&on_nodes[k]),
+            None => BodyDisplacement::Whole(&self.u[k]),
         }
     }
 
@@ -619,9 +636,7 @@ impl CoupledSystem {
         relative_residual: f64,
     ) -> CoupledSolution {
         let n = self.num_displacements();
-        let rigid: Vec<Vec<f64>> = (0..self.num_bodies())
-            .map(|k| x[n + self.rigid_offsets[k]..n + self.rigid_offsets[k + 1]].to_vec())
-            .collect();
+        let rigid = self.rigid_values(&x[n..]);
         let u: Vec<Vec<f64>> = (0..self.num_bodies())
             .map(|k| {
                 let mut u = x[self.body_dofs(k)].to_vec();
@@ -631,11 +646,114 @@ impl CoupledSystem {
                 u
             })
             .collect();
+        let traction = self.tractions(&x[n..], pairs, dim);
         let mut contact_force: Vec<Vec<f64>> = u.iter().map(|u| vec![0.0; u.len()]).collect();
+        for (pair, on_pair) in pairs.iter().zip(&traction) {
+            let (a, b) = (pair.primary, pair.secondary);
+            add_pair_forces(pair.coupling, on_pair, dim, |side, dof, value| {
+                contact_force[[a, b][side]][dof] += value;
+            });
+        }
+        CoupledSolution {
+            u,
+            on_nodes: None,
+            traction,
+            contact_force: contact_force.into_iter().map(LoadVector::new).collect(),
+            rigid,
+            relative_residual,
+        }
+    }
+
+    /// [`Self::solution`] on a rank of a distributed run, from its part `x` of the answer
+    /// (this rank's rows of each body, PETSc's order, then every multiplier:
+    /// `crate::contact::coupled::krylov_layout`), with no vector of a body's size: `u` holds
+    /// this rank's rows, and each body's displacement and interface forces at the nodes
+    /// `reads[k]` gathers (its boundary's and its contact surfaces') are received from the
+    /// ranks that own them (collective). The forces are the serial run's to the bit: each
+    /// node's terms are all made on the rank that owns it (`row_ownership::kept_nodes`), in
+    /// the same order.
+    pub fn solution_on_ranks(
+        &self,
+        x: &[f64],
+        (bodies, distributions, reads): (&[&AssembledBody], &[&Distribution], &[NodeGather]),
+        pairs: &[Pair],
+        dim: usize,
+        relative_residual: f64,
+    ) -> Result<CoupledSolution, ContactError> {
+        let mut local = vec![0];
+        for distribution in distributions {
+            local.push(local.last().unwrap() + distribution.local());
+        }
+        let n = *local.last().unwrap();
+        let rigid = self.rigid_values(&x[n..]);
+        let u: Vec<Vec<f64>> = (0..self.num_bodies())
+            .map(|k| {
+                let mut u = x[local[k]..local[k + 1]].to_vec();
+                for (column, a) in bodies[k].rigid.iter().zip(&rigid[k]) {
+                    for row in column
+                        .dofs
+                        .iter()
+                        .filter_map(|&d| distributions[k].own_row(d))
+                    {
+                        u[row] = *a;
+                    }
+                }
+                u
+            })
+            .collect();
+        let traction = self.tractions(&x[n..], pairs, dim);
+        let mut forces: Vec<Vec<f64>> = (reads.iter())
+            .map(|read| vec![0.0; dim * read.nodes().len()])
+            .collect();
+        for (pair, on_pair) in pairs.iter().zip(&traction) {
+            let (a, b) = (pair.primary, pair.secondary);
+            add_pair_forces(pair.coupling, on_pair, dim, |side, dof, value| {
+                let k = [a, b][side];
+                let place = (reads[k].place(dof / dim))
+                    .expect("the interface forces act at the contact surfaces' nodes");
+                forces[k][dim * place + dof % dim] += value;
+            });
+        }
+        let gathered = |what: &str, result: Result<Vec<f64>, crate::linalg::LinalgError>| {
+            result.map_err(|e| ContactError::Linalg(format!("gathering a body's {what}: {e}")))
+        };
+        let mut on_nodes = Vec::with_capacity(reads.len());
+        let mut contact_force = Vec::with_capacity(reads.len());
+        for (k, read) in reads.iter().enumerate() {
+            let values = gathered("displacement", read.from_rows(&u[k]))?;
+            on_nodes.push(NodeValues::new(read.nodes().to_vec(), values, dim));
+            let force = gathered("interface forces", read.from_owners(&forces[k]))?;
+            let entries = (read.nodes().iter())
+                .flat_map(|&node| (0..dim).map(move |c| dim * node as usize + c))
+                .zip(force)
+                .filter(|&(_, v)| v != 0.0);
+            let len = bodies[k].f.len();
+            contact_force.push(LoadVector::from_entries(len, entries.collect()));
+        }
+        Ok(CoupledSolution {
+            u,
+            on_nodes: Some(on_nodes),
+            traction,
+            contact_force,
+            rigid,
+            relative_residual,
+        })
+    }
+
+    /// Each body's force-controlled displacements from `x`'s part after the displacements.
+    fn rigid_values(&self, after: &[f64]) -> Vec<Vec<f64>> {
+        (0..self.num_bodies())
+            .map(|k| after[self.rigid_offsets[k]..self.rigid_offsets[k + 1]].to_vec())
+            .collect()
+    }
+
+    /// Each pair's tractions at its active nodes from the multipliers `lambda / s` (the part of
+    /// `x` after the displacements).
+    fn tractions(&self, multipliers: &[f64], pairs: &[Pair], dim: usize) -> Vec<Vec<[f64; 3]>> {
         let mut traction = Vec::with_capacity(pairs.len());
         for (p, pair) in pairs.iter().enumerate() {
             let coupling = pair.coupling;
-            let multipliers = &x[n + self.multiplier_offsets[p]..];
+            let multipliers = &multipliers[self.multiplier_offsets[p]..];
             let first = coupling.node_offsets();
             let on_pair: Vec<[f64; 3]> = (0..coupling.primary_nodes.len())
                 .map(|k| {
@@ -649,23 +767,9 @@ impl CoupledSystem {
                     lambda
                 })
                 .collect();
-            let [primary, secondary] = if pair.primary < pair.secondary {
-                let (a, b) = contact_force.split_at_mut(pair.secondary);
-                [&mut a[pair.primary], &mut b[0]]
-            } else {
-                let (a, b) = contact_force.split_at_mut(pair.primary);
-                [&mut b[0], &mut a[pair.secondary]]
-            };
-            add_pair_forces(coupling, &on_pair, dim, [primary, secondary]);
             traction.push(on_pair);
         }
-        CoupledSolution {
-            u,
-            traction,
-            contact_force: contact_force.into_iter().map(LoadVector::new).collect(),
-            rigid,
-            relative_residual,
-        }
+        traction
     }
 }
 

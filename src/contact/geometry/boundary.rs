@@ -9,6 +9,7 @@
 
 use std::collections::HashMap;
 
+use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::projection::SurfaceIndex;
 use crate::fem::kernels::facet_measure_and_normal;
 use crate::mesh::BodyMesh;
@@ -58,17 +59,20 @@ impl BodyBoundary {
         }
     }
 
-    /// The boundary displaced by the body's displacement `u` (body dofs; `None`: reference),
-    /// indexed for closest-point queries.
-    pub fn index(&self, u: Option<&[f64]>) -> SurfaceIndex {
+    /// The body's nodes on the boundary (each once, in no particular order).
+    pub fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+
+    /// The boundary displaced by the body's displacement `u` (`None`: reference), indexed for
+    /// closest-point queries.
+    pub fn index(&self, u: Option<BodyDisplacement>) -> SurfaceIndex {
         let dim = self.dim;
         let positions: Vec<[f64; 3]> = match u {
-            Some(u) => self
-                .nodes
-                .iter()
-                .zip(&self.coords)
+            Some(u) => (self.nodes.iter().zip(&self.coords))
                 .map(|(&n, x)| {
-                    std::array::from_fn(|k| x[k] + if k < dim { u[dim * n + k] } else { 0.0 })
+                    let displacement = u.at(dim, n);
+                    std::array::from_fn(|k| x[k] + displacement[k])
                 })
                 .collect(),
             None => self.coords.clone(),

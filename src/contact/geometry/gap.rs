@@ -38,6 +38,7 @@
 //! iteration on `e` that contracts only where `R12` reproduces the P1 surface, and diverged
 //! (error doubling each iteration) where it extrapolates, at the ends of two clamped blocks.
 
+use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::projection::{Projection, SurfaceIndex};
 use crate::contact::geometry::surface::ContactSurface;
 
@@ -105,8 +106,8 @@ pub enum RowNormal {
 pub fn geometric_gaps(
     own: &ContactSurface,
     other: &ContactSurface,
-    u_own: Option<&[f64]>,
-    u_other: Option<&[f64]>,
+    u_own: Option<BodyDisplacement>,
+    u_other: Option<BodyDisplacement>,
 ) -> Vec<f64> {
     let measure = Measure::new(own, other, u_own, u_other, RowNormal::Facet);
     (0..own.len())
@@ -146,7 +147,7 @@ struct NodeGap {
 struct Measure<'a> {
     own: &'a ContactSurface,
     other: &'a ContactSurface,
-    u_own: Option<&'a [f64]>,
+    u_own: Option<BodyDisplacement<'a>>,
     surface: SurfaceIndex,
     /// The other surface's displaced nodal normals, for [`RowNormal::Averaged`].
     nodal_normals: Option<Vec<[f64; 3]>>,
@@ -158,8 +159,8 @@ impl<'a> Measure<'a> {
     fn new(
         own: &'a ContactSurface,
         other: &'a ContactSurface,
-        u_own: Option<&'a [f64]>,
-        u_other: Option<&'a [f64]>,
+        u_own: Option<BodyDisplacement<'a>>,
+        u_other: Option<BodyDisplacement<'a>>,
         row_normal: RowNormal,
     ) -> Self {
         let surface = other.index(u_other);
@@ -271,24 +272,20 @@ pub struct GapRow {
     pub target: f64,
 }
 
-/// The gap rows of every primary candidate at the displacements `u1`, `u2` (body dofs; `None`:
-/// the reference configuration), each along the `row_normal` the pair's law asks for
+/// The gap rows of every primary candidate at the displacements `u1`, `u2` (`None`: the
+/// reference configuration), each along the `row_normal` the pair's law asks for
 /// (`crate::contact::law::ContactLaw::row_normal`).
 pub fn gap_rows(
     primary: &ContactSurface,
     secondary: &ContactSurface,
-    u1: Option<&[f64]>,
-    u2: Option<&[f64]>,
+    u1: Option<BodyDisplacement>,
+    u2: Option<BodyDisplacement>,
     row_normal: RowNormal,
 ) -> Vec<GapRow> {
     let measure = Measure::new(primary, secondary, u1, u2, row_normal);
     let dim = primary.dim;
-    let displacement = |surface: &ContactSurface, u: Option<&[f64]>, s: usize| -> [f64; 3] {
-        let node = surface.nodes[s];
-        std::array::from_fn(|k| match u {
-            Some(u) if k < dim => u[dim * node + k],
-            _ => 0.0,
-        })
+    let displacement = |surface: &ContactSurface, u: Option<BodyDisplacement>, s: usize| {
+        u.map_or([0.0; 3], |u| u.at(dim, surface.nodes[s]))
     };
     (0..primary.len())
         .map(|i| {

@@ -17,6 +17,7 @@ use std::collections::HashMap;
 use thiserror::Error;
 
 use crate::contact::geometry::boundary::BodyBoundary;
+use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::projection::SurfaceIndex;
 use crate::contact::geometry::rbf::nearest_distances;
 use crate::fem::LoadVector;
@@ -129,19 +130,17 @@ impl ContactSurface {
         self.nodes.is_empty()
     }
 
-    /// The position of node `s` displaced by the body's displacement `u` (body dofs, `dim`
-    /// per node).
-    pub fn deformed(&self, u: &[f64], s: usize) -> [f64; 3] {
-        let (dim, node) = (self.dim, self.nodes[s]);
-        std::array::from_fn(|k| self.coords[s][k] + if k < dim { u[dim * node + k] } else { 0.0 })
+    /// The position of node `s` displaced by the body's displacement `u`.
+    pub fn deformed(&self, u: BodyDisplacement, s: usize) -> [f64; 3] {
+        let displacement = u.at(self.dim, self.nodes[s]);
+        std::array::from_fn(|k| self.coords[s][k] + displacement[k])
     }
 
-    /// The body vector `u` (body dofs) at this surface's nodes, three components per node in
-    /// the surface's order (the third 0 in 2D).
-    pub fn values(&self, u: &[f64]) -> Vec<f64> {
-        let dim = self.dim;
+    /// The body's displacement `u` at this surface's nodes, three components per node in the
+    /// surface's order (the third 0 in 2D).
+    pub fn values(&self, u: BodyDisplacement) -> Vec<f64> {
         (self.nodes.iter())
-            .flat_map(|&node| (0..3).map(move |k| if k < dim { u[dim * node + k] } else { 0.0 }))
+            .flat_map(|&node| u.at(self.dim, node))
             .collect()
     }
 
@@ -165,7 +164,7 @@ impl ContactSurface {
     /// coordinates of a [`crate::contact::geometry::projection::Projection`] onto it.
     /// The outward unit normal at each node of the surface displaced by `u` (body dofs), as
     /// [`Self::normals`] are in the reference configuration.
-    pub fn displaced_normals(&self, u: &[f64]) -> Vec<[f64; 3]> {
+    pub fn displaced_normals(&self, u: BodyDisplacement) -> Vec<[f64; 3]> {
         let positions: Vec<[f64; 3]> = (0..self.len()).map(|s| self.deformed(u, s)).collect();
         area_weighted_normals(&self.facets, self.dim, &positions)
     }
@@ -192,9 +191,9 @@ impl ContactSurface {
         })
     }
 
-    /// The surface's facets at its nodes' positions displaced by `u` (body dofs; `None`: the
-    /// reference positions), indexed for closest-point projection.
-    pub fn index(&self, u: Option<&[f64]>) -> SurfaceIndex {
+    /// The surface's facets at its nodes' positions displaced by `u` (`None`: the reference
+    /// positions), indexed for closest-point projection.
+    pub fn index(&self, u: Option<BodyDisplacement>) -> SurfaceIndex {
         let positions: Vec<[f64; 3]> = match u {
             Some(u) => (0..self.len()).map(|s| self.deformed(u, s)).collect(),
             None => self.coords.clone(),

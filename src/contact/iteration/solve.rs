@@ -97,7 +97,7 @@ use crate::elastic::{
 };
 use crate::fem::LoadVector;
 use crate::fem::rigid_modes::RigidModes;
-use crate::linalg::BodySolverKind;
+use crate::linalg::{BodySolverKind, NodeGather};
 use crate::progress::Heartbeat;
 
 /// [`ContactSolver::check_held`]: a free motion is held when the Gram matrix's eigenvalue along
@@ -241,6 +241,23 @@ pub struct ContactSolver<'a> {
     laws: Vec<ContactLaw>,
     /// How each pair's law is enforced.
     methods: Vec<Enforcement>,
+    /// In a distributed run, how each body's values at the nodes the contact geometry reads
+    /// (its boundary's and its contact surfaces': [`geometry_nodes`]) reach every rank after a
+    /// solve; `None` on one process.
+    reads: Option<Vec<NodeGather>>,
+}
+
+/// The nodes of a body at which the contact geometry reads its displacement and the interfaces
+/// put their forces: its closed boundary's (inside or outside) and its contact surfaces', which
+/// lie on the boundary unless a surface group is inside the body. Increasing.
+fn geometry_nodes(surfaces: &[&ContactSurface]) -> Vec<u32> {
+    let mut nodes: Vec<u32> = (surfaces.iter())
+        .flat_map(|s| s.nodes.iter().chain(s.boundary.nodes()))
+        .map(|&node| node as u32)
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
 }
 
 /// The interface operators of `problem`, paired with the primary surface slid by `slid` over
@@ -382,6 +399,20 @@ impl<'a> ContactSolver<'a> {
                 Some(factors)
             }
         };
+        let reads = match factors
+            .as_ref()
+            .map(BodyFactors::distributions)
+            .transpose()?
+        {
+            Some(Some(shared)) => Some(
+                (shared.iter().enumerate())
+                    .map(|(k, distribution)| {
+                        distribution.node_gather(geometry_nodes(&surfaces_of(k)))
+                    })
+                    .collect(),
+            ),
+            _ => None,
+        };
         let operators = (pairs.iter())
             .map(|problem| pair(problem, [0.0; 3]))
             .collect::<Result<Vec<_>, _>>()?;
@@ -441,6 +472,7 @@ impl<'a> ContactSolver<'a> {
             kept,
             laws: pairs.iter().map(|p| ContactLaw::of(&p.settings)).collect(),
             methods: pairs.iter().map(Enforcement::of).collect(),
+            reads,
         })
     }
 
@@ -653,9 +685,9 @@ struct LoopState {
 }
 
 /// The last iterate as the loop keeps it between solves: each pair's coupling and the solution,
-/// whose displacements are, in a distributed run, this rank's rows alone
-/// ([`BodyFactors::own_rows`]), so that no rank holds a whole body's vector through the next
-/// solve. Read whole through [`Self::displacements`] and [`Self::into_whole`] (collective).
+/// whose displacements are, in a distributed run, this rank's rows and the values at the nodes
+/// the contact geometry reads ([`CoupledSolution::on_nodes`]), so that no rank holds a whole
+/// body's vector through the loop. Made whole by [`Self::into_whole`] (collective).
 struct KeptIterate {
     couplings: Vec<Coupling>,
     solution: CoupledSolution,
@@ -669,29 +701,6 @@ fn prediction_error(e: &crate::parallel::ParallelError) -> ContactError {
 }
 
 impl KeptIterate {
-    fn new(
-        couplings: Vec<Coupling>,
-        mut solution: CoupledSolution,
-        factors: Option<&BodyFactors>,
-    ) -> Result<Self, ContactError> {
-        if let Some(factors) = factors {
-            factors.own_rows(&mut solution.u)?;
-        }
-        Ok(Self {
-            couplings,
-            solution,
-        })
-    }
-
-    /// Each body's displacements, whole (collective).
-    fn displacements(&self, factors: Option<&BodyFactors>) -> Result<Vec<Vec<f64>>, ContactError> {
-        let mut u = self.solution.u.clone();
-        if let Some(factors) = factors {
-            factors.whole_rows(&mut u)?;
-        }
-        Ok(u)
-    }
-
     /// The couplings and the solution with its displacements whole (collective).
     fn into_whole(
         mut self,
@@ -700,6 +709,7 @@ impl KeptIterate {
         if let Some(factors) = factors {
             factors.whole_rows(&mut self.solution.u)?;
         }
+        self.solution.on_nodes = None;
         Ok((self.couplings, self.solution))
     }
 }
@@ -869,7 +879,10 @@ impl ContactSolver<'_> {
         if self.solver.verbose {
             log::debug!("{}", record.line(log::log_enabled!(log::Level::Trace)));
         }
-        let last = KeptIterate::new(couplings, solution, self.factors.as_ref())?;
+        let last = KeptIterate {
+            couplings,
+            solution,
+        };
         Ok(state.advance(record, last, step))
     }
 
@@ -925,11 +938,11 @@ impl ContactSolver<'_> {
                 continue;
             }
             let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-            let last = (state.last.as_ref())
-                .map(|last| last.displacements(self.factors.as_ref()))
-                .transpose()?;
-            let gaps = match last {
-                Some(u) => geometric_gaps(s1, s2, Some(&u[sides[0]]), Some(&u[sides[1]])),
+            let gaps = match &state.last {
+                Some(last) => {
+                    let u = |k: usize| Some(last.solution.displacement(k));
+                    geometric_gaps(s1, s2, u(sides[0]), u(sides[1]))
+                }
                 None => geometric_gaps(s1, s2, None, None),
             };
             // The force the contact carries, at most: the largest resultant of the loads and
@@ -1186,7 +1199,8 @@ impl ContactSolver<'_> {
         let problem = &self.pairs[p];
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
         let [a, b] = self.pair_bodies[p];
-        let jumps = self.operators[p].jumps(s1, s2, &solution.u[a], &solution.u[b])?;
+        let (u1, u2) = (solution.displacement(a), solution.displacement(b));
+        let jumps = self.operators[p].jumps(s1, s2, u1, u2)?;
         let linear = self.operators[p].linearized_gaps(&jumps);
         Ok(gaps.iter().zip(&linear).map(|(g, l)| g - l).collect())
     }
@@ -1265,7 +1279,8 @@ impl ContactSolver<'_> {
     ) -> Result<PairFriction, ContactError> {
         let problem = &self.pairs[p];
         let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-        let jumps = self.operators[p].jumps(s1, s2, &view.u[0], &view.u[1])?;
+        let (u1, u2) = (view.displacement(0), view.displacement(1));
+        let jumps = self.operators[p].jumps(s1, s2, u1, u2)?;
         let len = s1.len();
         let mut answer = PairFriction {
             state: vec![None; len],
@@ -1423,7 +1438,7 @@ impl ContactSolver<'_> {
             for (p, problem) in self.pairs.iter().enumerate() {
                 let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
                 let [a, b] = self.pair_bodies[p];
-                let (u1, u2) = (&solution.u[a][..], &solution.u[b][..]);
+                let (u1, u2) = (solution.displacement(a), solution.displacement(b));
                 let nodes = self.pair_nodes(&active.contact, p);
                 let operators = &self.operators[p];
                 let row_normal = self.laws[p].row_normal();
@@ -1583,7 +1598,10 @@ impl ContactSolver<'_> {
                         .collect();
                     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
                     let history = FrictionHistory {
-                        displacements: [s1.values(&view.u[0]), s2.values(&view.u[1])],
+                        displacements: [
+                            s1.values(view.displacement(0)),
+                            s2.values(view.displacement(1)),
+                        ],
                         accumulated_slip: fields.accumulated_slip.clone(),
                     };
                     (slip, Some(history), Some(fields.into_solution()))
@@ -1665,13 +1683,16 @@ impl ContactSolver<'_> {
                 tolerance: self.solver.residual_tolerance,
             });
         }
-        let mut solution = system.solution(&x, &bodies, &pairs, dim, residual);
-        if let Some(factors) = self.factors.as_ref() {
-            let all: Vec<usize> = (0..bodies.len()).collect();
-            let mut forces: Vec<&mut LoadVector> = solution.contact_force.iter_mut().collect();
-            factors.complete_forces(&all, &mut forces)?;
+        match (self.factors.as_ref(), &self.reads) {
+            (Some(factors), Some(reads)) => {
+                let shared = (factors.distributions()?).ok_or_else(|| {
+                    ContactError::Linalg("a distributed run's bodies are not shared".into())
+                })?;
+                let on_ranks = (&bodies[..], &shared[..], &reads[..]);
+                system.solution_on_ranks(&x, on_ranks, &pairs, dim, residual)
+            }
+            _ => Ok(system.solution(&x, &bodies, &pairs, dim, residual)),
         }
-        Ok(solution)
     }
 }
 

@@ -109,7 +109,7 @@ pub fn certify(
         (s2, s1, u2, u1, &solution.contact_force[1]),
     ];
     let gaps = sides.map(|(own, other, u_own, u_other, _)| {
-        geometric_gaps(own, other, Some(u_own), Some(u_other))
+        geometric_gaps(own, other, Some(u_own.into()), Some(u_other.into()))
     });
     let held = held_by_primary([s1, s2], [u1, u2], active);
     let mean: Vec<Vec<f64>> = sides
@@ -124,7 +124,7 @@ pub fn certify(
     // The penalty method's overlap `p / eps` at each primary node: what its law allows
     // (`crate::contact::method`); zero under INTERNODES.
     let law = ContactLaw::of(settings);
-    let rows = gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal());
+    let rows = gap_rows(s1, s2, Some(u1.into()), Some(u2.into()), law.row_normal());
     let enforcement = Enforcement::of(problem);
     let mut overlap = vec![0.0; s1.len()];
     for (k, &i) in solved.iter().enumerate() {
@@ -429,7 +429,7 @@ fn force_centres(sides: &[Side; 2], mean: &[Vec<f64>]) -> ForceCentres {
         (total > 0.0).then(|| {
             let mut moment = [0.0; 3];
             for s in 0..own.len() {
-                let (f, x) = (force(s), own.deformed(u_own, s));
+                let (f, x) = (force(s), own.deformed(u_own.into(), s));
                 (0..3).for_each(|k| moment[k] += f * x[k]);
             }
             moment.map(|m| m / total)
@@ -485,11 +485,11 @@ fn indentation_depth(
     gaps: &[f64],
     pressure: &[f64],
 ) -> f64 {
-    let displaced = secondary.index(Some(u2));
+    let displaced = secondary.index(Some(u2.into()));
     (0..primary.len())
         .filter(|&s| pressure[s] > 0.0)
         .map(|s| {
-            let touching = (displaced.project(&primary.deformed(u1, s)))
+            let touching = (displaced.project(&primary.deformed(u1.into(), s)))
                 .expect("a contact surface has facets");
             let q = secondary.reference_point(touching.facet, &touching.barycentric);
             let (x, n) = (primary.coords[s], primary.normals[s]);
@@ -680,10 +680,10 @@ fn held_by_primary(
         .flatten()
         .copied()
         .collect();
-    let displaced = primary.index(Some(u1));
+    let displaced = primary.index(Some(u1.into()));
     (0..secondary.len())
         .map(|s| {
-            let facet = (displaced.project(&secondary.deformed(u2, s)))
+            let facet = (displaced.project(&secondary.deformed(u2.into(), s)))
                 .expect("a contact surface has facets")
                 .facet;
             let corners = primary.facet_nodes(facet);
