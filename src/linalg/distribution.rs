@@ -310,6 +310,29 @@ impl Distribution {
         Some(self.own_sorted[at].1 as usize * self.block + dof % self.block)
     }
 
+    /// The rank that owns each of `nodes` (our numbering, any order). Reads the whole body's
+    /// map once: `O(n log m)` for `m` nodes.
+    pub fn owner_ranks(&self, nodes: &[usize]) -> Vec<u32> {
+        let mut sorted: Vec<(usize, usize)> = (nodes.iter().copied()).zip(0..).collect();
+        sorted.sort_unstable();
+        let mut owner = vec![0; nodes.len()];
+        let (mut rank, mut end) = (0, self.counts[0] / self.block);
+        for (p, &ours) in self.nodes.iter().enumerate() {
+            while p >= end {
+                rank += 1;
+                end += self.counts[rank] / self.block;
+            }
+            let first = sorted.partition_point(|&(node, _)| node < ours as usize);
+            for &(_, k) in sorted[first..]
+                .iter()
+                .take_while(|&&(n, _)| n == ours as usize)
+            {
+                owner[k] = rank as u32;
+            }
+        }
+        owner
+    }
+
     /// How every rank receives the values of `nodes` (our numbering, increasing) from their
     /// owners ([`NodeGather`]). Reads the whole body's map once: `O(n log m)` for `m` nodes.
     pub fn node_gather(&self, nodes: Vec<u32>) -> NodeGather {

@@ -143,6 +143,22 @@ pub fn all_gather(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelE
     gather_values(local, counts, false)
 }
 
+/// What every rank sent this one, by rank, where `sends[r]` is what this rank sends rank r
+/// (`MPI_Alltoallv`; `sends` holds one vector per rank). On one rank: `sends` itself.
+pub fn exchange(sends: Vec<Vec<f64>>) -> Result<Vec<Vec<f64>>, ParallelError> {
+    if sends.len() <= 1 {
+        return Ok(sends);
+    }
+    #[cfg(feature = "petsc")]
+    {
+        crate::linalg::petsc::exchange_values(&sends).map_err(|e| ParallelError::Mpi(e.to_string()))
+    }
+    #[cfg(not(feature = "petsc"))]
+    {
+        Err(ParallelError::NoPetsc(sends.len()))
+    }
+}
+
 /// [`all_gather`] onto rank 0 alone (`MPI_Gatherv`): the other ranks receive an empty
 /// vector. With one count: `local` itself.
 pub fn gather_to_root(local: &[f64], counts: &[usize]) -> Result<Vec<f64>, ParallelError> {

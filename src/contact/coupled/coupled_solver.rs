@@ -177,18 +177,17 @@ impl BodyFactors {
         self.ownership.as_ref()
     }
 
-    /// The nodes of each of `bodies` at which this rank keeps the interface transfers' entries,
-    /// in a distributed run ([`row_ownership::kept_nodes`]); `None` on one process, which keeps
-    /// them all.
-    pub fn kept_nodes(
+    /// Which ranks keep the interface transfers' entries at `nodes`, the secondary candidates
+    /// of a pair on body `k` of `bodies`, in a distributed run ([`row_ownership::Keepers`]);
+    /// `None` on one process, which keeps them all.
+    pub fn keepers(
         &self,
         bodies: &[&AssembledBody],
-    ) -> Result<Option<Vec<Vec<bool>>>, ContactError> {
-        Ok(shared_bodies(&self.solvers)?.map(|shared| {
-            (shared.iter().zip(bodies))
-                .map(|(distribution, body)| row_ownership::kept_nodes(distribution, body))
-                .collect()
-        }))
+        k: usize,
+        nodes: &[usize],
+    ) -> Result<Option<row_ownership::Keepers>, ContactError> {
+        Ok(shared_bodies(&self.solvers)?
+            .map(|shared| row_ownership::Keepers::new(shared[k], bodies[k], nodes)))
     }
 
     /// The forces on the bodies numbered `which`, made on this rank from the entries it keeps,

@@ -37,6 +37,7 @@
 use std::collections::HashMap;
 
 use crate::contact::ContactError;
+use crate::contact::coupled::row_ownership::{Keepers, send_to_keepers};
 use crate::contact::coupled::system::Coupling;
 use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::GapRow;
@@ -157,11 +158,12 @@ impl InterfaceOperators {
     /// `constraint`: each node's multipliers as `law` lays them out, the traction columns of
     /// the transfers, and the constraint rows.
     ///
-    /// `kept` (over the secondary candidates; `None`: all) says at which secondary nodes the
-    /// transfers' entries are kept: a rank of a distributed run keeps those of its own nodes
-    /// (the rows of `B` and columns of `C` it holds) and of force-controlled groups
-    /// (`crate::contact::coupled::row_ownership::kept_nodes`). The cache holds what the first
-    /// call kept, so every call of one solve passes the same `kept`.
+    /// `kept` (`None`: this process keeps every entry) says which ranks keep the transfers'
+    /// entries at each secondary candidate: in a distributed run a rank keeps those of its own
+    /// nodes (the rows of `B` and columns of `C` it holds) and of force-controlled groups; each
+    /// rank computes its share of the missing rows and columns, and sends each entry to the
+    /// ranks that keep it (`crate::contact::coupled::row_ownership`; collective). The cache
+    /// holds what the first call kept, so every call of one solve passes the same `kept`.
     pub fn coupling(
         &mut self,
         primary: &ContactSurface,
@@ -169,19 +171,30 @@ impl InterfaceOperators {
         (law, enforcement): (ContactLaw, Enforcement),
         active: &[usize],
         constraint: Constraint,
-        kept: Option<&[bool]>,
+        kept: Option<&Keepers>,
     ) -> Result<Coupling, ContactError> {
         let missing: Vec<usize> = active
             .iter()
             .copied()
             .filter(|i| !self.rows12.contains_key(i))
             .collect();
-        let keeps = |j: usize| kept.is_none_or(|kept| kept[j]);
-        let rows = self.r12.rows(&missing, keeps)?;
+        let rows = match kept {
+            None => self.r12.rows(&missing, |_| true)?,
+            Some(kept) => {
+                let computed = self.r12.rows_of_share(&missing, kept.share(), |_| true)?;
+                send_to_keepers(computed, |j| kept.ranks_keeping(j))?
+            }
+        };
         self.rows12.extend(missing.iter().copied().zip(rows));
         if let Some(r21) = &self.r21 {
             let receiving = &self.receiving;
-            let columns = r21.columns(&missing, |t| keeps(receiving[t]))?;
+            let columns = match kept {
+                None => r21.columns(&missing, |_| true)?,
+                Some(kept) => {
+                    let computed = r21.columns_of_share(&missing, kept.share(), |_| true)?;
+                    send_to_keepers(computed, |t| kept.ranks_keeping(receiving[t]))?
+                }
+            };
             self.columns21.extend(missing.iter().copied().zip(columns));
         }
         let to_body2 = |entries: &[(usize, f64)], weight: &dyn Fn(usize, f64) -> f64| {

@@ -2,10 +2,12 @@
 //! Krylov vectors (`crate::contact::coupled::krylov_layout`): this rank's rows of each body in
 //! PETSc's order, one body after another. The coupled system numbers the entries of `B` and
 //! `C` it keeps by it (`crate::contact::coupled::system::CoupledSystem::assemble_on`), and the
-//! interface transfers keep their entries at this rank's nodes only ([`kept_nodes`]); the
+//! interface transfers keep their entries at this rank's nodes only ([`Keepers`]); the
 //! forces they make are completed from the ranks that own them ([`complete_forces`]).
 
 use crate::contact::ContactError;
+use crate::contact::geometry::rbf::Entries;
+use crate::contact::geometry::rbf_patch::BlockShare;
 use crate::elastic::AssembledBody;
 use crate::fem::LoadVector;
 use crate::linalg::{BodySolver, Distribution};
@@ -98,26 +100,96 @@ pub fn shared_bodies(solvers: &[BodySolver]) -> Result<Option<Vec<&Distribution>
     }
 }
 
-/// The nodes of a shared `body` at which this rank keeps the entries of the interface
-/// transfers (`crate::contact::coupled::interface::InterfaceOperators::coupling`): its own
-/// nodes, whose entries are the rows of `B` and the columns of `C` it holds, and every node
-/// with a force-controlled unknown, whose entries go to the rigid block `D` that every rank
-/// holds whole. An entry elsewhere would be dropped by `CoupledSystem::assemble_on` anyway;
-/// kept, the transfers' rows and columns (the largest part of the interface at 1M DOFs) would
-/// be whole on every rank.
-pub fn kept_nodes(distribution: &Distribution, body: &AssembledBody) -> Vec<bool> {
-    let mut kept = vec![false; body.f.len() / body.dim];
-    for &node in distribution.own_nodes() {
-        kept[node as usize] = true;
+/// Which ranks keep the entries of the interface transfers
+/// (`crate::contact::coupled::interface::InterfaceOperators::coupling`) at each secondary
+/// candidate of a pair: the rank that owns its node, whose entries are the rows of `B` and
+/// the columns of `C` that rank holds, and every rank at a node with a force-controlled
+/// unknown, whose entries go to the rigid block `D` that every rank holds whole. An entry
+/// elsewhere would be dropped by `CoupledSystem::assemble_on` anyway; kept, the transfers'
+/// rows and columns (the largest part of the interface at 1M DOFs) would be whole on every
+/// rank. Each rank computes a share of the rows and columns and sends each entry to the ranks
+/// that keep it.
+#[derive(Debug, Clone)]
+pub struct Keepers {
+    /// This rank, and the number of ranks.
+    rank: u32,
+    size: u32,
+    /// The rank that owns each candidate's node.
+    owner: Vec<u32>,
+    /// Whether each candidate's node has a force-controlled unknown.
+    everywhere: Vec<bool>,
+}
+
+impl Keepers {
+    /// The keepers of the secondary candidates at `nodes` of a shared `body` distributed as
+    /// `distribution`.
+    pub fn new(distribution: &Distribution, body: &AssembledBody, nodes: &[usize]) -> Self {
+        let ranks = crate::parallel::ranks();
+        let mut forced: Vec<usize> = (body.rigid.iter())
+            .flat_map(|rigid| rigid.dofs.iter().map(|dof| dof / body.dim))
+            .collect();
+        forced.sort_unstable();
+        Self {
+            rank: ranks.rank as u32,
+            size: ranks.size as u32,
+            owner: distribution.owner_ranks(nodes),
+            everywhere: (nodes.iter())
+                .map(|node| forced.binary_search(node).is_ok())
+                .collect(),
+        }
     }
-    for dof in body.rigid.iter().flat_map(|rigid| &rigid.dofs) {
-        kept[dof / body.dim] = true;
+
+    /// The ranks that keep the entries at candidate `j`, increasing.
+    pub fn ranks_keeping(&self, j: usize) -> std::ops::Range<usize> {
+        match self.everywhere[j] {
+            true => 0..self.size as usize,
+            false => self.owner[j] as usize..self.owner[j] as usize + 1,
+        }
     }
-    kept
+
+    /// This rank's share of the blocks of rows and columns to compute.
+    pub fn share(&self) -> BlockShare {
+        BlockShare {
+            rank: self.rank as usize,
+            size: self.size as usize,
+        }
+    }
+}
+
+/// Rows (or columns) of a transfer that each rank computed a share of (`Some` where this rank
+/// did), each entry `(j, w)` sent to the ranks `ranks_keeping(j)` names ([`Keepers`]): returns
+/// every row with the entries this rank keeps, in the order they were computed in, so each row
+/// is the one this rank would have computed and filtered itself, bit for bit (collective: one
+/// `MPI_Alltoallv`).
+pub fn send_to_keepers(
+    computed: Vec<Option<Entries>>,
+    ranks_keeping: impl Fn(usize) -> std::ops::Range<usize>,
+) -> Result<Vec<Entries>, ContactError> {
+    let size = crate::parallel::ranks().size;
+    // Each entry as three values: its row, its column, its weight (the indices are exact in a
+    // `f64` below 2^53).
+    let mut sends = vec![Vec::new(); size];
+    for (k, row) in computed.iter().enumerate() {
+        for &(j, w) in row.iter().flatten() {
+            for rank in ranks_keeping(j) {
+                sends[rank].extend([k as f64, j as f64, w]);
+            }
+        }
+    }
+    let num_rows = computed.len();
+    drop(computed);
+    let received = crate::parallel::exchange(sends).map_err(|e| {
+        ContactError::Linalg(format!("sending the interface transfers' entries: {e}"))
+    })?;
+    let mut rows = vec![Vec::new(); num_rows];
+    for entry in received.iter().flat_map(|from| from.chunks_exact(3)) {
+        rows[entry[0] as usize].push((entry[1] as usize, entry[2]));
+    }
+    Ok(rows)
 }
 
 /// The forces `forces` on the shared bodies whose distributions are `bodies`, each made on
-/// this rank from the entries it keeps ([`kept_nodes`]), completed from their owners: every
+/// this rank from the entries it keeps ([`Keepers`]), completed from their owners: every
 /// unknown's terms are all on the rank that owns it, so its value there is whole, and each
 /// rank's own values are gathered onto every rank (the same sums in the same order as from
 /// whole transfers, bit for bit). Each force is whole only while it is gathered, and kept as

@@ -33,7 +33,9 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::SymbolicSparseRowMat;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::contact::geometry::rbf_patch::{self as patch, CompressedRows, Graph, row_entries};
+use crate::contact::geometry::rbf_patch::{
+    self as patch, BlockShare, CompressedRows, Graph, row_entries,
+};
 use crate::linalg::gmres;
 
 /// Starting value of the constant `c` of Algorithm 1 (`r_i = d_i / c`).
@@ -446,11 +448,24 @@ impl Interpolation {
         &self,
         targets: &[usize],
         keep: impl Fn(usize) -> bool + Sync,
-    ) -> Result<Vec<Vec<(usize, f64)>>, RbfError> {
+    ) -> Result<Vec<Entries>, RbfError> {
+        let rows = self.rows_of_share(targets, BlockShare::ALL, keep)?;
+        Ok(rows.into_iter().map(Option::unwrap_or_default).collect())
+    }
+
+    /// [`Self::rows`] of the blocks of nearby rows that `share` gives this process
+    /// (`rbf_patch::in_blocks`), `None` for the others; an uncovered target's empty row is
+    /// everyone's.
+    pub fn rows_of_share(
+        &self,
+        targets: &[usize],
+        share: BlockShare,
+        keep: impl Fn(usize) -> bool + Sync,
+    ) -> Result<Vec<Option<Entries>>, RbfError> {
         let covered: Vec<usize> = (targets.iter().copied())
             .filter(|&t| self.inv_d[t] != 0.0)
             .collect();
-        let solved = patch::in_blocks(&self.targets, &covered, |block| {
+        let solved = patch::in_blocks(&self.targets, &covered, share, |block| {
             let seeds: Vec<usize> = (block.iter())
                 .flat_map(|&t| row_entries(&self.phi_nm, t).map(|(j, _)| j))
                 .collect();
@@ -483,8 +498,8 @@ impl Interpolation {
         let mut solved = solved.into_iter();
         Ok((targets.iter())
             .map(|&t| match self.inv_d[t] != 0.0 {
-                true => solved.next().unwrap_or_default(),
-                false => Vec::new(),
+                true => solved.next().flatten(),
+                false => Some(Vec::new()),
             })
             .collect())
     }
@@ -497,7 +512,19 @@ impl Interpolation {
         &self,
         sources: &[usize],
         keep: impl Fn(usize) -> bool + Sync,
-    ) -> Result<Vec<Vec<(usize, f64)>>, RbfError> {
+    ) -> Result<Vec<Entries>, RbfError> {
+        let columns = self.columns_of_share(sources, BlockShare::ALL, keep)?;
+        Ok(columns.into_iter().map(Option::unwrap_or_default).collect())
+    }
+
+    /// [`Self::columns`] of the blocks of nearby columns that `share` gives this process
+    /// (`rbf_patch::in_blocks`), `None` for the others.
+    pub fn columns_of_share(
+        &self,
+        sources: &[usize],
+        share: BlockShare,
+        keep: impl Fn(usize) -> bool + Sync,
+    ) -> Result<Vec<Option<Entries>>, RbfError> {
         // The targets each source's support holds: those a patch's solution reaches.
         let mut reached = vec![Vec::new(); self.num_sources()];
         for t in 0..self.num_targets() {
@@ -505,7 +532,7 @@ impl Interpolation {
                 row_entries(&self.phi_nm, t).for_each(|(j, _)| reached[j].push(t));
             }
         }
-        patch::in_blocks(&self.sources, sources, |block| {
+        patch::in_blocks(&self.sources, sources, share, |block| {
             let right_hand_side = |k: usize, set: &mut dyn FnMut(usize, f64)| set(block[k], 1.0);
             let solution = patch::solve(
                 &self.phi_mm,
@@ -543,6 +570,9 @@ impl Interpolation {
         &self.uncovered
     }
 }
+
+/// A row or column of `R` as its entries `(index, weight)` above [`DROP_TOL`].
+pub type Entries = Vec<(usize, f64)>;
 
 /// Entries of `R` at or below this magnitude are dropped from the rows and columns returned by
 /// [`Interpolation::rows`] and [`Interpolation::columns`]. Entries of `R` are of order one (its
@@ -855,5 +885,49 @@ mod tests {
             Interpolation::new(&s, &[1.0, 0.0], &s),
             Err(RbfError::InvalidRadius { index: 1, .. })
         ));
+    }
+
+    #[test]
+    fn rows_and_columns_computed_in_shares_are_the_whole_ones_each_computed_once() {
+        // A 20 x 20 grid of sources and a shifted 18 x 18 grid of targets: several blocks of
+        // rows and of columns, shared among three ranks as a distributed run shares them.
+        let sources = grid(20, 0.05);
+        let targets: Vec<[f64; 3]> = (grid(18, 0.05).iter())
+            .map(|p| [p[0] + 0.031, p[1] + 0.017, 0.0])
+            .collect();
+        let radii = interpolation_radii(&sources, 2.0).unwrap();
+        let r = Interpolation::new(&sources, &radii, &targets).unwrap();
+        let all_targets: Vec<usize> = (0..targets.len()).collect();
+        let all_sources: Vec<usize> = (0..sources.len()).collect();
+        let whole = [
+            r.rows(&all_targets, |_| true).unwrap(),
+            r.columns(&all_sources, |_| true).unwrap(),
+        ];
+        let shares: Vec<[Vec<Option<Entries>>; 2]> = (0..3)
+            .map(|rank| {
+                let share = BlockShare { rank, size: 3 };
+                [
+                    r.rows_of_share(&all_targets, share, |_| true).unwrap(),
+                    r.columns_of_share(&all_sources, share, |_| true).unwrap(),
+                ]
+            })
+            .collect();
+        for (kind, whole) in whole.iter().enumerate() {
+            assert!(whole.len() > 2 * patch::BLOCK, "more than two blocks");
+            for (k, entries) in whole.iter().enumerate() {
+                let computed: Vec<&Entries> = (shares.iter())
+                    .filter_map(|share| share[kind][k].as_ref())
+                    .collect();
+                assert_eq!(computed.len(), 1, "row or column {k} computed once");
+                assert_eq!(computed[0], entries);
+            }
+            let per_rank: Vec<usize> = (shares.iter())
+                .map(|share| share[kind].iter().flatten().count())
+                .collect();
+            assert!(
+                per_rank.iter().all(|&n| n > 0),
+                "every rank computes some: {per_rank:?}"
+            );
+        }
     }
 }

@@ -219,25 +219,50 @@ fn solve_with(
     values
 }
 
+/// Which of the blocks of rows (columns) one process computes ([`in_blocks`]): in a distributed
+/// run each rank the blocks `b` with `b % size == rank`, taking turns along the Z curve so that
+/// the ranks share the blocks of every part of the surface; on one process every block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BlockShare {
+    pub rank: usize,
+    pub size: usize,
+}
+
+impl BlockShare {
+    /// Every block.
+    pub const ALL: Self = Self { rank: 0, size: 1 };
+
+    fn takes(&self, block: usize) -> bool {
+        block % self.size == self.rank
+    }
+}
+
 /// Requested rows (columns) `indices`, of points at `points[index]`, computed by `block` in
-/// blocks of [`BLOCK`] nearby ones (sorted along a Z curve), the blocks in parallel; the results
-/// in the order of `indices`.
-pub fn in_blocks<T: Send + Default, E: Send>(
+/// blocks of [`BLOCK`] nearby ones (sorted along a Z curve), the blocks of this process's
+/// `share` in parallel; the results in the order of `indices`, `None` where another rank
+/// computes it. The blocks are the same whatever the share, so a row is the same bits
+/// whichever rank computes it.
+pub fn in_blocks<T: Send, E: Send>(
     points: &[[f64; 3]],
     indices: &[usize],
+    share: BlockShare,
     block: impl Fn(&[usize]) -> Result<Vec<T>, E> + Sync,
-) -> Result<Vec<T>, E> {
+) -> Result<Vec<Option<T>>, E> {
     let coords: Vec<f64> = indices.iter().flat_map(|&i| points[i]).collect();
     let keys = z_curve_keys(&coords, 3);
     let mut order: Vec<usize> = (0..indices.len()).collect();
     order.sort_unstable_by_key(|&k| (keys[k], k));
-    let results: Vec<Vec<T>> = (order.par_chunks(BLOCK))
+    let mine: Vec<&[usize]> = (order.chunks(BLOCK).enumerate())
+        .filter(|&(b, _)| share.takes(b))
+        .map(|(_, chunk)| chunk)
+        .collect();
+    let results: Vec<Vec<T>> = (mine.par_iter())
         .map(|chunk| block(&chunk.iter().map(|&k| indices[k]).collect::<Vec<_>>()))
         .collect::<Result<_, _>>()?;
-    let mut out: Vec<T> = (0..indices.len()).map(|_| T::default()).collect();
-    for (chunk, result) in order.chunks(BLOCK).zip(results) {
+    let mut out: Vec<Option<T>> = (0..indices.len()).map(|_| None).collect();
+    for (chunk, result) in mine.iter().zip(results) {
         for (&k, value) in chunk.iter().zip(result) {
-            out[k] = value;
+            out[k] = Some(value);
         }
     }
     Ok(out)

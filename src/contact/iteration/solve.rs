@@ -77,6 +77,7 @@ use crate::contact::coupled::coupled_krylov::Tightness;
 use crate::contact::coupled::coupled_solver::{self, BodyFactors};
 use crate::contact::coupled::half_space::{compliance_factor, force_controlled_set, predicted_set};
 use crate::contact::coupled::interface::{Constraint, InterfaceOperators};
+use crate::contact::coupled::row_ownership::Keepers;
 use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
@@ -234,9 +235,10 @@ pub struct ContactSolver<'a> {
     /// Each pair's operators, paired for the slide of the last solve; a solve without a start
     /// pairs them again unslid, so that it does not depend on earlier solves.
     operators: Vec<InterfaceOperators>,
-    /// Each pair's secondary candidates at which this rank keeps the transfers' entries, in a
-    /// distributed run (`crate::contact::coupled::row_ownership::kept_nodes`); `None`: all.
-    kept: Vec<Option<Vec<bool>>>,
+    /// Which ranks keep the transfers' entries at each pair's secondary candidates, in a
+    /// distributed run (`crate::contact::coupled::row_ownership::Keepers`); `None`: this
+    /// process keeps them all.
+    kept: Vec<Option<Keepers>>,
     /// Each pair's contact law.
     laws: Vec<ContactLaw>,
     /// How each pair's law is enforced.
@@ -416,17 +418,14 @@ impl<'a> ContactSolver<'a> {
         let operators = (pairs.iter())
             .map(|problem| pair(problem, [0.0; 3]))
             .collect::<Result<Vec<_>, _>>()?;
-        let kept_nodes = match &factors {
-            Some(factors) => factors.kept_nodes(&body_refs)?,
-            None => None,
-        };
-        let kept = (pairs.iter().zip(&pair_bodies))
-            .map(|(problem, &[_, secondary])| {
-                let kept = kept_nodes.as_ref()?;
-                let nodes = &problem.secondary_surface.nodes;
-                Some(nodes.iter().map(|&node| kept[secondary][node]).collect())
-            })
-            .collect();
+        let mut kept = Vec::with_capacity(pairs.len());
+        for (problem, &[_, secondary]) in pairs.iter().zip(&pair_bodies) {
+            let nodes = &problem.secondary_surface.nodes;
+            kept.push(match &factors {
+                Some(factors) => factors.keepers(&body_refs, secondary, nodes)?,
+                None => None,
+            });
+        }
         let held_by_contact =
             coupled_solver::held_by_contacts_only(&body_refs, factors.as_ref(), solver.ordering)?
                 .into_iter()
@@ -1234,7 +1233,7 @@ impl ContactSolver<'_> {
             let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
             let operators = &mut self.operators[p];
             let enforced = (law, self.methods[p]);
-            let kept = self.kept[p].as_deref();
+            let kept = self.kept[p].as_ref();
             couplings.push(operators.coupling(s1, s2, enforced, &nodes[p], constraint, kept)?);
         }
         Ok(couplings)

@@ -81,7 +81,10 @@ use super::LinalgError;
 use super::distribution::{Distribution, RankRows};
 use super::node_order::NodeOrder;
 use crate::parallel::ranks::Ranks;
-pub use mpi::{abort_world, broadcast_bytes, finalize, gather_values, scatter_cells, world_ranks};
+pub use mpi::{
+    abort_world, broadcast_bytes, exchange_values, finalize, gather_values, scatter_cells,
+    world_ranks,
+};
 use runtime::{MpiFint, PETSC, petsc, petsc_error, text};
 pub use runtime::{concurrent_v_cycles, options_are_ours};
 

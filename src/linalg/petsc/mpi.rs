@@ -1,5 +1,6 @@
 //! The MPI calls of a distributed run, through PETSc's initialization of MPI: this process's
-//! place among the ranks, gathering values, broadcasting bytes, aborting and finalizing
+//! place among the ranks, gathering and exchanging values, broadcasting bytes, aborting and
+//! finalizing
 //! (`crate::parallel` puts them behind calls that also work without PETSc).
 
 use std::ffi::{c_char, c_int};
@@ -21,6 +22,20 @@ unsafe extern "C" {
         counts: *const c_int,
         displs: *const c_int,
         root_only: c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_exchange(
+        sent: *const f64,
+        send_counts: *const c_int,
+        send_displs: *const c_int,
+        received: *mut f64,
+        recv_counts: *const c_int,
+        recv_displs: *const c_int,
+        step: *mut *const c_char,
+    ) -> c_int;
+    fn internodes_mpi_exchange_counts(
+        send_counts: *const c_int,
+        recv_counts: *mut c_int,
         step: *mut *const c_char,
     ) -> c_int;
     fn internodes_mpi_broadcast_length(len: *mut i64, step: *mut *const c_char) -> c_int;
@@ -112,6 +127,52 @@ pub fn gather_values(
         0 => Ok(global),
         _ => Err(petsc_error(step, code)),
     }
+}
+
+/// What every rank sent this one: `sends[r]` goes to rank r, and the result's `r`th vector
+/// is what rank r sent this one (`MPI_Alltoall` of the counts, then `MPI_Alltoallv`;
+/// collective over `PETSC_COMM_WORLD`, `sends` holding one vector per rank).
+pub fn exchange_values(sends: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, LinalgError> {
+    let send_lengths: Vec<usize> = sends.iter().map(Vec::len).collect();
+    let (send_counts, send_displs) = counts_and_displacements(&send_lengths)?;
+    let mut recv_counts = vec![0 as c_int; sends.len()];
+    let mut step = std::ptr::null();
+    let _lock = petsc()?;
+    // SAFETY: both arrays hold one value per rank (the caller's contract); the lock is held.
+    let code = unsafe {
+        internodes_mpi_exchange_counts(send_counts.as_ptr(), recv_counts.as_mut_ptr(), &mut step)
+    };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    let recv_lengths: Vec<usize> = recv_counts.iter().map(|&c| c as usize).collect();
+    let (_, recv_displs) = counts_and_displacements(&recv_lengths)?;
+    let sent: Vec<f64> = sends.concat();
+    let mut received = vec![0.0; recv_lengths.iter().sum()];
+    // SAFETY: `sent` holds the sum of `send_counts` values, `received` the sum of
+    // `recv_counts`, the counts and displacements one value per rank; the lock is held.
+    let code = unsafe {
+        internodes_mpi_exchange(
+            sent.as_ptr(),
+            send_counts.as_ptr(),
+            send_displs.as_ptr(),
+            received.as_mut_ptr(),
+            recv_counts.as_ptr(),
+            recv_displs.as_ptr(),
+            &mut step,
+        )
+    };
+    if code != 0 {
+        return Err(petsc_error(step, code));
+    }
+    let mut rest = &received[..];
+    Ok((recv_lengths.iter())
+        .map(|&n| {
+            let (from, after) = rest.split_at(n);
+            rest = after;
+            from.to_vec()
+        })
+        .collect())
 }
 
 /// Rank 0's `bytes` on every rank (collective over `PETSC_COMM_WORLD`; the other ranks'

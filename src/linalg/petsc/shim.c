@@ -100,6 +100,27 @@ int internodes_mpi_gather(const double *local, int count, double *global, const 
     return 0;
 }
 
+/* Each rank's values for every rank: send_counts[r] values of `sent` (from send_displs[r]) to
+ * rank r, and recv_counts[r] values from rank r into `received` (from recv_displs[r])
+ * (MPI_Alltoallv over PETSC_COMM_WORLD). The counts each rank receives are exchanged first
+ * (internodes_mpi_exchange_counts). */
+int internodes_mpi_exchange(const double *sent, const int *send_counts, const int *send_displs,
+                            double *received, const int *recv_counts, const int *recv_displs,
+                            const char **step)
+{
+    TRY(MPI_Alltoallv(sent, send_counts, send_displs, MPI_DOUBLE, received, recv_counts,
+                      recv_displs, MPI_DOUBLE, PETSC_COMM_WORLD));
+    return 0;
+}
+
+/* How many values each rank sends this one: send_counts[r] (one value a rank) is what this
+ * rank sends rank r, recv_counts[r] what rank r sends it (MPI_Alltoall). */
+int internodes_mpi_exchange_counts(const int *send_counts, int *recv_counts, const char **step)
+{
+    TRY(MPI_Alltoall(send_counts, 1, MPI_INT, recv_counts, 1, MPI_INT, PETSC_COMM_WORLD));
+    return 0;
+}
+
 /* Rank 0's `len` bytes at `data` into `data` on every rank (every rank knows `len`: see
  * internodes_mpi_broadcast_length). In chunks, since MPI counts are ints. */
 int internodes_mpi_broadcast(void *data, int64_t len, const char **step)
