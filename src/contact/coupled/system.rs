@@ -134,24 +134,32 @@ pub struct CoupledSolution {
     pub relative_residual: f64,
 }
 
-/// The forces pair `coupling`'s tractions `on_pair` put on its bodies, term by term in a fixed
-/// order: `add(0, dof, f)` adds `f` to the primary's force at `dof` (`M_a lambda`), `add(1, dof,
-/// f)` to the secondary's (`-M_b R_ba lambda`).
+/// The forces pair `coupling`'s tractions `on_pair` put on its bodies, node by node in a fixed
+/// order: `add(0, node, f)` adds `f` (its first `dim` components) to the primary's force at
+/// `node` (`M_a lambda`), `add(1, node, f)` to the secondary's (`-M_b R_ba lambda`). Each
+/// unknown receives its terms in the same order whatever `add` does with them.
 fn add_pair_forces(
     coupling: &Coupling,
     on_pair: &[[f64; 3]],
-    dim: usize,
-    mut add: impl FnMut(usize, usize, f64),
+    mut add: impl FnMut(usize, usize, [f64; 3]),
 ) {
     for (k, lambda) in on_pair.iter().enumerate() {
-        let node = coupling.primary_nodes[k];
-        for (c, &component) in lambda.iter().enumerate().take(dim) {
-            add(0, dim * node + c, coupling.areas1[k] * component);
-            for &(node2, load) in &coupling.loads2[k] {
-                add(1, dim * node2 + c, -(load * component));
-            }
+        add(
+            0,
+            coupling.primary_nodes[k],
+            lambda.map(|l| coupling.areas1[k] * l),
+        );
+        for &(node2, load) in &coupling.loads2[k] {
+            add(1, node2, lambda.map(|l| -(load * l)));
         }
     }
+}
+
+/// `force[dim * node + c] += f[c]` for the first `dim` components.
+fn add_at(force: &mut [f64], dim: usize, node: usize, f: [f64; 3]) {
+    (force[dim * node..dim * (node + 1)].iter_mut())
+        .zip(f)
+        .for_each(|(v, f)| *v += f);
 }
 
 impl CoupledSolution {
@@ -161,8 +169,8 @@ impl CoupledSolution {
     pub fn of_pair(&self, p: usize, pair: &Pair, dim: usize) -> CoupledSolution {
         let (a, b) = (pair.primary, pair.secondary);
         let mut forces = [vec![0.0; self.u[a].len()], vec![0.0; self.u[b].len()]];
-        add_pair_forces(pair.coupling, &self.traction[p], dim, |side, dof, value| {
-            forces[side][dof] += value;
+        add_pair_forces(pair.coupling, &self.traction[p], |side, node, f| {
+            add_at(&mut forces[side], dim, node, f);
         });
         CoupledSolution {
             u: vec![self.u[a].clone(), self.u[b].clone()],
@@ -650,8 +658,8 @@ impl CoupledSystem {
         let mut contact_force: Vec<Vec<f64>> = u.iter().map(|u| vec![0.0; u.len()]).collect();
         for (pair, on_pair) in pairs.iter().zip(&traction) {
             let (a, b) = (pair.primary, pair.secondary);
-            add_pair_forces(pair.coupling, on_pair, dim, |side, dof, value| {
-                contact_force[[a, b][side]][dof] += value;
+            add_pair_forces(pair.coupling, on_pair, |side, node, f| {
+                add_at(&mut contact_force[[a, b][side]], dim, node, f);
             });
         }
         CoupledSolution {
@@ -707,11 +715,11 @@ impl CoupledSystem {
             .collect();
         for (pair, on_pair) in pairs.iter().zip(&traction) {
             let (a, b) = (pair.primary, pair.secondary);
-            add_pair_forces(pair.coupling, on_pair, dim, |side, dof, value| {
+            add_pair_forces(pair.coupling, on_pair, |side, node, f| {
                 let k = [a, b][side];
-                let place = (reads[k].place(dof / dim))
+                let place = (reads[k].place(node))
                     .expect("the interface forces act at the contact surfaces' nodes");
-                forces[k][dim * place + dof % dim] += value;
+                add_at(&mut forces[k], dim, place, f);
             });
         }
         let gathered = |what: &str, result: Result<Vec<f64>, crate::linalg::LinalgError>| {

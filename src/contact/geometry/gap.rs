@@ -111,17 +111,7 @@ pub fn geometric_gaps(
 ) -> Vec<f64> {
     let measure = Measure::new(own, other, u_own, u_other, RowNormal::Facet);
     (0..own.len())
-        .map(|s| {
-            let gap = measure.at(s);
-            if gap.beside_rim || gap.distance <= NEAR_SURFACE * gap.facet_size {
-                return gap.value;
-            }
-            if measure.inside(&gap.position) {
-                -gap.distance
-            } else {
-                gap.distance
-            }
-        })
+        .map(|s| measure.geometric(&measure.at(s)))
         .collect()
 }
 
@@ -142,17 +132,26 @@ struct NodeGap {
 }
 
 /// The projections one gap evaluation needs: the other surface displaced and its closed
-/// boundary, and which nodes lie beside the other surface's rim in the reference
-/// configuration.
+/// boundary, and the other surface in the reference configuration, where whether a node lies
+/// beside the other surface's rim is decided.
 struct Measure<'a> {
     own: &'a ContactSurface,
     other: &'a ContactSurface,
     u_own: Option<BodyDisplacement<'a>>,
     surface: SurfaceIndex,
+    /// The other surface in the reference configuration (`None`: it is `surface`).
+    reference: Option<SurfaceIndex>,
     /// The other surface's displaced nodal normals, for [`RowNormal::Averaged`].
     nodal_normals: Option<Vec<[f64; 3]>>,
     boundary: SurfaceIndex,
-    beside_in_reference: Vec<bool>,
+}
+
+/// A node's position, and its closest point on the other surface (`beside`: on the rim, with
+/// the node beyond it).
+struct Closest {
+    position: [f64; 3],
+    beside: Option<Projection>,
+    point: Projection,
 }
 
 impl<'a> Measure<'a> {
@@ -163,14 +162,6 @@ impl<'a> Measure<'a> {
         u_other: Option<BodyDisplacement<'a>>,
         row_normal: RowNormal,
     ) -> Self {
-        let surface = other.index(u_other);
-        let reference = u_other.map(|_| other.index(None));
-        let beside_in_reference = (0..own.len())
-            .map(|s| {
-                let index = reference.as_ref().unwrap_or(&surface);
-                beside_rim(own, other, index, &own.coords[s], s).is_some()
-            })
-            .collect();
         let nodal_normals = (row_normal == RowNormal::Averaged).then(|| match u_other {
             Some(u) => other.displaced_normals(u),
             None => other.normals.clone(),
@@ -180,23 +171,44 @@ impl<'a> Measure<'a> {
             other,
             u_own,
             boundary: other.boundary.index(u_other),
-            surface,
+            surface: other.index(u_other),
+            reference: u_other.map(|_| other.index(None)),
             nodal_normals,
-            beside_in_reference,
         }
     }
 
+    /// Node `s`'s gap along the direction its row asks for ([`RowNormal`]).
     fn at(&self, s: usize) -> NodeGap {
+        self.gap_of(&self.closest(s), self.nodal_normals.as_deref())
+    }
+
+    /// Where node `s` is and its closest point on the other surface: beside the rim (as judged
+    /// in the reference configuration, then at the displaced position) or facing it.
+    fn closest(&self, s: usize) -> Closest {
         let x = self
             .u_own
             .map_or(self.own.coords[s], |u| self.own.deformed(u, s));
-        let beside = self.beside_in_reference[s]
+        let reference = self.reference.as_ref().unwrap_or(&self.surface);
+        let beside_in_reference =
+            beside_rim(self.own, self.other, reference, &self.own.coords[s], s).is_some();
+        let beside = beside_in_reference
             .then(|| beside_rim(self.own, self.other, &self.surface, &x, s))
             .flatten();
-        let closest = beside.unwrap_or_else(|| {
+        let point = beside.unwrap_or_else(|| {
             (self.surface.project_facing(&x, Some(&self.own.normals[s])))
                 .expect("a contact surface has facets")
         });
+        Closest {
+            position: x,
+            beside,
+            point,
+        }
+    }
+
+    /// The gap at `closest` along the facet's normal, or the other surface's interpolated
+    /// `nodal_normals` where given.
+    fn gap_of(&self, closest: &Closest, nodal_normals: Option<&[[f64; 3]]>) -> NodeGap {
+        let (x, beside, closest) = (closest.position, closest.beside, closest.point);
         let offset: [f64; 3] = std::array::from_fn(|k| x[k] - closest.point[k]);
         let distance = closest.signed_distance.abs();
         let direction = match beside {
@@ -204,7 +216,7 @@ impl<'a> Measure<'a> {
                 let sign = if self.inside(&x) { -1.0 } else { 1.0 };
                 offset.map(|v| sign * v / distance)
             }
-            None => match &self.nodal_normals {
+            None => match nodal_normals {
                 Some(normals) => {
                     let corners = self.other.facet_nodes(closest.facet);
                     let sum: [f64; 3] = std::array::from_fn(|k| {
@@ -226,6 +238,19 @@ impl<'a> Measure<'a> {
             distance,
             beside_rim: beside.is_some(),
             facet_size: self.surface.facet_size(closest.facet),
+        }
+    }
+
+    /// The geometric gap ([`geometric_gaps`]) of a node whose gap along the facet's normal is
+    /// `gap`.
+    fn geometric(&self, gap: &NodeGap) -> f64 {
+        if gap.beside_rim || gap.distance <= NEAR_SURFACE * gap.facet_size {
+            return gap.value;
+        }
+        if self.inside(&gap.position) {
+            -gap.distance
+        } else {
+            gap.distance
         }
     }
 
@@ -283,33 +308,67 @@ pub fn gap_rows(
     row_normal: RowNormal,
 ) -> Vec<GapRow> {
     let measure = Measure::new(primary, secondary, u1, u2, row_normal);
+    (0..primary.len())
+        .map(|i| row(&measure, u2, i, &measure.at(i)))
+        .collect()
+}
+
+/// The geometric gap ([`geometric_gaps`]) and the gap row ([`gap_rows`]) of the primary
+/// candidates `nodes`, with one search for the closest point of each: the two functions'
+/// values, bit for bit, for the loop's iterate (a rank of a distributed run computes its
+/// share of the candidates).
+pub fn gaps_and_rows(
+    primary: &ContactSurface,
+    secondary: &ContactSurface,
+    [u1, u2]: [BodyDisplacement; 2],
+    row_normal: RowNormal,
+    nodes: &[usize],
+) -> Vec<(f64, GapRow)> {
+    let measure = Measure::new(primary, secondary, Some(u1), Some(u2), row_normal);
+    (nodes.iter())
+        .map(|&i| {
+            let closest = measure.closest(i);
+            let along_facet = measure.gap_of(&closest, None);
+            let gap = measure.geometric(&along_facet);
+            let row = match &measure.nodal_normals {
+                None => row(&measure, Some(u2), i, &along_facet),
+                Some(normals) => row(
+                    &measure,
+                    Some(u2),
+                    i,
+                    &measure.gap_of(&closest, Some(normals)),
+                ),
+            };
+            (gap, row)
+        })
+        .collect()
+}
+
+/// The gap row of primary node `i` whose gap along its row's direction is `node_gap`.
+fn row(measure: &Measure, u2: Option<BodyDisplacement>, i: usize, node_gap: &NodeGap) -> GapRow {
+    let (primary, secondary) = (measure.own, measure.other);
     let dim = primary.dim;
     let displacement = |surface: &ContactSurface, u: Option<BodyDisplacement>, s: usize| {
         u.map_or([0.0; 3], |u| u.at(dim, surface.nodes[s]))
     };
-    (0..primary.len())
-        .map(|i| {
-            let node_gap = measure.at(i);
-            let normal = node_gap.direction.map(|v| -v);
-            let corners: Vec<(usize, f64)> = (secondary.facet_nodes(node_gap.closest.facet))
-                .iter()
-                .zip(node_gap.closest.barycentric)
-                .map(|(&s, b)| (s, b))
-                .collect();
-            let own = displacement(primary, u1, i);
-            let jump: [f64; 3] = std::array::from_fn(|k| {
-                own[k]
-                    - (corners.iter())
-                        .map(|&(s, b)| b * displacement(secondary, u2, s)[k])
-                        .sum::<f64>()
-            });
-            let target = (0..3).map(|k| normal[k] * jump[k]).sum::<f64>() + node_gap.value;
-            GapRow {
-                corners,
-                normal,
-                gap: node_gap.value,
-                target,
-            }
-        })
-        .collect()
+    let normal = node_gap.direction.map(|v| -v);
+    let corners: Vec<(usize, f64)> = (secondary.facet_nodes(node_gap.closest.facet))
+        .iter()
+        .zip(node_gap.closest.barycentric)
+        .map(|(&s, b)| (s, b))
+        .collect();
+    let own = displacement(primary, measure.u_own, i);
+    let jump: [f64; 3] = std::array::from_fn(|k| {
+        own[k]
+            - (corners.iter())
+                .map(|&(s, b)| b * displacement(secondary, u2, s)[k])
+                .sum::<f64>()
+    });
+    let target = (0..3).map(|k| normal[k] * jump[k]).sum::<f64>() + node_gap.value;
+    GapRow {
+        corners,
+        normal,
+        gap: node_gap.value,
+        target,
+    }
 }

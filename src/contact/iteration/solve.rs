@@ -79,7 +79,8 @@ use crate::contact::coupled::half_space::{compliance_factor, force_controlled_se
 use crate::contact::coupled::interface::{Constraint, InterfaceOperators};
 use crate::contact::coupled::row_ownership::Keepers;
 use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
-use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
+use crate::contact::geometry::displacement::BodyDisplacement;
+use crate::contact::geometry::gap::{GapRow, RowNormal, gap_rows, gaps_and_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::iteration::safeguard::{CONTRACTION, Safeguard, Step};
 use crate::contact::law::coulomb::Turning;
@@ -247,6 +248,63 @@ pub struct ContactSolver<'a> {
     /// (its boundary's and its contact surfaces': [`geometry_nodes`]) reach every rank after a
     /// solve; `None` on one process.
     reads: Option<Vec<NodeGather>>,
+}
+
+/// The geometric gap and the gap row of every primary candidate at the displacements `u`
+/// (`crate::contact::geometry::gap::gaps_and_rows`). With `shared` (a distributed run) rank `r`
+/// of `N` measures the candidates `i` with `i % N == r` and receives the others' from the
+/// ranks that measured them (collective: one `MPI_Allgatherv`), the same bits as measured
+/// alone.
+fn measure_gaps(
+    primary: &ContactSurface,
+    secondary: &ContactSurface,
+    u: [BodyDisplacement; 2],
+    row_normal: RowNormal,
+    shared: bool,
+) -> Result<(Vec<f64>, Vec<GapRow>), ContactError> {
+    let m = primary.len();
+    let ranks = crate::parallel::ranks();
+    if !shared || ranks.size == 1 {
+        let all: Vec<usize> = (0..m).collect();
+        return Ok(gaps_and_rows(primary, secondary, u, row_normal, &all)
+            .into_iter()
+            .unzip());
+    }
+    let of_rank = |r: usize| (r..m).step_by(ranks.size);
+    let mine: Vec<usize> = of_rank(ranks.rank).collect();
+    // Each candidate as `2 dim + 6` values: its gap, its row's normal, gap and target, and its
+    // closest point's facet corners with their barycentric coordinates (`dim` of them).
+    let dim = primary.dim;
+    let width = 2 * dim + 6;
+    let mut sent = Vec::with_capacity(width * mine.len());
+    for (gap, row) in gaps_and_rows(primary, secondary, u, row_normal, &mine) {
+        debug_assert_eq!(row.corners.len(), dim);
+        sent.push(gap);
+        sent.extend(row.normal);
+        sent.extend([row.gap, row.target]);
+        sent.extend(row.corners.iter().flat_map(|&(s, b)| [s as f64, b]));
+    }
+    let counts: Vec<usize> = (0..ranks.size).map(|r| width * of_rank(r).len()).collect();
+    let arrived = crate::parallel::all_gather(&sent, &counts)
+        .map_err(|e| ContactError::Linalg(format!("gathering the gaps of the candidates: {e}")))?;
+    let mut measured: Vec<Option<(f64, GapRow)>> = vec![None; m];
+    let order = (0..ranks.size).flat_map(of_rank);
+    for (i, v) in order.zip(arrived.chunks_exact(width)) {
+        let row = GapRow {
+            normal: [v[1], v[2], v[3]],
+            gap: v[4],
+            target: v[5],
+            corners: v[6..]
+                .chunks_exact(2)
+                .map(|c| (c[0] as usize, c[1]))
+                .collect(),
+        };
+        measured[i] = Some((v[0], row));
+    }
+    Ok(measured
+        .into_iter()
+        .map(|g| g.expect("every candidate measured"))
+        .unzip())
 }
 
 /// The nodes of a body at which the contact geometry reads its displacement and the interfaces
@@ -1442,9 +1500,10 @@ impl ContactSolver<'_> {
                 let operators = &self.operators[p];
                 let row_normal = self.laws[p].row_normal();
                 let rows = &mut state.rows[p];
+                let shared = self.reads.is_some();
                 let (pair_gaps, jumps, pair_slid) = timed(&mut seconds.search, || {
-                    let gaps = geometric_gaps(s1, s2, Some(u1), Some(u2));
-                    *rows = gap_rows(s1, s2, Some(u1), Some(u2), row_normal);
+                    let (gaps, pair_rows) = measure_gaps(s1, s2, [u1, u2], row_normal, shared)?;
+                    *rows = pair_rows;
                     let jumps = operators.jumps(s1, s2, u1, u2)?;
                     let slid = operators.slide(s1, &jumps, &nodes);
                     Ok::<_, ContactError>((gaps, jumps, slid))
