@@ -289,34 +289,6 @@ fn arc_interpolation() -> (Interpolation, [usize; 2]) {
 }
 
 #[test]
-fn rows_and_columns_kept_at_some_nodes_are_the_whole_ones_there() {
-    // A rank of a distributed run keeps the entries at its own nodes only: exactly the whole
-    // row's (column's) entries there, bit for bit, and nothing elsewhere.
-    let (r, [num_sources, num_targets]) = arc_interpolation();
-    let mine = |i: usize| i % 3 != 1;
-    let all_targets: Vec<usize> = (0..num_targets).collect();
-    let all_sources: Vec<usize> = (0..num_sources).collect();
-    let pairs = [
-        (
-            r.rows(&all_targets, |_| true).unwrap(),
-            r.rows(&all_targets, mine).unwrap(),
-        ),
-        (
-            r.columns(&all_sources, |_| true).unwrap(),
-            r.columns(&all_sources, mine).unwrap(),
-        ),
-    ];
-    for (whole, kept) in pairs {
-        for (whole, kept) in whole.iter().zip(&kept) {
-            let expected: Vec<(usize, f64)> =
-                whole.iter().copied().filter(|&(i, _)| mine(i)).collect();
-            assert!(expected.len() < whole.len(), "some entries are left out");
-            assert_eq!(kept, &expected);
-        }
-    }
-}
-
-#[test]
 fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
     // Sources on an arc, targets on a shifted arc: R is dense, its rows and columns computed by
     // transposed and plain solves must match it to round-off, dropping only entries <= DROP_TOL.
@@ -330,7 +302,7 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         v
     };
     let all_targets: Vec<usize> = (0..num_targets).collect();
-    for (t, row) in r.rows(&all_targets, |_| true).unwrap().iter().enumerate() {
+    for (t, row) in r.rows(&all_targets).unwrap().iter().enumerate() {
         let row = dense_of(row, num_sources);
         for (j, value) in row.iter().enumerate() {
             assert!(
@@ -344,12 +316,7 @@ fn sparse_rows_and_columns_are_those_of_the_dense_matrix() {
         );
     }
     let all_sources: Vec<usize> = (0..num_sources).collect();
-    for (j, column) in r
-        .columns(&all_sources, |_| true)
-        .unwrap()
-        .iter()
-        .enumerate()
-    {
+    for (j, column) in r.columns(&all_sources).unwrap().iter().enumerate() {
         let column = dense_of(column, num_targets);
         for (t, value) in column.iter().enumerate() {
             assert!(
@@ -448,7 +415,7 @@ fn rows_and_columns_solved_on_patches_are_those_of_the_whole_solve() {
     let zone: Vec<usize> = (0..targets.len())
         .filter(|&t| near(&targets[t], 0.1))
         .collect();
-    let rows = r.rows(&zone, |_| true).unwrap();
+    let rows = r.rows(&zone).unwrap();
     // The difference at the entries a row keeps, and the largest entry it drops.
     let (mut error, mut dropped, mut reach) = (0.0f64, 0.0f64, 0.0f64);
     for (&t, row) in zone.iter().zip(&rows) {
@@ -470,7 +437,7 @@ fn rows_and_columns_solved_on_patches_are_those_of_the_whole_solve() {
     let in_zone: Vec<usize> = (0..sources.len())
         .filter(|&j| near(&sources[j], 0.1))
         .collect();
-    let columns = r.columns(&in_zone, |_| true).unwrap();
+    let columns = r.columns(&in_zone).unwrap();
     let (mut column_error, mut column_dropped) = (0.0f64, 0.0f64);
     for (&j, column) in in_zone.iter().zip(&columns) {
         let mut kept = vec![None; targets.len()];
@@ -532,7 +499,7 @@ fn wide_supports_interpolate_as_the_whole_solve_does() {
         let reference: f64 = whole[t].iter().zip(&g).map(|(w, g)| w * g).sum();
         apply_error = apply_error.max((value - reference).abs());
     }
-    let rows = r.rows(&all_rows, |_| true).unwrap();
+    let rows = r.rows(&all_rows).unwrap();
     let mut row_error = 0.0f64;
     for (row, whole) in rows.iter().zip(&whole) {
         let mut kept = vec![0.0; sources.len()];

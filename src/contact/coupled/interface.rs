@@ -179,9 +179,9 @@ impl InterfaceOperators {
             .filter(|i| !self.rows12.contains_key(i))
             .collect();
         let rows = match kept {
-            None => self.r12.rows(&missing, |_| true)?,
+            None => self.r12.rows(&missing)?,
             Some(kept) => {
-                let computed = self.r12.rows_of_share(&missing, kept.share(), |_| true)?;
+                let computed = self.r12.rows_of_share(&missing, kept.share())?;
                 send_to_keepers(computed, |j| kept.ranks_keeping(j))?
             }
         };
@@ -189,9 +189,9 @@ impl InterfaceOperators {
         if let Some(r21) = &self.r21 {
             let receiving = &self.receiving;
             let columns = match kept {
-                None => r21.columns(&missing, |_| true)?,
+                None => r21.columns(&missing)?,
                 Some(kept) => {
-                    let computed = r21.columns_of_share(&missing, kept.share(), |_| true)?;
+                    let computed = r21.columns_of_share(&missing, kept.share())?;
                     send_to_keepers(computed, |t| kept.ranks_keeping(receiving[t]))?
                 }
             };

@@ -206,3 +206,28 @@ pub fn complete_forces(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_sent_to_their_keepers_are_the_computed_rows_at_the_kept_entries() {
+        // One rank, which keeps the entries at even columns: every computed row's entries
+        // there, in their order, and an empty row where no rank computed one.
+        let computed = vec![
+            Some(vec![(0, 0.25), (3, -1.5), (4, 2.0)]),
+            None,
+            Some(vec![(1, 7.0), (2, 1e-12), (6, 3.0)]),
+        ];
+        let rows = send_to_keepers(computed, |j| 0..usize::from(j % 2 == 0)).unwrap();
+        assert_eq!(
+            rows,
+            [
+                vec![(0, 0.25), (4, 2.0)],
+                vec![],
+                vec![(2, 1e-12), (6, 3.0)]
+            ]
+        );
+    }
+}

@@ -440,16 +440,12 @@ impl Interpolation {
     }
 
     /// Rows `targets` of `R_NM`, each as its entries `(source, weight)` with `|weight| >`
-    /// [`DROP_TOL`] at the sources `keep` accepts: `R[t, :] = D_tt^-1 z_t` with `Phi_MM^T z_t =
+    /// [`DROP_TOL`]: `R[t, :] = D_tt^-1 z_t` with `Phi_MM^T z_t =
     /// Phi_NM[t, :]^T`, solved on a patch around the row's sources (`rbf_patch.rs`), nearby
     /// rows together. `D_tt` is the sum of `z_t` (`Phi_NM[t, :] Phi_MM^-1 1`), so that each row
     /// sums to one to round-off. A solve on a patch that fails is [`RbfError::SingularPhi`].
-    pub fn rows(
-        &self,
-        targets: &[usize],
-        keep: impl Fn(usize) -> bool + Sync,
-    ) -> Result<Vec<Entries>, RbfError> {
-        let rows = self.rows_of_share(targets, BlockShare::ALL, keep)?;
+    pub fn rows(&self, targets: &[usize]) -> Result<Vec<Entries>, RbfError> {
+        let rows = self.rows_of_share(targets, BlockShare::ALL)?;
         Ok(rows.into_iter().map(Option::unwrap_or_default).collect())
     }
 
@@ -460,7 +456,6 @@ impl Interpolation {
         &self,
         targets: &[usize],
         share: BlockShare,
-        keep: impl Fn(usize) -> bool + Sync,
     ) -> Result<Vec<Option<Entries>>, RbfError> {
         let covered: Vec<usize> = (targets.iter().copied())
             .filter(|&t| self.inv_d[t] != 0.0)
@@ -489,7 +484,7 @@ impl Interpolation {
                         let scale = 1.0 / z.iter().sum::<f64>();
                         let entries =
                             (solution.nodes.iter().copied()).zip(z.iter().map(|v| scale * v));
-                        sparse(entries, &keep)
+                        sparse(entries)
                     })
                     .collect(),
             )
@@ -505,15 +500,11 @@ impl Interpolation {
     }
 
     /// Columns `sources` of `R_NM`, each as its entries `(target, weight)` with `|weight| >`
-    /// [`DROP_TOL`] at the targets `keep` accepts: `R[:, j] = D^-1 Phi_NM x_j` with `Phi_MM x_j
+    /// [`DROP_TOL`]: `R[:, j] = D^-1 Phi_NM x_j` with `Phi_MM x_j
     /// = e_j`, solved on a patch around source `j` (`rbf_patch.rs`), nearby columns together.
     /// A solve on a patch that fails is [`RbfError::SingularPhi`].
-    pub fn columns(
-        &self,
-        sources: &[usize],
-        keep: impl Fn(usize) -> bool + Sync,
-    ) -> Result<Vec<Entries>, RbfError> {
-        let columns = self.columns_of_share(sources, BlockShare::ALL, keep)?;
+    pub fn columns(&self, sources: &[usize]) -> Result<Vec<Entries>, RbfError> {
+        let columns = self.columns_of_share(sources, BlockShare::ALL)?;
         Ok(columns.into_iter().map(Option::unwrap_or_default).collect())
     }
 
@@ -523,7 +514,6 @@ impl Interpolation {
         &self,
         sources: &[usize],
         share: BlockShare,
-        keep: impl Fn(usize) -> bool + Sync,
     ) -> Result<Vec<Option<Entries>>, RbfError> {
         // The targets each source's support holds: those a patch's solution reaches.
         let mut reached = vec![Vec::new(); self.num_sources()];
@@ -546,7 +536,6 @@ impl Interpolation {
             .map_err(|detail| RbfError::SingularPhi { detail })?;
             let mut candidates: Vec<usize> = (solution.nodes.iter())
                 .flat_map(|&j| reached[j].iter().copied())
-                .filter(|&t| keep(t))
                 .collect();
             candidates.sort_unstable();
             candidates.dedup();
@@ -558,7 +547,7 @@ impl Interpolation {
                             .sum();
                         (t, self.inv_d[t] * value)
                     });
-                    sparse(column, &|_| true)
+                    sparse(column)
                 })
                 .collect())
         })
@@ -595,15 +584,10 @@ fn finite(x: Vec<f64>) -> Result<Vec<f64>, RbfError> {
     }
 }
 
-/// The entries `(position, value)` above [`DROP_TOL`] at the positions `keep` accepts, sorted
+/// The entries `(position, value)` above [`DROP_TOL`], sorted
 /// by position.
-fn sparse(
-    entries: impl Iterator<Item = (usize, f64)>,
-    keep: &impl Fn(usize) -> bool,
-) -> Vec<(usize, f64)> {
-    let mut kept: Vec<(usize, f64)> = entries
-        .filter(|&(i, v)| v.abs() > DROP_TOL && keep(i))
-        .collect();
+fn sparse(entries: impl Iterator<Item = (usize, f64)>) -> Vec<(usize, f64)> {
+    let mut kept: Vec<(usize, f64)> = entries.filter(|&(_, v)| v.abs() > DROP_TOL).collect();
     kept.sort_unstable_by_key(|&(i, _)| i);
     kept
 }
@@ -900,15 +884,15 @@ mod tests {
         let all_targets: Vec<usize> = (0..targets.len()).collect();
         let all_sources: Vec<usize> = (0..sources.len()).collect();
         let whole = [
-            r.rows(&all_targets, |_| true).unwrap(),
-            r.columns(&all_sources, |_| true).unwrap(),
+            r.rows(&all_targets).unwrap(),
+            r.columns(&all_sources).unwrap(),
         ];
         let shares: Vec<[Vec<Option<Entries>>; 2]> = (0..3)
             .map(|rank| {
                 let share = BlockShare { rank, size: 3 };
                 [
-                    r.rows_of_share(&all_targets, share, |_| true).unwrap(),
-                    r.columns_of_share(&all_sources, share, |_| true).unwrap(),
+                    r.rows_of_share(&all_targets, share).unwrap(),
+                    r.columns_of_share(&all_sources, share).unwrap(),
                 ]
             })
             .collect();
