@@ -678,7 +678,7 @@ impl CoupledSystem {
     /// this rank's rows, and each body's displacement and interface forces at the nodes
     /// `reads[k]` gathers (its boundary's and its contact surfaces') are received from the
     /// ranks that own them (collective). The forces are the serial run's to the bit: each
-    /// node's terms are all made on the rank that owns it (`row_ownership::kept_nodes`), in
+    /// node's terms are all made on the rank that owns it (`row_ownership::Keepers`), in
     /// the same order.
     pub fn solution_on_ranks(
         &self,
