@@ -310,25 +310,12 @@ impl Distribution {
         Some(self.own_sorted[at].1 as usize * self.block + dof % self.block)
     }
 
-    /// The rank that owns each of `nodes` (our numbering, any order). Reads the whole body's
+    /// The rank that owns each of `nodes` (our numbering, increasing). Reads the whole body's
     /// map once: `O(n log m)` for `m` nodes.
-    pub fn owner_ranks(&self, nodes: &[usize]) -> Vec<u32> {
-        let mut sorted: Vec<(usize, usize)> = (nodes.iter().copied()).zip(0..).collect();
-        sorted.sort_unstable();
+    pub fn owner_ranks(&self, nodes: &[u32]) -> Vec<u32> {
         let mut owner = vec![0; nodes.len()];
-        let (mut rank, mut end) = (0, self.counts[0] / self.block);
-        for (p, &ours) in self.nodes.iter().enumerate() {
-            while p >= end {
-                rank += 1;
-                end += self.counts[rank] / self.block;
-            }
-            let first = sorted.partition_point(|&(node, _)| node < ours as usize);
-            for &(_, k) in sorted[first..]
-                .iter()
-                .take_while(|&&(n, _)| n == ours as usize)
-            {
-                owner[k] = rank as u32;
-            }
+        for (rank, _, place) in self.places_of(nodes) {
+            owner[place as usize] = rank as u32;
         }
         owner
     }
@@ -336,40 +323,40 @@ impl Distribution {
     /// How every rank receives the values of `nodes` (our numbering, increasing) from their
     /// owners ([`NodeGather`]). Reads the whole body's map once: `O(n log m)` for `m` nodes.
     pub fn node_gather(&self, nodes: Vec<u32>) -> NodeGather {
-        debug_assert!(nodes.windows(2).all(|w| w[0] < w[1]), "nodes increasing");
-        let ranks = self.counts.len();
-        // PETSc's node of each gathered node's place, found by one pass over PETSc's nodes.
-        let mut petsc = Vec::with_capacity(nodes.len());
-        for (p, ours) in self.nodes.iter().enumerate() {
-            if let Ok(place) = nodes.binary_search(ours) {
-                petsc.push((p as u32, place as u32));
-            }
-        }
-        // `petsc` is in PETSc's order: rank after rank.
-        let mut counts = vec![0; ranks];
-        let mut starts = Vec::with_capacity(ranks + 1);
-        starts.push(0);
-        for count in &self.counts {
-            starts.push(starts.last().unwrap() + count / self.block);
-        }
-        let mut rank = 0;
-        let mut sends = Vec::new();
-        for &(p, place) in &petsc {
-            while p as usize >= starts[rank + 1] {
-                rank += 1;
-            }
+        let mut counts = vec![0; self.counts.len()];
+        let (mut arrival, mut sends) = (Vec::with_capacity(nodes.len()), Vec::new());
+        for (rank, p, place) in self.places_of(&nodes) {
             counts[rank] += self.block;
-            if p as usize >= self.first && (p as usize) < self.first + self.local {
-                sends.push((p - self.first as u32, place));
+            arrival.push(place);
+            if (self.first..self.first + self.local).contains(&p) {
+                sends.push(((p - self.first) as u32, place));
             }
         }
         NodeGather {
-            arrival: petsc.iter().map(|&(_, place)| place).collect(),
+            arrival,
             nodes,
             counts,
             sends,
             block: self.block,
         }
+    }
+
+    /// Each of `nodes` (our numbering, increasing) as `(its owner, its PETSc node, its place in
+    /// `nodes`)`, in PETSc's order (rank after rank): one pass over the body's map.
+    fn places_of(&self, nodes: &[u32]) -> Vec<(usize, usize, u32)> {
+        debug_assert!(nodes.windows(2).all(|w| w[0] < w[1]), "nodes increasing");
+        let (mut rank, mut end) = (0, self.counts[0] / self.block);
+        let mut places = Vec::with_capacity(nodes.len());
+        for (p, ours) in self.nodes.iter().enumerate() {
+            while p >= end {
+                rank += 1;
+                end += self.counts[rank] / self.block;
+            }
+            if let Ok(place) = nodes.binary_search(ours) {
+                places.push((rank, p, place as u32));
+            }
+        }
+        places
     }
 
     /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank.
@@ -566,6 +553,10 @@ mod tests {
         }
         assert_eq!(plans[1].place(7), Some(3));
         assert_eq!(plans[1].place(5), None);
+        let owners: Vec<u32> = nodes.iter().map(|&a| owner[a as usize]).collect();
+        for d in &distributions {
+            assert_eq!(d.owner_ranks(&nodes), owners);
+        }
     }
 
     #[test]

@@ -121,8 +121,8 @@ pub struct Keepers {
 }
 
 impl Keepers {
-    /// The keepers of the secondary candidates at `nodes` of a shared `body` distributed as
-    /// `distribution`.
+    /// The keepers of the secondary candidates at `nodes` (increasing) of a shared `body`
+    /// distributed as `distribution`.
     pub fn new(distribution: &Distribution, body: &AssembledBody, nodes: &[usize]) -> Self {
         let ranks = crate::parallel::ranks();
         let mut forced: Vec<usize> = (body.rigid.iter())
@@ -132,7 +132,7 @@ impl Keepers {
         Self {
             rank: ranks.rank as u32,
             size: ranks.size as u32,
-            owner: distribution.owner_ranks(nodes),
+            owner: distribution.owner_ranks(&nodes.iter().map(|&n| n as u32).collect::<Vec<_>>()),
             everywhere: (nodes.iter())
                 .map(|node| forced.binary_search(node).is_ok())
                 .collect(),
