@@ -17,7 +17,11 @@ use internodes::mesh::{Mesh, MeshError, MeshSummary, read_msh, read_msh_bytes};
 fn coords_by_tag(mesh: &Mesh) -> HashMap<u64, [f64; 3]> {
     mesh.bodies
         .iter()
-        .flat_map(|b| b.node_tags.iter().zip(b.coords.iter().copied()))
+        .flat_map(|b| {
+            b.node_tags
+                .iter()
+                .zip(b.coords.as_whole().unwrap().iter().copied())
+        })
         .collect()
 }
 

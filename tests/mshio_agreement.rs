@@ -70,7 +70,13 @@ fn every_body_node_and_cell_agrees_with_mshio() {
         let mesh = read_msh(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
         let mut cells = 0;
         for body in &mesh.bodies {
-            for (x, tag) in body.coords.iter().zip(body.node_tags.iter()) {
+            for (x, tag) in body
+                .coords
+                .as_whole()
+                .unwrap()
+                .iter()
+                .zip(body.node_tags.iter())
+            {
                 assert_eq!(Some(x), coordinates.get(&tag), "{name}: node {tag}");
             }
             for c in 0..body.num_cells() {

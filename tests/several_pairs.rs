@@ -139,7 +139,7 @@ fn a_stack_of_three_blocks_carries_the_exact_uniaxial_strain_in_2d_and_3d_on_eve
             let mut bottom = 0.0;
             for (name, e) in BLOCKS {
                 let body = solution.bodies.iter().find(|b| b.name == name).unwrap();
-                let coords = &mesh.body(name).unwrap().coords;
+                let coords = mesh.body(name).unwrap().coords.as_whole().unwrap();
                 let y0 = coords
                     .iter()
                     .map(|x| x[dim - 1])

@@ -78,7 +78,7 @@ fn jittered_cube(n: usize) -> BodyMesh {
         physical_tag: 1,
         dim: 3,
         node_tags: (1..=coords.len() as u64).collect(),
-        coords,
+        coords: coords.into(),
         cells,
         cell_tags: (1..=num_cells as u64).collect(),
         boundary_groups: BTreeMap::new(),

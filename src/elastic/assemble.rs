@@ -19,7 +19,8 @@ use super::solution::{SolveStats, timed};
 use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_pattern};
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::{Constraints, LoadVector, NodeColumns, NodeGraph};
-use crate::linalg::{Distribution, LinalgError, RankRows};
+use crate::linalg::{Distribution, LinalgError, RankRows, own_order};
+use crate::mesh::{BodyMesh, RankPart};
 use crate::parallel::ranks::Ranks;
 
 /// A body's assembled system: `f` as assembled, the Dirichlet-constrained `K_c` (on the
@@ -320,8 +321,6 @@ pub fn assemble(
     stats.num_dofs = body.num_dofs();
     let constraints = constraints(problem)?;
     stats.num_prescribed_dofs = constraints.num_fixed();
-    let coordinates =
-        || -> Vec<f64> { body.coords.iter().flat_map(|x| x[..dim].to_vec()).collect() };
 
     // 1. Load vector f: surface loads and body force.
     let mut f = timed(stats, verbose, "assemble loads", || {
@@ -344,13 +343,19 @@ pub fn assemble(
     // 2. K_c and f_c, and the rows of K at the prescribed dofs.
     let ranks = crate::parallel::ranks();
     let constrained = match ranks.size {
-        1 => whole_stiffness(problem, &constraints, &f, coordinates(), stats, verbose),
+        1 => whole_stiffness(
+            problem,
+            &constraints,
+            &f,
+            whole_coordinates(body),
+            stats,
+            verbose,
+        ),
         _ => rank_stiffness(
             problem,
             &constraints,
             &mut f,
             &mut path_loads,
-            &coordinates(),
             ranks,
             stats,
             verbose,
@@ -550,7 +555,6 @@ fn rank_stiffness(
     constraints: &Constraints,
     f: &mut Vec<f64>,
     parts: &mut [PathLoads],
-    coordinates: &[f64],
     ranks: Ranks,
     stats: &mut SolveStats,
     verbose: bool,
@@ -561,8 +565,8 @@ fn rank_stiffness(
     let (graph, distribution) = timed(stats, verbose, "sparsity pattern", || {
         let graph = stiffness_graph(body);
         let distribution = match &body.part {
-            Some(part) => Distribution::with_owners(&part.owner, coordinates, dim, ranks),
-            None => Distribution::new(&graph, coordinates, ranks),
+            Some(part) => partitioned_distribution(body, part, ranks),
+            None => Distribution::new(&graph, &whole_coordinates(body), ranks),
         };
         distribution.map(|distribution| (graph, distribution))
     })?;
@@ -610,7 +614,7 @@ fn rank_stiffness(
     let k_scale = (crate::parallel::gather(local_largest).map_err(mpi)?)
         .into_iter()
         .fold(0.0, f64::max);
-    let rows = distribution.rows(&columns, coordinates);
+    let rows = distribution.rows(&columns, &body.coords);
     drop(graph);
     Ok(ConstrainedStiffness {
         graph: None,
@@ -619,6 +623,44 @@ fn rank_stiffness(
         prescribed_rows,
         k_scale,
     })
+}
+
+/// Every node's coordinates of a body that keeps them all (one process), `dim` a node.
+fn whole_coordinates(body: &BodyMesh) -> Vec<f64> {
+    let dim = body.dim;
+    (body.coords.kept())
+        .flat_map(|(_, x)| x[..dim].to_vec())
+        .collect()
+}
+
+/// The distribution of a body whose nodes rank 0 divided among the ranks (`crate::run`'s
+/// partition): each rank orders its own nodes along the Z curve within the whole body's box
+/// ([`own_order`]), and the ranks' orders are gathered one after the other (collective).
+fn partitioned_distribution(
+    body: &BodyMesh,
+    part: &RankPart,
+    ranks: Ranks,
+) -> Result<Distribution, LinalgError> {
+    let dim = body.dim;
+    let (mut own, mut coords) = (Vec::new(), Vec::new());
+    for ((a, x), &owner) in body.coords.kept().zip(&part.owner) {
+        if owner as usize == ranks.rank {
+            own.push(a as u32);
+            coords.extend_from_slice(&x[..dim]);
+        }
+    }
+    let extent = body.extent();
+    let order = own_order(&own, &coords, &extent.low[..dim], &extent.high[..dim]);
+    let nodes_per_rank: Vec<usize> = (crate::parallel::gather(order.len() as f64).map_err(mpi)?)
+        .into_iter()
+        .map(|count| count as usize)
+        .collect();
+    let sent: Vec<f64> = order.iter().map(|&a| f64::from(a)).collect();
+    let nodes = (crate::parallel::all_gather(&sent, &nodes_per_rank).map_err(mpi)?)
+        .into_iter()
+        .map(|a| a as u32)
+        .collect();
+    Ok(Distribution::from_order(nodes, &nodes_per_rank, dim, ranks))
 }
 
 fn mpi(e: crate::parallel::ParallelError) -> LinalgError {

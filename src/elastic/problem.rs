@@ -199,9 +199,9 @@ impl<'m> ElasticProblem<'m> {
             Err(other) => return Err(other),
         }
         let mut constraints = constraints(&problem)?;
-        let (coords, dim) = (&body.coords, body.dim);
-        let mut free = crate::fem::rigid_modes::free_rigid_modes(coords, dim, &constraints);
-        for node in far_apart_nodes(coords, dim) {
+        let dim = body.dim;
+        let mut free = crate::fem::rigid_modes::free_rigid_modes(body, &constraints);
+        for node in body.extent().far_apart {
             for c in 0..dim {
                 let dof = dim * node + c;
                 if free == 0 || constraints.is_fixed(dof) {
@@ -209,7 +209,7 @@ impl<'m> ElasticProblem<'m> {
                 }
                 let mut trial = constraints.clone();
                 trial.prescribe(dof, 0.0).expect("a free dof");
-                let left = crate::fem::rigid_modes::free_rigid_modes(coords, dim, &trial);
+                let left = crate::fem::rigid_modes::free_rigid_modes(body, &trial);
                 if left < free {
                     (constraints, free) = (trial, left);
                     problem.pins.push((node, c));
@@ -313,11 +313,7 @@ impl<'m> ElasticProblem<'m> {
             return Err(ProblemError::NoDirichlet { body: name() });
         }
         let constraints = constraints(self)?;
-        let free = crate::fem::rigid_modes::free_rigid_modes(
-            &self.body.coords,
-            self.body.dim,
-            &constraints,
-        );
+        let free = crate::fem::rigid_modes::free_rigid_modes(self.body, &constraints);
         if free > 0 {
             return Err(ProblemError::FreeRigidModes {
                 body: name(),
@@ -326,37 +322,6 @@ impl<'m> ElasticProblem<'m> {
         }
         Ok(())
     }
-}
-
-/// Three nodes far apart, for pins: the farthest from the centroid, the farthest from that
-/// one, and (3D) the farthest from the line through both.
-fn far_apart_nodes(coords: &[[f64; 3]], dim: usize) -> Vec<usize> {
-    let distance =
-        |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
-    let n = coords.len() as f64;
-    let centre: [f64; 3] = std::array::from_fn(|k| coords.iter().map(|x| x[k]).sum::<f64>() / n);
-    let farthest = |from: &dyn Fn(&[f64; 3]) -> f64| {
-        (0..coords.len()).max_by(|&a, &b| from(&coords[a]).total_cmp(&from(&coords[b])))
-    };
-    let Some(a) = farthest(&|x| distance(x, &centre)) else {
-        return Vec::new();
-    };
-    let Some(b) = farthest(&|x| distance(x, &coords[a])) else {
-        return vec![a];
-    };
-    let mut nodes = vec![a, b];
-    if dim == 3 {
-        let (pa, pb) = (coords[a], coords[b]);
-        let axis: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
-        let length = distance(&pa, &pb).max(f64::MIN_POSITIVE);
-        let off_line = |x: &[f64; 3]| {
-            let r: [f64; 3] = std::array::from_fn(|k| x[k] - pa[k]);
-            let along = (0..3).map(|k| r[k] * axis[k]).sum::<f64>() / length;
-            ((0..3).map(|k| r[k] * r[k]).sum::<f64>() - along * along).max(0.0)
-        };
-        nodes.extend(farthest(&off_line));
-    }
-    nodes
 }
 
 /// The prescribed dofs and values of a problem; conflicting values on shared nodes are errors.

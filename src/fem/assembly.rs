@@ -10,7 +10,10 @@ use super::{Material, NodeGraph, SparsityPattern};
 use crate::mesh::{BodyMesh, CellNodes, FacetGroup};
 
 /// Coordinates of the `N` nodes of a cell or facet.
-pub fn node_coords<const N: usize>(coords: &[[f64; 3]], nodes: &[usize]) -> [[f64; 3]; N] {
+pub fn node_coords<const N: usize, C>(coords: &C, nodes: &[usize]) -> [[f64; 3]; N]
+where
+    C: std::ops::Index<usize, Output = [f64; 3]> + ?Sized,
+{
     std::array::from_fn(|k| coords[nodes[k]])
 }
 

@@ -137,7 +137,7 @@ mod tests {
             physical_tag: 1,
             dim: 2,
             node_tags: (1..=5).collect(),
-            coords,
+            coords: coords.into(),
             cells: vec![0, 1, 2, 1, 3, 2, 1, 4, 3],
             cell_tags: vec![1, 2, 3].into(),
             boundary_groups: Default::default(),

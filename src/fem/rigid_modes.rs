@@ -7,6 +7,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::Constraints;
+use crate::mesh::BodyMesh;
 
 /// The rigid-body motions of one body, centred on its centroid and scaled by its size so that
 /// all have comparable norms: 3 in 2D (two translations, the rotation about z), 6 in 3D.
@@ -17,25 +18,16 @@ pub struct RigidModes {
 }
 
 impl RigidModes {
-    pub fn new(coords: &[[f64; 3]], dim: usize) -> Self {
-        let n = coords.len();
-        let mut centre = [0.0; 3];
-        for x in coords {
-            for k in 0..3 {
-                centre[k] += x[k] / n as f64;
-            }
+    /// The motions of `body`, about the centroid of its nodes and scaled by their largest
+    /// distance from it (of the whole body, also on a rank that keeps only some of its nodes:
+    /// [`BodyMesh::extent`]).
+    pub fn of(body: &BodyMesh) -> Self {
+        let extent = body.extent();
+        Self {
+            dim: body.dim,
+            centre: extent.centroid,
+            size: extent.radius.max(f64::MIN_POSITIVE),
         }
-        let size = coords
-            .iter()
-            .map(|x| {
-                (0..3)
-                    .map(|k| (x[k] - centre[k]).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .fold(0.0, f64::max)
-            .max(f64::MIN_POSITIVE);
-        Self { dim, centre, size }
     }
 
     /// The number of motions: 3 in 2D, 6 in 3D.
@@ -71,11 +63,12 @@ impl RigidModes {
     }
 }
 
-/// The rigid-body modes ([`RigidModes`]) as dof vectors (interleaved, `dim` per node).
-pub fn rigid_body_modes(coords: &[[f64; 3]], dim: usize) -> Vec<Vec<f64>> {
-    let modes = RigidModes::new(coords, dim);
-    let mut vectors = vec![vec![0.0; dim * coords.len()]; modes.count()];
-    for (a, x) in coords.iter().enumerate() {
+/// The rigid-body modes ([`RigidModes`]) of a body whose nodes are all kept, as dof vectors
+/// (interleaved, `dim` per node).
+pub fn rigid_body_modes(body: &BodyMesh) -> Vec<Vec<f64>> {
+    let (modes, dim) = (RigidModes::of(body), body.dim);
+    let mut vectors = vec![vec![0.0; body.num_dofs()]; modes.count()];
+    for (a, x) in body.coords.kept() {
         for (vector, m) in vectors.iter_mut().zip(modes.at(x)) {
             vector[dim * a..dim * a + dim].copy_from_slice(&m[..dim]);
         }
@@ -86,12 +79,8 @@ pub fn rigid_body_modes(coords: &[[f64; 3]], dim: usize) -> Vec<Vec<f64>> {
 /// The rigid-body motions (combinations of [`RigidModes`], one per column) that the fixed dofs
 /// of `constraints` do not hold: the eigenvectors of the Gram matrix of the modes restricted
 /// to the fixed dofs whose eigenvalues vanish.
-pub fn free_rigid_motions(
-    coords: &[[f64; 3]],
-    dim: usize,
-    constraints: &Constraints,
-) -> DMatrix<f64> {
-    let (gram, largest) = gram(coords, dim, constraints);
+pub fn free_rigid_motions(body: &BodyMesh, constraints: &Constraints) -> DMatrix<f64> {
+    let (gram, largest) = gram(body, constraints);
     let eigen = SymmetricEigen::new(gram);
     let free: Vec<usize> = (0..eigen.eigenvalues.len())
         .filter(|&i| eigen.eigenvalues[i] <= 1e-10 * largest || largest == 0.0)
@@ -101,15 +90,18 @@ pub fn free_rigid_motions(
     })
 }
 
-/// The Gram matrix of the rigid modes on the fixed dofs, and its largest eigenvalue.
-fn gram(coords: &[[f64; 3]], dim: usize, constraints: &Constraints) -> (DMatrix<f64>, f64) {
-    let modes = rigid_body_modes(coords, dim);
-    let m = modes.len();
+/// The Gram matrix of the rigid modes on the fixed dofs, and its largest eigenvalue. The
+/// modes are evaluated at the fixed dofs' nodes only (a rank keeps those nodes' coordinates:
+/// they lie on the body's groups and boundary).
+fn gram(body: &BodyMesh, constraints: &Constraints) -> (DMatrix<f64>, f64) {
+    let (modes, dim) = (RigidModes::of(body), body.dim);
+    let m = modes.count();
     let mut gram = DMatrix::<f64>::zeros(m, m);
-    for d in (0..dim * coords.len()).filter(|&d| constraints.is_fixed(d)) {
+    for d in (0..body.num_dofs()).filter(|&d| constraints.is_fixed(d)) {
+        let at = modes.at(&body.coords[d / dim]);
         for i in 0..m {
             for j in 0..m {
-                gram[(i, j)] += modes[i][d] * modes[j][d];
+                gram[(i, j)] += at[i][d % dim] * at[j][d % dim];
             }
         }
     }
@@ -126,6 +118,6 @@ fn gram(coords: &[[f64; 3]], dim: usize, constraints: &Constraints) -> (DMatrix<
 ///
 /// The Gram matrix `G_ij = sum_{d fixed} r_i[d] r_j[d]` of the modes restricted to the fixed
 /// dofs is singular along every motion that the constraints do not see.
-pub fn free_rigid_modes(coords: &[[f64; 3]], dim: usize, constraints: &Constraints) -> usize {
-    free_rigid_motions(coords, dim, constraints).ncols()
+pub fn free_rigid_modes(body: &BodyMesh, constraints: &Constraints) -> usize {
+    free_rigid_motions(body, constraints).ncols()
 }

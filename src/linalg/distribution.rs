@@ -19,9 +19,10 @@
 //! rank's rows back into one whole vector on every rank (`MPI_Allgatherv`).
 
 use super::LinalgError;
-use super::node_order::z_curve_keys;
+use super::node_order::{z_curve_key, z_curve_keys};
 use super::ordering::partition;
 use crate::fem::{NodeColumns, NodeGraph};
+use crate::mesh::NodeCoords;
 use crate::parallel::ranks::Ranks;
 
 #[derive(Debug)]
@@ -133,6 +134,22 @@ pub fn spread_parts(owner: &mut [u32], nodes_on_rank: &mut [usize]) -> Vec<usize
     rank_of_part
 }
 
+/// This rank's place in PETSc's numbering of a body's nodes (the order
+/// [`Distribution::with_owners`] gives them): its nodes `own` (increasing) sorted along the Z
+/// curve through their coordinates `coords` (`dim` values per node, in the order of `own`)
+/// within the whole body's bounding box `low`..`high`, ties by node. A rank that keeps only its
+/// part of a body's coordinates orders its own nodes this way, and the ranks' orders gathered
+/// one after the other are the whole body's ([`Distribution::from_order`]).
+pub fn own_order(own: &[u32], coords: &[f64], low: &[f64], high: &[f64]) -> Vec<u32> {
+    let dim = low.len();
+    let key = z_curve_key(low, high);
+    let mut keyed: Vec<(u64, u32)> = (own.iter().enumerate())
+        .map(|(i, &a)| (key(&coords[dim * i..dim * (i + 1)]), a))
+        .collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, a)| a).collect()
+}
+
 impl Distribution {
     /// The distribution over `ranks` of the unknowns of the body whose stiffness has the node
     /// graph `graph` and whose nodes are at `coords` (one value per unknown: `block` per node).
@@ -162,8 +179,8 @@ impl Distribution {
         }
         let keys = z_curve_keys(coords, block);
         let mut nodes = Vec::with_capacity(num_nodes);
-        let mut counts = vec![0; ranks.size];
-        for (rank, count) in counts.iter_mut().enumerate() {
+        let mut nodes_per_rank = vec![0; ranks.size];
+        for (rank, count) in nodes_per_rank.iter_mut().enumerate() {
             let first = nodes.len();
             nodes.extend(
                 (0..num_nodes)
@@ -171,9 +188,23 @@ impl Distribution {
                     .map(|a| a as u32),
             );
             nodes[first..].sort_by_key(|&a| (keys[a as usize], a));
-            *count = (nodes.len() - first) * block;
+            *count = nodes.len() - first;
         }
         drop(keys);
+        Ok(Self::from_order(nodes, &nodes_per_rank, block, ranks))
+    }
+
+    /// The distribution whose PETSc numbering holds our nodes `nodes` (those of rank 0 along
+    /// their Z curve, then those of rank 1, ...: [`own_order`] on each rank, gathered), of which
+    /// `nodes_per_rank[r]` are rank r's.
+    pub fn from_order(
+        nodes: Vec<u32>,
+        nodes_per_rank: &[usize],
+        block: usize,
+        ranks: Ranks,
+    ) -> Self {
+        debug_assert_eq!(nodes.len(), nodes_per_rank.iter().sum::<usize>());
+        let counts: Vec<usize> = nodes_per_rank.iter().map(|&n| n * block).collect();
         let first = counts[..ranks.rank].iter().sum::<usize>() / block;
         let local = counts[ranks.rank] / block;
         let mut own_sorted: Vec<(u32, u32)> = (nodes[first..first + local].iter())
@@ -181,14 +212,14 @@ impl Distribution {
             .map(|(&node, place)| (node, place))
             .collect();
         own_sorted.sort_unstable();
-        Ok(Self {
+        Self {
             nodes,
             own_sorted,
             counts,
             first,
             local,
             block,
-        })
+        }
     }
 
     /// Our unknown at PETSc's row `p`.
@@ -244,8 +275,8 @@ impl Distribution {
 
     /// This rank's rows for PETSc: `columns` (of this rank's [`Self::nodes`], constrained)
     /// read as rows, with global column indices in PETSc's numbering, sorted in each row, and
-    /// `coords` (`block` values per node, in our order) of this rank's nodes.
-    pub fn rows(self, columns: &NodeColumns, coords: &[f64]) -> RankRows {
+    /// the coordinates of this rank's nodes (`block` values a node, from `coords`).
+    pub fn rows(self, columns: &NodeColumns, coords: &NodeCoords) -> RankRows {
         let block = self.block;
         let rows: Vec<usize> = self.own().collect();
         debug_assert_eq!(columns.num_columns(), rows.len());
@@ -279,7 +310,9 @@ impl Distribution {
             values.extend(row.iter().map(|&(_, value)| value));
             row_ptr.push(petsc_columns.len() as i64);
         }
-        let coords = rows.iter().map(|&ours| coords[ours]).collect();
+        let coords = (rows.iter())
+            .map(|&ours| coords[ours / block][ours % block])
+            .collect();
         RankRows {
             distribution: self,
             row_ptr,
@@ -505,6 +538,44 @@ mod tests {
         spread_parts(&mut third, &mut nodes_on_rank);
         assert_eq!(third, parts(&[11, 10]));
         assert_eq!(nodes_on_rank, [164, 164]);
+    }
+
+    #[test]
+    fn each_rank_orders_its_own_nodes_as_the_whole_body_s_coordinates_do() {
+        // 40 nodes scattered over a box, owned by ranks 0, 1, 2 in turn.
+        let (num_nodes, block) = (40, 2);
+        let owner: Vec<u32> = (0..num_nodes).map(|a| (a % 3) as u32).collect();
+        let coords: Vec<f64> = (0..num_nodes)
+            .flat_map(|a| [(1.7 * a as f64).sin() * 3.0, (0.9 * a as f64).cos() - 2.0])
+            .collect();
+        let low: Vec<f64> = (0..block)
+            .map(|c| {
+                coords
+                    .iter()
+                    .skip(c)
+                    .step_by(block)
+                    .copied()
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        let high: Vec<f64> = (0..block)
+            .map(|c| {
+                (coords.iter().skip(c).step_by(block).copied()).fold(f64::NEG_INFINITY, f64::max)
+            })
+            .collect();
+        for rank in 0..3 {
+            let whole = Distribution::with_owners(&owner, &coords, block, Ranks { rank, size: 3 });
+            let own: Vec<u32> = (0..num_nodes as u32)
+                .filter(|&a| owner[a as usize] == rank as u32)
+                .collect();
+            let own_coords: Vec<f64> = (own.iter())
+                .flat_map(|&a| coords[block * a as usize..block * (a as usize + 1)].to_vec())
+                .collect();
+            assert_eq!(
+                own_order(&own, &own_coords, &low, &high),
+                whole.unwrap().own_nodes()
+            );
+        }
     }
 
     #[test]

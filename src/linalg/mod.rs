@@ -19,7 +19,8 @@ pub use body_solver::{
 };
 pub use cholesky::{Cholesky, CholeskySymbolic, Ordering};
 pub use distribution::{
-    BALANCED_INTERFACE_PER_RANK, Distribution, NodeGather, RankRows, node_owners, spread_parts,
+    BALANCED_INTERFACE_PER_RANK, Distribution, NodeGather, RankRows, node_owners, own_order,
+    spread_parts,
 };
 pub(crate) use node_order::z_curve_keys;
 

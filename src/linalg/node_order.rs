@@ -26,19 +26,30 @@
 /// its coordinates, each scaled to `63 / dim` bits over the nodes' bounding box, interleaved.
 pub(crate) fn z_curve_keys(coords: &[f64], dim: usize) -> Vec<u64> {
     let num_nodes = coords.len() / dim;
-    let node = |k: usize| &coords[k * dim..(k + 1) * dim];
     let (mut low, mut high) = (vec![f64::INFINITY; dim], vec![f64::NEG_INFINITY; dim]);
-    for k in 0..num_nodes {
-        for (c, &x) in node(k).iter().enumerate() {
+    for x in coords.chunks_exact(dim) {
+        for (c, &x) in x.iter().enumerate() {
             low[c] = low[c].min(x);
             high[c] = high[c].max(x);
         }
     }
+    let key = z_curve_key(&low, &high);
+    (0..num_nodes)
+        .map(|k| key(&coords[k * dim..(k + 1) * dim]))
+        .collect()
+}
+
+/// The Z-curve key of a point (its `dim` coordinates) within the box from `low` to `high`: on
+/// a rank that keeps some of a body's nodes, the body's box makes each node's key the one the
+/// whole body's nodes give it ([`z_curve_keys`]).
+pub(crate) fn z_curve_key(low: &[f64], high: &[f64]) -> impl Fn(&[f64]) -> u64 {
+    let dim = low.len();
+    let (low, high) = (low.to_vec(), high.to_vec());
     let bits = 63 / dim as u32;
     let cells = ((1u64 << bits) - 1) as f64;
-    let key = |k: usize| -> u64 {
+    move |node: &[f64]| -> u64 {
         let mut key = 0u64;
-        for (c, &x) in node(k).iter().enumerate() {
+        for (c, &x) in node.iter().enumerate() {
             let extent = high[c] - low[c];
             let scaled = match extent > 0.0 {
                 true => ((x - low[c]) / extent * cells).clamp(0.0, cells) as u64,
@@ -49,8 +60,7 @@ pub(crate) fn z_curve_keys(coords: &[f64], dim: usize) -> Vec<u64> {
             }
         }
         key
-    };
-    (0..num_nodes).map(key).collect()
+    }
 }
 
 /// A permutation of a body's nodes (`dim` dofs each, interleaved) and of their dofs.

@@ -6,7 +6,9 @@ use std::fs;
 use std::path::Path;
 
 use super::msh41::{self, ElementBlock, MshContents, element_type_name};
-use super::{BodyMesh, Dim, FacetGroup, GmshModel, Mesh, MeshError, PhysicalGroup, check_cells};
+use super::{
+    BodyMesh, Dim, FacetGroup, GmshModel, Mesh, MeshError, NodeCoords, PhysicalGroup, check_cells,
+};
 
 /// gmsh element types: 1 the 2-node line, 2 the 3-node triangle, 4 the 4-node tetrahedron, 15
 /// the point.
@@ -239,7 +241,7 @@ impl FileContents {
         let local: HashMap<u64, u32> = (node_tags.iter().enumerate())
             .map(|(i, &t)| (t, i as u32))
             .collect();
-        let coords = node_tags.iter().map(|t| self.coords[t]).collect();
+        let coords = NodeCoords::from(node_tags.iter().map(|t| self.coords[t]).collect::<Vec<_>>());
         Ok(BodyMesh {
             name,
             physical_tag: tag,
@@ -446,7 +448,10 @@ fn check_planar(path: &Path, bodies: &[BodyMesh]) -> Result<(), MeshError> {
 }
 
 /// Reorders `face` so that its right-hand normal points away from the cell's `opposite` node.
-fn orient_outward(coords: &[[f64; 3]], face: &mut [usize], opposite: usize, dim: Dim) {
+fn orient_outward<C>(coords: &C, face: &mut [usize], opposite: usize, dim: Dim)
+where
+    C: std::ops::Index<usize, Output = [f64; 3]> + ?Sized,
+{
     let p = |i: usize| nalgebra::Vector3::from(coords[i]);
     let normal = if dim == 2 {
         let t = p(face[1]) - p(face[0]);

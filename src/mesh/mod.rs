@@ -8,7 +8,9 @@
 //! Every boundary facet is stored with the node order that makes its right-hand normal point
 //! out of the body (worked out from the adjacent cell, never from the file's facet order).
 
+mod coords;
 mod error;
+mod extent;
 mod generate;
 mod gmsh;
 mod gmsh_tags;
@@ -18,12 +20,14 @@ mod part;
 mod quality;
 mod summary;
 
+pub use coords::NodeCoords;
 pub use error::MeshError;
+pub use extent::BodyExtent;
 pub use generate::mesh_geo;
 pub use gmsh::{mesh_from_model, read_msh, read_msh_bytes};
 pub use gmsh_tags::GmshTags;
 pub use model::{GmshModel, ModelElements, ModelGroup};
-pub use part::{CellsByRank, RankPart};
+pub use part::{CellsByRank, NODE_WORDS, NodesByRank, RankPart};
 pub use quality::{check_cells, signed_measure};
 pub use summary::MeshSummary;
 
@@ -93,8 +97,9 @@ pub struct BodyMesh {
     pub name: String,
     pub physical_tag: i32,
     pub dim: Dim,
-    /// Node coordinates; `z = 0` in 2D.
-    pub coords: Vec<[f64; 3]>,
+    /// Node coordinates; `z = 0` in 2D. On a rank of a distributed run, only those of the
+    /// nodes it reads ([`NodeCoords`]).
+    pub coords: NodeCoords,
     /// Local node index -> gmsh node tag, increasing (the nodes are numbered in tag order).
     pub node_tags: GmshTags,
     /// Cell connectivity, `dim + 1` local node indices per cell, flat. Stored as `u32`, half
@@ -231,15 +236,18 @@ impl BodyMesh {
 
     /// Axis-aligned bounding box `(min, max)` of the nodes.
     pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for x in &self.coords {
-            for k in 0..3 {
-                lo[k] = lo[k].min(x[k]);
-                hi[k] = hi[k].max(x[k]);
-            }
+        let extent = self.extent();
+        (extent.low, extent.high)
+    }
+
+    /// The extent of the whole body's nodes; on a rank that keeps the coordinates of some of
+    /// them only, as rank 0 measured it before the partition ([`RankPart::extent`]).
+    pub fn extent(&self) -> BodyExtent {
+        match (&self.part, self.coords.as_whole()) {
+            (Some(part), _) => part.extent.clone(),
+            (None, Some(coords)) => BodyExtent::of(coords, self.dim),
+            (None, None) => unreachable!("only the partition keeps some coordinates"),
         }
-        (lo, hi)
     }
 }
 

@@ -6,29 +6,36 @@
 //! output reads a cell: the contact loop works on surfaces. So a rank holds only the cells
 //! around those nodes (every cell that holds one: their columns are then complete, bit for
 //! bit), each with its index in the whole body (the output's row of the cell, which the rank
-//! that writes it sends to rank 0: `crate::run`'s output), and the two facts of the whole
-//! body the run still needs, the partition and the body's boundary
-//! ([`BodyMesh::boundary_facets`]). Rank 0, which reads the mesh, divides the cells
-//! ([`BodyMesh::cells_by_rank`]) and sends each rank its own (`crate::run`'s partition); the
-//! others never hold the whole body. Every node stays: the coordinates are 24 bytes a node
-//! against the cells' 16 bytes a cell and about 5.5 cells a node in 3D (the node tags are
-//! kept as runs: [`super::GmshTags`]).
+//! that writes it sends to rank 0: `crate::run`'s output), and the facts of the whole body the
+//! run still needs: the body's boundary ([`BodyMesh::boundary_facets`]) and the extent of its
+//! nodes ([`super::BodyExtent`]). Of the nodes it keeps the coordinates and owners of those it
+//! reads only: its own and its cells' nodes and those of the body's boundary and groups
+//! ([`BodyMesh::divide_nodes`]; 24 bytes a node of coordinates on every rank before, the
+//! largest array of a body's size a rank kept). Rank 0, which reads the mesh, divides the
+//! cells ([`BodyMesh::cells_by_rank`]) and the nodes and sends each rank its own
+//! (`crate::run`'s partition); the others never hold the whole body. The node tags stay whole,
+//! kept as runs ([`super::GmshTags`]).
 
 use rayon::slice::ParallelSliceMut;
 use serde::{Deserialize, Serialize};
 
-use super::{BodyMesh, GmshTags};
+use super::{BodyExtent, BodyMesh, GmshTags, NodeCoords};
 
 /// What a rank keeps of a body's mesh beside the cells ([`BodyMesh::part`]).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RankPart {
-    /// The rank that owns each node: the partition of the whole body's node graph that the
-    /// distribution of its unknowns follows (`crate::linalg::Distribution`).
+    /// The rank that owns each node whose coordinates the rank keeps, in the order of
+    /// [`BodyMesh::coords`]' kept nodes ([`BodyMesh::owner`]): the partition of the whole
+    /// body's node graph that the distribution of its unknowns follows
+    /// (`crate::linalg::Distribution`). Every node's on rank 0 until it divides the nodes.
     pub owner: Vec<u32>,
     /// The number of cells of the whole body.
     pub total_cells: usize,
     /// [`BodyMesh::boundary_facets`] of the whole body.
     pub boundary_facets: Vec<usize>,
+    /// The extent of the whole body's nodes ([`BodyMesh::extent`]), of which the rank keeps
+    /// the coordinates of the nodes it reads only ([`BodyMesh::divide_nodes`]).
+    pub extent: BodyExtent,
     /// The whole body's index of each cell this rank keeps, increasing ([`BodyMesh::cells`]
     /// holds them in this order): the row the output writes it in.
     pub cell_indices: Vec<u32>,
@@ -37,6 +44,27 @@ pub struct RankPart {
     /// other ranks. Never sent between ranks.
     #[serde(skip)]
     pub whole_cell_tags: Option<GmshTags>,
+}
+
+/// The nodes each rank keeps the coordinates of, one rank after the other: what rank 0 of a
+/// distributed run sends the ranks ([`BodyMesh::divide_nodes`]).
+#[derive(Debug, Clone, Default)]
+pub struct NodesByRank {
+    /// The nodes of rank 0, increasing, then those of rank 1, ...
+    pub nodes: Vec<u32>,
+    /// [`NODE_WORDS`] words a node: its coordinates, each one's 64 bits as two 32-bit words,
+    /// low first (so that they travel as the cells' words do, and arrive exact), then its owner.
+    pub words: Vec<u32>,
+    /// The number of nodes of each rank.
+    pub counts: Vec<usize>,
+}
+
+/// The 32-bit words of a node ([`NodesByRank::words`]).
+pub const NODE_WORDS: usize = 7;
+
+fn coordinate_words(x: &[f64; 3]) -> [u32; 6] {
+    let bits = x.map(f64::to_bits);
+    std::array::from_fn(|w| (bits[w / 2] >> (32 * (w % 2))) as u32)
 }
 
 /// Every rank's cells of a body, one rank after the other, each rank's in the body's order:
@@ -117,11 +145,13 @@ impl BodyMesh {
         debug_assert!(self.part.is_none(), "the cells of a whole body");
         let boundary_facets = self.boundary_facets();
         let total_cells = self.num_cells();
+        let extent = self.extent();
         self.cells = Vec::new();
         self.part = Some(RankPart {
             owner,
             total_cells,
             boundary_facets,
+            extent,
             cell_indices: Vec::new(),
             whole_cell_tags: None,
         });
@@ -136,6 +166,81 @@ impl BodyMesh {
         let part = self.part.as_mut().expect("a body whose cells were dropped");
         self.cells = cells;
         part.cell_indices = indices;
+    }
+
+    /// The nodes whose coordinates each rank keeps, of a body whose cells were divided into
+    /// `cells` ([`Self::cells_by_rank`], then [`Self::drop_cells`]): the rank's own nodes and
+    /// the nodes of its cells, of the body's boundary facets and the cell nodes opposite them (which orient
+    /// them), and of its boundary and point groups. Nothing else reads a node's position once
+    /// the mesh is divided: the assembly and the cell fields read their cells' nodes, the
+    /// loads, supports and pins their groups and the boundary, the contact geometry the
+    /// boundary. The body then keeps no coordinates until its own arrive
+    /// ([`Self::receive_nodes`]).
+    pub fn divide_nodes(&mut self, cells: &CellsByRank) -> NodesByRank {
+        let part = self.part.as_mut().expect("a body whose cells were dropped");
+        let owner = std::mem::take(&mut part.owner);
+        let mut everywhere: Vec<u32> = (part.boundary_facets.iter())
+            .chain(self.boundary_groups.values().flat_map(|g| &g.facets))
+            .chain(self.point_groups.values().flatten())
+            .map(|&a| a as u32)
+            .collect();
+        everywhere.sort_unstable();
+        everywhere.dedup();
+        let width = self.nodes_per_cell();
+        let mut owned: Vec<Vec<u32>> = vec![Vec::new(); cells.counts.len()];
+        for (a, &rank) in owner.iter().enumerate() {
+            owned[rank as usize].push(a as u32);
+        }
+        let mut by_rank = NodesByRank::default();
+        let mut first = 0;
+        for (&count, owned) in cells.counts.iter().zip(owned) {
+            let mut nodes: Vec<u32> = cells.cells[width * first..width * (first + count)].to_vec();
+            first += count;
+            nodes.extend(owned);
+            nodes.extend_from_slice(&everywhere);
+            nodes.par_sort_unstable();
+            nodes.dedup();
+            by_rank.counts.push(nodes.len());
+            for &a in &nodes {
+                by_rank
+                    .words
+                    .extend(coordinate_words(&self.coords[a as usize]));
+                by_rank.words.push(owner[a as usize]);
+            }
+            by_rank.nodes.extend(nodes);
+        }
+        self.coords = NodeCoords::of_nodes(self.num_nodes(), Vec::new(), Vec::new());
+        by_rank
+    }
+
+    /// This rank's nodes of a body whose nodes were divided ([`Self::divide_nodes`]), with
+    /// their words ([`NodesByRank::words`]).
+    pub fn receive_nodes(&mut self, nodes: Vec<u32>, words: &[u32]) {
+        debug_assert_eq!(words.len(), NODE_WORDS * nodes.len());
+        let (values, owner) = (words.chunks_exact(NODE_WORDS))
+            .map(|words| {
+                let x = std::array::from_fn(|k| {
+                    f64::from_bits(u64::from(words[2 * k]) | (u64::from(words[2 * k + 1]) << 32))
+                });
+                (x, words[NODE_WORDS - 1])
+            })
+            .unzip();
+        self.coords = NodeCoords::of_nodes(self.num_nodes(), nodes, values);
+        self.part
+            .as_mut()
+            .expect("a body whose nodes were divided")
+            .owner = owner;
+    }
+
+    /// The rank that owns `node`, of a body divided among the ranks ([`RankPart::owner`]);
+    /// `None` where its coordinates are not kept here or the body is whole.
+    pub fn owner(&self, node: usize) -> Option<u32> {
+        let part = self.part.as_ref()?;
+        let i = match self.coords.is_whole() {
+            true => node,
+            false => self.coords.position(node)?,
+        };
+        part.owner.get(i).copied()
     }
 
     /// The number of cells of the whole body (of which a rank's part keeps some).
@@ -190,6 +295,7 @@ impl BodyMesh {
 
 #[cfg(test)]
 mod tests {
+    use super::NODE_WORDS;
     use crate::mesh::read_msh;
 
     #[test]
@@ -235,6 +341,62 @@ mod tests {
             assert_eq!(part.part.as_ref().unwrap().owner, owner);
         }
         assert_eq!(at, split.cells.len());
+    }
+
+    #[test]
+    fn a_rank_keeps_the_coordinates_and_owners_of_the_nodes_it_reads_exactly() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/block_3d.msh");
+        let whole = read_msh(&path).unwrap().bodies.remove(0);
+        // Three ranks, each a slab of the block along x.
+        let (low, high) = whole.bounding_box();
+        let owner: Vec<u32> = (whole.coords.kept())
+            .map(|(_, x)| ((3.0 * (x[0] - low[0]) / (high[0] - low[0])) as u32).min(2))
+            .collect();
+        let split = whole.cells_by_rank(&owner, 3, |_| false);
+        let mut rank0 = whole.clone();
+        rank0.drop_cells(owner.clone());
+        let divided = rank0.divide_nodes(&split);
+        assert_eq!(rank0.coords.kept().count(), 0, "rank 0 sent them all");
+        assert_eq!(divided.counts.len(), 3);
+
+        let (boundary, groups) = (whole.boundary_facets(), whole.group_names());
+        let (mut at, mut cells_at, mut kept) = (0, 0, Vec::new());
+        for (rank, &count) in divided.counts.iter().enumerate() {
+            let nodes = divided.nodes[at..at + count].to_vec();
+            let words = &divided.words[NODE_WORDS * at..NODE_WORDS * (at + count)];
+            at += count;
+            let mut part = whole.clone();
+            part.drop_cells(owner.clone());
+            let cells = split.counts[rank];
+            part.receive_cells(
+                split.cells[4 * cells_at..4 * (cells_at + cells)].to_vec(),
+                split.indices[cells_at..cells_at + cells].to_vec(),
+            );
+            cells_at += cells;
+            part.receive_nodes(nodes, words);
+            assert!(!part.coords.is_whole());
+            kept.push(part.coords.kept().count());
+            // Every node it reads: its own, its cells', the boundary's (with the opposite
+            // nodes), the groups'; each exactly as read, with its owner.
+            let read = (0..whole.num_nodes())
+                .filter(|&a| owner[a] as usize == rank)
+                .chain(part.cells.iter().map(|&a| a as usize))
+                .chain(boundary.iter().copied())
+                .chain(groups.iter().flat_map(|g| whole.group_nodes(g).unwrap()));
+            for a in read {
+                assert_eq!(part.coords[a], whole.coords[a], "rank {rank} node {a}");
+                assert_eq!(part.owner(a), Some(owner[a]), "rank {rank} node {a}");
+            }
+            assert_eq!(part.extent(), whole.extent());
+        }
+        assert_eq!(at, divided.nodes.len());
+        // The slab at an end reaches the middle one's first layer only.
+        assert!(
+            kept[0] < whole.num_nodes(),
+            "{kept:?} of {}",
+            whole.num_nodes()
+        );
     }
 
     #[test]

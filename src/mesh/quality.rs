@@ -17,7 +17,10 @@ const DEGENERATE_RELATIVE_MEASURE: f64 = 1e-10;
 
 /// Signed measure (area in 2D, volume in 3D) of a P1 simplex, positive when counter-clockwise
 /// (2D) or right-handed (3D).
-pub fn signed_measure(coords: &[[f64; 3]], cell: &[usize], dim: Dim) -> f64 {
+pub fn signed_measure<C>(coords: &C, cell: &[usize], dim: Dim) -> f64
+where
+    C: std::ops::Index<usize, Output = [f64; 3]> + ?Sized,
+{
     let p = |k: usize| Vector3::from(coords[cell[k]]);
     if dim == 2 {
         let (a, b) = (p(1) - p(0), p(2) - p(0));
@@ -28,7 +31,10 @@ pub fn signed_measure(coords: &[[f64; 3]], cell: &[usize], dim: Dim) -> f64 {
     }
 }
 
-fn longest_edge(coords: &[[f64; 3]], cell: &[usize]) -> f64 {
+fn longest_edge<C>(coords: &C, cell: &[usize]) -> f64
+where
+    C: std::ops::Index<usize, Output = [f64; 3]> + ?Sized,
+{
     let mut longest: f64 = 0.0;
     for i in 0..cell.len() {
         for j in i + 1..cell.len() {

@@ -80,7 +80,10 @@ pub type CellRowsOf<'a> = dyn FnMut(usize, Range<usize>) -> Result<CellRows, Str
 /// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf` from the bodies' own cells (every body's
 /// mesh holds all of its cells).
 pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
-    write_xdmf_with(dir, stem, bodies, &mut |k, cells| {
+    let geometry: Vec<&[[f64; 3]]> = (bodies.iter())
+        .map(|b| b.mesh.coords.as_whole().unwrap_or_default())
+        .collect();
+    write_xdmf_with(dir, stem, bodies, &geometry, &mut |k, cells| {
         Ok(CellRows::of(&bodies[k], cells))
     })
 }
@@ -88,7 +91,8 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
 /// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`, the cell datasets from `cell_rows`:
 /// where the bodies' meshes hold only some of their cells (rank 0 of a distributed run), the
 /// rows of the others come from the ranks that hold them. The node datasets are written from
-/// the bodies' own arrays, which hold every node.
+/// `geometry` (every node's coordinates of each body: on rank 0 of a distributed run gathered
+/// from the ranks, which keep some each) and the bodies' own arrays, which hold every node.
 ///
 /// Each dataset is written body by body, a bounded chunk of rows at a time
 /// ([`CHUNK_ROWS`]), straight from the bodies' own arrays: the writer never holds a copy of
@@ -98,6 +102,7 @@ pub fn write_xdmf_with(
     dir: &Path,
     stem: &str,
     bodies: &[BodyFields],
+    geometry: &[&[[f64; 3]]],
     cell_rows: &mut CellRowsOf,
 ) -> Result<(), OutputError> {
     let h5_path = dir.join(format!("{stem}.h5"));
@@ -108,6 +113,7 @@ pub fn write_xdmf_with(
     let friction = (bodies.iter().flat_map(|b| &b.surfaces)).any(|s| s.friction.is_some());
     let grid = Grid {
         bodies,
+        geometry,
         dim,
         nodes: &nodes,
         cells: &cells,
@@ -156,6 +162,8 @@ fn chunks(cells: &[usize], chunk_rows: usize) -> Vec<(usize, Range<usize>)> {
 /// Every body's nodes and cells one after the other, as the datasets of the module doc.
 struct Grid<'a> {
     bodies: &'a [BodyFields<'a>],
+    /// Every node's coordinates of each body.
+    geometry: &'a [&'a [[f64; 3]]],
     dim: usize,
     /// Nodes and cells of each body.
     nodes: &'a [usize],
@@ -190,7 +198,7 @@ impl Grid<'_> {
                 Some(this)
             })
             .collect();
-        let geometry = |k: usize| body(k).mesh.coords.iter().flatten().copied();
+        let geometry = |k: usize| self.geometry[k].iter().flatten().copied();
         self.write_by_body(&mesh, "geometry", Width::Columns(3), nodes, geometry)?;
         let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|t| t as i64);
         self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
@@ -637,7 +645,8 @@ mod tests {
     fn strip(name: &str, x0: f64, n: usize) -> BodyMesh {
         let coords = (0..=n)
             .flat_map(|i| [[x0 + i as f64, 0.0, 0.0], [x0 + i as f64, 1.0, 0.0]])
-            .collect();
+            .collect::<Vec<_>>()
+            .into();
         let cells: Vec<u32> = (0..n as u32)
             .flat_map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 1])
             .collect();
@@ -662,7 +671,7 @@ mod tests {
         let material = Material::new(1000.0, 0.3).unwrap();
         let displacements: Vec<Vec<f64>> = (meshes.iter())
             .map(|m| {
-                (m.coords.iter())
+                (m.coords.kept().map(|(_, x)| x))
                     .flat_map(|x| [1e-3 * x[0] * x[1], -2e-3 * x[1]])
                     .collect()
             })
@@ -676,8 +685,12 @@ mod tests {
             })
             .collect();
         let (nodes, cells) = ([16, 12], [14, 10]);
+        let geometry: Vec<&[[f64; 3]]> = (meshes.iter())
+            .map(|m| m.coords.as_whole().unwrap())
+            .collect();
         let grid = Grid {
             bodies: &bodies,
+            geometry: &geometry,
             dim: 2,
             nodes: &nodes,
             cells: &cells,
@@ -746,8 +759,12 @@ mod tests {
             material: &material,
             surfaces: Vec::new(),
         }];
+        let geometry: Vec<&[[f64; 3]]> = (meshes.iter())
+            .map(|m| m.coords.as_whole().unwrap())
+            .collect();
         let grid = Grid {
             bodies: &bodies,
+            geometry: &geometry,
             dim: 2,
             nodes: &[6],
             cells: &[4],

@@ -8,6 +8,11 @@
 //! and no other sends it. Each rank computes the strain and stress of the cells it sends from
 //! the displacement, which every rank holds whole once the solve has ended. So rank 0 holds at
 //! most one chunk of rows beyond its own part of the mesh, and nobody reads the mesh file again.
+//!
+//! The geometry (every node's coordinates), which no rank keeps whole after the partition
+//! (`crate::mesh::NodeCoords`), is gathered onto rank 0 whole before it writes, from each node's
+//! owner ([`gather_geometry`]): 24 bytes a node on rank 0, as the displacement every rank holds
+//! at the end.
 
 use std::ops::Range;
 
@@ -85,6 +90,64 @@ pub(super) fn gather_cell_rows(
     Ok(rows)
 }
 
+/// Every node's coordinates of each body, on rank 0 (empty vectors on the other ranks), each
+/// node's sent by the rank that owns it. Collective: every rank calls it once, with the same
+/// bodies.
+pub(super) fn gather_geometry(bodies: &[BodyFields]) -> Result<Vec<Vec<[f64; 3]>>, ParallelError> {
+    let rank = parallel::ranks().rank;
+    let mut geometry = Vec::with_capacity(bodies.len());
+    for body in bodies {
+        let mesh = body.mesh;
+        let Some(part) = &mesh.part else {
+            geometry.push(
+                mesh.coords
+                    .as_whole()
+                    .map(<[_]>::to_vec)
+                    .unwrap_or_default(),
+            );
+            continue;
+        };
+        // A node as values: its index, then its coordinates.
+        let mut values = Vec::new();
+        for ((a, x), &owner) in mesh.coords.kept().zip(&part.owner) {
+            if owner as usize == rank {
+                values.push(a as f64);
+                values.extend_from_slice(x);
+            }
+        }
+        let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
+            .map(|&count| count as usize)
+            .collect();
+        let all = parallel::gather_to_root(&values, &counts)?;
+        if !parallel::is_root() {
+            geometry.push(Vec::new());
+            continue;
+        }
+        let mut coords = vec![[f64::NAN; 3]; mesh.num_nodes()];
+        let mut placed = vec![false; mesh.num_nodes()];
+        for node in all.chunks_exact(4) {
+            let a = node[0] as usize;
+            if a >= coords.len() || placed[a] {
+                return Err(ParallelError::Message(format!(
+                    "the output's node {a} of body '{}' was sent twice or is not one of its {}",
+                    mesh.name,
+                    coords.len()
+                )));
+            }
+            placed[a] = true;
+            coords[a].copy_from_slice(&node[1..]);
+        }
+        if let Some(a) = placed.iter().position(|&p| !p) {
+            return Err(ParallelError::Message(format!(
+                "no rank sent the coordinates of the output's node {a} of body '{}'",
+                mesh.name
+            )));
+        }
+        geometry.push(coords);
+    }
+    Ok(geometry)
+}
+
 /// On a rank other than 0: sends the rows of every cell this rank writes, chunk by chunk, as
 /// rank 0 gathers them while it writes (`gather_cell_rows`).
 pub(super) fn send_cell_rows(bodies: &[BodyFields]) -> Result<(), ParallelError> {
@@ -115,7 +178,10 @@ fn sent_cells<'a>(
         .partition_point(|&c| (c as usize) < cells.end);
     Box::new((first..end).filter_map(move |c| {
         let nodes = &body.mesh.cells[width * c..width * (c + 1)];
-        let writer = nodes.iter().map(|&a| part.owner[a as usize]).min();
+        let writer = nodes
+            .iter()
+            .filter_map(|&a| body.mesh.owner(a as usize))
+            .min();
         (writer == Some(rank)).then_some((c, part.cell_indices[c] as usize))
     }))
 }

@@ -216,8 +216,9 @@ fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunErro
     let mut solution = solve_case_on(&case, &mesh, timings)?;
     solution.rank_peak_memory_mb = gather_peak_memory()?;
     let summary = solution.summary_with(&case, &mesh, &solution.timings);
-    gathered_cells::send_cell_rows(&write::body_fields(&solution, &mesh))
-        .map_err(RunError::Parallel)?;
+    let fields = write::body_fields(&solution, &mesh);
+    gathered_cells::gather_geometry(&fields).map_err(RunError::Parallel)?;
+    gathered_cells::send_cell_rows(&fields).map_err(RunError::Parallel)?;
     Ok(SolvedRun {
         report: RunReport {
             output_dir: output.to_owned(),

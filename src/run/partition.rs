@@ -1,9 +1,10 @@
 //! The mesh of a distributed run divided among the ranks, before anything is assembled: rank 0
 //! reads the whole mesh, partitions each body's nodes once (METIS on the node graph of its
 //! whole mesh, each part given to the rank that keeps the ranks' totals even) and sends every
-//! rank what it keeps ([`crate::mesh::RankPart`]): the nodes, groups,
-//! partition and boundary of every body, and only the cells it assembles. No other rank ever
-//! holds a whole body's cells or the file's bytes. What reads a cell after this is the
+//! rank what it keeps ([`crate::mesh::RankPart`]): the groups and boundary of every body, the
+//! extent of its nodes, the cells it assembles and the coordinates and owners of the nodes it
+//! reads (those of its cells and of the body's boundary and groups). No other rank ever holds
+//! a whole body's cells or nodes, or the file's bytes. What reads a cell after this is the
 //! assembly of a rank's own columns and of the prescribed ones, the only cells it keeps, and
 //! the output, whose cell rows each rank sends rank 0 for the cells it writes (`super::write`).
 //! Only the export of the assembled matrices reads the mesh file again ([`whole_mesh`]).
@@ -15,7 +16,9 @@ use crate::case::{Case, CaseError};
 use crate::elastic::{SolveError, prescribed_dofs};
 use crate::fem::assembly::stiffness_graph;
 use crate::linalg::{node_owners, spread_parts};
-use crate::mesh::{BodyMesh, CellsByRank, GmshTags, Mesh, MeshError, read_msh};
+use crate::mesh::{
+    BodyMesh, CellsByRank, GmshTags, Mesh, MeshError, NODE_WORDS, NodesByRank, read_msh,
+};
 use crate::parallel::{self, ParallelError};
 
 use super::RunError;
@@ -58,26 +61,38 @@ pub(super) fn scatter_mesh(whole: Option<Mesh>, case: &Case) -> Result<Mesh, Run
                 indices,
                 counts,
             },
+            NodesByRank {
+                nodes,
+                words,
+                counts: node_counts,
+            },
             tags,
         ) = match divided.next() {
-            Some((cells, tags)) => (cells, Some(tags)),
-            None => (CellsByRank::default(), None),
+            Some((cells, nodes, tags)) => (cells, nodes, Some(tags)),
+            None => (CellsByRank::default(), NodesByRank::default(), None),
         };
         let width = body.nodes_per_cell();
-        let scatter = |values, width| {
-            parallel::scatter_cells(values, &counts, width).map_err(RunError::Parallel)
+        let scatter = |values, counts: &[usize], width| {
+            parallel::scatter_cells(values, counts, width).map_err(RunError::Parallel)
         };
-        let (cells, indices) = (scatter(cells, width)?, scatter(indices, 1)?);
+        let (cells, indices) = (
+            scatter(cells, &counts, width)?,
+            scatter(indices, &counts, 1)?,
+        );
         body.receive_cells(cells, indices);
+        let nodes = scatter(nodes, &node_counts, 1)?;
+        body.receive_nodes(nodes, &scatter(words, &node_counts, NODE_WORDS)?);
         if let Some(part) = body.part.as_mut() {
             part.whole_cell_tags = tags;
         }
         log::debug!(
-            "body '{}': rank {} keeps {} of its {} cells",
+            "body '{}': rank {} keeps {} of its {} cells and the coordinates of {} of its {} nodes",
             body.name,
             parallel::ranks().rank,
             body.num_cells(),
-            body.total_cells()
+            body.total_cells(),
+            body.coords.kept().len(),
+            body.num_nodes()
         );
     }
     drop(bytes);
@@ -101,7 +116,10 @@ fn return_freed_memory() {
 /// Rank 0's division of the cells of every body of `case` among the ranks, in the case's
 /// order of bodies, each with the body's element tags; each of those bodies of `mesh` is left
 /// without its cells and tags ([`crate::mesh::BodyMesh::drop_cells`]).
-fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, GmshTags)>, RunError> {
+fn divide_cells(
+    mesh: &mut Mesh,
+    case: &Case,
+) -> Result<Vec<(CellsByRank, NodesByRank, GmshTags)>, RunError> {
     // The problems below read the case's groups, which its checks vouch for first.
     case.check_bodies(mesh)?;
     let ranks = parallel::ranks();
@@ -146,7 +164,9 @@ fn divide_cells(mesh: &mut Mesh, case: &Case) -> Result<Vec<(CellsByRank, GmshTa
         let dim = body.dim;
         let everywhere = |a: usize| (0..dim).any(|c| prescribed.is_fixed(dim * a + c));
         let cells = body.cells_by_rank(&owner, ranks.size, everywhere);
-        divided.push((cells, body.drop_cells(owner)));
+        let tags = body.drop_cells(owner);
+        let nodes = body.divide_nodes(&cells);
+        divided.push((cells, nodes, tags));
     }
     Ok(divided)
 }
@@ -188,7 +208,8 @@ pub(super) fn whole_mesh<'a>(mesh: &'a Mesh, case_path: &Path) -> Result<Cow<'a,
     for body in &mesh.bodies {
         let same = whole.body(&body.name).is_some_and(|read| {
             read.node_tags == body.node_tags
-                && read.coords == body.coords
+                && read.num_nodes() == body.num_nodes()
+                && (body.coords.kept()).all(|(a, x)| read.coords.get(a) == Some(x))
                 && read.num_cells() == body.total_cells()
         });
         if !same {

@@ -15,7 +15,7 @@ use crate::output::{
     write_matrix_market, write_xdmf, write_xdmf_with,
 };
 
-use super::gathered_cells::gather_cell_rows;
+use super::gathered_cells::{gather_cell_rows, gather_geometry};
 use super::partition::whole_mesh;
 use super::solve::case_name;
 use super::{CaseSolution, RunError};
@@ -52,8 +52,11 @@ pub fn write_results(
     }
     let fields = body_fields(solution, mesh);
     if fields.iter().any(|b| b.mesh.part.is_some()) {
-        // A distributed run: the ranks send the rows of their cells as they are written.
-        write_xdmf_with(dir, "solution", &fields, &mut |k, cells| {
+        // A distributed run: the ranks send their nodes' coordinates, then the rows of their
+        // cells as they are written.
+        let geometry = gather_geometry(&fields).map_err(RunError::Parallel)?;
+        let geometry: Vec<&[[f64; 3]]> = geometry.iter().map(Vec::as_slice).collect();
+        write_xdmf_with(dir, "solution", &fields, &geometry, &mut |k, cells| {
             gather_cell_rows(&fields, k, cells).map_err(|e| e.to_string())
         })?;
     } else {

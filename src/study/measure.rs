@@ -76,7 +76,10 @@ pub fn contact_zone_spacing(
 }
 
 /// The mean length of the edges of `facets` (each facet's nodes in order, closed in 3D).
-fn mean_edge_length(coords: &[[f64; 3]], facets: &[&[usize]]) -> f64 {
+fn mean_edge_length<C>(coords: &C, facets: &[&[usize]]) -> f64
+where
+    C: std::ops::Index<usize, Output = [f64; 3]> + ?Sized,
+{
     let distance = |a: usize, b: usize| {
         (0..3)
             .map(|i| (coords[a][i] - coords[b][i]).powi(2))

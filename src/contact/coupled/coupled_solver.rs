@@ -721,7 +721,7 @@ mod tests {
             dim: 2,
             node_tags: (1..=coords.len() as u64).collect(),
             cell_tags: (1..=(cells.len() / 3) as u64).collect(),
-            coords,
+            coords: coords.into(),
             cells,
             boundary_groups: groups,
             point_groups: BTreeMap::new(),
@@ -1021,7 +1021,7 @@ mod tests {
                     let ranks = crate::parallel::Ranks { rank, size };
                     let distributions: Vec<Distribution> = (meshes.iter())
                         .map(|mesh| {
-                            let coords: Vec<f64> = (mesh.coords.iter())
+                            let coords: Vec<f64> = (mesh.coords.kept().map(|(_, x)| x))
                                 .flat_map(|x| x[..mesh.dim].to_vec())
                                 .collect();
                             Distribution::new(&stiffness_graph(mesh), &coords, ranks).unwrap()

@@ -100,6 +100,7 @@ use crate::elastic::{
 use crate::fem::LoadVector;
 use crate::fem::rigid_modes::RigidModes;
 use crate::linalg::{BodySolverKind, NodeGather};
+use crate::mesh::BodyMesh;
 use crate::progress::Heartbeat;
 
 /// [`ContactSolver::check_held`]: a free motion is held when the Gram matrix's eigenvalue along
@@ -114,9 +115,9 @@ const HELD_PER_ROW: f64 = 1e-6;
 /// leave free: those that vanish on its prescribed dofs and move each force-controlled group
 /// uniformly along its component (the group is one plate); its rigid-mode pins hold nothing.
 /// They are the null space of the Gram matrix of those conditions' rows.
-fn motions_left_free(coords: &[[f64; 3]], body: &AssembledBody) -> nalgebra::DMatrix<f64> {
-    let dim = body.dim;
-    let modes = RigidModes::new(coords, dim);
+fn motions_left_free(mesh: &BodyMesh, body: &AssembledBody) -> nalgebra::DMatrix<f64> {
+    let (dim, coords) = (body.dim, &mesh.coords);
+    let modes = RigidModes::of(mesh);
     let count = modes.count();
     let value = |dof: usize| -> Vec<f64> {
         let at = modes.at(&coords[dof / dim]);
@@ -507,7 +508,7 @@ impl<'a> ContactSolver<'a> {
         }
         let mut free_motions = Vec::new();
         for k in (0..bodies.len()).filter(|&k| held(k)) {
-            let motions = motions_left_free(&elastic(origin[k]).body.coords, &bodies[k]);
+            let motions = motions_left_free(elastic(origin[k]).body, &bodies[k]);
             free_motions.push((k, motions));
         }
         let mut offsets = vec![0];
@@ -1069,8 +1070,7 @@ impl ContactSolver<'_> {
                 continue;
             }
             let elastic = self.elastic(*k);
-            let dim = elastic.body.dim;
-            let modes = RigidModes::new(&elastic.body.coords, dim);
+            let modes = RigidModes::of(elastic.body);
             // Two sets of (point, held directions): the constraints' and the body's own.
             let mut sets: [Vec<HeldRow>; 2] = [Vec::new(), Vec::new()];
             for p in (0..self.pairs.len()).filter(|&p| self.pair_bodies[p].contains(k)) {
