@@ -656,11 +656,19 @@ fn partitioned_distribution(
         .map(|count| count as usize)
         .collect();
     let sent: Vec<f64> = order.iter().map(|&a| f64::from(a)).collect();
-    let nodes = (crate::parallel::all_gather(&sent, &nodes_per_rank).map_err(mpi)?)
+    let nodes: Vec<u32> = (crate::parallel::all_gather(&sent, &nodes_per_rank).map_err(mpi)?)
         .into_iter()
         .map(|a| a as u32)
         .collect();
-    Ok(Distribution::from_order(nodes, &nodes_per_rank, dim, ranks))
+    // This rank reads the nodes whose coordinates it keeps, and knows their PETSc nodes only.
+    let known: Vec<u32> = body.coords.kept().map(|(a, _)| a as u32).collect();
+    Ok(Distribution::from_order(
+        &nodes,
+        &nodes_per_rank,
+        dim,
+        ranks,
+        Some(&known),
+    ))
 }
 
 fn mpi(e: crate::parallel::ParallelError) -> LinalgError {

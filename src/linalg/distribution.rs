@@ -27,11 +27,14 @@ use crate::parallel::ranks::Ranks;
 
 #[derive(Debug)]
 pub struct Distribution {
-    /// Our node at each of PETSc's nodes (PETSc's rows `block p .. block (p + 1)` are our
-    /// node `nodes[p]`'s unknowns): a node, not an unknown, and 32 bits, as the mesh's cells
-    /// hold it, so that this map of the whole body costs every rank `4 / block` bytes per
-    /// unknown.
-    nodes: Vec<u32>,
+    /// This rank's nodes in PETSc's order: PETSc's rows `block (first + i) .. block (first +
+    /// i + 1)` are our node `own[i]`'s unknowns.
+    own: Vec<u32>,
+    /// PETSc's node of each node this rank reads, by our node, increasing: of every node on
+    /// one process, on a rank of a distributed run of those whose coordinates it keeps (its
+    /// own, its cells', its body's boundary's and groups': `crate::mesh::NodeCoords`), so that
+    /// no rank keeps a map of the whole body. 32 bits each, as the mesh's cells hold a node.
+    known: Vec<(u32, u32)>,
     /// This rank's nodes, increasing, each with its place among this rank's nodes in PETSc's
     /// order.
     own_sorted: Vec<(u32, u32)>,
@@ -191,40 +194,58 @@ impl Distribution {
             *count = nodes.len() - first;
         }
         drop(keys);
-        Ok(Self::from_order(nodes, &nodes_per_rank, block, ranks))
+        Ok(Self::from_order(
+            &nodes,
+            &nodes_per_rank,
+            block,
+            ranks,
+            None,
+        ))
     }
 
     /// The distribution whose PETSc numbering holds our nodes `nodes` (those of rank 0 along
     /// their Z curve, then those of rank 1, ...: [`own_order`] on each rank, gathered), of which
-    /// `nodes_per_rank[r]` are rank r's.
+    /// `nodes_per_rank[r]` are rank r's; this rank reads the nodes `known` (increasing), every
+    /// node where `None`.
     pub fn from_order(
-        nodes: Vec<u32>,
+        nodes: &[u32],
         nodes_per_rank: &[usize],
         block: usize,
         ranks: Ranks,
+        known: Option<&[u32]>,
     ) -> Self {
         debug_assert_eq!(nodes.len(), nodes_per_rank.iter().sum::<usize>());
         let counts: Vec<usize> = nodes_per_rank.iter().map(|&n| n * block).collect();
         let first = counts[..ranks.rank].iter().sum::<usize>() / block;
         let local = counts[ranks.rank] / block;
-        let mut own_sorted: Vec<(u32, u32)> = (nodes[first..first + local].iter())
-            .zip(0..)
+        let own = nodes[first..first + local].to_vec();
+        let mut own_sorted: Vec<(u32, u32)> = (own.iter().zip(0..))
             .map(|(&node, place)| (node, place))
             .collect();
         own_sorted.sort_unstable();
+        let mut all: Vec<(u32, u32)> = (nodes.iter().zip(0..)).map(|(&a, p)| (a, p)).collect();
+        all.sort_unstable();
+        let known = match known {
+            None => all,
+            Some(known) => {
+                let mut at = 0;
+                (known.iter())
+                    .filter_map(|&a| {
+                        at += all[at..].partition_point(|&(b, _)| b < a);
+                        all.get(at).filter(|&&(b, _)| b == a).copied()
+                    })
+                    .collect()
+            }
+        };
         Self {
-            nodes,
+            own,
+            known,
             own_sorted,
             counts,
             first,
             local,
             block,
         }
-    }
-
-    /// Our unknown at PETSc's row `p`.
-    fn ours(&self, p: usize) -> usize {
-        self.nodes[p / self.block] as usize * self.block + p % self.block
     }
 
     /// Each rank's number of unknowns, in rank order.
@@ -239,7 +260,7 @@ impl Distribution {
 
     /// This rank's nodes in PETSc's order.
     pub fn own_nodes(&self) -> &[u32] {
-        &self.nodes[self.first..self.first + self.local]
+        &self.own
     }
 
     /// This rank's nodes, increasing, each with its place in [`Self::own_nodes`].
@@ -285,12 +306,21 @@ impl Distribution {
         for (q, &(_, place)) in self.own_sorted.iter().enumerate() {
             column_of_place[place as usize] = q;
         }
-        // PETSc's node of each of our nodes.
-        let mut petsc_node = vec![0u32; self.nodes.len()];
-        for (p, &ours) in self.nodes.iter().enumerate() {
-            petsc_node[ours as usize] = p as u32;
+        // PETSc's node of each of our nodes that this rank reads (its columns' rows are its
+        // cells' nodes), for as long as the rows are made.
+        let mut petsc_node = vec![u32::MAX; coords.len()];
+        for &(ours, p) in &self.known {
+            petsc_node[ours as usize] = p;
         }
-        let petsc_of = |ours: usize| petsc_node[ours / block] as usize * block + ours % block;
+        let petsc_of = |ours: usize| {
+            let p = petsc_node[ours / block];
+            assert!(
+                p != u32::MAX,
+                "node {} of a column is not known here",
+                ours / block
+            );
+            p as usize * block + ours % block
+        };
         let mut row_ptr = Vec::with_capacity(rows.len() + 1);
         let mut petsc_columns = Vec::with_capacity(columns.nnz());
         let mut values = Vec::with_capacity(columns.nnz());
@@ -329,8 +359,8 @@ impl Distribution {
 
     /// Our unknown at each of this rank's rows, in PETSc's order.
     pub fn own(&self) -> impl Iterator<Item = usize> + '_ {
-        let rows = self.first * self.block..(self.first + self.local) * self.block;
-        rows.map(|p| self.ours(p))
+        let block = self.block;
+        (self.own.iter()).flat_map(move |&a| (0..block).map(move |c| a as usize * block + c))
     }
 
     /// The row among this rank's rows (PETSc's order) of our unknown `dof`, if this rank owns
@@ -343,61 +373,82 @@ impl Distribution {
         Some(self.own_sorted[at].1 as usize * self.block + dof % self.block)
     }
 
-    /// The rank that owns each of `nodes` (our numbering, increasing). Reads the whole body's
-    /// map once: `O(n log m)` for `m` nodes.
-    pub fn owner_ranks(&self, nodes: &[u32]) -> Vec<u32> {
+    /// The rank that owns each of `nodes` (our numbering, increasing, nodes this rank reads).
+    pub fn owner_ranks(&self, nodes: &[u32]) -> Result<Vec<u32>, LinalgError> {
         let mut owner = vec![0; nodes.len()];
-        for (rank, _, place) in self.places_of(nodes) {
+        for (rank, _, place) in self.places_of(nodes)? {
             owner[place as usize] = rank as u32;
         }
-        owner
+        Ok(owner)
     }
 
-    /// How every rank receives the values of `nodes` (our numbering, increasing) from their
-    /// owners ([`NodeGather`]). Reads the whole body's map once: `O(n log m)` for `m` nodes.
-    pub fn node_gather(&self, nodes: Vec<u32>) -> NodeGather {
+    /// How every rank receives the values of `nodes` (our numbering, increasing, nodes this
+    /// rank reads) from their owners ([`NodeGather`]).
+    pub fn node_gather(&self, nodes: Vec<u32>) -> Result<NodeGather, LinalgError> {
         let mut counts = vec![0; self.counts.len()];
         let (mut arrival, mut sends) = (Vec::with_capacity(nodes.len()), Vec::new());
-        for (rank, p, place) in self.places_of(&nodes) {
+        for (rank, p, place) in self.places_of(&nodes)? {
             counts[rank] += self.block;
             arrival.push(place);
             if (self.first..self.first + self.local).contains(&p) {
                 sends.push(((p - self.first) as u32, place));
             }
         }
-        NodeGather {
+        Ok(NodeGather {
             arrival,
             nodes,
             counts,
             sends,
             block: self.block,
-        }
+        })
     }
 
     /// Each of `nodes` (our numbering, increasing) as `(its owner, its PETSc node, its place in
-    /// `nodes`)`, in PETSc's order (rank after rank): one pass over the body's map.
-    fn places_of(&self, nodes: &[u32]) -> Vec<(usize, usize, u32)> {
+    /// `nodes`)`, in PETSc's order (rank after rank); an error names a node this rank does not
+    /// read (whose PETSc node it does not know).
+    fn places_of(&self, nodes: &[u32]) -> Result<Vec<(usize, usize, u32)>, LinalgError> {
         debug_assert!(nodes.windows(2).all(|w| w[0] < w[1]), "nodes increasing");
-        let (mut rank, mut end) = (0, self.counts[0] / self.block);
+        // The first PETSc node of each rank after the first, increasing.
+        let starts: Vec<usize> = (self.counts.iter())
+            .scan(0, |start, &count| {
+                *start += count / self.block;
+                Some(*start)
+            })
+            .collect();
         let mut places = Vec::with_capacity(nodes.len());
-        for (p, ours) in self.nodes.iter().enumerate() {
-            while p >= end {
-                rank += 1;
-                end += self.counts[rank] / self.block;
-            }
-            if let Ok(place) = nodes.binary_search(ours) {
-                places.push((rank, p, place as u32));
+        let mut at = 0;
+        for (place, &a) in nodes.iter().enumerate() {
+            at += self.known[at..].partition_point(|&(b, _)| b < a);
+            match self.known.get(at) {
+                Some(&(b, p)) if b == a => {
+                    let p = p as usize;
+                    let rank = starts.partition_point(|&start| start <= p);
+                    places.push((rank, p, place as u32));
+                }
+                _ => {
+                    return Err(LinalgError::Sizes(format!(
+                        "node {a} is not one this rank reads (its own, its cells', the boundary's)"
+                    )));
+                }
             }
         }
-        places
+        places.sort_unstable_by_key(|&(_, p, _)| p);
+        Ok(places)
     }
 
-    /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank.
+    /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank:
+    /// each rank's values and its nodes (`MPI_Allgatherv` each), so that no rank needs a map of
+    /// every node.
     pub fn gather(&self, local: &[f64], whole: &mut [f64]) -> Result<(), LinalgError> {
-        let petsc = crate::parallel::all_gather(local, &self.counts)
-            .map_err(|e| LinalgError::Mpi(e.to_string()))?;
-        for (p, value) in petsc.into_iter().enumerate() {
-            whole[self.ours(p)] = value;
+        let mpi = |e: crate::parallel::ParallelError| LinalgError::Mpi(e.to_string());
+        let values = crate::parallel::all_gather(local, &self.counts).map_err(mpi)?;
+        let nodes_per_rank: Vec<usize> = self.counts.iter().map(|c| c / self.block).collect();
+        let own: Vec<f64> = self.own.iter().map(|&a| f64::from(a)).collect();
+        let nodes = crate::parallel::all_gather(&own, &nodes_per_rank).map_err(mpi)?;
+        let block = self.block;
+        for (&a, values) in nodes.iter().zip(values.chunks_exact(block)) {
+            let d = a as usize * block;
+            whole[d..d + block].copy_from_slice(values);
         }
         Ok(())
     }
@@ -592,7 +643,7 @@ mod tests {
             .map(|r| Distribution::with_owners(&owner, &coords, block, ranks(r)).unwrap())
             .collect();
         let plans: Vec<NodeGather> = (distributions.iter())
-            .map(|d| d.node_gather(nodes.clone()))
+            .map(|d| d.node_gather(nodes.clone()).unwrap())
             .collect();
         let expected: Vec<f64> = (nodes.iter())
             .flat_map(|&a| whole[block * a as usize..block * (a as usize + 1)].to_vec())
@@ -626,7 +677,7 @@ mod tests {
         assert_eq!(plans[1].place(5), None);
         let owners: Vec<u32> = nodes.iter().map(|&a| owner[a as usize]).collect();
         for d in &distributions {
-            assert_eq!(d.owner_ranks(&nodes), owners);
+            assert_eq!(d.owner_ranks(&nodes).unwrap(), owners);
         }
     }
 

@@ -186,8 +186,9 @@ impl BodyFactors {
         k: usize,
         nodes: &[usize],
     ) -> Result<Option<row_ownership::Keepers>, ContactError> {
-        Ok(shared_bodies(&self.solvers)?
-            .map(|shared| row_ownership::Keepers::new(shared[k], bodies[k], nodes)))
+        (shared_bodies(&self.solvers)?)
+            .map(|shared| row_ownership::Keepers::new(shared[k], bodies[k], nodes))
+            .transpose()
     }
 
     /// The forces on the bodies numbered `which`, made on this rank from the entries it keeps,

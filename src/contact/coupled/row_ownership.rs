@@ -123,20 +123,26 @@ pub struct Keepers {
 impl Keepers {
     /// The keepers of the secondary candidates at `nodes` (increasing) of a shared `body`
     /// distributed as `distribution`.
-    pub fn new(distribution: &Distribution, body: &AssembledBody, nodes: &[usize]) -> Self {
+    pub fn new(
+        distribution: &Distribution,
+        body: &AssembledBody,
+        nodes: &[usize],
+    ) -> Result<Self, ContactError> {
         let ranks = crate::parallel::ranks();
         let mut forced: Vec<usize> = (body.rigid.iter())
             .flat_map(|rigid| rigid.dofs.iter().map(|dof| dof / body.dim))
             .collect();
         forced.sort_unstable();
-        Self {
+        let nodes32: Vec<u32> = nodes.iter().map(|&n| n as u32).collect();
+        Ok(Self {
             rank: ranks.rank as u32,
             size: ranks.size as u32,
-            owner: distribution.owner_ranks(&nodes.iter().map(|&n| n as u32).collect::<Vec<_>>()),
+            owner: (distribution.owner_ranks(&nodes32))
+                .map_err(|e| ContactError::Linalg(e.to_string()))?,
             everywhere: (nodes.iter())
                 .map(|node| forced.binary_search(node).is_ok())
                 .collect(),
-        }
+        })
     }
 
     /// The ranks that keep the entries at candidate `j`, increasing.

@@ -468,9 +468,10 @@ impl<'a> ContactSolver<'a> {
             Some(Some(shared)) => Some(
                 (shared.iter().enumerate())
                     .map(|(k, distribution)| {
-                        distribution.node_gather(geometry_nodes(&surfaces_of(k)))
+                        (distribution.node_gather(geometry_nodes(&surfaces_of(k))))
+                            .map_err(|e| ContactError::Linalg(e.to_string()))
                     })
-                    .collect(),
+                    .collect::<Result<Vec<_>, _>>()?,
             ),
             _ => None,
         };
