@@ -266,13 +266,7 @@ mod with_petsc {
             }
             assert!(constraints.num_fixed() < body.num_dofs());
             let (k_c, mut u) = constraints.apply(k, &vec![0.0; body.num_dofs()]);
-            let coords: Vec<f64> = body
-                .coords
-                .as_whole()
-                .unwrap()
-                .iter()
-                .flat_map(|x| x[..dim].to_vec())
-                .collect();
+            let coords = body.coords.flat(dim);
             let solver = BodySolver::cg_amg(&k_c, dim, &coords, 1e-12).unwrap();
             solver.solve_in_place(&mut u, 1).unwrap();
             let exact: Vec<f64> = (body.coords.as_whole().unwrap().iter())

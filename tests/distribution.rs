@@ -48,13 +48,7 @@ fn the_ranks_rows_are_the_whole_constrained_matrix() {
         let whole = k_c.to_dense();
         let f_c_scale = f_c.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let graph = stiffness_graph(body);
-        let coords: Vec<f64> = body
-            .coords
-            .as_whole()
-            .unwrap()
-            .iter()
-            .flat_map(|x| x[..dim].to_vec())
-            .collect();
+        let coords = body.coords.flat(dim);
 
         for size in [1, 2, 3] {
             let distributions: Vec<Distribution> = (0..size)

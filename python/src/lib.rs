@@ -1560,9 +1560,7 @@ impl BodyResult {
         let (n, m, dim) = (body.num_nodes(), body.num_cells(), body.dim);
         let fields = cell_fields(body, &solved.material, &solved.solution.displacement);
         // One process keeps every node's coordinates (only a distributed run divides them).
-        let coordinates = (body.coords.kept())
-            .flat_map(|(_, x)| x[..dim].to_vec())
-            .collect();
+        let coordinates = body.coords.flat(dim);
         let tensors = |t: &[[f64; 9]]| t.iter().flatten().copied().collect::<Vec<f64>>();
         let surfaces = PyDict::new(py);
         for surface in &solved.surfaces {

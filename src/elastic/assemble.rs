@@ -347,7 +347,7 @@ pub fn assemble(
             problem,
             &constraints,
             &f,
-            whole_coordinates(body),
+            body.coords.flat(dim),
             stats,
             verbose,
         ),
@@ -566,7 +566,7 @@ fn rank_stiffness(
         let graph = stiffness_graph(body);
         let distribution = match &body.part {
             Some(part) => partitioned_distribution(body, part, ranks),
-            None => Distribution::new(&graph, &whole_coordinates(body), ranks),
+            None => Distribution::new(&graph, &body.coords.flat(dim), ranks),
         };
         distribution.map(|distribution| (graph, distribution))
     })?;
@@ -623,14 +623,6 @@ fn rank_stiffness(
         prescribed_rows,
         k_scale,
     })
-}
-
-/// Every node's coordinates of a body that keeps them all (one process), `dim` a node.
-fn whole_coordinates(body: &BodyMesh) -> Vec<f64> {
-    let dim = body.dim;
-    (body.coords.kept())
-        .flat_map(|(_, x)| x[..dim].to_vec())
-        .collect()
 }
 
 /// The distribution of a body whose nodes rank 0 divided among the ranks (`crate::run`'s

@@ -84,6 +84,15 @@ impl NodeCoords {
         }
     }
 
+    /// The kept nodes' first `dim` coordinates, one node after the other in increasing node
+    /// order (every node's where all are kept): the layout a solver's rigid-body near-null
+    /// space and the Z curve read.
+    pub fn flat(&self, dim: usize) -> Vec<f64> {
+        (self.values.iter())
+            .flat_map(|x| x[..dim].iter().copied())
+            .collect()
+    }
+
     /// The kept nodes and their coordinates, in increasing node order (every node, where all
     /// are kept).
     pub fn kept(&self) -> impl ExactSizeIterator<Item = (usize, &[f64; 3])> + '_ {

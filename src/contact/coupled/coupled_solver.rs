@@ -1022,9 +1022,7 @@ mod tests {
                     let ranks = crate::parallel::Ranks { rank, size };
                     let distributions: Vec<Distribution> = (meshes.iter())
                         .map(|mesh| {
-                            let coords: Vec<f64> = (mesh.coords.kept().map(|(_, x)| x))
-                                .flat_map(|x| x[..mesh.dim].to_vec())
-                                .collect();
+                            let coords = mesh.coords.flat(mesh.dim);
                             Distribution::new(&stiffness_graph(mesh), &coords, ranks).unwrap()
                         })
                         .collect();
