@@ -50,6 +50,10 @@ PARTS = [
     # The patches' solves, on rayon's threads.
     ("RBF interpolation: rows and columns", "rbf_patch::"),
     ("coupled system blocks", "CoupledSystem::assemble"),
+    # On several ranks each row and column is computed by one rank and its entries sent to
+    # the ranks that keep them: what a rank keeps is allocated where they arrive, inside the
+    # coupling's frame.
+    ("RBF interpolation: rows and columns", "row_ownership::send_to_keepers"),
     ("interface coupling", "InterfaceOperators::coupling"),
     ("interface operators (other)", "InterfaceOperators::"),
     ("half-space preconditioner (S~^-1)", "HalfSpace::new"),

@@ -9,14 +9,17 @@
 //! rows by contiguous ranges, so PETSc's numbering puts the nodes of rank 0 first, then those
 //! of rank 1, and so on, each rank's along a Z curve through their coordinates (locality for the
 //! products of GAMG's set-up and V-cycles: `super::node_order`), each node's `dim` unknowns
-//! together (the block structure GAMG aggregates by). Every rank computes the same partition
-//! and order (METIS is deterministic for a given graph), assembles the columns of its own
-//! nodes only ([`crate::fem::NodeColumns`]: its rows, `K` being symmetric; in our order) and
-//! hands them to PETSc, in PETSc's order, as [`RankRows`].
+//! together (the block structure GAMG aggregates by). Rank 0 partitions the body
+//! (`crate::run`'s partition); each rank orders its own nodes along the curve ([`own_order`]),
+//! the orders are gathered into PETSc's numbering, and a rank keeps the PETSc number of the
+//! nodes it reads only (its own, its cells', its boundary's). It assembles the columns of its
+//! own nodes only ([`crate::fem::NodeColumns`]: its rows, `K` being symmetric; in our order)
+//! and hands them to PETSc, in PETSc's order, as [`RankRows`].
 //!
 //! Vectors cross between the two numberings here: [`Distribution::local_part`] takes this
 //! rank's rows out of a whole vector in our numbering, [`Distribution::gather`] puts every
-//! rank's rows back into one whole vector on every rank (`MPI_Allgatherv`).
+//! rank's rows back into one whole vector on every rank (`MPI_Allgatherv`, with the rows'
+//! nodes), [`NodeGather`] some nodes' values.
 
 use super::LinalgError;
 use super::node_order::{z_curve_key, z_curve_keys};

@@ -168,14 +168,14 @@ impl BodyMesh {
         part.cell_indices = indices;
     }
 
-    /// The nodes whose coordinates each rank keeps, of a body whose cells were divided into
-    /// `cells` ([`Self::cells_by_rank`], then [`Self::drop_cells`]): the rank's own nodes and
-    /// the nodes of its cells, of the body's boundary facets and the cell nodes opposite them (which orient
-    /// them), and of its boundary and point groups. Nothing else reads a node's position once
-    /// the mesh is divided: the assembly and the cell fields read their cells' nodes, the
-    /// loads, supports and pins their groups and the boundary, the contact geometry the
-    /// boundary. The body then keeps no coordinates until its own arrive
-    /// ([`Self::receive_nodes`]).
+    /// The nodes whose coordinates and owners each rank keeps, of a body whose cells were
+    /// divided into `cells` ([`Self::cells_by_rank`], then [`Self::drop_cells`]): the rank's
+    /// own nodes, the nodes of its cells, of the body's boundary facets and of the cell
+    /// vertices opposite them (which orient them), and of its boundary and point groups.
+    /// Nothing else reads a node's position once the mesh is divided: the assembly and the
+    /// cell fields read their cells' nodes, the loads, supports and pins their groups and the
+    /// boundary, the contact geometry the boundary. The body then keeps no coordinates until
+    /// its own arrive ([`Self::receive_nodes`]).
     pub fn divide_nodes(&mut self, cells: &CellsByRank) -> NodesByRank {
         let part = self.part.as_mut().expect("a body whose cells were dropped");
         let owner = std::mem::take(&mut part.owner);
