@@ -20,7 +20,7 @@ use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_patter
 use crate::fem::loads::{add_body_force, add_surface_load};
 use crate::fem::{Constraints, LoadVector, NodeColumns, NodeGraph};
 use crate::linalg::{Distribution, LinalgError, RankRows, own_order};
-use crate::mesh::{BodyMesh, RankPart};
+use crate::mesh::BodyMesh;
 use crate::parallel::ranks::Ranks;
 
 /// A body's assembled system: `f` as assembled, the Dirichlet-constrained `K_c` (on the
@@ -565,7 +565,7 @@ fn rank_stiffness(
     let (graph, distribution) = timed(stats, verbose, "sparsity pattern", || {
         let graph = stiffness_graph(body);
         let distribution = match &body.part {
-            Some(part) => partitioned_distribution(body, part, ranks),
+            Some(_) => partitioned_distribution(body, ranks),
             None => Distribution::new(&graph, &body.coords.flat(dim), ranks),
         };
         distribution.map(|distribution| (graph, distribution))
@@ -628,18 +628,12 @@ fn rank_stiffness(
 /// The distribution of a body whose nodes rank 0 divided among the ranks (`crate::run`'s
 /// partition): each rank orders its own nodes along the Z curve within the whole body's box
 /// ([`own_order`]), and the ranks' orders are gathered one after the other (collective).
-fn partitioned_distribution(
-    body: &BodyMesh,
-    part: &RankPart,
-    ranks: Ranks,
-) -> Result<Distribution, LinalgError> {
+fn partitioned_distribution(body: &BodyMesh, ranks: Ranks) -> Result<Distribution, LinalgError> {
     let dim = body.dim;
     let (mut own, mut coords) = (Vec::new(), Vec::new());
-    for ((a, x), &owner) in body.coords.kept().zip(&part.owner) {
-        if owner as usize == ranks.rank {
-            own.push(a as u32);
-            coords.extend_from_slice(&x[..dim]);
-        }
+    for (a, x) in body.owned_by(ranks.rank) {
+        own.push(a as u32);
+        coords.extend_from_slice(&x[..dim]);
     }
     let extent = body.extent();
     let order = own_order(&own, &coords, &extent.low[..dim], &extent.high[..dim]);

@@ -243,6 +243,15 @@ impl BodyMesh {
         part.owner.get(i).copied()
     }
 
+    /// The nodes `rank` owns among those whose coordinates are kept here, with their
+    /// coordinates, increasing (none for a whole body).
+    pub fn owned_by(&self, rank: usize) -> impl Iterator<Item = (usize, &[f64; 3])> + '_ {
+        let owner = self.part.as_ref().map_or(&[][..], |part| &part.owner[..]);
+        (self.coords.kept().zip(owner))
+            .filter(move |&(_, &owner)| owner as usize == rank)
+            .map(|(node, _)| node)
+    }
+
     /// The number of cells of the whole body (of which a rank's part keeps some).
     pub fn total_cells(&self) -> usize {
         self.part

@@ -98,7 +98,7 @@ pub(super) fn gather_geometry(bodies: &[BodyFields]) -> Result<Vec<Vec<[f64; 3]>
     let mut geometry = Vec::with_capacity(bodies.len());
     for body in bodies {
         let mesh = body.mesh;
-        let Some(part) = &mesh.part else {
+        if mesh.part.is_none() {
             geometry.push(
                 mesh.coords
                     .as_whole()
@@ -106,14 +106,12 @@ pub(super) fn gather_geometry(bodies: &[BodyFields]) -> Result<Vec<Vec<[f64; 3]>
                     .unwrap_or_default(),
             );
             continue;
-        };
+        }
         // A node as values: its index, then its coordinates.
         let mut values = Vec::new();
-        for ((a, x), &owner) in mesh.coords.kept().zip(&part.owner) {
-            if owner as usize == rank {
-                values.push(a as f64);
-                values.extend_from_slice(x);
-            }
+        for (a, x) in mesh.owned_by(rank) {
+            values.push(a as f64);
+            values.extend_from_slice(x);
         }
         let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
             .map(|&count| count as usize)
