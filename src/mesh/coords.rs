@@ -11,7 +11,7 @@
 //! What reads every node (the output's geometry, the Z curve and the rigid-body frame of the
 //! whole body) reads them on rank 0 before the partition or gathers them.
 
-use std::ops::Index;
+use std::ops::{Index, Range};
 
 use serde::{Deserialize, Serialize};
 
@@ -96,10 +96,25 @@ impl NodeCoords {
     /// The kept nodes and their coordinates, in increasing node order (every node, where all
     /// are kept).
     pub fn kept(&self) -> impl ExactSizeIterator<Item = (usize, &[f64; 3])> + '_ {
-        (0..self.values.len()).map(move |i| {
-            let node = self.kept.as_ref().map_or(i, |kept| kept[i] as usize);
-            (node, &self.values[i])
-        })
+        (0..self.values.len()).map(move |i| self.kept_at(i))
+    }
+
+    /// The kept node at `position` among them (`0..` in increasing node order) and its
+    /// coordinates.
+    pub fn kept_at(&self, position: usize) -> (usize, &[f64; 3]) {
+        let node = (self.kept.as_ref()).map_or(position, |kept| kept[position] as usize);
+        (node, &self.values[position])
+    }
+
+    /// The positions among the kept nodes of those in `nodes` (a binary search each end).
+    pub fn positions_within(&self, nodes: Range<usize>) -> Range<usize> {
+        match &self.kept {
+            None => nodes.start.min(self.count)..nodes.end.min(self.count),
+            Some(kept) => {
+                let first = kept.partition_point(|&n| (n as usize) < nodes.start);
+                first..first + kept[first..].partition_point(|&n| (n as usize) < nodes.end)
+            }
+        }
     }
 }
 
@@ -145,6 +160,11 @@ mod tests {
         assert_eq!(part.get(10), None);
         let kept: Vec<usize> = part.kept().map(|(n, _)| n).collect();
         assert_eq!(kept, [1, 4, 9]);
+        assert_eq!(part.positions_within(2..9), 1..2);
+        assert_eq!(part.positions_within(0..10), 0..3);
+        assert_eq!(part.positions_within(5..9), 2..2);
+        assert_eq!(part.kept_at(2), (9, &[9.0, 18.0, 0.0]));
+        assert_eq!(whole.positions_within(8..12), 8..10);
         assert!(whole.kept().all(|(n, x)| x[0] == n as f64));
     }
 }

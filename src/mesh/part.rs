@@ -16,6 +16,8 @@
 //! (`crate::run`'s partition); the others never hold the whole body. The node tags stay whole,
 //! kept as runs ([`super::GmshTags`]).
 
+use std::ops::Range;
+
 use rayon::slice::ParallelSliceMut;
 use serde::{Deserialize, Serialize};
 
@@ -246,10 +248,20 @@ impl BodyMesh {
     /// The nodes `rank` owns among those whose coordinates are kept here, with their
     /// coordinates, increasing (none for a whole body).
     pub fn owned_by(&self, rank: usize) -> impl Iterator<Item = (usize, &[f64; 3])> + '_ {
+        self.owned_within(rank, 0..self.num_nodes())
+    }
+
+    /// [`Self::owned_by`] among `nodes` only (found by a binary search, not a scan of the kept
+    /// nodes: the output asks for its nodes a chunk at a time).
+    pub fn owned_within(
+        &self,
+        rank: usize,
+        nodes: Range<usize>,
+    ) -> impl Iterator<Item = (usize, &[f64; 3])> + '_ {
         let owner = self.part.as_ref().map_or(&[][..], |part| &part.owner[..]);
-        (self.coords.kept().zip(owner))
-            .filter(move |&(_, &owner)| owner as usize == rank)
-            .map(|(node, _)| node)
+        (self.coords.positions_within(nodes))
+            .filter(move |&i| owner.get(i).is_some_and(|&o| o as usize == rank))
+            .map(|i| self.coords.kept_at(i))
     }
 
     /// The number of cells of the whole body (of which a rank's part keeps some).

@@ -16,7 +16,9 @@ pub use plot::{PLOT_SIZE, PlotError, write_force_displacement_png};
 pub use summary::{
     BodySummary, CaseSummary, ContactSummary, Verdict, force_displacement_csv, peak_memory_mb,
 };
-pub use xdmf::{BodyFields, CellRows, CellRowsOf, cell_chunks, write_xdmf, write_xdmf_with};
+pub use xdmf::{
+    BodyFields, CellRows, CellRowsOf, NodeRowsOf, row_chunks, write_xdmf, write_xdmf_with,
+};
 
 use std::path::PathBuf;
 

@@ -74,35 +74,41 @@ impl CellRows {
 }
 
 /// What gives the cell rows of body `k`'s cells `cells` (indices in the whole body), one
-/// chunk at a time ([`cell_chunks`]); an error is a message.
+/// chunk at a time ([`row_chunks`]); an error is a message.
 pub type CellRowsOf<'a> = dyn FnMut(usize, Range<usize>) -> Result<CellRows, String> + 'a;
 
-/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf` from the bodies' own cells (every body's
-/// mesh holds all of its cells).
+/// What gives the coordinates of body `k`'s nodes `nodes` (indices in the whole body), one
+/// chunk at a time ([`row_chunks`]); an error is a message.
+pub type NodeRowsOf<'a> = dyn FnMut(usize, Range<usize>) -> Result<Vec<[f64; 3]>, String> + 'a;
+
+/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf` from the bodies' own nodes and cells
+/// (every body's mesh holds all of them).
 pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
-    let geometry: Vec<&[[f64; 3]]> = (bodies.iter())
-        .map(|b| b.mesh.coords.as_whole().unwrap_or_default())
-        .collect();
-    write_xdmf_with(dir, stem, bodies, &geometry, &mut |k, cells| {
+    let mut geometry_rows = |k: usize, nodes: Range<usize>| {
+        let whole = bodies[k].mesh.coords.as_whole();
+        (whole.and_then(|x| x.get(nodes.clone())).map(<[_]>::to_vec))
+            .ok_or_else(|| format!("body {k}: the coordinates of its nodes {nodes:?} are not here"))
+    };
+    write_xdmf_with(dir, stem, bodies, &mut geometry_rows, &mut |k, cells| {
         Ok(CellRows::of(&bodies[k], cells))
     })
 }
 
-/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`, the cell datasets from `cell_rows`:
-/// where the bodies' meshes hold only some of their cells (rank 0 of a distributed run), the
-/// rows of the others come from the ranks that hold them. The node datasets are written from
-/// `geometry` (every node's coordinates of each body: on rank 0 of a distributed run gathered
-/// from the ranks, which keep some each) and the bodies' own arrays, which hold every node.
+/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`, the geometry from `geometry_rows` and the
+/// cell datasets from `cell_rows`: where the bodies' meshes hold only some of their nodes and
+/// cells (rank 0 of a distributed run), the rows of the others come from the ranks that hold
+/// them. The other node datasets are written from the bodies' own arrays, which hold every
+/// node.
 ///
 /// Each dataset is written body by body, a bounded chunk of rows at a time
-/// ([`CHUNK_ROWS`]), straight from the bodies' own arrays: the writer never holds a copy of
-/// the whole grid (at 1M DOFs that copy was 470 MB beside the fields themselves, on the
-/// process that writes).
+/// ([`CHUNK_ROWS`]), straight from the bodies' own arrays or as `geometry_rows` and
+/// `cell_rows` give them: the writer never holds a copy of the whole grid (at 1M DOFs that
+/// copy was 470 MB beside the fields themselves, on the process that writes).
 pub fn write_xdmf_with(
     dir: &Path,
     stem: &str,
     bodies: &[BodyFields],
-    geometry: &[&[[f64; 3]]],
+    geometry_rows: &mut NodeRowsOf,
     cell_rows: &mut CellRowsOf,
 ) -> Result<(), OutputError> {
     let h5_path = dir.join(format!("{stem}.h5"));
@@ -113,7 +119,6 @@ pub fn write_xdmf_with(
     let friction = (bodies.iter().flat_map(|b| &b.surfaces)).any(|s| s.friction.is_some());
     let grid = Grid {
         bodies,
-        geometry,
         dim,
         nodes: &nodes,
         cells: &cells,
@@ -121,7 +126,7 @@ pub fn write_xdmf_with(
         friction,
         chunk_rows: CHUNK_ROWS,
     };
-    grid.write_h5(&h5_path, cell_rows)
+    grid.write_h5(&h5_path, geometry_rows, cell_rows)
         .map_err(|source| OutputError::Hdf5 {
             path: h5_path.clone(),
             source,
@@ -143,14 +148,15 @@ pub fn write_xdmf_with(
 /// own arrays (at most 4.7 MB, for the 9 values of a strain or stress row).
 const CHUNK_ROWS: usize = 1 << 16;
 
-/// The chunks the cell datasets are written in, for bodies of `cells[k]` cells: (body,
-/// its cells), the bodies in order. Every rank of a distributed run sends its rows in these.
-pub fn cell_chunks(cells: &[usize]) -> Vec<(usize, Range<usize>)> {
-    chunks(cells, CHUNK_ROWS)
+/// The chunks the geometry and the cell datasets are written in, for bodies of `rows[k]`
+/// nodes or cells: (body, its rows), the bodies in order. Every rank of a distributed run
+/// sends its rows in these.
+pub fn row_chunks(rows: &[usize]) -> Vec<(usize, Range<usize>)> {
+    chunks(rows, CHUNK_ROWS)
 }
 
-fn chunks(cells: &[usize], chunk_rows: usize) -> Vec<(usize, Range<usize>)> {
-    (cells.iter().enumerate())
+fn chunks(rows: &[usize], chunk_rows: usize) -> Vec<(usize, Range<usize>)> {
+    (rows.iter().enumerate())
         .flat_map(|(k, &count)| {
             (0..count)
                 .step_by(chunk_rows)
@@ -159,11 +165,20 @@ fn chunks(cells: &[usize], chunk_rows: usize) -> Vec<(usize, Range<usize>)> {
         .collect()
 }
 
+/// The first row of each body when bodies of `rows[k]` rows are written one after the other.
+fn first_rows(rows: &[usize]) -> Vec<usize> {
+    (rows.iter())
+        .scan(0, |first, &n| {
+            let this = *first;
+            *first += n;
+            Some(this)
+        })
+        .collect()
+}
+
 /// Every body's nodes and cells one after the other, as the datasets of the module doc.
 struct Grid<'a> {
     bodies: &'a [BodyFields<'a>],
-    /// Every node's coordinates of each body.
-    geometry: &'a [&'a [[f64; 3]]],
     dim: usize,
     /// Nodes and cells of each body.
     nodes: &'a [usize],
@@ -184,22 +199,20 @@ enum Width {
 }
 
 impl Grid<'_> {
-    fn write_h5(&self, path: &Path, cell_rows: &mut CellRowsOf) -> hdf5::Result<()> {
+    fn write_h5(
+        &self,
+        path: &Path,
+        geometry_rows: &mut NodeRowsOf,
+        cell_rows: &mut CellRowsOf,
+    ) -> hdf5::Result<()> {
         let (bodies, dim) = (self.bodies, self.dim);
         let file = hdf5::File::create(path)?;
         let mesh = file.create_group("mesh")?;
         let fields = file.create_group("fields")?;
         let (nodes, cells) = (self.nodes, self.cells);
         let body = |k: usize| &bodies[k];
-        let first_nodes: Vec<usize> = (nodes.iter())
-            .scan(0, |first, &n| {
-                let this = *first;
-                *first += n;
-                Some(this)
-            })
-            .collect();
-        let geometry = |k: usize| self.geometry[k].iter().flatten().copied();
-        self.write_by_body(&mesh, "geometry", Width::Columns(3), nodes, geometry)?;
+        let first_nodes = first_rows(nodes);
+        self.write_geometry(&mesh, &first_nodes, geometry_rows)?;
         let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|t| t as i64);
         self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
         let node_body = |k: usize| std::iter::repeat_n(k as i32, nodes[k]);
@@ -349,6 +362,36 @@ impl Grid<'_> {
         Ok(())
     }
 
+    /// The dataset `geometry` (in `mesh`) of the bodies' nodes, from `geometry_rows`,
+    /// [`Self::chunk_rows`] nodes at a time; `first_nodes[k]`: the grid's index of body `k`'s
+    /// first node.
+    fn write_geometry(
+        &self,
+        mesh: &hdf5::Group,
+        first_nodes: &[usize],
+        geometry_rows: &mut NodeRowsOf,
+    ) -> hdf5::Result<()> {
+        let total: usize = self.nodes.iter().sum();
+        let geometry = mesh
+            .new_dataset::<f64>()
+            .shape((total, 3))
+            .create("geometry")?;
+        for (k, nodes) in chunks(self.nodes, self.chunk_rows) {
+            let chunk = geometry_rows(k, nodes.clone()).map_err(hdf5::Error::from)?;
+            if chunk.len() != nodes.len() {
+                return Err(hdf5::Error::from(format!(
+                    "body {k}: {} coordinates for its nodes {nodes:?}",
+                    chunk.len()
+                )));
+            }
+            let table = ndarray::ArrayView2::from_shape((chunk.len(), 3), chunk.as_flattened())
+                .expect("3 coordinates a node");
+            let rows = first_nodes[k] + nodes.start..first_nodes[k] + nodes.end;
+            geometry.write_slice(table, ndarray::s![rows, ..])?;
+        }
+        Ok(())
+    }
+
     /// The datasets `topology` (in `mesh`), `strain`, `stress` (9 values a cell) and
     /// `von_mises` (in `fields`) of the bodies' cells, from `cell_rows`, [`Self::chunk_rows`]
     /// cells at a time; `first_nodes[k]`: the grid's index of body `k`'s first node.
@@ -377,13 +420,7 @@ impl Grid<'_> {
             .new_dataset::<f64>()
             .shape(total)
             .create("von_mises")?;
-        let first_cells: Vec<usize> = (self.cells.iter())
-            .scan(0, |first, &n| {
-                let this = *first;
-                *first += n;
-                Some(this)
-            })
-            .collect();
+        let first_cells = first_rows(self.cells);
         let mut nodes = Vec::new();
         for (k, cells) in chunks(self.cells, self.chunk_rows) {
             let n = cells.len();
@@ -685,12 +722,8 @@ mod tests {
             })
             .collect();
         let (nodes, cells) = ([16, 12], [14, 10]);
-        let geometry: Vec<&[[f64; 3]]> = (meshes.iter())
-            .map(|m| m.coords.as_whole().unwrap())
-            .collect();
         let grid = Grid {
             bodies: &bodies,
-            geometry: &geometry,
             dim: 2,
             nodes: &nodes,
             cells: &cells,
@@ -700,8 +733,16 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("grid.h5");
+        // The geometry as a distributed run's rank 0 receives it: a chunk at a time, each
+        // asked for once.
+        let mut asked = Vec::new();
+        let mut geometry_rows = |k: usize, nodes: Range<usize>| {
+            asked.push((k, nodes.clone()));
+            Ok(meshes[k].coords.as_whole().unwrap()[nodes].to_vec())
+        };
         let mut rows = |k: usize, cells| Ok(CellRows::of(&bodies[k], cells));
-        grid.write_h5(&path, &mut rows).unwrap();
+        grid.write_h5(&path, &mut geometry_rows, &mut rows).unwrap();
+        assert_eq!(asked, chunks(&nodes, 3));
 
         let file = hdf5::File::open(&path).unwrap();
         let read = |name: &str| file.dataset(name).unwrap().read_raw::<f64>().unwrap();
@@ -720,6 +761,10 @@ mod tests {
             .read_raw::<i32>()
             .unwrap();
         assert_eq!(cell_body, [vec![0; 14], vec![1; 10]].concat());
+        let geometry: Vec<f64> = (meshes.iter())
+            .flat_map(|m| m.coords.kept().flat_map(|(_, x)| *x))
+            .collect();
+        assert_eq!(read("mesh/geometry"), geometry);
         let tags = file
             .dataset("mesh/node_tag")
             .unwrap()
@@ -759,12 +804,8 @@ mod tests {
             material: &material,
             surfaces: Vec::new(),
         }];
-        let geometry: Vec<&[[f64; 3]]> = (meshes.iter())
-            .map(|m| m.coords.as_whole().unwrap())
-            .collect();
         let grid = Grid {
             bodies: &bodies,
-            geometry: &geometry,
             dim: 2,
             nodes: &[6],
             cells: &[4],
@@ -783,6 +824,16 @@ mod tests {
             error
                 .to_string()
                 .contains("short: body 0 has 2 values for 1 rows of 3")
+        );
+        // So is a chunk of the geometry with a node missing.
+        let mut short_geometry = |_, nodes: Range<usize>| Ok(vec![[0.0; 3]; nodes.len() - 1]);
+        let error = grid
+            .write_geometry(&group, &[0], &mut short_geometry)
+            .unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("body 0: 2 coordinates for its nodes 0..3")
         );
     }
 }

@@ -6,7 +6,7 @@
 //! the default log, `-v` and `-vv` of docs/output.md, "The log"), warnings at level warn: the
 //! command line prints them on stderr, the Python module hands them to Python's `logging`.
 
-mod gathered_cells;
+mod gathered_rows;
 mod partition;
 mod solve;
 mod write;
@@ -217,8 +217,7 @@ fn solve_beside_root(mut case: Case, output: &Path) -> Result<SolvedRun, RunErro
     solution.rank_peak_memory_mb = gather_peak_memory()?;
     let summary = solution.summary_with(&case, &mesh, &solution.timings);
     let fields = write::body_fields(&solution, &mesh);
-    gathered_cells::gather_geometry(&fields).map_err(RunError::Parallel)?;
-    gathered_cells::send_cell_rows(&fields).map_err(RunError::Parallel)?;
+    gathered_rows::send_output_rows(&fields).map_err(RunError::Parallel)?;
     Ok(SolvedRun {
         report: RunReport {
             output_dir: output.to_owned(),

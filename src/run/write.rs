@@ -1,7 +1,7 @@
 //! The result files of a solved case: `solution.xdmf` and `solution.h5` (every body's fields),
 //! `summary.json`, and in contact runs `force_displacement.csv` and `.png`; `matrices/` when the
 //! case asks for them. Rank 0 of a distributed run writes them, with the rows of the cells it
-//! does not hold sent by the other ranks (`super::gathered_cells`).
+//! does not hold sent by the other ranks (`super::gathered_rows`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -15,7 +15,7 @@ use crate::output::{
     write_matrix_market, write_xdmf, write_xdmf_with,
 };
 
-use super::gathered_cells::{gather_cell_rows, gather_geometry};
+use super::gathered_rows::{gather_cell_rows, gather_node_rows};
 use super::partition::whole_mesh;
 use super::solve::case_name;
 use super::{CaseSolution, RunError};
@@ -53,12 +53,14 @@ pub fn write_results(
     let fields = body_fields(solution, mesh);
     if fields.iter().any(|b| b.mesh.part.is_some()) {
         // A distributed run: the ranks send their nodes' coordinates, then the rows of their
-        // cells as they are written.
-        let geometry = gather_geometry(&fields).map_err(RunError::Parallel)?;
-        let geometry: Vec<&[[f64; 3]]> = geometry.iter().map(Vec::as_slice).collect();
-        write_xdmf_with(dir, "solution", &fields, &geometry, &mut |k, cells| {
-            gather_cell_rows(&fields, k, cells).map_err(|e| e.to_string())
-        })?;
+        // cells, as they are written.
+        write_xdmf_with(
+            dir,
+            "solution",
+            &fields,
+            &mut |k, nodes| gather_node_rows(&fields, k, nodes).map_err(|e| e.to_string()),
+            &mut |k, cells| gather_cell_rows(&fields, k, cells).map_err(|e| e.to_string()),
+        )?;
     } else {
         write_xdmf(dir, "solution", &fields)?;
     }

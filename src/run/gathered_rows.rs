@@ -1,22 +1,20 @@
-//! The cell rows of a distributed run's output, gathered onto rank 0 a chunk at a time.
+//! The rows of a distributed run's output that rank 0 does not hold, gathered onto it a chunk
+//! at a time.
 //!
-//! After the partition no rank holds a whole body's cells (`super::partition`), so rank 0,
-//! which writes `solution.h5`, receives the rows of the cell datasets (each cell's nodes,
-//! strain, stress and von Mises stress) from the ranks that hold the cells, in the chunks it
-//! writes them in (`crate::output::cell_chunks`). A cell is sent by one rank, the lowest that
-//! owns one of its nodes: that rank holds it (a rank keeps every cell around its own nodes),
-//! and no other sends it. Each rank computes the strain and stress of the cells it sends from
-//! the displacement, which every rank holds whole once the solve has ended. So rank 0 holds at
-//! most one chunk of rows beyond its own part of the mesh, and nobody reads the mesh file again.
-//!
-//! The geometry (every node's coordinates), which no rank keeps whole after the partition
-//! (`crate::mesh::NodeCoords`), is gathered onto rank 0 whole before it writes, from each node's
-//! owner ([`gather_geometry`]): 24 bytes a node on rank 0, as the displacement every rank holds
-//! at the end.
+//! After the partition no rank holds a whole body's cells (`super::partition`) or every node's
+//! coordinates (`crate::mesh::NodeCoords`), so rank 0, which writes `solution.h5`, receives the
+//! rows of the geometry (each node's coordinates) and of the cell datasets (each cell's nodes,
+//! strain, stress and von Mises stress) from the ranks that hold them, in the chunks it writes
+//! them in (`crate::output::row_chunks`). A node is sent by its owner, which keeps its
+//! coordinates. A cell is sent by one rank, the lowest that owns one of its nodes: that rank
+//! holds it (a rank keeps every cell around its own nodes), and no other sends it. Each rank
+//! computes the strain and stress of the cells it sends from the displacement, which every rank
+//! holds whole once the solve has ended. So rank 0 holds at most one chunk of rows beyond its
+//! own part of the mesh, and nobody reads the mesh file again.
 
 use std::ops::Range;
 
-use crate::output::{BodyFields, CellRows, cell_chunks};
+use crate::output::{BodyFields, CellRows, row_chunks};
 use crate::parallel::{self, ParallelError};
 
 /// The rows of body `k`'s cells `cells` (indices in the whole body), on rank 0; an empty
@@ -90,67 +88,70 @@ pub(super) fn gather_cell_rows(
     Ok(rows)
 }
 
-/// Every node's coordinates of each body, on rank 0 (empty vectors on the other ranks), each
-/// node's sent by the rank that owns it. Collective: every rank calls it once, with the same
-/// bodies.
-pub(super) fn gather_geometry(bodies: &[BodyFields]) -> Result<Vec<Vec<[f64; 3]>>, ParallelError> {
-    let rank = parallel::ranks().rank;
-    let mut geometry = Vec::with_capacity(bodies.len());
-    for body in bodies {
-        let mesh = body.mesh;
-        if mesh.part.is_none() {
-            geometry.push(
-                mesh.coords
-                    .as_whole()
-                    .map(<[_]>::to_vec)
-                    .unwrap_or_default(),
-            );
-            continue;
-        }
-        // A node as values: its index, then its coordinates.
-        let mut values = Vec::new();
-        for (a, x) in mesh.owned_by(rank) {
-            values.push(a as f64);
-            values.extend_from_slice(x);
-        }
-        let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
-            .map(|&count| count as usize)
-            .collect();
-        let all = parallel::gather_to_root(&values, &counts)?;
-        if !parallel::is_root() {
-            geometry.push(Vec::new());
-            continue;
-        }
-        let mut coords = vec![[f64::NAN; 3]; mesh.num_nodes()];
-        let mut placed = vec![false; mesh.num_nodes()];
-        for node in all.chunks_exact(4) {
-            let a = node[0] as usize;
-            if a >= coords.len() || placed[a] {
-                return Err(ParallelError::Message(format!(
-                    "the output's node {a} of body '{}' was sent twice or is not one of its {}",
-                    mesh.name,
-                    coords.len()
-                )));
-            }
-            placed[a] = true;
-            coords[a].copy_from_slice(&node[1..]);
-        }
-        if let Some(a) = placed.iter().position(|&p| !p) {
+/// The coordinates of body `k`'s nodes `nodes` (indices in the whole body), on rank 0; an
+/// empty vector on the other ranks. Collective: every rank calls it with the same `k` and
+/// `nodes`, in the same order, and sends the coordinates of the nodes it owns among them.
+pub(super) fn gather_node_rows(
+    bodies: &[BodyFields],
+    k: usize,
+    nodes: Range<usize>,
+) -> Result<Vec<[f64; 3]>, ParallelError> {
+    let mesh = bodies[k].mesh;
+    if mesh.part.is_none() {
+        // A body every rank holds whole: rank 0 has every node's.
+        let whole = mesh.coords.as_whole().unwrap_or_default();
+        return match parallel::is_root() {
+            true => Ok(whole.get(nodes.clone()).unwrap_or_default().to_vec()),
+            false => Ok(Vec::new()),
+        };
+    }
+    // A node as values: its index, then its coordinates.
+    let mut values = Vec::new();
+    for (a, x) in mesh.owned_within(parallel::ranks().rank, nodes.clone()) {
+        values.push(a as f64);
+        values.extend_from_slice(x);
+    }
+    let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
+        .map(|&count| count as usize)
+        .collect();
+    let all = parallel::gather_to_root(&values, &counts)?;
+    if !parallel::is_root() {
+        return Ok(Vec::new());
+    }
+    let mut coords = vec![[f64::NAN; 3]; nodes.len()];
+    let mut placed = vec![false; nodes.len()];
+    for node in all.chunks_exact(4) {
+        let a = node[0] as usize;
+        let at = a.wrapping_sub(nodes.start);
+        if at >= coords.len() || placed[at] {
             return Err(ParallelError::Message(format!(
-                "no rank sent the coordinates of the output's node {a} of body '{}'",
+                "the output's node {a} of body '{}' was sent twice or is not in {nodes:?}",
                 mesh.name
             )));
         }
-        geometry.push(coords);
+        placed[at] = true;
+        coords[at].copy_from_slice(&node[1..]);
     }
-    Ok(geometry)
+    if let Some(at) = placed.iter().position(|&p| !p) {
+        return Err(ParallelError::Message(format!(
+            "no rank sent the coordinates of the output's node {} of body '{}'",
+            nodes.start + at,
+            mesh.name
+        )));
+    }
+    Ok(coords)
 }
 
-/// On a rank other than 0: sends the rows of every cell this rank writes, chunk by chunk, as
-/// rank 0 gathers them while it writes (`gather_cell_rows`).
-pub(super) fn send_cell_rows(bodies: &[BodyFields]) -> Result<(), ParallelError> {
+/// On a rank other than 0: sends the coordinates of every node this rank owns, then the rows
+/// of every cell it writes, chunk by chunk, as rank 0 gathers them while it writes: the
+/// geometry first, then the cells (`gather_node_rows`, `gather_cell_rows`).
+pub(super) fn send_output_rows(bodies: &[BodyFields]) -> Result<(), ParallelError> {
+    let nodes: Vec<usize> = bodies.iter().map(|b| b.mesh.num_nodes()).collect();
+    for (k, range) in row_chunks(&nodes) {
+        gather_node_rows(bodies, k, range)?;
+    }
     let cells: Vec<usize> = bodies.iter().map(|b| b.mesh.total_cells()).collect();
-    for (k, range) in cell_chunks(&cells) {
+    for (k, range) in row_chunks(&cells) {
         gather_cell_rows(bodies, k, range)?;
     }
     Ok(())
