@@ -39,6 +39,7 @@
 
 use std::collections::HashMap;
 use std::fmt;
+use std::ops::Range;
 
 use rayon::prelude::*;
 use thiserror::Error;
@@ -75,7 +76,8 @@ pub const TIGHT_RTOL: f64 = 1e-12;
 pub const LOOSE_RTOL: f64 = 1e-6;
 
 /// Krylov vectors kept before a restart: 50 vectors of the whole system, 0.4 GB at a million
-/// unknowns; a solve's iteration count stays below it (a restart costs one product).
+/// unknowns (divided among the ranks of a distributed run); a solve's iteration count stays
+/// below it (a restart costs one product).
 const RESTART: usize = 50;
 
 /// How far below its starting residual a [`Tightness::Reduced`] solve goes at least: the
@@ -220,8 +222,8 @@ pub struct KrylovProblem<'a> {
 }
 
 /// Solves the coupled system of `problem` to `tightness` from the last solve kept in `state`;
-/// returns `x = [u_1; ...; u_N; lambda / s]` as this process holds it (`KrylovLayout`: whole,
-/// or this rank's rows of each body, then every multiplier).
+/// returns `x = [u_1; ...; u_N; lambda / s]` with the displacement rows this process holds
+/// (`KrylovLayout`: every row, or this rank's rows of each body) and every multiplier.
 pub fn solve(
     problem: &KrylovProblem,
     state: &mut KrylovState,
@@ -229,7 +231,6 @@ pub fn solve(
     max_iterations: usize,
 ) -> Result<Vec<f64>, ContactError> {
     let system = problem.system;
-    let rhs = system.rhs();
     let tolerance = tightness.relative();
     let schur = (problem.pairs.iter().enumerate())
         .map(|(p, pair)| {
@@ -239,10 +240,18 @@ pub fn solve(
         .collect();
     let num_bodies = system.num_bodies();
     let product = CoupledProduct::new(problem)?;
-    let rows = product.layout.num_rows(system);
-    let rhs_norm = product.layout.dot(&rhs, &rhs)?.sqrt();
-    let mut local_x = starting_guess(system, state, rows);
+    let layout = &product.layout;
+    let rows = layout.num_rows(system);
+    let rhs = layout.own_part(system.rhs());
+    let rhs_norm = layout.dot(&rhs, &rhs)?.sqrt();
+    let mut local_x = layout.own_part(starting_guess(system, state, rows));
     let local_scratch = vec![0.0; rows];
+    // Every multiplier of the vectors `P^-1` is applied to, where they hold a block of them.
+    let multipliers = || match layout {
+        KrylovLayout::Whole => Vec::new(),
+        KrylovLayout::Shared(_) => vec![0.0; system.m],
+    };
+    let (residual_multipliers, preconditioned_multipliers) = (multipliers(), multipliers());
     let mut operators = Blocks {
         product,
         schur,
@@ -252,6 +261,8 @@ pub fn solve(
         rhs_norm,
         cancel: &state.cancel,
         local_scratch,
+        residual_multipliers,
+        preconditioned_multipliers,
     };
     let settings = GmresSettings {
         tolerance: tolerance * rhs_norm,
@@ -285,14 +296,15 @@ pub fn solve(
             tolerance,
         }));
     }
+    let x = (operators.product.layout).with_every_multiplier(local_x, system)?;
     keep(
         system,
-        &local_x,
+        &x,
         rows,
         &mut state.displacements,
         &mut state.tractions,
     );
-    Ok(local_x)
+    Ok(x)
 }
 
 /// The last solve's displacements (scaled to this load step's factors:
@@ -356,7 +368,8 @@ fn keep(
 /// but for the order of its terms.
 pub fn relative_residual(problem: &KrylovProblem, x: Vec<f64>) -> Result<f64, ContactError> {
     let mut product = CoupledProduct::new(problem)?;
-    let rhs = problem.system.rhs();
+    let rhs = product.layout.own_part(problem.system.rhs());
+    let x = product.layout.own_part(x);
     let rhs_norm = product.layout.dot(&rhs, &rhs)?.sqrt();
     let mut residual = vec![0.0; x.len()];
     product.apply(&x, &mut residual)?;
@@ -375,25 +388,30 @@ struct CoupledProduct<'a> {
     /// Each body's constrained stiffness (symmetric), `k_c` (or its solver's copy).
     bodies: &'a [&'a AssembledBody],
     solvers: &'a [BodySolver],
-    /// How the vectors are held: whole, or this rank's rows of each body.
+    /// How the vectors are held: whole, or this rank's rows of each body and block of the
+    /// multipliers.
     layout: KrylovLayout,
-    /// A rank's part of `C u` over its columns (empty on one process).
+    /// A rank's part of `C u` over its columns, and every multiplier of the vector a product
+    /// is applied to (empty on one process).
     partial: Vec<f64>,
+    multipliers: Vec<f64>,
 }
 
 impl<'a> CoupledProduct<'a> {
     fn new(problem: &KrylovProblem<'a>) -> Result<Self, ContactError> {
         let layout = KrylovLayout::new(problem.system, problem.solvers)?;
-        let partial = match &layout {
+        let scratch = || match &layout {
             KrylovLayout::Whole => Vec::new(),
             KrylovLayout::Shared(_) => vec![0.0; problem.system.m],
         };
+        let (partial, multipliers) = (scratch(), scratch());
         Ok(Self {
             system: problem.system,
             bodies: problem.bodies,
             solvers: problem.solvers,
             layout,
             partial,
+            multipliers,
         })
     }
 
@@ -413,14 +431,16 @@ impl<'a> CoupledProduct<'a> {
                 .try_for_each(|(((out, body), solver), range)| {
                     stiffness_product(body, Some(solver), &x[range[0]..range[1]], out)
                 })?;
-            multiplier_rows(system, &x[n..], out_l);
+            multiplier_rows(system, &x[n..], 0..system.m, out_l);
             system.add_b_product(&x[n..], 1.0, out);
             system.add_c_product(&x[..n], &mut out[n..]);
             return Ok(());
         };
-        // This rank's rows: `K u` by each body's rows, `B lambda` by this rank's entries, and
-        // `C u` as every rank's part over its columns, summed.
+        // This rank's rows: `K u` by each body's rows, `B lambda` by this rank's entries (of
+        // every multiplier, gathered), and on this rank's multipliers `D lambda` and `C u` as
+        // every rank's part over its columns, summed.
         let rows = layout.num_local();
+        layout.gather_multipliers(&x[rows..], &mut self.multipliers)?;
         let (out_u, out_l) = out.split_at_mut(rows);
         for (k, solver) in self.solvers.iter().enumerate() {
             let range = layout.local_range(k);
@@ -428,11 +448,11 @@ impl<'a> CoupledProduct<'a> {
                 .multiply_rows(&x[range.clone()], &mut out_u[range])
                 .map_err(|e| ContactError::Linalg(format!("a body's stiffness product: {e}")))?;
         }
-        multiplier_rows(system, &x[rows..], out_l);
+        multiplier_rows(system, &self.multipliers, layout.own_multipliers(), out_l);
         self.partial.fill(0.0);
         system.add_c_product(&x[..rows], &mut self.partial);
-        layout.add_rank_sums(&self.partial, out_l)?;
-        system.add_b_product(&x[rows..], 1.0, out);
+        layout.add_to_owners(&self.partial, out_l)?;
+        system.add_b_product(&self.multipliers, 1.0, out_u);
         Ok(())
     }
 }
@@ -451,6 +471,10 @@ struct Blocks<'a> {
     cancel: &'a Cancel,
     /// `r_u - B y_l` of an application of `P^-1`, on the rows the vectors hold.
     local_scratch: Vec<f64>,
+    /// Every multiplier of `r` and of `y_l` in an application of `P^-1` of a distributed run
+    /// (whose vectors hold a block of them).
+    residual_multipliers: Vec<f64>,
+    preconditioned_multipliers: Vec<f64>,
 }
 
 impl Operators for Blocks<'_> {
@@ -466,13 +490,28 @@ impl Operators for Blocks<'_> {
         let solvers = self.product.solvers;
         let rows = self.product.layout.num_rows(system);
         let (out_u, out_l) = out.split_at_mut(rows);
+        // `y_l = S~^-1 r_l` over every multiplier: the half-space blocks are dense over a
+        // pair's multipliers, so a distributed run gathers them and keeps its block of `y_l`.
+        let (r_l, y_l) = match &self.product.layout {
+            KrylovLayout::Whole => (&r[rows..], &mut out_l[..]),
+            KrylovLayout::Shared(layout) => {
+                layout.gather_multipliers(&r[rows..], &mut self.residual_multipliers)?;
+                (
+                    &self.residual_multipliers[..],
+                    &mut self.preconditioned_multipliers[..],
+                )
+            }
+        };
         for (p, schur) in self.schur.iter().enumerate() {
             let range = system.pair_multipliers(p);
-            schur.apply(&r[rows + range.start..rows + range.end], &mut out_l[range]);
+            schur.apply(&r_l[range.clone()], &mut y_l[range]);
         }
-        self.rigid.apply(&r[rows..], out_l);
+        self.rigid.apply(r_l, y_l);
         self.local_scratch.copy_from_slice(&r[..rows]);
-        system.add_b_product(out_l, -1.0, &mut self.local_scratch);
+        system.add_b_product(y_l, -1.0, &mut self.local_scratch);
+        if let KrylovLayout::Shared(layout) = &self.product.layout {
+            out_l.copy_from_slice(&self.preconditioned_multipliers[layout.own_multipliers()]);
+        }
         let scratch = &self.local_scratch;
         match &self.product.layout {
             // Whole vectors: the bodies' blocks on their threads.
@@ -518,13 +557,21 @@ impl Operators for Blocks<'_> {
     }
 }
 
-/// `out = D lambda` on the multiplier rows (`lambda` the multiplier block of a vector).
-fn multiplier_rows(system: &CoupledSystem, lambda: &[f64], out: &mut [f64]) {
-    for ((o, d), l) in out.iter_mut().zip(&system.d).zip(lambda) {
+/// `out = D lambda` on the multiplier rows `rows` (`lambda` every multiplier of a vector, `out`
+/// those rows' values).
+fn multiplier_rows(system: &CoupledSystem, lambda: &[f64], rows: Range<usize>, out: &mut [f64]) {
+    let first = rows.start;
+    for ((o, d), l) in out
+        .iter_mut()
+        .zip(&system.d[rows.clone()])
+        .zip(&lambda[rows.clone()])
+    {
         *o = d * l;
     }
     for &(k, l, value) in &system.d_coupled {
-        out[k] += value * lambda[l];
+        if rows.contains(&k) {
+            out[k - first] += value * lambda[l];
+        }
     }
 }
 
