@@ -1,21 +1,20 @@
 #!/usr/bin/python3
-"""A memory model per rank, measured: the heap at its peak per part on 1, 2 and 4 ranks at three
+"""A memory model per rank, measured: the heap at its peak per part on 1, 2 and 4 ranks at four
 sizes of the contact benchmark's case, each part fitted as a power of the size times a share
 that the ranks divide, and extrapolated to 100M DOFs on 64 and 256 ranks.
 
 The case: ``geo/hemisphere_on_block.toml`` (the demo's sphere on a block) in one load step at
-the contact benchmark's levels 0.25, 1.25 and 2.02 (31k, 217k and 1.02M DOFs; meshed once each
-by gmsh into ``validation/build/memory_model``). Each run goes through
+the contact benchmark's levels 0.25, 1.25, 2.02 and 2.56 (31k, 217k, 1.02M and 3.06M DOFs;
+meshed once each by gmsh into ``validation/build/memory_model``, the last in about 4.5 minutes). Each run goes through
 ``memory_breakdown.breakdown`` (heaptrack, the bytes each part holds when a rank's heap is at
 its peak). For each part, with ``n`` the DOFs and ``N`` the ranks, the model of a distributed
 run is
 
     MB per rank = c n^p (s / N + 1 - s),
 
-``c`` and ``p`` from the 2-rank runs at the two largest sizes, the share ``s`` that the ranks
+``c`` and ``p`` from the 2-rank runs at the two largest sizes (1M and 3M), the share ``s`` that the ranks
 divide from the 2- and 4-rank runs at the largest size (a rank's mean over the ranks). The other
-runs are not used by the fit: they test it (the 4-rank run at 217k and the 31k runs, printed
-against the model). The fit reads each part at each rank's peak, and the moment of that peak moves
+distributed runs are not used by the fit: they test it (printed against the model). The fit reads each part at each rank's peak, and the moment of that peak moves
 between runs: since the ranks keep only their rows of the Krylov vectors and of the coupling
 blocks, the 4-rank run at 217k peaked where its GMRES basis held 0.4 MB (23 MB on 2 ranks), so
 the 2-rank runs took its place in the fit. (Rank 0 also peaked at 1M in the post-processing,
@@ -24,9 +23,8 @@ the output is written a chunk at a time, every rank peaks in the contact loop: t
 whether the GMRES basis is live at a run's peak.) One process is another program (it keeps the whole stiffness for the body
 solves, and several threads run dense products), so the serial runs are shown, not fitted. The
 contact surface grows like ``n^(2/3)`` under uniform refinement and the half-space blocks like
-its square: the exponents are measured, not assumed (but the one of ``FIXED_EXPONENTS``, whose
-method changes between the sizes), and two points give them to about 0.1 only (the GMRES basis
-follows its iteration count). 4 ranks on a 2-core machine are
+its square: the exponents are measured, not assumed, and two points give them to about 0.1 only
+(the GMRES basis follows its iteration count). 4 ranks on a 2-core machine are
 oversubscribed: fine for memory, not for time.
 
 The heap counts what was allocated, not what was written: faer's dense products reserve a
@@ -60,7 +58,7 @@ BUILD = REPO / "validation" / "build" / "memory_model"
 CASE = REPO / "geo" / "hemisphere_on_block.toml"
 MEASUREMENTS = REPO / "validation" / "memory_model.json"
 # (name, refinement level of geo/hemisphere_on_block.geo), as in contact_benchmark.SIZES.
-SIZES = (("31k", 0.25), ("217k", 1.25), ("1M", 2.02))
+SIZES = (("31k", 0.25), ("217k", 1.25), ("1M", 2.02), ("3M", 2.56))
 RANKS = (1, 2, 4)
 # Where the model is extrapolated to: (DOFs, ranks).
 TARGETS = ((100e6, 64), (100e6, 256))
@@ -84,16 +82,6 @@ def case_file(level: float) -> Path:
 
 
 
-# Parts whose growth is known and which the two largest sizes do not show: the half-space
-# preconditioner changes method between them (assembled and LU-factored on at most 1,000
-# multipliers, which the 217k run has in its last iterations; the two-level inverse at 1M, which
-# keeps per multiplier its fine level's 20 nodes and the coarse columns of its near clusters, a
-# number that does not grow with the zone: the contact zone's growth, n^(2/3). Its coarse factor,
-# (3m/128)^2, grows like n^(4/3) but is 18 MB at 100M, which this exponent leaves out.) Its
-# replicated share is 0 (every rank holds all of it); c from the largest size.
-FIXED_EXPONENTS = {"half-space preconditioner (S~^-1)": 2 / 3}
-
-
 # The rank count of the runs ``c`` and ``p`` are fitted on (the script's doc says why 2).
 FIT_RANKS = 2
 # A part held only in the contact loop: a run whose peak holds none of it peaked elsewhere.
@@ -107,10 +95,6 @@ def fit(mb: dict, parts: list[str], sizes: list[str], dofs: dict) -> dict:
     model = {}
     for part in parts:
         b_small, b_large = mb[small, FIT_RANKS].get(part, 0.0), mb[large, FIT_RANKS].get(part, 0.0)
-        if part in FIXED_EXPONENTS and b_large > 0:
-            p = FIXED_EXPONENTS[part]
-            model[part] = (b_large / dofs[large] ** p, p, 0.0)
-            continue
         if b_small <= 0 or b_large <= 0:
             model[part] = (b_large, 0.0, 0.0)
             continue
@@ -182,7 +166,8 @@ def report(data: dict) -> str:
               + ", ".join(f"{s} {contact_nodes[s]:,}" for s in sizes) + ".", ""]
     lines += ["## The fit tested on the distributed runs it did not use (heap without the buffer)", "",
               "| run | measured MB | model MB | model / measured |", "|---|---:|---:|---:|"]
-    for x, r in ((sizes[-2], 4), (sizes[0], 2), (sizes[0], 4)):
+    fitted = {(sizes[-2], FIT_RANKS), (sizes[-1], FIT_RANKS), (sizes[-1], 4)}
+    for x, r in ((x, r) for x in reversed(sizes) for r in RANKS[1:] if (x, r) not in fitted):
         real = sum(v for p, v in mb[x, r].items() if p != BUFFER)
         pred = sum(predict(model[p], dofs[x], r) for p in parts if p != BUFFER)
         lines.append(f"| {x} x{r} | {real:.0f} | {pred:.0f} | {pred / real:.2f} |")
