@@ -43,13 +43,9 @@ pub(super) fn gather_cell_rows(
         values.extend_from_slice(&sent.stress[9 * s..9 * (s + 1)]);
         values.push(sent.von_mises[s]);
     }
-    let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
-        .map(|&count| count as usize)
-        .collect();
-    let all = parallel::gather_to_root(&values, &counts)?;
-    if !parallel::is_root() {
+    let Some(all) = on_root(&values)? else {
         return Ok(CellRows::default());
-    }
+    };
     // Rank 0: each cell's rows in its place in the chunk.
     let n = cells.len();
     let mut rows = CellRows {
@@ -111,13 +107,9 @@ pub(super) fn gather_node_rows(
         values.push(a as f64);
         values.extend_from_slice(x);
     }
-    let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
-        .map(|&count| count as usize)
-        .collect();
-    let all = parallel::gather_to_root(&values, &counts)?;
-    if !parallel::is_root() {
+    let Some(all) = on_root(&values)? else {
         return Ok(Vec::new());
-    }
+    };
     let mut coords = vec![[f64::NAN; 3]; nodes.len()];
     let mut placed = vec![false; nodes.len()];
     for node in all.chunks_exact(4) {
@@ -140,6 +132,16 @@ pub(super) fn gather_node_rows(
         )));
     }
     Ok(coords)
+}
+
+/// Every rank's `values`, one rank's after the other in rank order, on rank 0; `None` on the
+/// other ranks (collective).
+fn on_root(values: &[f64]) -> Result<Option<Vec<f64>>, ParallelError> {
+    let counts: Vec<usize> = (parallel::gather(values.len() as f64)?.iter())
+        .map(|&count| count as usize)
+        .collect();
+    let all = parallel::gather_to_root(values, &counts)?;
+    Ok(parallel::is_root().then_some(all))
 }
 
 /// On a rank other than 0: sends the coordinates of every node this rank owns, then the rows
