@@ -364,7 +364,7 @@ int internodes_cgamg_set_up(InternodesCgAmg *s, const char **step)
     PC pc;
     PetscInt levels;
     PetscMPIInt size;
-    PetscBool user_chose;
+    PetscBool user_chose, user_chose_clear;
     /* On one process GAMG's Galerkin products P^T A P (SeqAIJ) take PETSc's "rap" algorithm
      * (P^T formed once, then R A P) instead of the default "scalable" one: the same products,
      * the set-up of the 1M hemisphere 32.2 s -> 21.0 s at the same peak (docs/decisions.md).
@@ -374,8 +374,16 @@ int internodes_cgamg_set_up(InternodesCgAmg *s, const char **step)
     TRY(PetscOptionsHasName(NULL, NULL, "-matptap_via", &user_chose));
     const PetscBool choose_rap = size == 1 && !user_chose;
     if (choose_rap) TRY(PetscOptionsSetValue(NULL, "-matptap_via", "rap"));
+    /* Each of GAMG's matrix products keeps the intermediate data of a reuse that never comes
+     * (the hierarchy is built once). "-mat_product_clear" frees it as soon as each product is
+     * computed, level by level, rather than all of it after the set-up (below): on several
+     * ranks those data are as large as the products, and all levels' together made the set-up
+     * the run's peak at 3M DOFs (docs/parallel.md). Set for this set-up alone, as above. */
+    TRY(PetscOptionsHasName(NULL, NULL, "-mat_product_clear", &user_chose_clear));
+    if (!user_chose_clear) TRY(PetscOptionsSetValue(NULL, "-mat_product_clear", NULL));
     PetscErrorCode set_up = KSPSetUp(s->ksp);
     if (choose_rap) TRY(PetscOptionsClearValue(NULL, "-matptap_via"));
+    if (!user_chose_clear) TRY(PetscOptionsClearValue(NULL, "-mat_product_clear"));
     if (set_up) {
         *step = "KSPSetUp(s->ksp)";
         return (int)set_up;
