@@ -36,6 +36,7 @@ The measurements go to ``validation/memory_model.json``; ``--refit`` prints the 
 file and runs nothing.
 
 Usage:  /usr/bin/python3 validation/memory_model.py [--binary PATH] [--out FILE.md] [--refit]
+                                                     [--only 3M:2,3M:4]
 Takes about 20 minutes on this 2-core machine (the 1M runs under heaptrack).
 """
 
@@ -114,25 +115,33 @@ def predict(model: tuple, n: float, ranks: int) -> float:
     return c * n ** p * (s / ranks + 1 - s)
 
 
-def measure(binary: Path) -> dict:
-    """Every size on every rank count: heap per part (MB, a rank's mean), resident peak."""
-    runs, dofs, contact_nodes = [], {}, {}
+def measure(binary: Path, only: set | None = None, kept: dict | None = None) -> dict:
+    """Every size on every rank count (or the runs ``only`` names, as (size, ranks), the others
+    kept from ``kept``, an earlier measurement): heap per part (MB, a rank's mean), resident
+    peak, and the commit of the binary of each run."""
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
+                            text=True).stdout.strip()
+    runs = []
+    dofs, contact_nodes = dict((kept or {}).get("dofs", {})), dict((kept or {}).get("contact_nodes", {}))
     for name, level in SIZES:
         case = case_file(level)
         for ranks in RANKS:
+            if only is not None and (name, ranks) not in only:
+                old = next(r for r in kept["runs"] if (r["size"], r["ranks"]) == (name, ranks))
+                runs.append({"binary_commit": kept.get("binary_commit"), **old})
+                continue
             print(f"{name} on {ranks} rank(s) ...", file=sys.stderr, flush=True)
             columns, summary, log = breakdown(case, ranks, binary)
             parts = {p for c in columns for p in c}
             runs.append({"size": name, "ranks": ranks,
                          "heap_mb": {p: sum(c.get(p, 0) for c in columns) / ranks / 1e6 for p in parts},
                          "resident_peak_mb_largest_rank":
-                             max(summary.get("rank_peak_memory_mb") or [summary.get("peak_memory_mb")])})
+                             max(summary.get("rank_peak_memory_mb") or [summary.get("peak_memory_mb")]),
+                         "binary_commit": commit})
             dofs[name] = sum(body["num_dofs"] for body in summary["bodies"])
             contact_nodes[name] = sum(int(k) for k in re.findall(r"(\d+) candidate nodes", log))
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
-                            text=True).stdout.strip()
-    return {"case": "geo/hemisphere_on_block.toml, one load step", "binary_commit": commit,
-            "dofs": dofs, "contact_nodes": contact_nodes, "runs": runs}
+    return {"case": "geo/hemisphere_on_block.toml, one load step", "dofs": dofs,
+            "contact_nodes": contact_nodes, "runs": runs}
 
 
 def report(data: dict) -> str:
@@ -144,8 +153,13 @@ def report(data: dict) -> str:
     sizes = [name for name, _ in SIZES]
     parts = sorted({p for m in mb.values() for p in m}, key=lambda p: -mb[sizes[-1], 4].get(p, 0))
     model = fit(mb, parts, sizes, dofs)
+    commits = {}
+    for r in data["runs"]:
+        commits.setdefault(r.get("binary_commit", data.get("binary_commit")), []).append(
+            f"{r['size']} x{r['ranks']}")
+    measured = "; ".join(f"commit {c}: {', '.join(runs)}" for c, runs in commits.items())
     lines = ["# Memory per rank, measured and extrapolated (`validation/memory_model.py`)", "",
-             f"Measured with the binary of commit {data['binary_commit']} ({data['case']}); "
+             f"Measured with the binary of {measured} ({data['case']}); "
              "the model and why in the script's doc.", "",
              "## Heap per rank at its peak (MB, a rank's mean) and the fitted model", "",
              "| part | " + " | ".join(f"{s} x{r}" for s in sizes for r in RANKS) + " | p | s |",
@@ -193,9 +207,14 @@ def main() -> int:
     parser.add_argument("--binary", type=Path, default=REPO / "target/release/internodes")
     parser.add_argument("--out", type=Path, help="also write the tables to this markdown file")
     parser.add_argument("--refit", action="store_true", help="fit the measurements file again, run nothing")
+    parser.add_argument("--only", help="run only these, e.g. 3M:2,3M:4, and keep the others from the "
+                        "measurements file (each run's commit is reported)")
     args = parser.parse_args()
     if args.refit:
         data = json.loads(MEASUREMENTS.read_text())
+    elif args.only:
+        only = {(size, int(ranks)) for size, ranks in (item.split(":") for item in args.only.split(","))}
+        data = measure(args.binary, only, json.loads(MEASUREMENTS.read_text()))
     else:
         data = measure(args.binary)
         MEASUREMENTS.write_text(json.dumps(data, indent=1) + "\n")
