@@ -12,8 +12,12 @@ run is
 
     MB per rank = c n^p (s / N + 1 - s),
 
-``c`` and ``p`` from the 2-rank runs at the two largest sizes (1M and 3M), the share ``s`` that the ranks
-divide from the 2- and 4-rank runs at the largest size (a rank's mean over the ranks). The other
+``c`` and ``p`` from the 2-rank runs at 217k and 1M (``FIT_SIZES``), the share ``s`` that the
+ranks divide from the 2- and 4-rank runs at 1M (a rank's mean over the ranks). Not at 3M, though
+the issue asked for that size: there the moment of a rank's peak falls where GMRES's basis holds
+a quarter of its vectors (161 and 166 MB a rank on 2 and 4 ranks against 638 in one process), so
+a fit on it reads the basis as a part no rank divides; 3M tests the extrapolation instead, three
+times beyond the sizes fitted. The other
 distributed runs are not used by the fit: they test it (printed against the model). The fit reads each part at each rank's peak, and the moment of that peak moves
 between runs: since the ranks keep only their rows of the Krylov vectors and of the coupling
 blocks, the 4-rank run at 217k peaked where its GMRES basis held 0.4 MB (23 MB on 2 ranks), so
@@ -37,7 +41,7 @@ file and runs nothing.
 
 Usage:  /usr/bin/python3 validation/memory_model.py [--binary PATH] [--out FILE.md] [--refit]
                                                      [--only 3M:2,3M:4]
-Takes about 20 minutes on this 2-core machine (the 1M runs under heaptrack).
+Takes about 55 minutes on this 2-core machine (half of them the 3M runs under heaptrack and their mesh).
 """
 
 from __future__ import annotations
@@ -85,14 +89,17 @@ def case_file(level: float) -> Path:
 
 # The rank count of the runs ``c`` and ``p`` are fitted on (the script's doc says why 2).
 FIT_RANKS = 2
+# The sizes the model is fitted on (the script's doc says why not 3M): ``c`` and ``p`` from
+# their ``FIT_RANKS``-rank runs, the share ``s`` from the 2- and 4-rank runs at the larger.
+FIT_SIZES = ("217k", "1M")
 # A part held only in the contact loop: a run whose peak holds none of it peaked elsewhere.
 LOOP_PART = "GMRES basis and vectors"
 
 
-def fit(mb: dict, parts: list[str], sizes: list[str], dofs: dict) -> dict:
-    """(c, p, s) per part from the ``FIT_RANKS``-rank runs at the two largest sizes and the 2-
-    and 4-rank runs at the largest (``mb[size, ranks][part]``, MB)."""
-    (small, large) = sizes[-2:]
+def fit(mb: dict, parts: list[str], dofs: dict) -> dict:
+    """(c, p, s) per part from the ``FIT_RANKS``-rank runs at the ``FIT_SIZES`` and the 2- and
+    4-rank runs at the larger (``mb[size, ranks][part]``, MB)."""
+    (small, large) = FIT_SIZES
     model = {}
     for part in parts:
         b_small, b_large = mb[small, FIT_RANKS].get(part, 0.0), mb[large, FIT_RANKS].get(part, 0.0)
@@ -152,7 +159,7 @@ def report(data: dict) -> str:
     dofs, contact_nodes = data["dofs"], data["contact_nodes"]
     sizes = [name for name, _ in SIZES]
     parts = sorted({p for m in mb.values() for p in m}, key=lambda p: -mb[sizes[-1], 4].get(p, 0))
-    model = fit(mb, parts, sizes, dofs)
+    model = fit(mb, parts, dofs)
     commits = {}
     for r in data["runs"]:
         commits.setdefault(r.get("binary_commit", data.get("binary_commit")), []).append(
@@ -180,7 +187,7 @@ def report(data: dict) -> str:
               + ", ".join(f"{s} {contact_nodes[s]:,}" for s in sizes) + ".", ""]
     lines += ["## The fit tested on the distributed runs it did not use (heap without the buffer)", "",
               "| run | measured MB | model MB | model / measured |", "|---|---:|---:|---:|"]
-    fitted = {(sizes[-2], FIT_RANKS), (sizes[-1], FIT_RANKS), (sizes[-1], 4)}
+    fitted = {(FIT_SIZES[0], FIT_RANKS), (FIT_SIZES[1], FIT_RANKS), (FIT_SIZES[1], 4)}
     for x, r in ((x, r) for x in reversed(sizes) for r in RANKS[1:] if (x, r) not in fitted):
         real = sum(v for p, v in mb[x, r].items() if p != BUFFER)
         pred = sum(predict(model[p], dofs[x], r) for p in parts if p != BUFFER)
@@ -212,11 +219,12 @@ def main() -> int:
     args = parser.parse_args()
     if args.refit:
         data = json.loads(MEASUREMENTS.read_text())
-    elif args.only:
-        only = {(size, int(ranks)) for size, ranks in (item.split(":") for item in args.only.split(","))}
-        data = measure(args.binary, only, json.loads(MEASUREMENTS.read_text()))
     else:
-        data = measure(args.binary)
+        only, kept = None, None
+        if args.only:
+            only = {(size, int(ranks)) for size, ranks in (item.split(":") for item in args.only.split(","))}
+            kept = json.loads(MEASUREMENTS.read_text())
+        data = measure(args.binary, only, kept)
         MEASUREMENTS.write_text(json.dumps(data, indent=1) + "\n")
     text = report(data)
     print(text)
