@@ -259,6 +259,19 @@ fn ranks_give_the_serial_answer_of(
         b["rank_peak_memory_mb"].as_array().map(Vec::len),
         Some(ranks)
     );
+    // The bodies' reactions (every rank reads its displacement at the nodes it keeps, the
+    // prescribed rows' columns among them), within the solves' agreement of the largest (a
+    // body held by its contacts has reactions of round-off alone).
+    let reactions = |summary: &serde_json::Value| -> Vec<f64> {
+        (summary["bodies"].as_array().unwrap().iter())
+            .flat_map(|body| body["reactions"].as_object().unwrap().values())
+            .flat_map(|r| r.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+            .collect()
+    };
+    let (r, q) = (reactions(&a), reactions(&b));
+    assert!(r.iter().any(|&v| v != 0.0), "{name}: no reaction");
+    let d = relative_difference(&r, &q);
+    assert!(d <= AGREEMENT, "{name}: the reactions differ by {d:.2e}");
     let mut totals = vec![0i64; ranks];
     let mut largest_difference = 0;
     for body in b["bodies"].as_array().unwrap() {

@@ -12,7 +12,11 @@ use crate::progress::Heartbeat;
 /// writes them a chunk of cells at a time, so that no process holds them whole.
 #[derive(Debug, Clone)]
 pub struct ElasticSolution {
-    /// Nodal displacement, interleaved (`dim` per node).
+    /// Nodal displacement, interleaved (`dim` per node): every node's on one process; on a
+    /// rank of a distributed run only at the nodes whose coordinates the body's mesh keeps
+    /// (its own, its cells', the boundary's and the groups'), in their order, so that no rank
+    /// holds a whole body's vector: `crate::mesh::NodeCoords::position` finds a node's
+    /// values, and the output gathers the nodes' values from their owners.
     pub displacement: Vec<f64>,
     /// Reaction force of each Dirichlet group: `sum (K u - f)` over its prescribed dofs, with
     /// `K`, `f` unconstrained (a node in two groups counts in both).

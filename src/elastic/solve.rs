@@ -83,7 +83,10 @@ impl Default for SolverSettings {
 /// Reaction of each Dirichlet and force-controlled group: `sum (K u - f_s - f_other)` over its
 /// prescribed and force-controlled dofs, with `f_s` the loads at a step of `factors`
 /// ([`AssembledBody::load`]) and `f_other` forces not in `f` (contact forces; empty for a
-/// single body). A group named by both kinds of condition has one entry.
+/// single body). A group named by both kinds of condition has one entry. `u` is laid out like
+/// the body's kept coordinates (`crate::mesh::NodeCoords`: whole on one process, on a rank of
+/// a distributed run the nodes it reads), which hold every node a prescribed row reaches (the
+/// cells around the groups are every rank's).
 pub fn reactions(
     problem: &ElasticProblem,
     system: &AssembledBody,
@@ -93,10 +96,18 @@ pub fn reactions(
 ) -> Vec<(String, Vec<f64>)> {
     let body = problem.body;
     let dim = body.dim;
-    let mut r = vec![0.0; u.len()];
-    for (dof, row) in &system.prescribed_rows {
-        r[*dof] = row.iter().map(|&(j, value)| value * u[j]).sum();
-    }
+    let u_at = |dof: usize| {
+        let at = (body.coords.position(dof / dim))
+            .expect("a prescribed row reaches the nodes of the cells around its group, kept");
+        u[dim * at + dof % dim]
+    };
+    // `(K u)_d` at a prescribed or force-controlled dof `d` (its row of `K`); no other is read.
+    let k_u = |dof: usize| match (system.prescribed_rows).binary_search_by_key(&dof, |(d, _)| *d) {
+        Ok(at) => (system.prescribed_rows[at].1.iter())
+            .map(|&(j, value)| value * u_at(j))
+            .sum(),
+        Err(_) => 0.0,
+    };
     let mut groups: Vec<(&String, [bool; 3])> = Vec::new();
     let conditions = (problem.dirichlet.iter().map(|d| (&d.group, d.components)))
         .chain(problem.forces.iter().map(|f| (&f.group, f.components)));
@@ -115,7 +126,8 @@ pub fn reactions(
             for node in nodes {
                 for c in (0..dim).filter(|&c| mask[c]) {
                     let d = dim * node + c;
-                    total[c] += r[d] - system.load(d, factors) - f_other.map_or(0.0, |f| f.get(d));
+                    total[c] +=
+                        k_u(d) - system.load(d, factors) - f_other.map_or(0.0, |f| f.get(d));
                 }
             }
             (group.clone(), total)
@@ -320,6 +332,9 @@ pub fn solve(
     full.paths = (problem.paths().into_iter())
         .map(|path| (path.to_string(), 1.0))
         .collect();
+    // On a rank of a distributed run, the solution at the nodes it keeps (what the output and
+    // the reactions read), as a contact solve's.
+    let u = body.coords.kept_values(u, body.dim);
     let reactions = reactions(problem, &system, &u, &full, None);
     Ok(ElasticSolution {
         displacement: u,

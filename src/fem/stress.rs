@@ -32,7 +32,8 @@ fn von_mises(s: &[f64; 9]) -> f64 {
         .sqrt()
 }
 
-/// Strain and stress of the displacement `u` (interleaved, `dim` per node) on every cell.
+/// Strain and stress of the displacement `u` (interleaved, `dim` per node, laid out as
+/// [`cell_field`] reads it) on every cell.
 pub fn cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellFields {
     // Sized once: grown by doubling, the three vectors would reserve up to twice their 152
     // bytes a cell (1.9M cells at 1M DOFs: 480 MB at the peak instead of 290).
@@ -51,8 +52,10 @@ pub fn cell_fields(body: &BodyMesh, material: &Material, u: &[f64]) -> CellField
     fields
 }
 
-/// Strain, stress and von Mises stress of the displacement `u` (interleaved, `dim` per node)
-/// on cell `c`: what the output writes a chunk of cells at a time, never holding the whole
+/// Strain, stress and von Mises stress of the displacement `u` (interleaved, `dim` per node,
+/// laid out like the body's kept coordinates: every node's on one process, on a rank of a
+/// distributed run those of the nodes it reads, `crate::mesh::NodeCoords::position`) on
+/// cell `c`: what the output writes a chunk of cells at a time, never holding the whole
 /// field (`crate::output::write_xdmf`).
 pub fn cell_field(
     body: &BodyMesh,
@@ -65,7 +68,8 @@ pub fn cell_field(
     // The cell's displacements, `dim` per node, on the stack: this runs once per cell written.
     let mut ue = [0.0; 12];
     for (k, &a) in cell.iter().enumerate() {
-        ue[dim * k..dim * k + dim].copy_from_slice(&u[dim * a..dim * a + dim]);
+        let at = (body.coords.position(a)).expect("a cell's nodes are kept with it");
+        ue[dim * k..dim * k + dim].copy_from_slice(&u[dim * at..dim * at + dim]);
     }
     let ue = &ue[..dim * cell.len()];
     let (strain, stress) = if dim == 2 {

@@ -411,13 +411,7 @@ impl Distribution {
     /// read (whose PETSc node it does not know).
     fn places_of(&self, nodes: &[u32]) -> Result<Vec<(usize, usize, u32)>, LinalgError> {
         debug_assert!(nodes.windows(2).all(|w| w[0] < w[1]), "nodes increasing");
-        // The first PETSc node of each rank after the first, increasing.
-        let starts: Vec<usize> = (self.counts.iter())
-            .scan(0, |start, &count| {
-                *start += count / self.block;
-                Some(*start)
-            })
-            .collect();
+        let starts = self.rank_ends();
         let mut places = Vec::with_capacity(nodes.len());
         let mut at = 0;
         for (place, &a) in nodes.iter().enumerate() {
@@ -437,6 +431,76 @@ impl Distribution {
         }
         places.sort_unstable_by_key(|&(_, p, _)| p);
         Ok(places)
+    }
+
+    /// The PETSc node after each rank's last, in rank order: the owner of PETSc node `p` is
+    /// the number of them at or below `p`.
+    fn rank_ends(&self) -> Vec<usize> {
+        (self.counts.iter())
+            .scan(0, |start, &count| {
+                *start += count / self.block;
+                Some(*start)
+            })
+            .collect()
+    }
+
+    /// The values of the body's vector at every node this rank reads (`block` each, the nodes
+    /// increasing: on a rank of a distributed run those whose coordinates its mesh keeps,
+    /// `crate::mesh::NodeCoords`, so the values are laid out like its kept coordinates), from
+    /// `rows`, this rank's rows of it in PETSc's order (collective). Its own nodes' values are
+    /// its rows'; the others' it asks of their owners, and each rank answers what the others
+    /// read of its nodes (two `MPI_Alltoallv`): no rank receives more than it reads, and the
+    /// values are the owners' to the bit.
+    pub fn at_read_nodes(&self, rows: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        let b = self.block;
+        let mpi = |e: crate::parallel::ParallelError| LinalgError::Mpi(e.to_string());
+        let own = self.first..self.first + self.local;
+        let ends = self.rank_ends();
+        let mut values = vec![0.0; b * self.known.len()];
+        // What this rank asks each rank for (PETSc nodes), and where each answer goes.
+        let mut asked = vec![Vec::new(); ends.len()];
+        let mut places = vec![Vec::new(); ends.len()];
+        for (place, &(_, p)) in self.known.iter().enumerate() {
+            let p = p as usize;
+            if own.contains(&p) {
+                let row = p - self.first;
+                values[b * place..b * (place + 1)].copy_from_slice(&rows[b * row..b * (row + 1)]);
+            } else {
+                let rank = ends.partition_point(|&end| end <= p);
+                asked[rank].push(p as f64);
+                places[rank].push(place);
+            }
+        }
+        let asks = crate::parallel::exchange(asked).map_err(mpi)?;
+        let mut answers = Vec::with_capacity(asks.len());
+        for nodes in &asks {
+            let mut answer = Vec::with_capacity(b * nodes.len());
+            for &p in nodes {
+                let p = p as usize;
+                if !own.contains(&p) {
+                    return Err(LinalgError::Sizes(format!(
+                        "a rank asked for PETSc node {p}, which this rank does not own"
+                    )));
+                }
+                let row = p - self.first;
+                answer.extend_from_slice(&rows[b * row..b * (row + 1)]);
+            }
+            answers.push(answer);
+        }
+        let answered = crate::parallel::exchange(answers).map_err(mpi)?;
+        for (places, answer) in places.iter().zip(&answered) {
+            if answer.len() != b * places.len() {
+                return Err(LinalgError::Sizes(format!(
+                    "{} values answered for {} nodes asked",
+                    answer.len(),
+                    places.len()
+                )));
+            }
+            for (&place, value) in places.iter().zip(answer.chunks_exact(b)) {
+                values[b * place..b * (place + 1)].copy_from_slice(value);
+            }
+        }
+        Ok(values)
     }
 
     /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank:

@@ -84,6 +84,19 @@ impl NodeCoords {
         }
     }
 
+    /// `whole`'s values (`dim` a node, every node's) at the kept nodes, in their order: the
+    /// layout of a field held at the kept nodes, in which [`Self::position`] finds a node's
+    /// values (`whole` itself where every node is kept).
+    pub fn kept_values(&self, whole: Vec<f64>, dim: usize) -> Vec<f64> {
+        match &self.kept {
+            None => whole,
+            Some(kept) => (kept.iter())
+                .flat_map(|&a| &whole[dim * a as usize..dim * (a as usize + 1)])
+                .copied()
+                .collect(),
+        }
+    }
+
     /// The kept nodes' first `dim` coordinates, one node after the other in increasing node
     /// order (every node's where all are kept): the layout a solver's rigid-body near-null
     /// space and the Z curve read.

@@ -17,7 +17,8 @@ pub use summary::{
     BodySummary, CaseSummary, ContactSummary, Verdict, force_displacement_csv, peak_memory_mb,
 };
 pub use xdmf::{
-    BodyFields, CellRows, CellRowsOf, NodeRowsOf, row_chunks, write_xdmf, write_xdmf_with,
+    BodyFields, CellRows, CellRowsOf, NodeRowsOf, NodeTable, row_chunks, write_xdmf,
+    write_xdmf_with,
 };
 
 use std::path::PathBuf;

@@ -25,7 +25,8 @@ use crate::mesh::BodyMesh;
 /// One body's mesh and fields, as written.
 pub struct BodyFields<'a> {
     pub mesh: &'a BodyMesh,
-    /// Interleaved, `dim` per node.
+    /// Interleaved, `dim` per node, laid out like the mesh's kept coordinates (every node's
+    /// on one process: `crate::elastic::ElasticSolution::displacement`).
     pub displacement: &'a [f64],
     /// What the cell fields (strain, stress, von Mises) are computed with, a chunk of cells
     /// at a time as they are written.
@@ -77,38 +78,81 @@ impl CellRows {
 /// chunk at a time ([`row_chunks`]); an error is a message.
 pub type CellRowsOf<'a> = dyn FnMut(usize, Range<usize>) -> Result<CellRows, String> + 'a;
 
-/// What gives the coordinates of body `k`'s nodes `nodes` (indices in the whole body), one
-/// chunk at a time ([`row_chunks`]); an error is a message.
-pub type NodeRowsOf<'a> = dyn FnMut(usize, Range<usize>) -> Result<Vec<[f64; 3]>, String> + 'a;
+/// The node datasets of three values a node that a distributed run's rank 0 receives from the
+/// nodes' owners, a chunk at a time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NodeTable {
+    /// `/mesh/geometry`: each node's coordinates.
+    Geometry,
+    /// `/fields/displacement`: each node's displacement (`z` 0 in 2D).
+    Displacement,
+}
+
+impl NodeTable {
+    /// The dataset's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Geometry => "geometry",
+            Self::Displacement => "displacement",
+        }
+    }
+}
+
+impl BodyFields<'_> {
+    /// Node `node`'s row of `table`, where this process keeps the node (its coordinates and
+    /// displacement: [`Self::displacement`]'s layout).
+    pub fn node_row(&self, table: NodeTable, node: usize) -> Option<[f64; 3]> {
+        let at = self.mesh.coords.position(node)?;
+        Some(match table {
+            NodeTable::Geometry => *self.mesh.coords.get(node)?,
+            NodeTable::Displacement => {
+                let dim = self.mesh.dim;
+                let u = self.displacement.get(dim * at..dim * (at + 1))?;
+                std::array::from_fn(|c| if c < dim { u[c] } else { 0.0 })
+            }
+        })
+    }
+}
+
+/// What gives the rows of `table` for body `k`'s nodes `nodes` (indices in the whole body),
+/// one chunk at a time ([`row_chunks`]); an error is a message.
+pub type NodeRowsOf<'a> =
+    dyn FnMut(usize, NodeTable, Range<usize>) -> Result<Vec<[f64; 3]>, String> + 'a;
 
 /// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf` from the bodies' own nodes and cells
 /// (every body's mesh holds all of them).
 pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), OutputError> {
-    let mut geometry_rows = |k: usize, nodes: Range<usize>| {
-        let whole = bodies[k].mesh.coords.as_whole();
-        (whole.and_then(|x| x.get(nodes.clone())).map(<[_]>::to_vec))
-            .ok_or_else(|| format!("body {k}: the coordinates of its nodes {nodes:?} are not here"))
+    let mut node_rows = |k: usize, table: NodeTable, nodes: Range<usize>| {
+        (nodes.clone())
+            .map(|a| bodies[k].node_row(table, a))
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| {
+                format!(
+                    "body {k}: the {} of its nodes {nodes:?} is not here",
+                    table.name()
+                )
+            })
     };
-    write_xdmf_with(dir, stem, bodies, &mut geometry_rows, &mut |k, cells| {
+    write_xdmf_with(dir, stem, bodies, &mut node_rows, &mut |k, cells| {
         Ok(CellRows::of(&bodies[k], cells))
     })
 }
 
-/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`, the geometry from `geometry_rows` and the
-/// cell datasets from `cell_rows`: where the bodies' meshes hold only some of their nodes and
-/// cells (rank 0 of a distributed run), the rows of the others come from the ranks that hold
-/// them. The other node datasets are written from the bodies' own arrays, which hold every
-/// node.
+/// Writes `<dir>/<stem>.h5` and `<dir>/<stem>.xdmf`, the geometry and the displacement from
+/// `node_rows` and the cell datasets from `cell_rows`: where the bodies' meshes hold only
+/// some of their nodes and cells (rank 0 of a distributed run), the rows of the others come
+/// from the ranks that hold them. The other node datasets (tags, interface fields) are
+/// written from the bodies' own arrays, which hold every node.
 ///
 /// Each dataset is written body by body, a bounded chunk of rows at a time
-/// ([`CHUNK_ROWS`]), straight from the bodies' own arrays or as `geometry_rows` and
+/// ([`CHUNK_ROWS`]), straight from the bodies' own arrays or as `node_rows` and
 /// `cell_rows` give them: the writer never holds a copy of the whole grid (at 1M DOFs that
 /// copy was 470 MB beside the fields themselves, on the process that writes).
 pub fn write_xdmf_with(
     dir: &Path,
     stem: &str,
     bodies: &[BodyFields],
-    geometry_rows: &mut NodeRowsOf,
+    node_rows: &mut NodeRowsOf,
     cell_rows: &mut CellRowsOf,
 ) -> Result<(), OutputError> {
     let h5_path = dir.join(format!("{stem}.h5"));
@@ -126,7 +170,7 @@ pub fn write_xdmf_with(
         friction,
         chunk_rows: CHUNK_ROWS,
     };
-    grid.write_h5(&h5_path, geometry_rows, cell_rows)
+    grid.write_h5(&h5_path, node_rows, cell_rows)
         .map_err(|source| OutputError::Hdf5 {
             path: h5_path.clone(),
             source,
@@ -202,17 +246,17 @@ impl Grid<'_> {
     fn write_h5(
         &self,
         path: &Path,
-        geometry_rows: &mut NodeRowsOf,
+        node_rows: &mut NodeRowsOf,
         cell_rows: &mut CellRowsOf,
     ) -> hdf5::Result<()> {
-        let (bodies, dim) = (self.bodies, self.dim);
+        let bodies = self.bodies;
         let file = hdf5::File::create(path)?;
         let mesh = file.create_group("mesh")?;
         let fields = file.create_group("fields")?;
         let (nodes, cells) = (self.nodes, self.cells);
         let body = |k: usize| &bodies[k];
         let first_nodes = first_rows(nodes);
-        self.write_geometry(&mesh, &first_nodes, geometry_rows)?;
+        self.write_node_table(&mesh, NodeTable::Geometry, &first_nodes, node_rows)?;
         let node_tag = |k: usize| body(k).mesh.node_tags.iter().map(|t| t as i64);
         self.write_by_body(&mesh, "node_tag", Width::Scalar, nodes, node_tag)?;
         let node_body = |k: usize| std::iter::repeat_n(k as i32, nodes[k]);
@@ -230,20 +274,7 @@ impl Grid<'_> {
         self.write_by_body(&mesh, "cell_tag", Width::Scalar, cells, cell_tag)?;
         let cell_body = |k: usize| std::iter::repeat_n(k as i32, cells[k]);
         self.write_by_body(&mesh, "cell_body", Width::Scalar, cells, cell_body)?;
-        let displacement = |k: usize| {
-            (body(k).displacement.chunks_exact(dim)).flat_map(move |u| {
-                let mut padded = [0.0; 3];
-                padded[..dim].copy_from_slice(u);
-                padded
-            })
-        };
-        self.write_by_body(
-            &fields,
-            "displacement",
-            Width::Columns(3),
-            nodes,
-            displacement,
-        )?;
+        self.write_node_table(&fields, NodeTable::Displacement, &first_nodes, node_rows)?;
         self.write_cells(&mesh, &fields, &first_nodes, cell_rows)?;
         if self.contact {
             let traction = |k: usize| {
@@ -362,32 +393,31 @@ impl Grid<'_> {
         Ok(())
     }
 
-    /// The dataset `geometry` (in `mesh`) of the bodies' nodes, from `geometry_rows`,
-    /// [`Self::chunk_rows`] nodes at a time; `first_nodes[k]`: the grid's index of body `k`'s
-    /// first node.
-    fn write_geometry(
+    /// The dataset of `table` (`geometry` in `mesh`, or `displacement` in `fields`, as
+    /// `group` is) of the bodies' nodes, from `node_rows`, [`Self::chunk_rows`] nodes at a
+    /// time; `first_nodes[k]`: the grid's index of body `k`'s first node.
+    fn write_node_table(
         &self,
-        mesh: &hdf5::Group,
+        group: &hdf5::Group,
+        table: NodeTable,
         first_nodes: &[usize],
-        geometry_rows: &mut NodeRowsOf,
+        node_rows: &mut NodeRowsOf,
     ) -> hdf5::Result<()> {
         let total: usize = self.nodes.iter().sum();
-        let geometry = mesh
-            .new_dataset::<f64>()
-            .shape((total, 3))
-            .create("geometry")?;
+        let name = table.name();
+        let dataset = group.new_dataset::<f64>().shape((total, 3)).create(name)?;
         for (k, nodes) in chunks(self.nodes, self.chunk_rows) {
-            let chunk = geometry_rows(k, nodes.clone()).map_err(hdf5::Error::from)?;
+            let chunk = node_rows(k, table, nodes.clone()).map_err(hdf5::Error::from)?;
             if chunk.len() != nodes.len() {
                 return Err(hdf5::Error::from(format!(
-                    "body {k}: {} coordinates for its nodes {nodes:?}",
+                    "body {k}: {} rows of {name} for its nodes {nodes:?}",
                     chunk.len()
                 )));
             }
-            let table = ndarray::ArrayView2::from_shape((chunk.len(), 3), chunk.as_flattened())
-                .expect("3 coordinates a node");
+            let view = ndarray::ArrayView2::from_shape((chunk.len(), 3), chunk.as_flattened())
+                .expect("3 values a node");
             let rows = first_nodes[k] + nodes.start..first_nodes[k] + nodes.end;
-            geometry.write_slice(table, ndarray::s![rows, ..])?;
+            dataset.write_slice(view, ndarray::s![rows, ..])?;
         }
         Ok(())
     }
@@ -736,13 +766,23 @@ mod tests {
         // The geometry as a distributed run's rank 0 receives it: a chunk at a time, each
         // asked for once.
         let mut asked = Vec::new();
-        let mut geometry_rows = |k: usize, nodes: Range<usize>| {
-            asked.push((k, nodes.clone()));
-            Ok(meshes[k].coords.as_whole().unwrap()[nodes].to_vec())
+        let mut node_rows = |k: usize, table, nodes: Range<usize>| {
+            asked.push((table, k, nodes.clone()));
+            Ok(nodes
+                .map(|a| bodies[k].node_row(table, a).unwrap())
+                .collect())
         };
         let mut rows = |k: usize, cells| Ok(CellRows::of(&bodies[k], cells));
-        grid.write_h5(&path, &mut geometry_rows, &mut rows).unwrap();
-        assert_eq!(asked, chunks(&nodes, 3));
+        grid.write_h5(&path, &mut node_rows, &mut rows).unwrap();
+        let each = |table| {
+            chunks(&nodes, 3)
+                .into_iter()
+                .map(move |(k, n)| (table, k, n))
+        };
+        let expected: Vec<_> = (each(NodeTable::Geometry))
+            .chain(each(NodeTable::Displacement))
+            .collect();
+        assert_eq!(asked, expected);
 
         let file = hdf5::File::open(&path).unwrap();
         let read = |name: &str| file.dataset(name).unwrap().read_raw::<f64>().unwrap();
@@ -826,14 +866,14 @@ mod tests {
                 .contains("short: body 0 has 2 values for 1 rows of 3")
         );
         // So is a chunk of the geometry with a node missing.
-        let mut short_geometry = |_, nodes: Range<usize>| Ok(vec![[0.0; 3]; nodes.len() - 1]);
+        let mut short_geometry = |_, _, nodes: Range<usize>| Ok(vec![[0.0; 3]; nodes.len() - 1]);
         let error = grid
-            .write_geometry(&group, &[0], &mut short_geometry)
+            .write_node_table(&group, NodeTable::Geometry, &[0], &mut short_geometry)
             .unwrap_err();
         assert!(
             error
                 .to_string()
-                .contains("body 0: 2 coordinates for its nodes 0..3")
+                .contains("body 0: 2 rows of geometry for its nodes 0..3")
         );
     }
 }

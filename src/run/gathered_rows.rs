@@ -1,20 +1,22 @@
 //! The rows of a distributed run's output that rank 0 does not hold, gathered onto it a chunk
 //! at a time.
 //!
-//! After the partition no rank holds a whole body's cells (`super::partition`) or every node's
-//! coordinates (`crate::mesh::NodeCoords`), so rank 0, which writes `solution.h5`, receives the
-//! rows of the geometry (each node's coordinates) and of the cell datasets (each cell's nodes,
-//! strain, stress and von Mises stress) from the ranks that hold them, in the chunks it writes
-//! them in (`crate::output::row_chunks`). A node is sent by its owner, which keeps its
-//! coordinates. A cell is sent by one rank, the lowest that owns one of its nodes: that rank
-//! holds it (a rank keeps every cell around its own nodes), and no other sends it. Each rank
-//! computes the strain and stress of the cells it sends from the displacement, which every rank
-//! holds whole once the solve has ended. So rank 0 holds at most one chunk of rows beyond its
-//! own part of the mesh, and nobody reads the mesh file again.
+//! After the partition no rank holds a whole body's cells (`super::partition`), every node's
+//! coordinates (`crate::mesh::NodeCoords`) or every node's displacement
+//! (`crate::elastic::ElasticSolution::displacement`: those of the nodes it keeps), so rank 0,
+//! which writes `solution.h5`, receives the rows of the geometry and the displacement (each
+//! node's coordinates and displacement) and of the cell datasets (each cell's nodes, strain,
+//! stress and von Mises stress) from the ranks that hold them, in the chunks it writes them in
+//! (`crate::output::row_chunks`). A node is sent by its owner, which keeps its coordinates and
+//! displacement. A cell is sent by one rank, the lowest that owns one of its nodes: that rank
+//! holds it (a rank keeps every cell around its own nodes, and the displacement of their
+//! nodes), and no other sends it; it computes the cell's strain and stress. So rank 0 holds at
+//! most one chunk of rows beyond its own part of the mesh and of the displacement, and nobody
+//! reads the mesh file again.
 
 use std::ops::Range;
 
-use crate::output::{BodyFields, CellRows, row_chunks};
+use crate::output::{BodyFields, CellRows, NodeTable, row_chunks};
 use crate::parallel::{self, ParallelError};
 
 /// The rows of body `k`'s cells `cells` (indices in the whole body), on rank 0; an empty
@@ -84,54 +86,63 @@ pub(super) fn gather_cell_rows(
     Ok(rows)
 }
 
-/// The coordinates of body `k`'s nodes `nodes` (indices in the whole body), on rank 0; an
-/// empty vector on the other ranks. Collective: every rank calls it with the same `k` and
-/// `nodes`, in the same order, and sends the coordinates of the nodes it owns among them.
+/// The rows of `table` (each node's coordinates or displacement) for body `k`'s nodes `nodes`
+/// (indices in the whole body), on rank 0; an empty vector on the other ranks. Collective:
+/// every rank calls it with the same `k`, `table` and `nodes`, in the same order, and sends
+/// the rows of the nodes it owns among them.
 pub(super) fn gather_node_rows(
     bodies: &[BodyFields],
     k: usize,
+    table: NodeTable,
     nodes: Range<usize>,
 ) -> Result<Vec<[f64; 3]>, ParallelError> {
-    let mesh = bodies[k].mesh;
+    let body = &bodies[k];
+    let mesh = body.mesh;
+    let missing = |a: usize| {
+        ParallelError::Message(format!(
+            "the output's node {a} of body '{}' is not kept by the rank that sends it",
+            mesh.name
+        ))
+    };
     if mesh.part.is_none() {
         // A body every rank holds whole: rank 0 has every node's.
-        let whole = mesh.coords.as_whole().unwrap_or_default();
         return match parallel::is_root() {
-            true => Ok(whole.get(nodes.clone()).unwrap_or_default().to_vec()),
+            true => (nodes.map(|a| body.node_row(table, a).ok_or_else(|| missing(a)))).collect(),
             false => Ok(Vec::new()),
         };
     }
-    // A node as values: its index, then its coordinates.
+    // A node as values: its index, then its row.
     let mut values = Vec::new();
-    for (a, x) in mesh.owned_within(parallel::ranks().rank, nodes.clone()) {
+    for (a, _) in mesh.owned_within(parallel::ranks().rank, nodes.clone()) {
         values.push(a as f64);
-        values.extend_from_slice(x);
+        values.extend_from_slice(&body.node_row(table, a).ok_or_else(|| missing(a))?);
     }
     let Some(all) = on_root(&values)? else {
         return Ok(Vec::new());
     };
-    let mut coords = vec![[f64::NAN; 3]; nodes.len()];
+    let mut rows = vec![[f64::NAN; 3]; nodes.len()];
     let mut placed = vec![false; nodes.len()];
     for node in all.chunks_exact(4) {
         let a = node[0] as usize;
         let at = a.wrapping_sub(nodes.start);
-        if at >= coords.len() || placed[at] {
+        if at >= rows.len() || placed[at] {
             return Err(ParallelError::Message(format!(
                 "the output's node {a} of body '{}' was sent twice or is not in {nodes:?}",
                 mesh.name
             )));
         }
         placed[at] = true;
-        coords[at].copy_from_slice(&node[1..]);
+        rows[at].copy_from_slice(&node[1..]);
     }
     if let Some(at) = placed.iter().position(|&p| !p) {
         return Err(ParallelError::Message(format!(
-            "no rank sent the coordinates of the output's node {} of body '{}'",
+            "no rank sent the {} of the output's node {} of body '{}'",
+            table.name(),
             nodes.start + at,
             mesh.name
         )));
     }
-    Ok(coords)
+    Ok(rows)
 }
 
 /// Every rank's `values`, one rank's after the other in rank order, on rank 0; `None` on the
@@ -144,13 +155,16 @@ fn on_root(values: &[f64]) -> Result<Option<Vec<f64>>, ParallelError> {
     Ok(parallel::is_root().then_some(all))
 }
 
-/// On a rank other than 0: sends the coordinates of every node this rank owns, then the rows
-/// of every cell it writes, chunk by chunk, as rank 0 gathers them while it writes: the
-/// geometry first, then the cells (`gather_node_rows`, `gather_cell_rows`).
+/// On a rank other than 0: sends the coordinates of every node this rank owns, then their
+/// displacements, then the rows of every cell it writes, chunk by chunk, as rank 0 gathers
+/// them while it writes (`gather_node_rows`, `gather_cell_rows`; the order of
+/// `crate::output::write_xdmf_with`).
 pub(super) fn send_output_rows(bodies: &[BodyFields]) -> Result<(), ParallelError> {
     let nodes: Vec<usize> = bodies.iter().map(|b| b.mesh.num_nodes()).collect();
-    for (k, range) in row_chunks(&nodes) {
-        gather_node_rows(bodies, k, range)?;
+    for table in [NodeTable::Geometry, NodeTable::Displacement] {
+        for (k, range) in row_chunks(&nodes) {
+            gather_node_rows(bodies, k, table, range)?;
+        }
     }
     let cells: Vec<usize> = bodies.iter().map(|b| b.mesh.total_cells()).collect();
     for (k, range) in row_chunks(&cells) {

@@ -52,13 +52,15 @@ pub fn write_results(
     }
     let fields = body_fields(solution, mesh);
     if fields.iter().any(|b| b.mesh.part.is_some()) {
-        // A distributed run: the ranks send their nodes' coordinates, then the rows of their
-        // cells, as they are written.
+        // A distributed run: the ranks send their nodes' coordinates and displacements, then
+        // the rows of their cells, as they are written.
         write_xdmf_with(
             dir,
             "solution",
             &fields,
-            &mut |k, nodes| gather_node_rows(&fields, k, nodes).map_err(|e| e.to_string()),
+            &mut |k, table, nodes| {
+                gather_node_rows(&fields, k, table, nodes).map_err(|e| e.to_string())
+            },
             &mut |k, cells| gather_cell_rows(&fields, k, cells).map_err(|e| e.to_string()),
         )?;
     } else {

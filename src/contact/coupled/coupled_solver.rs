@@ -214,16 +214,17 @@ impl BodyFactors {
         shared_bodies(&self.solvers)
     }
 
-    /// Each body's displacements whole from every rank's rows of them (this rank's, PETSc's
-    /// order, in `u`: a distributed run's solve answers so; collective, the same values to the
-    /// bit); unchanged on one process.
-    pub fn whole_rows(&self, u: &mut [Vec<f64>]) -> Result<(), ContactError> {
+    /// Each body's displacements at the nodes this rank reads (those whose coordinates its
+    /// mesh keeps, in their order: `Distribution::at_read_nodes`) from every rank's rows of
+    /// them (this rank's, PETSc's order, in `u`: a distributed run's solve answers so;
+    /// collective, the owners' values to the bit); unchanged on one process, where they are
+    /// whole.
+    pub fn at_read_nodes(&self, u: &mut [Vec<f64>]) -> Result<(), ContactError> {
         if let Some(shared) = shared_bodies(&self.solvers)? {
             for (distribution, u) in shared.iter().zip(u.iter_mut()) {
-                let mut whole = vec![0.0; distribution.counts().iter().sum()];
-                (distribution.gather(u, &mut whole))
-                    .map_err(|e| ContactError::Linalg(format!("gathering a body's vector: {e}")))?;
-                *u = whole;
+                *u = (distribution.at_read_nodes(u)).map_err(|e| {
+                    ContactError::Linalg(format!("a body's displacement at its nodes: {e}"))
+                })?;
             }
         }
         Ok(())

@@ -51,7 +51,7 @@
 //! on return. A rigid unknown is a displacement, of the scale of `u`: it is not scaled (its
 //! unit load carries the weight `1 / s`, which cancels the multipliers' `s`).
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 
 use faer::sparse::{SparseColMat, Triplet};
@@ -114,11 +114,15 @@ pub struct Pair<'a> {
 
 /// The solution of one iteration.
 pub struct CoupledSolution {
-    /// Displacements of each body: whole, or in a distributed run's contact loop this rank's
-    /// rows of it (PETSc's order; [`CoupledSystem::solution_on_ranks`]).
+    /// Displacements of each body: whole on one process; on a rank of a distributed run, in
+    /// the contact loop this rank's rows of it (PETSc's order;
+    /// [`CoupledSystem::solution_on_ranks`]), and once the loop has ended its values at the
+    /// nodes whose coordinates the body's mesh keeps, in their order (`dim` each:
+    /// `crate::mesh::NodeCoords::position` finds a node's), which the output and the
+    /// reactions read.
     pub u: Vec<Vec<f64>>,
-    /// In a distributed run's contact loop, each body's displacement at the nodes the contact
-    /// geometry reads, from every rank ([`Self::displacement`]); `None` where `u` is whole.
+    /// In a distributed run, each body's displacement at the nodes the contact geometry reads,
+    /// from every rank ([`Self::displacement`]); `None` where `u` is whole.
     pub on_nodes: Option<Vec<NodeValues>>,
     /// Traction on each pair's primary at its active nodes, one vector per node (for
     /// frictionless, `lambda_n n`).
@@ -168,15 +172,25 @@ impl CoupledSolution {
     /// this pair alone on them (a body in several pairs receives the others' too).
     pub fn of_pair(&self, p: usize, pair: &Pair, dim: usize) -> CoupledSolution {
         let (a, b) = (pair.primary, pair.secondary);
-        let mut forces = [vec![0.0; self.u[a].len()], vec![0.0; self.u[b].len()]];
+        // The forces at the interface's dofs alone, each summed in the order of a whole
+        // vector's (`u` need not be whole: [`Self::u`]).
+        let mut forces = [BTreeMap::new(), BTreeMap::new()];
         add_pair_forces(pair.coupling, &self.traction[p], |side, node, f| {
-            add_at(&mut forces[side], dim, node, f);
+            for (c, f) in f.iter().enumerate().take(dim) {
+                *forces[side].entry(dim * node + c).or_insert(0.0) += f;
+            }
         });
+        let lengths = [self.contact_force[a].len(), self.contact_force[b].len()];
+        let forces = [0, 1].map(|side| {
+            let entries = std::mem::take(&mut forces[side]).into_iter();
+            LoadVector::from_entries(lengths[side], entries.filter(|&(_, v)| v != 0.0).collect())
+        });
+        let on_nodes = (self.on_nodes.as_ref()).map(|on| vec![on[a].clone(), on[b].clone()]);
         CoupledSolution {
             u: vec![self.u[a].clone(), self.u[b].clone()],
-            on_nodes: None,
+            on_nodes,
             traction: vec![self.traction[p].clone()],
-            contact_force: forces.map(LoadVector::new).into(),
+            contact_force: forces.into(),
             rigid: vec![self.rigid[a].clone(), self.rigid[b].clone()],
             relative_residual: self.relative_residual,
         }

@@ -1,6 +1,6 @@
-//! A body's displacement as the contact geometry reads it: whole (one process, and the final
-//! answer of a distributed run), or at the nodes of the body's boundary alone (each iterate of
-//! the contact loop in a distributed run).
+//! A body's displacement as the contact geometry reads it: whole (one process), or at the nodes
+//! of the body's boundary alone (each iterate of a distributed run's contact loop, and its
+//! answer's checks).
 //!
 //! The geometry of a contact reads a body's displacement only on its boundary: a contact
 //! surface's nodes ([`crate::contact::geometry::surface`]) and, to tell inside from outside,

@@ -746,7 +746,8 @@ struct LoopState {
 /// The last iterate as the loop keeps it between solves: each pair's coupling and the solution,
 /// whose displacements are, in a distributed run, this rank's rows and the values at the nodes
 /// the contact geometry reads ([`CoupledSolution::on_nodes`]), so that no rank holds a whole
-/// body's vector through the loop. Made whole by [`Self::into_whole`] (collective).
+/// body's vector through the loop. Its displacements are read at the nodes each rank keeps
+/// once the loop has ended ([`Self::into_answer`], collective).
 struct KeptIterate {
     couplings: Vec<Coupling>,
     solution: CoupledSolution,
@@ -760,15 +761,18 @@ fn prediction_error(e: &crate::parallel::ParallelError) -> ContactError {
 }
 
 impl KeptIterate {
-    /// The couplings and the solution with its displacements whole (collective).
-    fn into_whole(
+    /// The couplings and the solution, its displacements whole on one process and on a rank
+    /// of a distributed run at the nodes its mesh keeps (its own, its cells', the boundary's
+    /// and the groups': what the output and the reactions read), so that no rank holds a
+    /// whole body's vector at the end either (collective). The contact geometry's checks read
+    /// the boundary's values the loop already holds ([`CoupledSolution::displacement`]).
+    fn into_answer(
         mut self,
         factors: Option<&BodyFactors>,
     ) -> Result<(Vec<Coupling>, CoupledSolution), ContactError> {
         if let Some(factors) = factors {
-            factors.whole_rows(&mut self.solution.u)?;
+            factors.at_read_nodes(&mut self.solution.u)?;
         }
-        self.solution.on_nodes = None;
         Ok((self.couplings, self.solution))
     }
 }
@@ -1602,7 +1606,7 @@ impl ContactSolver<'_> {
         state: LoopState,
     ) -> Result<Vec<ContactSolution>, ContactError> {
         let last = state.last.expect("max_iterations >= 1 is validated");
-        let (couplings, solution) = last.into_whole(self.factors.as_ref())?;
+        let (couplings, solution) = last.into_answer(self.factors.as_ref())?;
         let dim = self.pairs[0].primary_surface.dim;
         let mut answers = Vec::with_capacity(self.pairs.len());
         // Each Coulomb pair's tangential states the last iterate was solved with.

@@ -66,6 +66,7 @@ use std::collections::HashSet;
 
 use crate::contact::certificate::{Certificate, CertificateCheck, CheckKind};
 use crate::contact::coupled::system::CoupledSolution;
+use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::{GapRow, gap_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::law::coulomb::norm;
@@ -103,13 +104,15 @@ pub fn certify(
 ) -> (Certificate, [Vec<f64>; 2]) {
     let settings = &problem.settings;
     let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
-    let (u1, u2) = (&solution.u[0][..], &solution.u[1][..]);
+    // The displacements at the surfaces' nodes (on a rank of a distributed run, the boundary's
+    // values the loop gathered: `CoupledSolution::displacement`).
+    let (u1, u2) = (solution.displacement(0), solution.displacement(1));
     let sides: [Side; 2] = [
         (s1, s2, u1, u2, &solution.contact_force[0]),
         (s2, s1, u2, u1, &solution.contact_force[1]),
     ];
     let gaps = sides.map(|(own, other, u_own, u_other, _)| {
-        geometric_gaps(own, other, Some(u_own.into()), Some(u_other.into()))
+        geometric_gaps(own, other, Some(u_own), Some(u_other))
     });
     let held = held_by_primary([s1, s2], [u1, u2], active);
     let mean: Vec<Vec<f64>> = sides
@@ -124,7 +127,7 @@ pub fn certify(
     // The penalty method's overlap `p / eps` at each primary node: what its law allows
     // (`crate::contact::method`); zero under INTERNODES.
     let law = ContactLaw::of(settings);
-    let rows = gap_rows(s1, s2, Some(u1.into()), Some(u2.into()), law.row_normal());
+    let rows = gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal());
     let enforcement = Enforcement::of(problem);
     let mut overlap = vec![0.0; s1.len()];
     for (k, &i) in solved.iter().enumerate() {
@@ -410,8 +413,8 @@ struct ForceCentres {
 type Side<'a> = (
     &'a ContactSurface,
     &'a ContactSurface,
-    &'a [f64],
-    &'a [f64],
+    BodyDisplacement<'a>,
+    BodyDisplacement<'a>,
     &'a LoadVector,
 );
 
@@ -429,7 +432,7 @@ fn force_centres(sides: &[Side; 2], mean: &[Vec<f64>]) -> ForceCentres {
         (total > 0.0).then(|| {
             let mut moment = [0.0; 3];
             for s in 0..own.len() {
-                let (f, x) = (force(s), own.deformed(u_own.into(), s));
+                let (f, x) = (force(s), own.deformed(u_own, s));
                 (0..3).for_each(|k| moment[k] += f * x[k]);
             }
             moment.map(|m| m / total)
@@ -481,15 +484,15 @@ impl ForceCentres {
 fn indentation_depth(
     primary: &ContactSurface,
     secondary: &ContactSurface,
-    [u1, u2]: [&[f64]; 2],
+    [u1, u2]: [BodyDisplacement; 2],
     gaps: &[f64],
     pressure: &[f64],
 ) -> f64 {
-    let displaced = secondary.index(Some(u2.into()));
+    let displaced = secondary.index(Some(u2));
     (0..primary.len())
         .filter(|&s| pressure[s] > 0.0)
         .map(|s| {
-            let touching = (displaced.project(&primary.deformed(u1.into(), s)))
+            let touching = (displaced.project(&primary.deformed(u1, s)))
                 .expect("a contact surface has facets");
             let q = secondary.reference_point(touching.facet, &touching.barycentric);
             let (x, n) = (primary.coords[s], primary.normals[s]);
@@ -669,7 +672,7 @@ enum Held {
 /// `active` primary nodes (surface indices).
 fn held_by_primary(
     [primary, secondary]: [&ContactSurface; 2],
-    [u1, u2]: [&[f64]; 2],
+    [u1, u2]: [BodyDisplacement; 2],
     active: &[usize],
 ) -> Vec<Held> {
     let is_active: HashSet<usize> = active.iter().copied().collect();
@@ -680,10 +683,10 @@ fn held_by_primary(
         .flatten()
         .copied()
         .collect();
-    let displaced = primary.index(Some(u1.into()));
+    let displaced = primary.index(Some(u1));
     (0..secondary.len())
         .map(|s| {
-            let facet = (displaced.project(&secondary.deformed(u2.into(), s)))
+            let facet = (displaced.project(&secondary.deformed(u2, s)))
                 .expect("a contact surface has facets")
                 .facet;
             let corners = primary.facet_nodes(facet);
