@@ -707,6 +707,7 @@ mod tests {
 
     use super::*;
     use crate::fem::stress::cell_fields;
+    use crate::mesh::NodeCoords;
 
     /// A strip of `n` unit squares (two triangles each) from `x0`.
     fn strip(name: &str, x0: f64, n: usize) -> BodyMesh {
@@ -831,6 +832,50 @@ mod tests {
         assert_eq!(read("fields/strain"), strain);
         assert_eq!(read("fields/stress"), stress);
         assert_eq!(read("fields/von_mises"), von_mises);
+    }
+
+    #[test]
+    fn a_displacement_held_at_the_kept_nodes_gives_the_whole_ones_rows_there() {
+        // A rank of a distributed run keeps some nodes (here those of cells 2 to 5) and the
+        // displacement at them, in their order: its rows are the whole body's.
+        let whole_mesh = strip("a", 0.0, 5);
+        let material = Material::new(1000.0, 0.3).unwrap();
+        let u: Vec<f64> = (whole_mesh.coords.kept().map(|(_, x)| x))
+            .flat_map(|x| [1e-3 * x[0] * x[1] + 2e-4 * x[0], -2e-3 * x[1] * x[0]])
+            .collect();
+        let cells = 2..6;
+        let mut kept: Vec<u32> = whole_mesh.cells[3 * cells.start..3 * cells.end].to_vec();
+        kept.sort_unstable();
+        kept.dedup();
+        let mut part_mesh = strip("a", 0.0, 5);
+        part_mesh.coords = NodeCoords::of_nodes(
+            whole_mesh.num_nodes(),
+            kept.clone(),
+            kept.iter()
+                .map(|&a| whole_mesh.coords[a as usize])
+                .collect(),
+        );
+        let kept_u = part_mesh.coords.kept_values(u.clone(), 2);
+        assert_eq!(kept_u.len(), 2 * kept.len());
+        let body = |mesh, displacement| BodyFields {
+            mesh,
+            displacement,
+            material: &material,
+            surfaces: Vec::new(),
+        };
+        let (whole, part) = (body(&whole_mesh, &u[..]), body(&part_mesh, &kept_u[..]));
+        for table in [NodeTable::Geometry, NodeTable::Displacement] {
+            for a in 0..whole_mesh.num_nodes() {
+                match kept.contains(&(a as u32)) {
+                    true => assert_eq!(part.node_row(table, a), whole.node_row(table, a)),
+                    false => assert_eq!(part.node_row(table, a), None),
+                }
+            }
+        }
+        assert_eq!(
+            CellRows::of(&part, cells.clone()),
+            CellRows::of(&whole, cells)
+        );
     }
 
     #[test]
