@@ -108,7 +108,8 @@ def breakdown(case: Path, ranks: int, binary: Path) -> tuple[list[dict[str, int]
         run = subprocess.run(command, cwd=work, capture_output=True, text=True, env=dict(os.environ))
         if run.returncode not in (0, 2, 3):
             raise RuntimeError(f"{' '.join(command)} exited with {run.returncode}:\n{run.stdout}{run.stderr}")
-        profiles = sorted(work.glob("heaptrack.internodes.*.zst"), key=lambda p: int(p.name.split(".")[2]))
+        # heaptrack names a profile after the binary's file name and the process id.
+        profiles = sorted(work.glob(f"heaptrack.{binary.name}.*.zst"), key=lambda p: int(p.name.split(".")[-2]))
         if len(profiles) != ranks:
             raise RuntimeError(f"expected {ranks} heaptrack profiles, found {len(profiles)}")
         columns = []

@@ -148,12 +148,14 @@ def measure(binary: Path, only: set | None = None, kept: dict | None = None) -> 
     runs = []
     dofs, contact_nodes = dict((kept or {}).get("dofs", {})), dict((kept or {}).get("contact_nodes", {}))
     for name, level in SIZES:
-        case = case_file(level)
+        case = None
         for ranks in RANKS:
             if only is not None and (name, ranks) not in only:
                 old = next(r for r in kept["runs"] if (r["size"], r["ranks"]) == (name, ranks))
                 runs.append({"binary_commit": kept.get("binary_commit"), **old})
                 continue
+            # Meshed only for the sizes that run.
+            case = case or case_file(level)
             print(f"{name} on {ranks} rank(s) ...", file=sys.stderr, flush=True)
             columns, summary, log = breakdown(case, ranks, binary)
             parts = {p for c in columns for p in c}
