@@ -432,23 +432,10 @@ fn cg_amg_error(e: LinalgError) -> ContactError {
 /// rank's rows of it) goes to PETSc and ours is freed, then the multigrid hierarchies are
 /// built, so that a process never holds its matrices beside a hierarchy being set up. On one
 /// process this is `K_c` once instead of twice (at 1M DOFs about 0.9 GB less).
-///
-/// The hierarchies are built largest body first. A set-up's peak is the intermediate data of
-/// its finest Galerkin product `P^T A P`, live until the product is done and larger than the
-/// hierarchy it leaves (the demo's case at 3M DOFs on 2 ranks: about 1.45 GB a rank for the
-/// block's, where both bodies' finished hierarchies take 1.1 GB), and it comes beside the
-/// hierarchies built before it. Both grow with a body's size, the data faster, so largest
-/// first puts the largest product beside no hierarchy and each smaller one beside larger
-/// hierarchies: of two bodies `L` and `s`, `max(T_L, H_L + T_s) <= H_s + T_L` when
-/// `H_L - H_s <= T_L - T_s`, the lower peak of the two orders. (In the case's order, sphere
-/// then block, the block's set-up beside the sphere's hierarchy was one rank's peak at 3M on
-/// 2 ranks, above the contact loop's.)
 pub fn petsc_solvers(
     bodies: &mut [AssembledBody],
     settings: &SolverSettings,
 ) -> Result<Vec<BodySolver>, ContactError> {
-    let mut largest_first: Vec<usize> = (0..bodies.len()).collect();
-    largest_first.sort_by_key(|&k| std::cmp::Reverse(bodies[k].f.len()));
     let mut pending = Vec::with_capacity(bodies.len());
     for body in bodies.iter_mut() {
         let matrix = match body.stiffness.take_rows() {
@@ -460,16 +447,11 @@ pub fn petsc_solvers(
                 BodySolver::cg_amg_matrix(&k_c, body.dim, &coordinates, settings.rtol)
             }
         };
-        pending.push(Some(matrix.map_err(cg_amg_error)?));
+        pending.push(matrix.map_err(cg_amg_error)?);
     }
-    let mut solvers: Vec<Option<BodySolver>> = (0..bodies.len()).map(|_| None).collect();
-    for k in largest_first {
-        let matrix = pending[k]
-            .take()
-            .expect("each body's matrix is set up once");
-        solvers[k] = Some(matrix.set_up().map_err(cg_amg_error)?);
-    }
-    Ok(solvers.into_iter().flatten().collect())
+    (pending.into_iter())
+        .map(|matrix| matrix.set_up().map_err(cg_amg_error))
+        .collect()
 }
 
 /// The coupled system solved by one sparse LU of its whole matrix.
