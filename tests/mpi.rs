@@ -587,6 +587,57 @@ fn a_single_body_on_two_ranks_gives_the_serial_answer() {
 }
 
 #[test]
+fn a_single_body_under_a_force_on_two_ranks_gives_the_serial_answer() {
+    // The block's top face pushed by a total force (one displacement for the face, an unknown
+    // bordering the body's system): each rank solves on its rows alone and adds its part of
+    // `k^T W` and `k^T u0` to the others'.
+    let dir = tempfile::tempdir().unwrap();
+    let force = "\n[[body.force]]\ngroup = \"block_top\"\nfz = -1.0\n";
+    let extra = format!("{force}\n[solver]\nbody = \"cg-amg\"\n");
+    let case = example_case(dir.path(), "block_3d", &extra);
+    let case = case.to_str().unwrap();
+    let (one, two) = (dir.path().join("one"), dir.path().join("two"));
+    let serial_run = serial(&["solve", case, "-q", "-o", one.to_str().unwrap()]);
+    let parallel_run = mpirun(2, &["solve", case, "-q", "-o", two.to_str().unwrap()]);
+    assert!(serial_run.status.success(), "{}", text(&serial_run));
+    assert!(parallel_run.status.success(), "{}", text(&parallel_run));
+    same_mesh_written(&one, &two, "block_3d");
+    for field in ["fields/displacement", "fields/stress"] {
+        let d = relative_difference(&read(&one, field), &read(&two, field));
+        assert!(d <= 1e-8, "{field} differs by {d:.2e}");
+    }
+    // The top face (z = 0) moves as one: every node of it has the same `uz`, on either run.
+    for dir in [&one, &two] {
+        let (geometry, u) = (read(dir, "mesh/geometry"), read(dir, "fields/displacement"));
+        let top: Vec<f64> = (geometry.chunks_exact(3).zip(u.chunks_exact(3)))
+            .filter(|(x, _)| x[2] == 0.0)
+            .map(|(_, u)| u[2])
+            .collect();
+        assert!(top.len() > 10 && top[0] < 0.0, "{top:?}");
+        assert!(top.iter().all(|&uz| uz == top[0]), "{top:?}");
+    }
+    let (a, b) = (summary(&one), summary(&two));
+    for s in [&a, &b] {
+        let reactions = &s["bodies"][0]["reactions"];
+        let top = reactions["block_top"][2].as_f64().unwrap();
+        let base = reactions["block_base"][2].as_f64().unwrap();
+        // The face's reaction is the force it carries; the base holds it and the pressure.
+        assert!((top + 1.0).abs() <= 1e-8, "{reactions}");
+        assert!(base > 1.0, "{reactions}");
+        let residual = s["bodies"][0]["solve"]["relative_residual"]
+            .as_f64()
+            .unwrap();
+        assert!(residual <= 1e-8, "relative residual {residual:.2e}");
+    }
+    let base = |s: &serde_json::Value| s["bodies"][0]["reactions"]["block_base"][2].as_f64();
+    let (p, q) = (base(&a).unwrap(), base(&b).unwrap());
+    assert!(
+        (p - q).abs() <= 1e-8 * p.abs(),
+        "base reactions {p} and {q}"
+    );
+}
+
+#[test]
 fn a_rank_that_fails_alone_ends_every_rank_with_its_error() {
     // Rank 0 alone writes, so it alone finds that the output folder is a file; rank 1 goes on
     // into the body solver's collective set-up and would wait for rank 0 for ever.

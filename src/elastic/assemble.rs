@@ -87,6 +87,21 @@ impl AssembledBody {
         rhs
     }
 
+    /// [`Self::rhs`] at `dof` alone, the same bits (the same products, added in the same
+    /// order): what a rank of a distributed run reads at its rows.
+    pub fn rhs_at(&self, dof: usize, factors: &StepFactors) -> f64 {
+        if self.parts.is_empty() {
+            return factors.default * self.f_c.get(dof);
+        }
+        let mut rhs = 0.0;
+        for part in &self.parts {
+            if let Some(value) = part.f_c.kept_entry(dof) {
+                rhs += factors.of(part.path.as_deref()) * value;
+            }
+        }
+        rhs
+    }
+
     /// The load (the step's `f`) at `dof` at a step of `factors`.
     pub fn load(&self, dof: usize, factors: &StepFactors) -> f64 {
         match self.parts.is_empty() {

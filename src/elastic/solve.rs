@@ -10,8 +10,8 @@ use super::solution::{ElasticSolution, SolveStats, timed};
 use crate::cancel::Cancel;
 use crate::fem::LoadVector;
 use crate::linalg::{
-    BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
-    relative_difference, relative_residual,
+    BodyRows, BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, LinalgError, Ordering,
+    relative_residual,
 };
 
 /// How to solve; every field has a documented default.
@@ -144,10 +144,20 @@ const UNHELD_STIFFNESS: f64 = 1e-8;
 
 /// The body's own stiffness along its force-controlled components, `S = D_aa - k^T W` (the
 /// Schur complement of `K_c` in the bordered matrix of `RigidColumn`), given `W = K_c^-1 [k_1
-/// .. k_r]` (the columns one after another).
-pub fn rigid_stiffness(system: &AssembledBody, w: &[f64]) -> nalgebra::DMatrix<f64> {
+/// .. k_r]` (the columns one after another, each held as `rows` says; collective on a rank of
+/// a distributed run, every rank receiving the same `S`).
+pub fn rigid_stiffness(
+    system: &AssembledBody,
+    rows: &BodyRows,
+    w: &[f64],
+) -> Result<nalgebra::DMatrix<f64>, LinalgError> {
     let r = system.rigid.len();
-    let n = system.f_c.len();
+    let n = rows.len();
+    let mut k_w = Vec::with_capacity(r * r);
+    for rigid in &system.rigid {
+        k_w.extend((0..r).map(|j| rows.dot_entries(&rigid.column, &w[j * n..(j + 1) * n])));
+    }
+    let k_w = rows.sum_over_ranks(k_w)?;
     let mut s = nalgebra::DMatrix::<f64>::zeros(r, r);
     for (i, rigid) in system.rigid.iter().enumerate() {
         s[(i, i)] += rigid.diagonal;
@@ -155,11 +165,10 @@ pub fn rigid_stiffness(system: &AssembledBody, w: &[f64]) -> nalgebra::DMatrix<f
             s[(i, j)] += c;
         }
         for j in 0..r {
-            let w = &w[j * n..(j + 1) * n];
-            s[(i, j)] -= rigid.column.iter().map(|&(dof, k)| k * w[dof]).sum::<f64>();
+            s[(i, j)] -= k_w[i * r + j];
         }
     }
-    s
+    Ok(s)
 }
 
 /// The force-controlled components (indices into `system.rigid`) that nothing but their group
@@ -176,14 +185,20 @@ pub fn unheld_components(system: &AssembledBody, s: &nalgebra::DMatrix<f64>) -> 
 }
 
 /// The displacements `a` of a single body's force-controlled components (step 5 of
-/// [`solve`]): `u0` is `K_c^-1 f_c`, `w` the columns `K_c^-1 k_j` one after another.
+/// [`solve`]): `u0` is `K_c^-1 f_c`, `w` the columns `K_c^-1 k_j` one after another, each held
+/// as `rows` says (collective).
 fn rigid_displacements(
     problem: &ElasticProblem,
     system: &AssembledBody,
+    rows: &BodyRows,
     u0: &[f64],
     w: &[f64],
 ) -> Result<Vec<f64>, SolveError> {
-    let s = rigid_stiffness(system, w);
+    let linalg = |source| SolveError::Linalg {
+        body: problem.body.name.clone(),
+        source,
+    };
+    let s = rigid_stiffness(system, rows, w).map_err(linalg)?;
     let unheld = |i: usize| {
         let rigid = &system.rigid[i];
         SolveError::Unheld {
@@ -195,16 +210,13 @@ fn rigid_displacements(
     if let Some(&i) = unheld_components(system, &s).first() {
         return Err(unheld(i));
     }
+    let pulls = (system.rigid.iter())
+        .map(|rigid| rows.dot_entries(&rigid.column, u0))
+        .collect();
+    let pulls = rows.sum_over_ranks(pulls).map_err(linalg)?;
     let b = nalgebra::DVector::from_iterator(
         system.rigid.len(),
-        (system.rigid.iter()).map(|rigid| {
-            let pull = rigid
-                .column
-                .iter()
-                .map(|&(dof, k)| k * u0[dof])
-                .sum::<f64>();
-            rigid.force + rigid.applied - pull
-        }),
+        (system.rigid.iter().zip(pulls)).map(|(rigid, pull)| rigid.force + rigid.applied - pull),
     );
     let a = s.lu().solve(&b).ok_or_else(|| unheld(0))?;
     Ok(a.iter().copied().collect())
@@ -275,20 +287,21 @@ pub fn solve(
     // 5. Solve and check the residual of the constrained system. Force-controlled components
     //    (`RigidColumn`) border it: with `W = K_c^-1 [k_1 .. k_r]` and `u0 = K_c^-1 f_c`, their
     //    displacements solve `(D_aa - k^T W) a = (force + applied) - k^T u0`, and `u = u0 - W a`.
+    //    Each vector is whole on one process and this rank's rows on a rank of a distributed
+    //    run (`BodyRows`), where the answer is then gathered at the nodes the rank keeps only.
+    let rows = BodyRows::new(solver.distribution(), system.f_c.len());
     let r = system.rigid.len();
-    let n = system.f_c.len();
-    let mut columns = system.f_c.to_vec();
+    let n = rows.len();
+    let mut columns = rows.of_load(&system.f_c);
     for rigid in &system.rigid {
-        let mut k = vec![0.0; n];
-        rigid.column.iter().for_each(|&(dof, v)| k[dof] = v);
-        columns.extend(k);
+        columns.extend(rows.of_entries(&rigid.column));
     }
     let phase = match solver.kind() {
         BodySolverKind::CgAmg => "CG + AMG solve",
         _ => "triangular solves",
     };
     let iterations = timed(&mut stats, verbose, phase, || {
-        solver.solve_in_place(&mut columns, 1 + r)
+        solver.solve_rows_in_place(&mut columns, 1 + r)
     })
     .map_err(linalg)?;
     if solver.kind() == BodySolverKind::CgAmg {
@@ -297,24 +310,25 @@ pub fn solve(
     let (mut u, w) = (columns[..n].to_vec(), &columns[n..]);
     let a = match r {
         0 => Vec::new(),
-        _ => rigid_displacements(problem, &system, &u, w)?,
+        _ => rigid_displacements(problem, &system, &rows, &u, w)?,
     };
-    let mut rhs = system.f_c.to_vec();
+    let mut rhs = rows.of_load(&system.f_c);
     for (j, (rigid, a)) in system.rigid.iter().zip(&a).enumerate() {
         u.iter_mut().zip(&w[j * n..]).for_each(|(u, w)| *u -= w * a);
-        rigid.column.iter().for_each(|&(dof, v)| rhs[dof] -= v * a);
+        (rigid.column.iter())
+            .filter_map(|&(dof, v)| rows.row(dof).map(|row| (row, v)))
+            .for_each(|(row, v)| rhs[row] -= v * a);
     }
+    drop(columns);
     stats.relative_residual = match system.stiffness.whole() {
         Some(k_c) => relative_residual(k_c, &u, &rhs),
         None => {
             let mut ku = vec![0.0; n];
-            solver.multiply(&u, &mut ku).map_err(linalg)?;
-            relative_difference(&ku, &rhs)
+            solver.multiply_rows(&u, &mut ku).map_err(linalg)?;
+            rows.relative_difference(&ku, &rhs).map_err(linalg)?
         }
     };
-    // The factor or multigrid hierarchy can be the largest object of the run: freed before
-    // the cell fields.
-    drop(solver);
+    drop(rhs);
     if stats.relative_residual.is_nan() || stats.relative_residual > settings.residual_tolerance {
         return Err(SolveError::Inaccurate {
             body: body.name.clone(),
@@ -323,8 +337,17 @@ pub fn solve(
         });
     }
     for (rigid, a) in system.rigid.iter().zip(&a) {
-        rigid.dofs.iter().for_each(|&dof| u[dof] = *a);
+        (rigid.dofs.iter())
+            .filter_map(|&dof| rows.row(dof))
+            .for_each(|row| u[row] = *a);
     }
+    // On a rank of a distributed run, the solution at the nodes it keeps (what the output and
+    // the reactions read), as a contact solve's (collective: before the solver is freed,
+    // which holds the distribution).
+    let u = (rows.at_kept_nodes(u, &body.coords, body.dim)).map_err(linalg)?;
+    // The factor or multigrid hierarchy can be the largest object of the run: freed before
+    // the cell fields.
+    drop(solver);
 
     // 6. Reactions.
     // Every load and prescribed value at its full value: every path at factor 1.
@@ -332,9 +355,6 @@ pub fn solve(
     full.paths = (problem.paths().into_iter())
         .map(|path| (path.to_string(), 1.0))
         .collect();
-    // On a rank of a distributed run, the solution at the nodes it keeps (what the output and
-    // the reactions read), as a contact solve's.
-    let u = body.coords.kept_values(u, body.dim);
     let reactions = reactions(problem, &system, &u, &full, None);
     Ok(ElasticSolution {
         displacement: u,

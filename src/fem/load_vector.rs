@@ -83,6 +83,28 @@ impl LoadVector {
         }
     }
 
+    /// The entry at `dof` as it is kept: `None` where a sparse vector keeps none (what
+    /// [`Self::add_scaled_to`] skips).
+    pub fn kept_entry(&self, dof: usize) -> Option<f64> {
+        match self {
+            Self::Whole(whole) => Some(whole[dof]),
+            Self::Sparse { entries, .. } => entries
+                .binary_search_by_key(&dof, |&(d, _)| d)
+                .ok()
+                .map(|k| entries[k].1),
+        }
+    }
+
+    /// The entries that are not zero, by increasing dof.
+    pub fn nonzero_entries(&self) -> Box<dyn Iterator<Item = (usize, f64)> + '_> {
+        match self {
+            Self::Whole(whole) => {
+                Box::new((whole.iter().copied().enumerate()).filter(|&(_, v)| v != 0.0))
+            }
+            Self::Sparse { entries, .. } => Box::new(entries.iter().copied()),
+        }
+    }
+
     /// The whole vector.
     pub fn to_vec(&self) -> Vec<f64> {
         self.scaled(1.0)
@@ -159,6 +181,15 @@ mod tests {
                 let mut expected = vec![0.0; whole.len()];
                 (expected.iter_mut().zip(&whole)).for_each(|(o, v)| *o += s * v);
                 assert_eq!(out, expected);
+            }
+            let nonzero: Vec<(usize, f64)> = (whole.iter().copied().enumerate())
+                .filter(|&(_, v)| v != 0.0)
+                .collect();
+            assert_eq!(kept.nonzero_entries().collect::<Vec<_>>(), nonzero);
+            // A sparse vector keeps its nonzero entries; a whole one every entry.
+            for (d, v) in whole.iter().enumerate() {
+                let kept_here = !sparse || *v != 0.0;
+                assert_eq!(kept.kept_entry(d), kept_here.then_some(*v));
             }
             for c in 0..3 {
                 let expected: f64 = whole.iter().skip(c).step_by(3).sum();

@@ -288,6 +288,32 @@ impl BodySolver {
         }
     }
 
+    /// [`Self::solve_in_place`] on this rank's rows alone ([`Self::distribution`]: each
+    /// column holds this rank's rows in PETSc's order; collective), so that no rank holds a
+    /// whole vector; on one process, the whole vectors.
+    pub fn solve_rows_in_place(
+        &self,
+        rhs: &mut [f64],
+        num_rhs: usize,
+    ) -> Result<usize, LinalgError> {
+        match self {
+            #[cfg(feature = "petsc")]
+            Self::CgAmg(cg) if cg.distribution().is_some() => {
+                let mut most = 0;
+                if num_rhs == 0 || rhs.is_empty() {
+                    return Ok(0);
+                }
+                for column in rhs.chunks_mut(rhs.len() / num_rhs) {
+                    let (x, stats) = cg.solve_rows(column)?;
+                    column.copy_from_slice(&x);
+                    most = most.max(stats.iterations);
+                }
+                Ok(most)
+            }
+            _ => self.solve_in_place(rhs, num_rhs),
+        }
+    }
+
     /// `x = P^-1 r` for the body's preconditioner in a coupled Krylov solve: the factor's exact
     /// solve, or one AMG V-cycle. Called from several threads, V-cycles of different bodies
     /// run at the same time (the one PETSc call that does not wait for all others:

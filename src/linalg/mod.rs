@@ -4,6 +4,7 @@
 //! program solver for the half-space model of the contact zone, plus the residual check every
 //! solve reports.
 
+mod body_rows;
 mod body_solver;
 pub mod bound_qp;
 mod cholesky;
@@ -14,6 +15,7 @@ mod ordering;
 #[cfg(feature = "petsc")]
 pub mod petsc;
 
+pub use body_rows::BodyRows;
 pub use body_solver::{
     AUTO_CG_AMG_MIN_DOFS_3D, BodySolver, BodySolverKind, CG_AMG_AVAILABLE, PendingCgAmg,
 };

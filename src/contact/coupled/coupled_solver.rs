@@ -46,7 +46,8 @@ use crate::elastic::AssembledBody;
 use crate::elastic::SolverSettings;
 use crate::fem::LoadVector;
 use crate::linalg::{
-    BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Distribution, LinalgError, Ordering,
+    BodyRows, BodySolver, BodySolverKind, Cholesky, CholeskySymbolic, Distribution, LinalgError,
+    Ordering,
 };
 
 /// The solvers (Cholesky factors, or CG + AMG) of every body's constrained stiffness matrix,
@@ -382,15 +383,17 @@ pub fn held_by_contacts_only(
                 &own
             }
         };
-        let n = body.f_c.len();
-        let mut w = vec![0.0; n * body.rigid.len()];
-        for (j, rigid) in body.rigid.iter().enumerate() {
-            rigid.column.iter().for_each(|&(dof, v)| w[j * n + dof] = v);
+        // `W` held as the solver holds a body's vectors: this rank's rows on a rank.
+        let rows = BodyRows::new(solver.distribution(), body.f_c.len());
+        let mut w = Vec::with_capacity(rows.len() * body.rigid.len());
+        for rigid in &body.rigid {
+            w.extend(rows.of_entries(&rigid.column));
         }
         solver
-            .solve_in_place(&mut w, body.rigid.len())
+            .solve_rows_in_place(&mut w, body.rigid.len())
             .map_err(body_solve_error)?;
-        let stiffness = crate::elastic::rigid_stiffness(body, &w);
+        let stiffness = crate::elastic::rigid_stiffness(body, &rows, &w)
+            .map_err(|e| ContactError::Linalg(format!("a body's own stiffness: {e}")))?;
         held.push(crate::elastic::unheld_components(body, &stiffness));
     }
     Ok(held)

@@ -72,6 +72,19 @@ impl RowOwnership {
         self.num_local
     }
 
+    /// Body `k`'s unknowns of this rank: each one's place among this rank's rows and the
+    /// unknown (the body's numbering).
+    pub fn own_rows(&self, k: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let body = &self.bodies[k];
+        let block = body.block;
+        (body.nodes.iter()).flat_map(move |&(node, place)| {
+            (0..block).map(move |c| {
+                let row = body.local + place as usize * block + c;
+                (row, node as usize * block + c)
+            })
+        })
+    }
+
     /// The place of unknown `global` (the system's numbering) among this rank's rows, if it is
     /// this rank's.
     pub fn place(&self, global: usize) -> Option<usize> {
@@ -197,18 +210,29 @@ pub fn send_to_keepers(
 /// The forces `forces` on the shared bodies whose distributions are `bodies`, each made on
 /// this rank from the entries it keeps ([`Keepers`]), completed from their owners: every
 /// unknown's terms are all on the rank that owns it, so its value there is whole, and each
-/// rank's own values are gathered onto every rank (the same sums in the same order as from
-/// whole transfers, bit for bit). Each force is whole only while it is gathered, and kept as
-/// its nonzero entries after (`LoadVector::new`).
+/// rank's own nonzero values, with their unknowns, are gathered onto every rank (the same
+/// values as from whole transfers, bit for bit). A force is nonzero at the interface's nodes
+/// only, so no rank holds a vector of the body's size (`LoadVector::from_entries` keeps it as
+/// `LoadVector::new` would keep the whole vector).
 pub fn complete_forces(
     bodies: &[&Distribution],
     forces: &mut [&mut LoadVector],
 ) -> Result<(), ContactError> {
+    let mpi = |e: crate::parallel::ParallelError| ContactError::Linalg(e.to_string());
     for (distribution, force) in bodies.iter().zip(forces.iter_mut()) {
-        let mut whole = force.to_vec();
-        let own = distribution.local_part(&whole);
-        (distribution.gather(&own, &mut whole)).map_err(|e| ContactError::Linalg(e.to_string()))?;
-        **force = LoadVector::new(whole);
+        // This rank's own unknowns' values as `[dof, value]` pairs (a dof is exact in an f64).
+        let own: Vec<f64> = (force.nonzero_entries())
+            .filter(|&(dof, _)| distribution.own_row(dof).is_some())
+            .flat_map(|(dof, value)| [dof as f64, value])
+            .collect();
+        let counts = crate::parallel::gather(own.len() as f64).map_err(mpi)?;
+        let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
+        let every = crate::parallel::all_gather(&own, &counts).map_err(mpi)?;
+        let mut entries: Vec<(usize, f64)> = (every.chunks_exact(2))
+            .map(|pair| (pair[0] as usize, pair[1]))
+            .collect();
+        entries.sort_unstable_by_key(|&(dof, _)| dof);
+        **force = LoadVector::from_entries(force.len(), entries);
     }
     Ok(())
 }

@@ -412,10 +412,8 @@ impl CoupledSystem {
             Some(ownership) => {
                 let mut f = vec![0.0; ownership.num_local()];
                 for (k, body) in bodies.iter().enumerate() {
-                    for (dof, value) in body.rhs(factors).into_iter().enumerate() {
-                        if let Some(place) = ownership.place(offsets[k] + dof) {
-                            f[place] = value;
-                        }
+                    for (place, dof) in ownership.own_rows(k) {
+                        f[place] = body.rhs_at(dof, factors);
                     }
                 }
                 f

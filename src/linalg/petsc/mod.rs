@@ -608,7 +608,49 @@ impl CgAmg {
                 self.n
             )));
         }
-        let local_rhs = self.local_part(rhs);
+        let (local_x, iterations, residual, reason) =
+            self.solve_local(&self.local_part(rhs), rtol)?;
+        let mut x = vec![0.0; self.n];
+        self.assemble_whole(local_x, &mut x)?;
+        let norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        converged(x, iterations, residual, norm, reason)
+    }
+
+    /// [`Self::solve`] on this rank's rows alone (PETSc's order, [`Self::distribution`];
+    /// collective): `rhs` and the answer hold this rank's rows, and no rank holds a whole
+    /// vector. On one process, the whole vectors in our numbering.
+    pub fn solve_rows(&self, rhs: &[f64]) -> Result<(Vec<f64>, CgStats), LinalgError> {
+        let Layout::Shared(_) = &self.layout else {
+            return self.solve(rhs);
+        };
+        if rhs.len() != self.local_len() {
+            return Err(LinalgError::Sizes(format!(
+                "a right-hand side of {} values for this rank's {} rows",
+                rhs.len(),
+                self.local_len()
+            )));
+        }
+        let (x, iterations, residual, reason) = self.solve_local(rhs, self.rtol)?;
+        // Every rank's sum of squares, added in rank order: the same norm on every rank.
+        let squares = rhs.iter().map(|v| v * v).sum::<f64>();
+        let squares = gather_values(&[squares], &vec![1; world_ranks()?.size], false)?;
+        converged(
+            x,
+            iterations,
+            residual,
+            squares.iter().sum::<f64>().sqrt(),
+            reason,
+        )
+    }
+
+    /// PETSc's CG from `x = 0` on this rank's rows of the right-hand side (as PETSc's vectors
+    /// hold them): the rows of the answer, the iterations, the residual's norm and PETSc's
+    /// reason.
+    fn solve_local(
+        &self,
+        local_rhs: &[f64],
+        rtol: f64,
+    ) -> Result<(Vec<f64>, usize, f64, c_int), LinalgError> {
         let mut local_x = self.local_buffer();
         let (mut iterations, mut residual, mut reason) = (0i64, 0.0, 0);
         let mut step = std::ptr::null();
@@ -632,33 +674,42 @@ impl CgAmg {
         if code != 0 {
             return Err(petsc_error(step, code));
         }
-        let mut x = vec![0.0; self.n];
-        self.assemble_whole(local_x, &mut x)?;
-        let iterations = iterations.max(0) as usize;
-        let norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let relative_residual = if norm > 0.0 {
-            residual / norm
-        } else {
-            residual
-        };
-        // Converged on the relative (2, 1) or absolute (3, 9) residual, or CG's exact
-        // breakdown (8); CONVERGED_ITS and the CG trust-region reasons do not apply here.
-        if !matches!(reason, 1 | 2 | 3 | 8 | 9) {
-            return Err(LinalgError::NotConverged {
-                // SAFETY: plain lookup of a static string.
-                reason: text(unsafe { internodes_ksp_reason_name(reason) }),
-                iterations,
-                relative_residual,
-            });
-        }
-        Ok((
-            x,
-            CgStats {
-                iterations,
-                relative_residual,
-            },
-        ))
+        Ok((local_x, iterations.max(0) as usize, residual, reason))
     }
+}
+
+/// The answer `x` of a CG solve with its statistics, or [`LinalgError::NotConverged`] unless
+/// PETSc's `reason` says it converged; `residual` is the residual's norm, `norm` the
+/// right-hand side's.
+fn converged(
+    x: Vec<f64>,
+    iterations: usize,
+    residual: f64,
+    norm: f64,
+    reason: c_int,
+) -> Result<(Vec<f64>, CgStats), LinalgError> {
+    let relative_residual = if norm > 0.0 {
+        residual / norm
+    } else {
+        residual
+    };
+    // Converged on the relative (2, 1) or absolute (3, 9) residual, or CG's exact
+    // breakdown (8); CONVERGED_ITS and the CG trust-region reasons do not apply here.
+    if !matches!(reason, 1 | 2 | 3 | 8 | 9) {
+        return Err(LinalgError::NotConverged {
+            // SAFETY: plain lookup of a static string.
+            reason: text(unsafe { internodes_ksp_reason_name(reason) }),
+            iterations,
+            relative_residual,
+        });
+    }
+    Ok((
+        x,
+        CgStats {
+            iterations,
+            relative_residual,
+        },
+    ))
 }
 
 impl CgAmg {
