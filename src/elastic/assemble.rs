@@ -4,7 +4,8 @@
 //! One process assembles the whole `K_c`. A rank of a distributed run (`crate::parallel`)
 //! assembles only the rows of its own nodes (`crate::linalg::Distribution`: a METIS partition
 //! of the body's nodes), which go to PETSc; what every rank needs whole is small or a vector:
-//! `f_c` (each rank computes its rows, then all are gathered), the rows of `K` at the
+//! `f_c` (each rank computes its rows, then their nonzero entries are gathered: a load vector
+//! kept sparse where few dofs carry one, `crate::fem::LoadVector`), the rows of `K` at the
 //! prescribed dofs (every rank assembles those columns: the cells along the Dirichlet groups)
 //! and the largest diagonal entry (the largest of the ranks').
 
@@ -399,7 +400,7 @@ pub fn assemble(
         constraints,
         stiffness: constrained.stiffness,
         k_scale: constrained.k_scale,
-        f_c: LoadVector::new(constrained.f_c),
+        f_c: constrained.f_c,
         rigid,
         parts,
     })
@@ -507,7 +508,7 @@ fn path_loads(problem: &ElasticProblem) -> Vec<PathLoads> {
 struct ConstrainedStiffness {
     graph: Option<NodeGraph>,
     stiffness: Stiffness,
-    f_c: Vec<f64>,
+    f_c: LoadVector,
     prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
     k_scale: f64,
 }
@@ -551,7 +552,7 @@ fn whole_stiffness(
         graph: Some(graph),
         k_scale: largest_diagonal(&k_c),
         stiffness: Stiffness::Whole { k_c, coordinates },
-        f_c,
+        f_c: LoadVector::new(f_c),
         prescribed_rows,
     }
 }
@@ -559,7 +560,7 @@ fn whole_stiffness(
 /// This rank's rows of `K_c` in a distributed run: the body's nodes are partitioned (as the
 /// mesh's [`crate::mesh::RankPart`] says, where the run kept only this rank's cells), the
 /// columns of this rank's nodes assembled and constrained (its rows: `K` is symmetric), and
-/// its rows of `f_c` computed and gathered whole on every rank. Every rank assembles the
+/// its rows of `f_c` computed and their nonzero entries gathered on every rank. Every rank assembles the
 /// columns at the prescribed dofs too (the cells along the Dirichlet groups), for the
 /// reactions. Where the rank kept only its cells, a body force in `f` and in the `parts` is
 /// right at its own nodes only: those vectors are made whole from their owners' entries.
@@ -611,10 +612,11 @@ fn rank_stiffness(
         .collect();
     drop(prescribed);
 
-    let mut f_c = vec![0.0; f.len()];
+    let mut f_c = LoadVector::new(Vec::new());
     let local_largest = timed(stats, verbose, "apply Dirichlet conditions", || {
         let local_f_c = constraints.apply_to_columns(&mut columns, f);
-        distribution.gather(&distribution.in_petsc_order(&local_f_c), &mut f_c)?;
+        let own = (local_f_c.iter().enumerate()).map(|(q, &value)| (columns.dof(q), value));
+        f_c = LoadVector::from_entries(f.len(), distribution.gather_nonzero(own)?);
         Ok::<_, LinalgError>(
             (0..columns.num_columns())
                 .flat_map(|q| {
@@ -642,7 +644,10 @@ fn rank_stiffness(
 
 /// The distribution of a body whose nodes rank 0 divided among the ranks (`crate::run`'s
 /// partition): each rank orders its own nodes along the Z curve within the whole body's box
-/// ([`own_order`]), and the ranks' orders are gathered one after the other (collective).
+/// ([`own_order`]), PETSc numbering rank 0's first, then rank 1's, and so on; each rank learns
+/// the PETSc node of every node it reads that another rank owns from that rank (one
+/// `MPI_Alltoallv` of the questions, one of the answers), so that no rank holds the whole
+/// body's order (collective).
 fn partitioned_distribution(body: &BodyMesh, ranks: Ranks) -> Result<Distribution, LinalgError> {
     let dim = body.dim;
     let (mut own, mut coords) = (Vec::new(), Vec::new());
@@ -652,23 +657,63 @@ fn partitioned_distribution(body: &BodyMesh, ranks: Ranks) -> Result<Distributio
     }
     let extent = body.extent();
     let order = own_order(&own, &coords, &extent.low[..dim], &extent.high[..dim]);
+    drop((own, coords));
     let nodes_per_rank: Vec<usize> = (crate::parallel::gather(order.len() as f64).map_err(mpi)?)
         .into_iter()
         .map(|count| count as usize)
         .collect();
-    let sent: Vec<f64> = order.iter().map(|&a| f64::from(a)).collect();
-    let nodes: Vec<u32> = (crate::parallel::all_gather(&sent, &nodes_per_rank).map_err(mpi)?)
-        .into_iter()
-        .map(|a| a as u32)
-        .collect();
-    // This rank reads the nodes whose coordinates it keeps, and knows their PETSc nodes only.
-    let known: Vec<u32> = body.coords.kept().map(|(a, _)| a as u32).collect();
-    Ok(Distribution::from_order(
-        &nodes,
+    // The PETSc node of each of this rank's nodes, by our node.
+    let first = nodes_per_rank[..ranks.rank].iter().sum::<usize>() as u32;
+    let mut own_petsc: Vec<(u32, u32)> =
+        (order.iter().zip(first..)).map(|(&a, p)| (a, p)).collect();
+    own_petsc.sort_unstable();
+    let petsc_of_own = |a: u32| {
+        (own_petsc.binary_search_by_key(&a, |&(b, _)| b))
+            .map(|at| own_petsc[at].1)
+            .map_err(|_| LinalgError::Sizes(format!("node {a} is not this rank's own")))
+    };
+    // This rank reads the nodes whose coordinates it keeps, and knows their PETSc nodes only:
+    // its own from its order, the others' asked of their owners.
+    let mut known = Vec::with_capacity(body.coords.kept().len());
+    let (mut asked, mut waiting) = (vec![Vec::new(); ranks.size], vec![Vec::new(); ranks.size]);
+    for (a, _) in body.coords.kept() {
+        let owner = (body.owner(a))
+            .ok_or_else(|| LinalgError::Partition(format!("node {a} kept without its owner")))?;
+        if owner as usize == ranks.rank {
+            known.push((a as u32, petsc_of_own(a as u32)?));
+        } else {
+            asked[owner as usize].push(a as f64);
+            waiting[owner as usize].push(known.len());
+            known.push((a as u32, u32::MAX));
+        }
+    }
+    let questions = crate::parallel::exchange(asked).map_err(mpi)?;
+    let answers = (questions.iter())
+        .map(|nodes| {
+            (nodes.iter())
+                .map(|&a| petsc_of_own(a as u32).map(f64::from))
+                .collect::<Result<Vec<f64>, _>>()
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let answered = crate::parallel::exchange(answers).map_err(mpi)?;
+    for (places, answer) in waiting.iter().zip(&answered) {
+        if answer.len() != places.len() {
+            return Err(LinalgError::Sizes(format!(
+                "{} PETSc nodes answered for {} nodes asked",
+                answer.len(),
+                places.len()
+            )));
+        }
+        for (&k, &p) in places.iter().zip(answer) {
+            known[k].1 = p as u32;
+        }
+    }
+    Ok(Distribution::from_parts(
+        order,
         &nodes_per_rank,
         dim,
         ranks,
-        Some(&known),
+        known,
     ))
 }
 

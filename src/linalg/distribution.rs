@@ -11,8 +11,9 @@
 //! products of GAMG's set-up and V-cycles: `super::node_order`), each node's `dim` unknowns
 //! together (the block structure GAMG aggregates by). Rank 0 partitions the body
 //! (`crate::run`'s partition); each rank orders its own nodes along the curve ([`own_order`]),
-//! the orders are gathered into PETSc's numbering, and a rank keeps the PETSc number of the
-//! nodes it reads only (its own, its cells', its boundary's). It assembles the columns of its
+//! and a rank keeps the PETSc number of the nodes it reads only (its own, its cells', its
+//! boundary's), asked of their owners ([`Distribution::from_parts`]: no rank gathers the whole
+//! order). It assembles the columns of its
 //! own nodes only ([`crate::fem::NodeColumns`]: its rows, `K` being symmetric; in our order)
 //! and hands them to PETSc, in PETSc's order, as [`RankRows`].
 //!
@@ -218,14 +219,8 @@ impl Distribution {
         known: Option<&[u32]>,
     ) -> Self {
         debug_assert_eq!(nodes.len(), nodes_per_rank.iter().sum::<usize>());
-        let counts: Vec<usize> = nodes_per_rank.iter().map(|&n| n * block).collect();
-        let first = counts[..ranks.rank].iter().sum::<usize>() / block;
-        let local = counts[ranks.rank] / block;
-        let own = nodes[first..first + local].to_vec();
-        let mut own_sorted: Vec<(u32, u32)> = (own.iter().zip(0..))
-            .map(|(&node, place)| (node, place))
-            .collect();
-        own_sorted.sort_unstable();
+        let first: usize = nodes_per_rank[..ranks.rank].iter().sum();
+        let own = nodes[first..first + nodes_per_rank[ranks.rank]].to_vec();
         let mut all: Vec<(u32, u32)> = (nodes.iter().zip(0..)).map(|(&a, p)| (a, p)).collect();
         all.sort_unstable();
         let known = match known {
@@ -240,6 +235,32 @@ impl Distribution {
                     .collect()
             }
         };
+        Self::from_parts(own, nodes_per_rank, block, ranks, known)
+    }
+
+    /// The distribution in which this rank's nodes are `own` (in PETSc's order), rank `r` has
+    /// `nodes_per_rank[r]`, and this rank reads the nodes of `known` (each with its PETSc
+    /// node, increasing by our node): what [`Self::from_order`] makes from the whole order,
+    /// without it.
+    pub fn from_parts(
+        own: Vec<u32>,
+        nodes_per_rank: &[usize],
+        block: usize,
+        ranks: Ranks,
+        known: Vec<(u32, u32)>,
+    ) -> Self {
+        debug_assert_eq!(own.len(), nodes_per_rank[ranks.rank]);
+        debug_assert!(
+            known.windows(2).all(|w| w[0].0 < w[1].0),
+            "known increasing"
+        );
+        let counts: Vec<usize> = nodes_per_rank.iter().map(|&n| n * block).collect();
+        let first = counts[..ranks.rank].iter().sum::<usize>() / block;
+        let local = counts[ranks.rank] / block;
+        let mut own_sorted: Vec<(u32, u32)> = (own.iter().zip(0..))
+            .map(|(&node, place)| (node, place))
+            .collect();
+        own_sorted.sort_unstable();
         Self {
             own,
             known,
@@ -282,19 +303,6 @@ impl Distribution {
             .iter()
             .map(|&(node, _)| node as usize)
             .collect()
-    }
-
-    /// Values at this rank's unknowns in the order of its [`NodeColumns`] (its nodes
-    /// increasing) in PETSc's order, as [`Self::gather`] takes them.
-    pub fn in_petsc_order(&self, in_node_order: &[f64]) -> Vec<f64> {
-        let block = self.block;
-        let mut petsc = vec![0.0; in_node_order.len()];
-        for (q, &(_, place)) in self.own_sorted.iter().enumerate() {
-            let p = place as usize;
-            petsc[p * block..(p + 1) * block]
-                .copy_from_slice(&in_node_order[q * block..(q + 1) * block]);
-        }
-        petsc
     }
 
     /// This rank's rows for PETSc: `columns` (of this rank's [`Self::nodes`], constrained)
@@ -501,6 +509,29 @@ impl Distribution {
             }
         }
         Ok(values)
+    }
+
+    /// The nonzero entries `(unknown, value)` (our numbering) of a vector whose values each
+    /// rank holds at its own unknowns, `own` this rank's (at its unknowns only), gathered onto
+    /// every rank by increasing unknown (`MPI_Allgatherv` of the entries): a vector nonzero at
+    /// few unknowns crosses the ranks without a vector of the body's size (collective).
+    pub fn gather_nonzero(
+        &self,
+        own: impl Iterator<Item = (usize, f64)>,
+    ) -> Result<Vec<(usize, f64)>, LinalgError> {
+        let mpi = |e: crate::parallel::ParallelError| LinalgError::Mpi(e.to_string());
+        // `[unknown, value]` pairs: an unknown is exact in an f64.
+        let sent: Vec<f64> = (own.filter(|&(_, value)| value != 0.0))
+            .flat_map(|(unknown, value)| [unknown as f64, value])
+            .collect();
+        let counts = crate::parallel::gather(sent.len() as f64).map_err(mpi)?;
+        let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
+        let every = crate::parallel::all_gather(&sent, &counts).map_err(mpi)?;
+        let mut entries: Vec<(usize, f64)> = (every.chunks_exact(2))
+            .map(|pair| (pair[0] as usize, pair[1]))
+            .collect();
+        entries.sort_unstable_by_key(|&(unknown, _)| unknown);
+        Ok(entries)
     }
 
     /// Every rank's `local` rows (PETSc's order) into `whole` (our numbering), on every rank:

@@ -218,20 +218,10 @@ pub fn complete_forces(
     bodies: &[&Distribution],
     forces: &mut [&mut LoadVector],
 ) -> Result<(), ContactError> {
-    let mpi = |e: crate::parallel::ParallelError| ContactError::Linalg(e.to_string());
     for (distribution, force) in bodies.iter().zip(forces.iter_mut()) {
-        // This rank's own unknowns' values as `[dof, value]` pairs (a dof is exact in an f64).
-        let own: Vec<f64> = (force.nonzero_entries())
-            .filter(|&(dof, _)| distribution.own_row(dof).is_some())
-            .flat_map(|(dof, value)| [dof as f64, value])
-            .collect();
-        let counts = crate::parallel::gather(own.len() as f64).map_err(mpi)?;
-        let counts: Vec<usize> = counts.iter().map(|&c| c as usize).collect();
-        let every = crate::parallel::all_gather(&own, &counts).map_err(mpi)?;
-        let mut entries: Vec<(usize, f64)> = (every.chunks_exact(2))
-            .map(|pair| (pair[0] as usize, pair[1]))
-            .collect();
-        entries.sort_unstable_by_key(|&(dof, _)| dof);
+        let own = (force.nonzero_entries()).filter(|&(dof, _)| distribution.own_row(dof).is_some());
+        let entries =
+            (distribution.gather_nonzero(own)).map_err(|e| ContactError::Linalg(e.to_string()))?;
         **force = LoadVector::from_entries(force.len(), entries);
     }
     Ok(())
