@@ -560,9 +560,9 @@ fn whole_stiffness(
 /// This rank's rows of `K_c` in a distributed run: the body's nodes are partitioned (as the
 /// mesh's [`crate::mesh::RankPart`] says, where the run kept only this rank's cells), the
 /// columns of this rank's nodes assembled and constrained (its rows: `K` is symmetric), and
-/// its rows of `f_c` computed and their nonzero entries gathered on every rank. Every rank assembles the
-/// columns at the prescribed dofs too (the cells along the Dirichlet groups), for the
-/// reactions. Where the rank kept only its cells, a body force in `f` and in the `parts` is
+/// its rows of `f_c` computed and their nonzero entries gathered on every rank. Every rank
+/// assembles the columns at the prescribed dofs too (the cells along the Dirichlet groups),
+/// for the reactions. Where the rank kept only its cells, a body force in `f` and in the `parts` is
 /// right at its own nodes only: those vectors are made whole from their owners' entries.
 /// Collective: every rank calls it for every body, in the same order.
 #[allow(clippy::too_many_arguments)]
