@@ -612,21 +612,19 @@ fn rank_stiffness(
         .collect();
     drop(prescribed);
 
-    let mut f_c = LoadVector::new(Vec::new());
-    let local_largest = timed(stats, verbose, "apply Dirichlet conditions", || {
+    let (f_c, local_largest) = timed(stats, verbose, "apply Dirichlet conditions", || {
         let local_f_c = constraints.apply_to_columns(&mut columns, f);
         let own = (local_f_c.iter().enumerate()).map(|(q, &value)| (columns.dof(q), value));
-        f_c = LoadVector::from_entries(f.len(), distribution.gather_nonzero(own)?);
-        Ok::<_, LinalgError>(
-            (0..columns.num_columns())
-                .flat_map(|q| {
-                    let dof = columns.dof(q);
-                    let (rows, values) = columns.column(q);
-                    rows.iter().zip(values).filter(move |(i, _)| **i == dof)
-                })
-                .map(|(_, value)| value.abs())
-                .fold(0.0, f64::max),
-        )
+        let f_c = LoadVector::from_entries(f.len(), distribution.gather_nonzero(own)?);
+        let largest = (0..columns.num_columns())
+            .flat_map(|q| {
+                let dof = columns.dof(q);
+                let (rows, values) = columns.column(q);
+                rows.iter().zip(values).filter(move |(i, _)| **i == dof)
+            })
+            .map(|(_, value)| value.abs())
+            .fold(0.0, f64::max);
+        Ok::<_, LinalgError>((f_c, largest))
     })?;
     let k_scale = (crate::parallel::gather(local_largest).map_err(mpi)?)
         .into_iter()

@@ -270,21 +270,10 @@ impl BodySolver {
                 Ok(0)
             }
             #[cfg(feature = "petsc")]
-            Self::CgAmg(cg) => {
-                let mut most = 0;
-                if num_rhs == 0 || rhs.is_empty() {
-                    return Ok(0);
-                }
-                for column in rhs.chunks_mut(rhs.len() / num_rhs) {
-                    let (x, stats) = match rtol {
-                        Some(rtol) => cg.solve_within(column, rtol)?,
-                        None => cg.solve(column)?,
-                    };
-                    column.copy_from_slice(&x);
-                    most = most.max(stats.iterations);
-                }
-                Ok(most)
-            }
+            Self::CgAmg(cg) => each_column(rhs, num_rhs, |column| match rtol {
+                Some(rtol) => cg.solve_within(column, rtol),
+                None => cg.solve(column),
+            }),
         }
     }
 
@@ -298,18 +287,7 @@ impl BodySolver {
     ) -> Result<usize, LinalgError> {
         match self {
             #[cfg(feature = "petsc")]
-            Self::CgAmg(cg) if cg.distribution().is_some() => {
-                let mut most = 0;
-                if num_rhs == 0 || rhs.is_empty() {
-                    return Ok(0);
-                }
-                for column in rhs.chunks_mut(rhs.len() / num_rhs) {
-                    let (x, stats) = cg.solve_rows(column)?;
-                    column.copy_from_slice(&x);
-                    most = most.max(stats.iterations);
-                }
-                Ok(most)
-            }
+            Self::CgAmg(cg) => each_column(rhs, num_rhs, |column| cg.solve_rows(column)),
             _ => self.solve_in_place(rhs, num_rhs),
         }
     }
@@ -329,6 +307,27 @@ impl BodySolver {
             Self::CgAmg(cg) => cg.precondition(r, x),
         }
     }
+}
+
+/// Overwrites each of the `num_rhs` columns of `rhs` (one after the other) with its CG
+/// answer by `solve`, one column at a time (each CG solve holds PETSc exclusively); returns
+/// the most iterations a column took.
+#[cfg(feature = "petsc")]
+fn each_column(
+    rhs: &mut [f64],
+    num_rhs: usize,
+    solve: impl Fn(&[f64]) -> Result<(Vec<f64>, super::petsc::CgStats), LinalgError>,
+) -> Result<usize, LinalgError> {
+    if num_rhs == 0 || rhs.is_empty() {
+        return Ok(0);
+    }
+    let mut most = 0;
+    for column in rhs.chunks_mut(rhs.len() / num_rhs) {
+        let (x, stats) = solve(column)?;
+        column.copy_from_slice(&x);
+        most = most.max(stats.iterations);
+    }
+    Ok(most)
 }
 
 /// A CG + AMG solver whose matrix PETSc holds, its multigrid hierarchy not yet built
