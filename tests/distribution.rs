@@ -74,7 +74,7 @@ fn the_ranks_rows_are_the_whole_constrained_matrix() {
                 let mut columns =
                     NodeColumns::assemble(body, &material, &graph, distribution.nodes());
                 // This rank's entries of f_c, at the unknowns of its columns.
-                let values = constraints.apply_to_columns(&mut columns, &f);
+                let values = constraints.apply_to_columns(&mut columns, |dof| f[dof]);
                 let local_f_c: std::collections::HashMap<usize, f64> = (values.iter().enumerate())
                     .map(|(q, &value)| (columns.dof(q), value))
                     .collect();

@@ -368,20 +368,46 @@ fn a_load_path_on_two_ranks_gives_the_serial_answer() {
     // The demo's sphere pushed down along a load path that presses, then releases part way,
     // its lateral supports on the default path: each path's part of f_c is lifted from the
     // rows of K at the prescribed dofs, which every rank holds whole.
-    ranks_give_the_serial_answer_of(2, "hemisphere_on_block", "", 1, 0, &|case| {
-        case["contact"].as_table_mut().unwrap().remove("load_steps");
-        let paths: toml::Table = toml::from_str("press = [0.4, 1.0, 0.7]").unwrap();
-        case.insert("load_path".into(), paths.into());
-        let sphere = &mut case["body"].as_array_mut().unwrap()[0];
-        let top = sphere["dirichlet"].as_array_mut().unwrap();
-        let mut pushed = top[0].as_table().unwrap().clone();
-        for key in ["ux", "uy"] {
-            pushed.remove(key);
-        }
-        pushed.insert("path".into(), "press".into());
-        top[0].as_table_mut().unwrap().remove("uz");
-        top.push(pushed.into());
+    ranks_give_the_serial_answer_of(2, "hemisphere_on_block", "", 1, 0, &pressed_along_a_path);
+}
+
+#[test]
+fn a_body_force_beside_a_load_path_on_three_ranks_gives_the_serial_answer() {
+    // The load path above with each body under its weight (on the default path): each rank
+    // keeps its part of f and of each path's f_c (its own and the prescribed dofs), never the
+    // whole vectors, and the reactions at the base read the weight at the prescribed dofs.
+    ranks_give_the_serial_answer_of(3, "hemisphere_on_block", "", 1, 0, &|case| {
+        pressed_along_a_path(case);
+        under_weight(case, [0.02, 0.1]);
     });
+}
+
+/// The demo's sphere pushed down along the load path `press`, which presses, then releases
+/// part way, its lateral supports on the default path.
+fn pressed_along_a_path(case: &mut toml::Table) {
+    case["contact"].as_table_mut().unwrap().remove("load_steps");
+    let paths: toml::Table = toml::from_str("press = [0.4, 1.0, 0.7]").unwrap();
+    case.insert("load_path".into(), paths.into());
+    let sphere = &mut case["body"].as_array_mut().unwrap()[0];
+    let top = sphere["dirichlet"].as_array_mut().unwrap();
+    let mut pushed = top[0].as_table().unwrap().clone();
+    for key in ["ux", "uy"] {
+        pushed.remove(key);
+    }
+    pushed.insert("path".into(), "press".into());
+    top[0].as_table_mut().unwrap().remove("uz");
+    top.push(pushed.into());
+}
+
+/// Each body of `case` under a body force `-weights[k]` along `z`.
+fn under_weight(case: &mut toml::Table, weights: [f64; 2]) {
+    let bodies = case["body"].as_array_mut().unwrap();
+    for (body, weight) in bodies.iter_mut().zip(weights) {
+        let force = toml::Value::Array(vec![0.0.into(), 0.0.into(), (-weight).into()]);
+        body.as_table_mut()
+            .unwrap()
+            .insert("body_force".into(), force);
+    }
 }
 
 #[test]
@@ -524,31 +550,19 @@ fn a_stack_of_three_2d_bodies_on_two_ranks_gives_the_serial_answer() {
 #[test]
 fn a_body_force_on_three_ranks_gives_the_serial_answer() {
     // The hemisphere pressed by a force, each body under its weight (the block's 3.2, which
-    // its base carries, the sphere's 0.04 against the force of 0.8). Each rank keeps only the cells around its own and the
-    // prescribed nodes, so its body force is right at its own and the prescribed nodes only
-    // until the load vector is made whole from the owners' entries (the answer reads it
-    // there alone, but for the resultant that places a force-controlled body's first contact
-    // zone, which must be the same on every rank). Solved to 1e-9 h as the test without
-    // weight.
+    // its base carries, the sphere's 0.04 against the force of 0.8). Each rank keeps only the
+    // cells around its own and the prescribed nodes, so its body force is right at its own and
+    // the prescribed nodes only, and that part is all it keeps of the load vector (the answer
+    // reads it there alone; the resultant that places a force-controlled body's first contact
+    // zone, which must be the same on every rank, adds the ranks' sums over their own dofs).
+    // Solved to 1e-9 h as the test without weight.
     ranks_give_the_serial_answer_of(
         3,
         "hemisphere_pressed_by_force",
         "penetration_tolerance = 1e-9",
         1,
         0,
-        &|case| {
-            for (body, weight) in case["body"]
-                .as_array_mut()
-                .unwrap()
-                .iter_mut()
-                .zip([0.02, 0.1])
-            {
-                let force = toml::Value::Array(vec![0.0.into(), 0.0.into(), (-weight).into()]);
-                body.as_table_mut()
-                    .unwrap()
-                    .insert("body_force".into(), force);
-            }
-        },
+        &|case| under_weight(case, [0.02, 0.1]),
     );
 }
 

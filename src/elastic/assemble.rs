@@ -7,7 +7,10 @@
 //! `f_c` (each rank computes its rows, then their nonzero entries are gathered: a load vector
 //! kept sparse where few dofs carry one, `crate::fem::LoadVector`), the rows of `K` at the
 //! prescribed dofs (every rank assembles those columns: the cells along the Dirichlet groups)
-//! and the largest diagonal entry (the largest of the ranks').
+//! and the largest diagonal entry (the largest of the ranks'). `f` is summed at the nodes the
+//! process keeps (`crate::fem::loads::LoadSum`), never over the whole body on a rank; a body
+//! force, which loads most dofs and which a rank knows only around its own and the prescribed
+//! nodes, stays the rank's part there (`LoadVector::Part`), and so does `f_c` at its rows.
 
 use std::collections::HashMap;
 
@@ -15,12 +18,14 @@ use faer::sparse::SparseColMat;
 
 use super::StepFactors;
 use super::error::SolveError;
-use super::problem::{ElasticProblem, ForcedComponent, constraints, forced_components};
+use super::problem::{
+    ElasticProblem, ForcedComponent, LoadCondition, constraints, forced_components,
+};
 use super::solution::{SolveStats, timed};
 use crate::fem::assembly::{assemble_stiffness, stiffness_graph, stiffness_pattern};
-use crate::fem::loads::{add_body_force, add_surface_load};
+use crate::fem::loads::{LoadSum, add_body_force, add_surface_load};
 use crate::fem::{Constraints, LoadVector, NodeColumns, NodeGraph};
-use crate::linalg::{Distribution, LinalgError, RankRows, own_order};
+use crate::linalg::{BodyRows, Distribution, LinalgError, RankRows, own_order};
 use crate::mesh::BodyMesh;
 use crate::parallel::ranks::Ranks;
 
@@ -37,8 +42,11 @@ pub struct AssembledBody {
     /// all the reactions need of it. The whole `K` is not kept: at a million DOFs it is a
     /// gigabyte beside `K_c` and the solver's own copies.
     pub prescribed_rows: Vec<(usize, Vec<(usize, f64)>)>,
-    /// The loads as assembled.
+    /// The loads as assembled (on a rank with a body force, its part:
+    /// [`LoadVector::Part`]).
     pub f: LoadVector,
+    /// The sum of each component of `f` over the whole body (the resultant's).
+    pub load_sums: Vec<f64>,
     pub constraints: Constraints,
     /// The constrained stiffness `K_c`: whole, or this rank's rows of it.
     pub stiffness: Stiffness,
@@ -65,6 +73,8 @@ pub struct RhsPart {
     pub path: Option<String>,
     /// The loads that follow it (with the body force on the default path), assembled.
     pub f: LoadVector,
+    /// The sum of each component of `f` over the whole body.
+    pub load_sums: Vec<f64>,
     /// Its constrained right-hand side: at a free dof its loads less the pull of the values it
     /// prescribes (`-K_FD g_D`), at a prescribed dof `K_dd g_d` of its own value (0 at the
     /// dofs other paths prescribe), so that `sum_p s_p f_c(p)` is `f_c` of the loads and
@@ -139,7 +149,6 @@ impl AssembledBody {
     /// force-controlled groups at a step of `factors`.
     pub fn resultant(&self, factors: &StepFactors) -> f64 {
         let dim = self.dim;
-        let sum = |f: &LoadVector, c: usize| f.component_sum(c, dim);
         let magnitude = |force: &dyn Fn(&RigidColumn) -> f64, loads: &dyn Fn(usize) -> f64| {
             (0..dim)
                 .map(|c| {
@@ -154,13 +163,13 @@ impl AssembledBody {
         };
         if self.parts.is_empty() && self.rigid.iter().all(|r| r.path.is_none()) {
             // At factor 1, then scaled: the operations of one factor for all.
-            return factors.default * magnitude(&|rigid| rigid.force, &|c| sum(&self.f, c));
+            return factors.default * magnitude(&|rigid| rigid.force, &|c| self.load_sums[c]);
         }
         let force = |rigid: &RigidColumn| factors.of(rigid.path.as_deref()) * rigid.force;
         let loads = |c: usize| match self.parts.is_empty() {
-            true => factors.default * sum(&self.f, c),
+            true => factors.default * self.load_sums[c],
             false => (self.parts.iter())
-                .map(|part| factors.of(part.path.as_deref()) * sum(&part.f, c))
+                .map(|part| factors.of(part.path.as_deref()) * part.load_sums[c])
                 .sum(),
         };
         magnitude(&force, &loads)
@@ -266,8 +275,8 @@ fn rigid_columns(
     forced: Vec<ForcedComponent>,
     prescribed_rows: &[(usize, Vec<(usize, f64)>)],
     constraints: &Constraints,
-    f: &[f64],
-    parts: &[PathLoads],
+    f: &LoadVector,
+    parts: &[PathLoads<LoadVector>],
 ) -> Vec<RigidColumn> {
     let mut owner: HashMap<usize, usize> = HashMap::new();
     for (r, component) in forced.iter().enumerate() {
@@ -286,9 +295,9 @@ fn rigid_columns(
             let (mut diagonal, mut applied) = (0.0, 0.0);
             let mut applied_parts = vec![0.0; parts.len()];
             for &d in &component.dofs {
-                applied += f[d];
+                applied += f.get(d);
                 for (a, part) in applied_parts.iter_mut().zip(parts) {
-                    *a += part.f[d];
+                    *a += part.f.get(d);
                 }
                 for &(j, value) in row(d) {
                     match (constraints.value(j), owner.get(&j)) {
@@ -338,26 +347,20 @@ pub fn assemble(
     let constraints = constraints(problem)?;
     stats.num_prescribed_dofs = constraints.num_fixed();
 
-    // 1. Load vector f: surface loads and body force.
-    let mut f = timed(stats, verbose, "assemble loads", || {
-        let mut f = vec![0.0; body.num_dofs()];
-        for load in &problem.loads {
-            let group = body
-                .boundary_group(&load.group)
-                .expect("groups are checked first");
-            add_surface_load(body, group, &load.load, &mut f);
-        }
-        if let Some(b) = &problem.body_force {
-            add_body_force(body, b, &mut f);
-        }
-        f
+    // 1. Load vector f: surface loads and body force, summed at the nodes this process keeps.
+    let f = timed(stats, verbose, "assemble loads", || {
+        load_sum(problem, |_| true, true)
     });
 
     // With named load paths, f split by path (its parts' constrained `f_c` follow below).
-    let mut path_loads = path_loads(problem);
+    let path_loads = path_loads(problem);
 
     // 2. K_c and f_c, and the rows of K at the prescribed dofs.
     let ranks = crate::parallel::ranks();
+    let linalg = |source| SolveError::Linalg {
+        body: body.name.clone(),
+        source,
+    };
     let constrained = match ranks.size {
         1 => whole_stiffness(
             problem,
@@ -367,21 +370,28 @@ pub fn assemble(
             stats,
             verbose,
         ),
-        _ => rank_stiffness(
-            problem,
-            &constraints,
-            &mut f,
-            &mut path_loads,
-            ranks,
-            stats,
-            verbose,
-        )
-        .map_err(|source| SolveError::Linalg {
-            body: body.name.clone(),
-            source,
-        })?,
+        _ => rank_stiffness(problem, &constraints, &f, ranks, stats, verbose).map_err(linalg)?,
     };
-    // 3. The force-controlled components, and with named load paths f_c split by path.
+
+    // 3. f as this process keeps it: whole (or sparse) where it knows every entry; with a
+    //    body force on a rank that keeps only the cells around its own and the prescribed
+    //    nodes, the rank's part: its own dofs and the prescribed ones, all it reads.
+    let own = match (&constrained.stiffness, body_force_in_part(problem)) {
+        (Stiffness::Rows(rows), true) => Some(&rows.distribution),
+        _ => None,
+    };
+    let kept = |sum: LoadSum| match own {
+        None => sum.into_whole(),
+        Some(distribution) => {
+            sum.into_part(|dof| distribution.own_row(dof).is_some() || constraints.is_fixed(dof))
+        }
+    };
+    let f = kept(f);
+    let path_loads: Vec<PathLoads<LoadVector>> = (path_loads.into_iter())
+        .map(|part| part.map(kept))
+        .collect();
+
+    // 4. The force-controlled components, and with named load paths f_c split by path.
     let rigid = rigid_columns(
         forced_components(problem),
         &constrained.prescribed_rows,
@@ -390,13 +400,16 @@ pub fn assemble(
         &path_loads,
     );
     let parts = (path_loads.into_iter())
-        .map(|part| part.constrained(&constraints, &constrained.prescribed_rows))
-        .collect();
+        .map(|part| part.constrained(dim, &constraints, &constrained.prescribed_rows, own))
+        .collect::<Result<_, _>>()
+        .map_err(linalg)?;
+    let load_sums = load_sums(&f, dim, own).map_err(linalg)?;
     Ok(AssembledBody {
         dim,
         graph: constrained.graph,
         prescribed_rows: constrained.prescribed_rows,
-        f: LoadVector::new(f),
+        f,
+        load_sums,
         constraints,
         stiffness: constrained.stiffness,
         k_scale: constrained.k_scale,
@@ -406,15 +419,75 @@ pub fn assemble(
     })
 }
 
-/// The loads and prescribed values of one load path ([`path_loads`]).
-struct PathLoads {
+/// Whether the body has a body force and this rank keeps only its part of the cells: its
+/// load vector is then known at its own and the prescribed nodes only.
+fn body_force_in_part(problem: &ElasticProblem) -> bool {
+    problem.body_force.is_some() && problem.body.part.is_some()
+}
+
+/// The loads of `problem` that `follows` selects (in the case's order), then its body force
+/// with `body_force`, summed at the nodes this process keeps ([`LoadSum`]).
+fn load_sum<'m>(
+    problem: &ElasticProblem<'m>,
+    follows: impl Fn(&LoadCondition) -> bool,
+    body_force: bool,
+) -> LoadSum<'m> {
+    let body = problem.body;
+    let mut sum = LoadSum::new(body);
+    let mut add = |dof, value| sum.add(dof, value);
+    for load in problem.loads.iter().filter(|load| follows(load)) {
+        let group = body
+            .boundary_group(&load.group)
+            .expect("groups are checked first");
+        add_surface_load(body, group, &load.load, &mut add);
+    }
+    if let (true, Some(b)) = (body_force, &problem.body_force) {
+        add_body_force(body, b, &mut add);
+    }
+    sum
+}
+
+/// The sum of each component of `f`, for the resultant: over every entry in dof order (a
+/// whole vector's sum, to the bit), or, where this rank keeps its part of `f` (`own`), over
+/// its own dofs, added to the other ranks' sums in rank order (collective).
+fn load_sums(
+    f: &LoadVector,
+    dim: usize,
+    own: Option<&Distribution>,
+) -> Result<Vec<f64>, LinalgError> {
+    let Some(distribution) = own else {
+        return Ok((0..dim).map(|c| f.component_sum(c, dim)).collect());
+    };
+    let mut sums = vec![0.0; dim];
+    for (dof, value) in f.nonzero_entries() {
+        if distribution.own_row(dof).is_some() {
+            sums[dof % dim] += value;
+        }
+    }
+    BodyRows::new(Some(distribution), f.len()).sum_over_ranks(sums)
+}
+
+/// The loads and prescribed values of one load path ([`path_loads`]): `f` being summed
+/// ([`LoadSum`]), then as this process keeps it ([`LoadVector`]).
+struct PathLoads<F> {
     path: Option<String>,
-    f: Vec<f64>,
+    f: F,
     /// Its nonzero prescribed values, by dof.
     values: HashMap<usize, f64>,
 }
 
-impl PathLoads {
+impl<F> PathLoads<F> {
+    /// The same path with `f` kept as `kept` makes it.
+    fn map<G>(self, kept: impl Fn(F) -> G) -> PathLoads<G> {
+        PathLoads {
+            path: self.path,
+            f: kept(self.f),
+            values: self.values,
+        }
+    }
+}
+
+impl PathLoads<LoadVector> {
     /// The value this path prescribes at the prescribed dof `dof` (0 where another path
     /// prescribes it).
     fn value(&self, dof: usize) -> f64 {
@@ -422,43 +495,40 @@ impl PathLoads {
     }
 
     /// This path's part of the right-hand side: `f_c` of its loads and values, the rows of `K`
-    /// at the prescribed dofs giving the pull of the values on the free dofs (`K` is
-    /// symmetric: a row is a column), as [`Constraints::apply`] eliminates them. From the rows
-    /// every rank holds whole, so a distributed run computes it as one process does.
+    /// at the prescribed dofs giving the pull of the values on the free dofs
+    /// ([`Constraints::apply_to_load`]), and the sums of its loads. From the rows every rank
+    /// holds whole, so a distributed run computes it as one process does; where the rank keeps
+    /// its part of `f` (`own`), it keeps `f_c` at its own dofs, the rows it reads (collective
+    /// then, for the sums).
     fn constrained(
         self,
+        dim: usize,
         constraints: &Constraints,
         prescribed_rows: &[(usize, Vec<(usize, f64)>)],
-    ) -> RhsPart {
-        let mut f_c = self.f.clone();
-        for (j, _) in prescribed_rows {
-            f_c[*j] = 0.0;
-        }
-        for (j, row) in prescribed_rows {
-            let g = self.value(*j);
-            if g == 0.0 {
-                continue;
+        own: Option<&Distribution>,
+    ) -> Result<RhsPart, LinalgError> {
+        let f_c = constraints.apply_to_load(&self.f, prescribed_rows, |j| self.value(j));
+        let f_c = match own {
+            None => f_c,
+            Some(distribution) => {
+                let entries = f_c.nonzero_entries();
+                let own_entries = entries.filter(|&(d, _)| distribution.own_row(d).is_some());
+                LoadVector::part(f_c.len(), own_entries.collect())
             }
-            for &(i, k) in row {
-                if i == *j {
-                    f_c[i] = k * g;
-                } else if !constraints.is_fixed(i) {
-                    f_c[i] -= k * g;
-                }
-            }
-        }
-        RhsPart {
+        };
+        Ok(RhsPart {
             path: self.path,
-            f: LoadVector::new(self.f),
-            f_c: LoadVector::new(f_c),
-        }
+            load_sums: load_sums(&self.f, dim, own)?,
+            f: self.f,
+            f_c,
+        })
     }
 }
 
 /// The loads and prescribed values of `problem` by load path, the default path first, then
 /// the named ones by name: empty unless a load or Dirichlet condition follows a named path
 /// (the forces' paths are their `RigidColumn`s'). The body force follows the default path.
-fn path_loads(problem: &ElasticProblem) -> Vec<PathLoads> {
+fn path_loads<'m>(problem: &ElasticProblem<'m>) -> Vec<PathLoads<LoadSum<'m>>> {
     let named: std::collections::BTreeSet<&str> = (problem.loads.iter())
         .map(|l| l.path.as_deref())
         .chain(problem.dirichlet.iter().map(|d| d.path.as_deref()))
@@ -472,16 +542,7 @@ fn path_loads(problem: &ElasticProblem) -> Vec<PathLoads> {
     let paths = std::iter::once(None).chain(named.into_iter().map(Some));
     paths
         .map(|path| {
-            let mut f = vec![0.0; body.num_dofs()];
-            for load in problem.loads.iter().filter(|l| l.path.as_deref() == path) {
-                let group = body
-                    .boundary_group(&load.group)
-                    .expect("groups are checked first");
-                add_surface_load(body, group, &load.load, &mut f);
-            }
-            if let (None, Some(b)) = (path, &problem.body_force) {
-                add_body_force(body, b, &mut f);
-            }
+            let f = load_sum(problem, |l| l.path.as_deref() == path, path.is_none());
             let mut values = HashMap::new();
             for condition in (problem.dirichlet.iter()).filter(|d| d.path.as_deref() == path) {
                 let nodes = body
@@ -519,7 +580,7 @@ struct ConstrainedStiffness {
 fn whole_stiffness(
     problem: &ElasticProblem,
     constraints: &Constraints,
-    f: &[f64],
+    f: &LoadSum,
     coordinates: Vec<f64>,
     stats: &mut SolveStats,
     verbose: bool,
@@ -546,7 +607,7 @@ fn whole_stiffness(
             .collect()
     };
     let (k_c, f_c) = timed(stats, verbose, "apply Dirichlet conditions", || {
-        constraints.apply(k, f)
+        constraints.apply(k, f.as_whole().expect("one process keeps every node"))
     });
     ConstrainedStiffness {
         graph: Some(graph),
@@ -562,15 +623,13 @@ fn whole_stiffness(
 /// columns of this rank's nodes assembled and constrained (its rows: `K` is symmetric), and
 /// its rows of `f_c` computed and their nonzero entries gathered on every rank. Every rank
 /// assembles the columns at the prescribed dofs too (the cells along the Dirichlet groups),
-/// for the reactions. Where the rank kept only its cells, a body force in `f` and in the `parts` is
-/// right at its own nodes only: those vectors are made whole from their owners' entries.
+/// for the reactions. Where the rank kept only its cells, a body force in `f` is right at its
+/// own and the prescribed nodes only: the rank keeps its rows of `f_c` then, not gathered.
 /// Collective: every rank calls it for every body, in the same order.
-#[allow(clippy::too_many_arguments)]
 fn rank_stiffness(
     problem: &ElasticProblem,
     constraints: &Constraints,
-    f: &mut Vec<f64>,
-    parts: &mut [PathLoads],
+    f: &LoadSum,
     ranks: Ranks,
     stats: &mut SolveStats,
     verbose: bool,
@@ -586,12 +645,6 @@ fn rank_stiffness(
         };
         distribution.map(|distribution| (graph, distribution))
     })?;
-    if body.part.is_some() && problem.body_force.is_some() {
-        for loads in std::iter::once(&mut *f).chain(parts.iter_mut().map(|part| &mut part.f)) {
-            let local = distribution.local_part(loads);
-            distribution.gather(&local, loads)?;
-        }
-    }
     let mut columns = timed(stats, verbose, "assemble stiffness", || {
         NodeColumns::assemble(body, &problem.material, &graph, distribution.nodes())
     });
@@ -613,9 +666,17 @@ fn rank_stiffness(
     drop(prescribed);
 
     let (f_c, local_largest) = timed(stats, verbose, "apply Dirichlet conditions", || {
-        let local_f_c = constraints.apply_to_columns(&mut columns, f);
+        let local_f_c = constraints.apply_to_columns(&mut columns, |dof| f.get(dof));
         let own = (local_f_c.iter().enumerate()).map(|(q, &value)| (columns.dof(q), value));
-        let f_c = LoadVector::from_entries(f.len(), distribution.gather_nonzero(own)?);
+        let len = body.num_dofs();
+        let f_c = match body_force_in_part(problem) {
+            true => {
+                let mut entries: Vec<(usize, f64)> = own.filter(|&(_, v)| v != 0.0).collect();
+                entries.sort_unstable_by_key(|&(dof, _)| dof);
+                LoadVector::part(len, entries)
+            }
+            false => LoadVector::from_entries(len, distribution.gather_nonzero(own)?),
+        };
         let largest = (0..columns.num_columns())
             .flat_map(|q| {
                 let dof = columns.dof(q);

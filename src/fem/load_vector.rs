@@ -8,6 +8,12 @@
 //! per unknown of the body (at 1M unknowns 8 MB a vector, at 100M 800 MB). So a vector with
 //! few nonzero entries keeps only those; one that most dofs load (a body force) is kept whole.
 //!
+//! A body force loads most dofs, and in a distributed run a rank keeps only the cells around
+//! its own nodes (and the prescribed ones): it knows the force there only, and keeps a
+//! [`LoadVector::Part`], the entries of those dofs, which are all it reads (its rows of the
+//! system and the reactions at the prescribed dofs). Gathered whole, `f` and `f_c` would cost
+//! every rank 16 bytes per unknown of the body for the whole run.
+//!
 //! Every value read from it is the one the whole vector gives, to the bit: a missing entry
 //! reads as `0.0`, and [`LoadVector::scaled`] writes `s * 0.0` there as the whole vector's
 //! product would (`-0.0` for a negative `s`); [`LoadVector::component_sum`] adds the entries
@@ -21,6 +27,13 @@ pub enum LoadVector {
     Whole(Vec<f64>),
     /// The entries that are not zero, by increasing dof, of a vector of `len` entries.
     Sparse {
+        len: usize,
+        entries: Vec<(usize, f64)>,
+    },
+    /// A rank's part of a vector of `len` entries ([module doc](self)): the nonzero entries at
+    /// the dofs whose value this rank knows, by increasing dof. It reads as the vector that is
+    /// zero elsewhere, so only those dofs may be read from it.
+    Part {
         len: usize,
         entries: Vec<(usize, f64)>,
     },
@@ -61,11 +74,21 @@ impl LoadVector {
         Self::Sparse { len, entries }
     }
 
+    /// A rank's part of a vector of `len` entries: its nonzero `entries` (by increasing dof) at
+    /// the dofs whose values it knows, never made whole.
+    pub fn part(len: usize, entries: Vec<(usize, f64)>) -> Self {
+        debug_assert!(
+            entries.windows(2).all(|w| w[0].0 < w[1].0),
+            "dofs increasing"
+        );
+        Self::Part { len, entries }
+    }
+
     /// The number of entries (the body's dofs).
     pub fn len(&self) -> usize {
         match self {
             Self::Whole(whole) => whole.len(),
-            Self::Sparse { len, .. } => *len,
+            Self::Sparse { len, .. } | Self::Part { len, .. } => *len,
         }
     }
 
@@ -77,7 +100,7 @@ impl LoadVector {
     pub fn get(&self, dof: usize) -> f64 {
         match self {
             Self::Whole(whole) => whole[dof],
-            Self::Sparse { entries, .. } => entries
+            Self::Sparse { entries, .. } | Self::Part { entries, .. } => entries
                 .binary_search_by_key(&dof, |&(d, _)| d)
                 .map_or(0.0, |k| entries[k].1),
         }
@@ -88,7 +111,7 @@ impl LoadVector {
     pub fn kept_entry(&self, dof: usize) -> Option<f64> {
         match self {
             Self::Whole(whole) => Some(whole[dof]),
-            Self::Sparse { entries, .. } => entries
+            Self::Sparse { entries, .. } | Self::Part { entries, .. } => entries
                 .binary_search_by_key(&dof, |&(d, _)| d)
                 .ok()
                 .map(|k| entries[k].1),
@@ -101,7 +124,9 @@ impl LoadVector {
             Self::Whole(whole) => {
                 Box::new((whole.iter().copied().enumerate()).filter(|&(_, v)| v != 0.0))
             }
-            Self::Sparse { entries, .. } => Box::new(entries.iter().copied()),
+            Self::Sparse { entries, .. } | Self::Part { entries, .. } => {
+                Box::new(entries.iter().copied())
+            }
         }
     }
 
@@ -114,7 +139,7 @@ impl LoadVector {
     pub fn scaled(&self, s: f64) -> Vec<f64> {
         match self {
             Self::Whole(whole) => whole.iter().map(|v| s * v).collect(),
-            Self::Sparse { len, entries } => {
+            Self::Sparse { len, entries } | Self::Part { len, entries } => {
                 let mut out = vec![s * 0.0; *len];
                 for &(d, v) in entries {
                     out[d] = s * v;
@@ -129,7 +154,7 @@ impl LoadVector {
     pub fn add_scaled_to(&self, s: f64, out: &mut [f64]) {
         match self {
             Self::Whole(whole) => out.iter_mut().zip(whole).for_each(|(o, v)| *o += s * v),
-            Self::Sparse { entries, .. } => {
+            Self::Sparse { entries, .. } | Self::Part { entries, .. } => {
                 for &(d, v) in entries {
                     out[d] += s * v;
                 }
@@ -143,7 +168,7 @@ impl LoadVector {
     pub fn component_sum(&self, c: usize, dim: usize) -> f64 {
         match self {
             Self::Whole(whole) => whole.iter().skip(c).step_by(dim).sum(),
-            Self::Sparse { entries, .. } => {
+            Self::Sparse { entries, .. } | Self::Part { entries, .. } => {
                 let sum: f64 = (entries.iter())
                     .filter(|&&(d, _)| d % dim == c)
                     .map(|&(_, v)| v)

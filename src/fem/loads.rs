@@ -5,6 +5,7 @@
 //! `f = -sum_facets n_F (M_F p)`, so that any other code given the same nodal values (dolfinx
 //! with a P1 `Function`) assembles the same vector to round-off.
 
+use super::LoadVector;
 use super::assembly::node_coords;
 use super::kernels::{
     facet_mass, facet_measure_and_normal, tetrahedron_gradients, triangle_gradients,
@@ -44,8 +45,14 @@ impl PressureField {
     }
 }
 
-/// Adds the load of `load` on `group` to `f` (interleaved, `dim` per node).
-pub fn add_surface_load(body: &BodyMesh, group: &FacetGroup, load: &SurfaceLoad, f: &mut [f64]) {
+/// Adds the load of `load` on `group` by `add(dof, value)` (dofs interleaved, `dim` per node),
+/// facet after facet in the group's order.
+pub fn add_surface_load(
+    body: &BodyMesh,
+    group: &FacetGroup,
+    load: &SurfaceLoad,
+    add: &mut impl FnMut(usize, f64),
+) {
     let dim = body.dim;
     for k in 0..group.num_facets(dim) {
         let facet = group.facet(k, dim);
@@ -54,21 +61,25 @@ pub fn add_surface_load(body: &BodyMesh, group: &FacetGroup, load: &SurfaceLoad,
         let m = facet_mass(measure, dim);
         for (a, &node) in facet.iter().enumerate() {
             for c in 0..dim {
-                f[dim * node + c] += match load {
-                    // sum_b M_ab t = t * measure / dim
-                    SurfaceLoad::Traction(t) => t[c] * measure / dim as f64,
-                    SurfaceLoad::Pressure(p) => {
-                        let mp: f64 = (0..dim).map(|b| m[a][b] * p.at(&x[b])).sum();
-                        -normal[c] * mp
-                    }
-                };
+                add(
+                    dim * node + c,
+                    match load {
+                        // sum_b M_ab t = t * measure / dim
+                        SurfaceLoad::Traction(t) => t[c] * measure / dim as f64,
+                        SurfaceLoad::Pressure(p) => {
+                            let mp: f64 = (0..dim).map(|b| m[a][b] * p.at(&x[b])).sum();
+                            -normal[c] * mp
+                        }
+                    },
+                );
             }
         }
     }
 }
 
-/// Adds a constant body force `b` (per unit volume; per unit area in 2D): `f_a = b |T| / (d+1)`.
-pub fn add_body_force(body: &BodyMesh, b: &[f64; 3], f: &mut [f64]) {
+/// Adds a constant body force `b` (per unit volume; per unit area in 2D), `f_a = b |T| / (d+1)`,
+/// by `add(dof, value)`, cell after cell of those the body's mesh keeps.
+pub fn add_body_force(body: &BodyMesh, b: &[f64; 3], add: &mut impl FnMut(usize, f64)) {
     let dim = body.dim;
     for c in 0..body.num_cells() {
         let cell = body.cell(c);
@@ -78,9 +89,72 @@ pub fn add_body_force(body: &BodyMesh, b: &[f64; 3], f: &mut [f64]) {
             tetrahedron_gradients(&node_coords(&body.coords, &cell)).1
         };
         for &node in cell.iter() {
-            for k in 0..dim {
-                f[dim * node + k] += b[k] * measure / (dim + 1) as f64;
+            for (k, b_k) in b.iter().enumerate().take(dim) {
+                add(dim * node + k, b_k * measure / (dim + 1) as f64);
             }
         }
+    }
+}
+
+/// A load vector while it is summed: its values at the nodes whose coordinates this process
+/// keeps (`crate::mesh::NodeCoords`: every node on one process; on a rank of a distributed
+/// run the nodes it reads, which hold every node a load of it reaches: the groups' nodes and
+/// its cells' nodes), so that no rank sums a vector of the whole body's size. Each dof's
+/// contributions are added in the order they come, from `0.0`, as in a whole vector.
+pub struct LoadSum<'a> {
+    body: &'a BodyMesh,
+    values: Vec<f64>,
+}
+
+impl<'a> LoadSum<'a> {
+    /// Zero at every kept node of `body`.
+    pub fn new(body: &'a BodyMesh) -> Self {
+        let values = vec![0.0; body.dim * body.coords.kept().len()];
+        Self { body, values }
+    }
+
+    /// Adds `value` at `dof`, whose node this process keeps (the partition keeps every node a
+    /// load of the rank reaches: a dof elsewhere is a program error).
+    pub fn add(&mut self, dof: usize, value: f64) {
+        let dim = self.body.dim;
+        let at = (self.body.coords.position(dof / dim)).expect("a loaded node is kept");
+        self.values[dim * at + dof % dim] += value;
+    }
+
+    /// The value summed at `dof` (`0.0` at a node this process does not keep).
+    pub fn get(&self, dof: usize) -> f64 {
+        let dim = self.body.dim;
+        (self.body.coords.position(dof / dim)).map_or(0.0, |at| self.values[dim * at + dof % dim])
+    }
+
+    /// Every dof's value, where every node is kept (one process); `None` on a rank.
+    pub fn as_whole(&self) -> Option<&[f64]> {
+        self.body.coords.is_whole().then_some(&self.values[..])
+    }
+
+    /// The nonzero values at the kept nodes, by increasing dof.
+    fn nonzero(self) -> impl Iterator<Item = (usize, f64)> + 'a {
+        let dim = self.body.dim;
+        let nodes = self.body.coords.kept().map(|(node, _)| node);
+        let dofs = nodes.flat_map(move |node| (0..dim).map(move |c| dim * node + c));
+        dofs.zip(self.values).filter(|&(_, v)| v != 0.0)
+    }
+
+    /// The whole vector, kept as [`LoadVector::new`] keeps it: right where every value it
+    /// reaches was summed here (one process, or loads on groups alone, whose facets every rank
+    /// keeps).
+    pub fn into_whole(self) -> LoadVector {
+        let len = self.body.num_dofs();
+        match self.body.coords.is_whole() {
+            true => LoadVector::new(self.values),
+            false => LoadVector::from_entries(len, self.nonzero().collect()),
+        }
+    }
+
+    /// A rank's part of the vector ([`LoadVector::Part`]): its values at the dofs `known`
+    /// selects (where this rank summed every cell around the node).
+    pub fn into_part(self, known: impl Fn(usize) -> bool) -> LoadVector {
+        let len = self.body.num_dofs();
+        LoadVector::part(len, self.nonzero().filter(|&(d, _)| known(d)).collect())
     }
 }
