@@ -164,7 +164,9 @@ impl LoadVector {
 
     /// The sum of the entries of component `c` (`dim` components per node), in dof order: the
     /// whole vector's sum to the bit (`+ 0.0` turns the empty sum's `-0.0` into the `+0.0`
-    /// that the whole vector's zeros sum to, and changes no other sum).
+    /// that the whole vector's zeros sum to, and changes no other sum). Of a [`Self::Part`],
+    /// the sum of the entries it keeps, which several ranks may keep: not the vector's sum,
+    /// which the ranks' sums over their own dofs make (the assembly's `load_sums`).
     pub fn component_sum(&self, c: usize, dim: usize) -> f64 {
         match self {
             Self::Whole(whole) => whole.iter().skip(c).step_by(dim).sum(),
