@@ -359,3 +359,61 @@ fn a_partitioned_mesh_is_rejected_as_such_with_the_fix() {
         "{message}"
     );
 }
+
+#[test]
+fn a_facet_in_two_boundary_groups_belongs_to_both() {
+    // A cube whose bottom face is in two physical groups, `base` and `bottom`, and whose
+    // other faces are in `sides`: each group gets its facets, the two alike, the bottom's
+    // outward normal pointing down; the groups' facets are the whole boundary once.
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let geo = dir.path().join("cube.geo");
+    std::fs::write(
+        &geo,
+        "SetFactory(\"OpenCASCADE\");\nBox(1) = {0, 0, 0, 1, 1, 1};\n\
+         Mesh.MeshSizeMax = 0.4;\nPhysical Volume(\"cube\") = {1};\n\
+         Physical Surface(\"base\") = {5};\nPhysical Surface(\"bottom\") = {5};\n\
+         Physical Surface(\"sides\") = {1, 2, 3, 4, 6};\n",
+    )
+    .expect("writes the geo script");
+    let msh = dir.path().join("cube.msh");
+    internodes::mesh::mesh_geo(&geo, &msh, &[]).expect("gmsh meshes");
+    let mesh = read_msh(&msh).expect("the mesh reads");
+    let cube = mesh.body("cube").unwrap();
+    let base = cube.boundary_group("base").unwrap();
+    let bottom = cube.boundary_group("bottom").unwrap();
+    let sides = cube.boundary_group("sides").unwrap();
+    assert!(base.num_facets(3) > 0);
+    assert_eq!(base.facets, bottom.facets);
+    assert_eq!(base.facet_cells, bottom.facet_cells);
+    for facet in base.facets.chunks_exact(3) {
+        let points: Vec<[f64; 3]> = facet.iter().map(|&n| cube.coords[n]).collect();
+        let (area, normal) = facet_measure_and_normal(&points, 3);
+        assert!(area > 0.0);
+        assert!((normal[2] + 1.0).abs() < 1e-12, "{normal:?}");
+    }
+    // Every face of a cell that no other cell shares is in `base` or `sides`, once.
+    let mut faces = std::collections::HashMap::<[usize; 3], usize>::new();
+    for c in 0..cube.num_cells() {
+        let cell = cube.cell(c);
+        for opposite in 0..4 {
+            let mut face: Vec<usize> = (0..4).filter(|&k| k != opposite).map(|k| cell[k]).collect();
+            face.sort_unstable();
+            *faces.entry([face[0], face[1], face[2]]).or_default() += 1;
+        }
+    }
+    let mut grouped: Vec<[usize; 3]> = (base.facets.chunks_exact(3))
+        .chain(sides.facets.chunks_exact(3))
+        .map(|f| {
+            let mut f = [f[0], f[1], f[2]];
+            f.sort_unstable();
+            f
+        })
+        .collect();
+    grouped.sort_unstable();
+    let mut boundary: Vec<[usize; 3]> = (faces.into_iter())
+        .filter(|&(_, n)| n == 1)
+        .map(|(f, _)| f)
+        .collect();
+    boundary.sort_unstable();
+    assert_eq!(grouped, boundary);
+}

@@ -1,9 +1,11 @@
 //! Splitting a gmsh MSH 4.1 file (parsed by [`super::msh41`]) into bodies, boundary groups and
 //! point groups.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::fs;
 use std::path::Path;
+
+use rustc_hash::FxHashMap;
 
 use super::msh41::{self, ElementBlock, MshContents, element_type_name};
 use super::{
@@ -91,7 +93,7 @@ struct GroupElements {
 struct FileContents {
     dim: Dim,
     /// gmsh node tag -> coordinates.
-    coords: HashMap<u64, [f64; 3]>,
+    coords: FxHashMap<u64, [f64; 3]>,
     /// (dimension, physical tag) -> its elements, for P1 cells and facets only.
     groups: BTreeMap<(Dim, i32), GroupElements>,
 }
@@ -200,15 +202,19 @@ impl FileContents {
 
     /// Adds to `body` the boundary and point groups with facets or nodes on it.
     fn add_groups(&self, body: &mut BodyMesh, names: &BTreeMap<(Dim, i32), String>) {
-        for (&(fd, ftag), facets) in &self.groups {
-            if fd + 1 == self.dim {
-                let group = self.facet_group(body, ftag, facets);
-                if !group.facets.is_empty() {
-                    body.boundary_groups
-                        .insert(group_name(names, fd, ftag), group);
-                }
-            } else if fd == 0 {
-                let nodes = self.point_group(body, facets);
+        let facet_groups: Vec<(&(Dim, i32), &GroupElements)> = (self.groups.iter())
+            .filter(|((fd, _), _)| fd + 1 == self.dim)
+            .collect();
+        let facets = self.facet_groups(body, facet_groups.iter().map(|(key, g)| (key.1, *g)));
+        for (&(fd, ftag), group) in facet_groups.iter().map(|(key, _)| *key).zip(facets) {
+            if !group.facets.is_empty() {
+                body.boundary_groups
+                    .insert(group_name(names, fd, ftag), group);
+            }
+        }
+        for (&(fd, ftag), points) in &self.groups {
+            if fd == 0 {
+                let nodes = self.point_group(body, points);
                 if !nodes.is_empty() {
                     body.point_groups.insert(group_name(names, fd, ftag), nodes);
                 }
@@ -238,7 +244,7 @@ impl FileContents {
                 nodes: node_tags.len(),
             });
         }
-        let local: HashMap<u64, u32> = (node_tags.iter().enumerate())
+        let local: FxHashMap<u64, u32> = (node_tags.iter().enumerate())
             .map(|(i, &t)| (t, i as u32))
             .collect();
         let coords = NodeCoords::from(node_tags.iter().map(|t| self.coords[t]).collect::<Vec<_>>());
@@ -268,61 +274,92 @@ impl FileContents {
         nodes
     }
 
-    /// The facets of a boundary group that are faces of `body`'s cells, oriented outward.
-    fn facet_group(&self, body: &BodyMesh, tag: i32, facets: &GroupElements) -> FacetGroup {
+    /// The facets of each boundary group (`(physical tag, elements)`) that are faces of
+    /// `body`'s cells, oriented outward, in the groups' order.
+    ///
+    /// One pass over the cells for all the groups, each face looked up by its sorted nodes:
+    /// a pass per group, with a key allocated per face, took a third of reading a mesh.
+    fn facet_groups<'a>(
+        &self,
+        body: &BodyMesh,
+        groups: impl Iterator<Item = (i32, &'a GroupElements)>,
+    ) -> Vec<FacetGroup> {
         let dim = self.dim;
-        let local: HashMap<u64, usize> = body
-            .node_tags
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (t, i))
-            .collect();
-        // Facets of the group that lie on the body, keyed by their sorted local nodes.
-        let mut wanted: HashMap<Vec<usize>, usize> = HashMap::new();
-        for (f, facet) in facets.node_tags.chunks_exact(dim).enumerate() {
-            let nodes: Option<Vec<usize>> = facet.iter().map(|t| local.get(t).copied()).collect();
-            if let Some(mut nodes) = nodes {
-                nodes.sort_unstable();
-                wanted.insert(nodes, f);
+        let groups: Vec<(i32, &GroupElements)> = groups.collect();
+        // A facet's sorted local nodes, padded: the key of a face (dim nodes).
+        let key_of = |nodes: &[usize]| {
+            let mut key = [usize::MAX; 3];
+            key[..nodes.len()].copy_from_slice(nodes);
+            key[..nodes.len()].sort_unstable();
+            key
+        };
+        // The facets of every group that lie on the body, keyed by their sorted local nodes:
+        // (group, facet) pairs, a facet repeated in a group standing for its last copy.
+        let mut wanted: FxHashMap<[usize; 3], Vec<(usize, usize)>> = FxHashMap::default();
+        for (g, (_, facets)) in groups.iter().enumerate() {
+            for (f, facet) in facets.node_tags.chunks_exact(dim).enumerate() {
+                let nodes: Option<Vec<usize>> =
+                    facet.iter().map(|&t| body.node_tags.position(t)).collect();
+                let Some(nodes) = nodes else {
+                    continue;
+                };
+                let entries = wanted.entry(key_of(&nodes)).or_default();
+                match entries.iter_mut().find(|(other, _)| *other == g) {
+                    Some(entry) => entry.1 = f,
+                    None => entries.push((g, f)),
+                }
             }
         }
-        let mut found: Vec<(usize, Vec<usize>, usize)> = Vec::new();
+        // Per group: (facet, its nodes oriented outward, its cell).
+        let mut found: Vec<Vec<(usize, [usize; 3], usize)>> = vec![Vec::new(); groups.len()];
         // A facet that is a face of a second cell lies inside the body (gmsh `Line In Surface`,
         // `Surface In Volume`, or the interface of two volumes in one body): it keeps its first
         // cell, and its element tag is recorded so that a pressure on it can be refused.
-        let mut taken = vec![false; facets.element_tags.len()];
-        let mut interior: Vec<(usize, u64)> = Vec::new();
+        let mut taken: Vec<Vec<bool>> = (groups.iter())
+            .map(|(_, facets)| vec![false; facets.element_tags.len()])
+            .collect();
+        let mut interior: Vec<Vec<(usize, u64)>> = vec![Vec::new(); groups.len()];
         if !wanted.is_empty() {
             for c in 0..body.num_cells() {
                 let cell = body.cell(c);
                 for opposite in 0..cell.len() {
-                    let mut face: Vec<usize> = (0..cell.len())
-                        .filter(|&k| k != opposite)
-                        .map(|k| cell[k])
-                        .collect();
-                    let mut key = face.clone();
-                    key.sort_unstable();
-                    let Some(&f) = wanted.get(&key) else {
+                    let mut face = [usize::MAX; 3];
+                    let others = (0..cell.len()).filter(|&k| k != opposite);
+                    for (slot, k) in face.iter_mut().zip(others) {
+                        *slot = cell[k];
+                    }
+                    let Some(entries) = wanted.get(&key_of(&face[..dim])) else {
                         continue;
                     };
-                    if std::mem::replace(&mut taken[f], true) {
-                        interior.push((f, facets.element_tags[f]));
-                    } else {
-                        orient_outward(&body.coords, &mut face, cell[opposite], dim);
-                        found.push((f, face, c));
+                    for &(g, f) in entries {
+                        if std::mem::replace(&mut taken[g][f], true) {
+                            interior[g].push((f, groups[g].1.element_tags[f]));
+                        } else {
+                            let mut oriented = face;
+                            orient_outward(&body.coords, &mut oriented[..dim], cell[opposite], dim);
+                            found[g].push((f, oriented, c));
+                        }
                     }
                 }
             }
         }
-        // Keep the file's facet order so that results are reproducible.
-        found.sort_unstable_by_key(|(f, _, _)| *f);
-        interior.sort_unstable();
-        FacetGroup {
-            physical_tag: tag,
-            facets: found.iter().flat_map(|(_, face, _)| face.clone()).collect(),
-            facet_cells: found.iter().map(|(_, _, c)| *c).collect(),
-            interior_facets: interior.into_iter().map(|(_, tag)| tag).collect(),
-        }
+        (groups.iter().zip(found).zip(interior))
+            .map(|(((tag, _), mut found), mut interior)| {
+                // Keep the file's facet order so that results are reproducible.
+                found.sort_unstable_by_key(|(f, _, _)| *f);
+                interior.sort_unstable();
+                FacetGroup {
+                    physical_tag: *tag,
+                    facets: found
+                        .iter()
+                        .flat_map(|(_, face, _)| &face[..dim])
+                        .copied()
+                        .collect(),
+                    facet_cells: found.iter().map(|(_, _, c)| *c).collect(),
+                    interior_facets: interior.into_iter().map(|(_, tag)| tag).collect(),
+                }
+            })
+            .collect()
     }
 }
 
@@ -390,7 +427,7 @@ fn unsupported_element(
 fn check_nodes_defined(
     path: &Path,
     block: &ElementBlock,
-    nodes: &HashMap<u64, [f64; 3]>,
+    nodes: &FxHashMap<u64, [f64; 3]>,
 ) -> Result<(), MeshError> {
     let elements = block
         .element_tags

@@ -8,6 +8,8 @@ use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 use std::path::Path;
 
+use rustc_hash::FxHashMap;
+
 use super::msh41::{ElementBlock, MshContents, PhysicalName, element_type_name, nodes_per_element};
 use super::{Dim, MeshError};
 
@@ -73,7 +75,7 @@ impl GmshModel {
 }
 
 /// gmsh node tag -> coordinates: three finite coordinates per tag, each tag once.
-fn nodes(tags: &[u64], coords: &[f64]) -> Result<HashMap<u64, [f64; 3]>, String> {
+fn nodes(tags: &[u64], coords: &[f64]) -> Result<FxHashMap<u64, [f64; 3]>, String> {
     if coords.len() != 3 * tags.len() {
         return Err(format!(
             "{} node tags but {} coordinates: expected three per node",
@@ -81,7 +83,7 @@ fn nodes(tags: &[u64], coords: &[f64]) -> Result<HashMap<u64, [f64; 3]>, String>
             coords.len()
         ));
     }
-    let mut nodes = HashMap::with_capacity(tags.len());
+    let mut nodes = FxHashMap::with_capacity_and_hasher(tags.len(), Default::default());
     for (&tag, xyz) in tags.iter().zip(coords.chunks_exact(3)) {
         if !xyz.iter().all(|x| x.is_finite()) {
             return Err(format!("node {tag} has a coordinate that is not finite"));

@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use nalgebra::{Matrix2, Matrix3, Vector3};
+use rayon::prelude::*;
 
 use super::{BodyMesh, Dim, MeshError};
 
@@ -48,21 +49,32 @@ where
 /// Checks that no cell of `body` is degenerate or inverted.
 pub fn check_cells(path: &Path, body: &BodyMesh) -> Result<(), MeshError> {
     let dim = body.dim;
+    // Each cell on its own: in parallel (a tenth of reading a 1M-DOF mesh serially), the
+    // first degenerate cell in the file's order reported as before.
     let measures: Vec<f64> = (0..body.num_cells())
+        .into_par_iter()
         .map(|c| signed_measure(&body.coords, &body.cell(c), dim))
         .collect();
-    for (c, &m) in measures.iter().enumerate() {
-        let relative = m.abs() / longest_edge(&body.coords, &body.cell(c)).powi(dim as i32);
-        if relative.is_nan() || relative < DEGENERATE_RELATIVE_MEASURE {
-            return Err(MeshError::DegenerateCell {
-                path: path.to_owned(),
-                body: body.name.clone(),
-                element_tag: body.cell_tags.get(c),
-                measure_name: if dim == 2 { "area" } else { "volume" },
-                measure: m.abs(),
-                relative,
-            });
-        }
+    let degenerate = (measures.par_iter().enumerate())
+        .map(|(c, &m)| {
+            (
+                c,
+                m,
+                m.abs() / longest_edge(&body.coords, &body.cell(c)).powi(dim as i32),
+            )
+        })
+        .find_first(|&(_, _, relative)| {
+            relative.is_nan() || relative < DEGENERATE_RELATIVE_MEASURE
+        });
+    if let Some((c, m, relative)) = degenerate {
+        return Err(MeshError::DegenerateCell {
+            path: path.to_owned(),
+            body: body.name.clone(),
+            element_tag: body.cell_tags.get(c),
+            measure_name: if dim == 2 { "area" } else { "volume" },
+            measure: m.abs(),
+            relative,
+        });
     }
     let positive = measures.iter().filter(|&&m| m > 0.0).count();
     let negative = measures.len() - positive;
