@@ -37,10 +37,12 @@ demo: build
 	$(BINARY) solve geo/hemisphere_on_block.toml --output out/demo
 
 # Unit and integration tests (tests/mpi.rs runs the solver on 2 and 3 MPI ranks with mpirun),
-# the Python module's tests and examples, then the quick validation: the coarsest level of every
-# suite, same thresholds (report in validation/build/report-quick/).
+# the API docs without a broken or private link, the Python module's tests and examples, then
+# the quick validation: the coarsest level of every suite, same thresholds (report in
+# validation/build/report-quick/).
 test: build python
 	cargo test --release --features "$(FEATURES)"
+	RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --features "$(FEATURES)"
 	$(VENV)/bin/python -m pytest python/tests
 	$(PYTHON) validation/run.py --quick
 

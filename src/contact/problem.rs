@@ -67,7 +67,7 @@ pub enum OtherPrimary {
     /// coarser one (auto's, for accuracy) may be the one that fails.
     RetryIfUntrusted,
     /// Solve with it too, and check that the two contact forces agree: a named primary at
-    /// least [`SIMILAR_STIFFNESS`] times stiffer than the other body, the choice auto avoids.
+    /// least `SIMILAR_STIFFNESS` times stiffer than the other body, the choice auto avoids.
     /// Such a primary passed every check of the certificate with a force 3% off (a stiff block
     /// twice finer than an R/25 hemisphere, 3D).
     CheckAgreement,
@@ -223,7 +223,7 @@ impl<'m> ContactProblem<'m> {
     }
 
     /// The penalty `eps = penalty E* / h` of a penalty pair (`crate::contact::method`), `h` the
-    /// primary's spacing where contact starts ([`contact_zone_spacing`]): one number per pair,
+    /// primary's spacing where contact starts (`contact_zone_spacing`): one number per pair,
     /// as the penalty codes take it; `None` under INTERNODES.
     pub fn penalty_stiffness(&self) -> Option<f64> {
         let factor = self.settings.penalty_factor()?;

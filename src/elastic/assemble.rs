@@ -55,7 +55,7 @@ pub struct AssembledBody {
     /// The constrained right-hand side.
     pub f_c: LoadVector,
     /// The force-controlled components of the body, in the order of
-    /// [`forced_components`]: their dofs are held at 0 in `K_c` and move by unknowns of the
+    /// `forced_components`: their dofs are held at 0 in `K_c` and move by unknowns of the
     /// contact solve.
     pub rigid: Vec<RigidColumn>,
     /// `f` and `f_c` split by load path, the default one first, then the named ones by name,

@@ -20,7 +20,7 @@
 //! in the whole vector's order, and its zeros change no partial sum. Only the sign of a zero
 //! can differ, where [`LoadVector::add_scaled_to`] skips the zeros.
 
-/// A load vector ([module doc](self)).
+/// A load vector (the module doc).
 #[derive(Debug, Clone, PartialEq)]
 pub enum LoadVector {
     /// Every entry.
@@ -30,7 +30,7 @@ pub enum LoadVector {
         len: usize,
         entries: Vec<(usize, f64)>,
     },
-    /// A rank's part of a vector of `len` entries ([module doc](self)): the nonzero entries at
+    /// A rank's part of a vector of `len` entries (the module doc): the nonzero entries at
     /// the dofs whose value this rank knows, by increasing dof. It reads as the vector that is
     /// zero elsewhere, so only those dofs may be read from it.
     Part {

@@ -13,7 +13,7 @@ use super::{Distribution, LinalgError, relative_difference};
 use crate::fem::LoadVector;
 use crate::mesh::NodeCoords;
 
-/// How this process holds a body's vectors in a solve ([module doc](self)).
+/// How this process holds a body's vectors in a solve (the module doc).
 #[derive(Debug, Clone, Copy)]
 pub struct BodyRows<'a> {
     /// The body's distribution on a rank of a distributed run; `None` on one process.

@@ -295,7 +295,7 @@ impl BodySolver {
     /// `x = P^-1 r` for the body's preconditioner in a coupled Krylov solve: the factor's exact
     /// solve, or one AMG V-cycle. Called from several threads, V-cycles of different bodies
     /// run at the same time (the one PETSc call that does not wait for all others:
-    /// [`super::petsc`]'s "PETSc in a Rust process"); those of one body take turns.
+    /// `linalg::petsc`'s "PETSc in a Rust process"); those of one body take turns.
     pub fn precondition(&self, r: &[f64], x: &mut [f64]) -> Result<(), LinalgError> {
         match self {
             Self::Cholesky(factor) | Self::CholeskyOfCopy { factor, .. } => {

@@ -269,7 +269,7 @@ impl ContactSummary {
 
 /// The load steps of each pair of `curves` (its name and its steps) as
 /// `force_displacement.csv`: one header line, one row per step. One pair: the columns of
-/// [`pair_csv`]. Several: the step and load factor (and each load path's factor), then each
+/// `pair_csv`. Several: the step and load factor (and each load path's factor), then each
 /// pair's other columns, their names prefixed by the pair's (`upper-middle.contact_force_y`);
 /// the pairs share the loop, so they have the same steps.
 pub fn force_displacement_csv(curves: &[(&str, &[StepRecord])]) -> String {

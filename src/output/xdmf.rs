@@ -145,7 +145,7 @@ pub fn write_xdmf(dir: &Path, stem: &str, bodies: &[BodyFields]) -> Result<(), O
 /// written from the bodies' own arrays, which hold every node.
 ///
 /// Each dataset is written body by body, a bounded chunk of rows at a time
-/// ([`CHUNK_ROWS`]), straight from the bodies' own arrays or as `node_rows` and
+/// (`CHUNK_ROWS`), straight from the bodies' own arrays or as `node_rows` and
 /// `cell_rows` give them: the writer never holds a copy of the whole grid (at 1M DOFs that
 /// copy was 470 MB beside the fields themselves, on the process that writes).
 pub fn write_xdmf_with(

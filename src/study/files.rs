@@ -1,5 +1,5 @@
 //! The study's files: `study.json` (everything), `study.csv` (one row per level), `study.md`
-//! (the two tables a publication reports) and `study.png` ([`super::plot`]).
+//! (the two tables a publication reports) and `study.png` (`super::plot`).
 
 use std::path::{Path, PathBuf};
 

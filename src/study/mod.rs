@@ -1,11 +1,11 @@
 //! `internodes study CASE --parameter NAME=V1,V2,...`: a mesh refinement study of a contact case
 //! whose mesh is a gmsh `.geo`. The case is solved once per value of the gmsh parameter `NAME`
 //! (each solve as `internodes solve` runs it, into its own folder), the contact quantities of
-//! every level are read from its summary ([`quantities`]), the spacing of every level is measured
-//! on its mesh ([`measure`]), and each quantity's discretization error is estimated from the
+//! every level are read from its summary (`quantities`), the spacing of every level is measured
+//! on its mesh (`measure`), and each quantity's discretization error is estimated from the
 //! levels by the grid convergence index of Celik et al. (2008), on every triplet of consecutive
 //! levels ([`gci`]). The results go into `study.json`, `study.csv`, `study.md` and `study.png`
-//! ([`files`], [`plot`]); `docs/study.md` is the user's page.
+//! ([`files`], `plot`); `docs/study.md` is the user's page.
 
 pub mod files;
 pub mod gci;

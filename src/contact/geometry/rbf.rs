@@ -228,7 +228,7 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
 ///   [`interpolation_radii`] at their default is well conditioned (`docs/method.md` 2.2), so the
 ///   solve costs a few dozen sparse products and keeps nothing but its Krylov vectors while it
 ///   runs. Where GMRES stops short (wide supports), the whole `Phi_MM` is factored by sparse LU
-///   and that factor serves every solve after ([`patch::WholeFactor`]).
+///   and that factor serves every solve after (`rbf_patch::WholeFactor`).
 /// * **Rows and columns of `R`** ([`Interpolation::rows`], [`Interpolation::columns`]): each
 ///   from a solve on a patch of sources around it (`rbf_patch.rs`), since the entries of
 ///   `Phi_MM^-1` decay exponentially with the number of steps in `Phi_MM`'s graph.
@@ -254,7 +254,7 @@ pub struct Interpolation {
     /// Targets with `D_ii` not clearly positive (see [`UNCOVERED_TOL`]).
     uncovered: Vec<usize>,
     /// The whole `Phi_MM`'s sparse LU, factored only where a solve needs it
-    /// ([`patch::WholeFactor`]).
+    /// (`rbf_patch::WholeFactor`).
     whole: patch::WholeFactor,
 }
 

@@ -174,7 +174,7 @@ impl ContactSurface {
     }
 
     /// Whether the point with `barycentric` coordinates on facet `facet` (a closest point,
-    /// [`crate::contact::geometry::projection::Projection`]) lies on the surface's rim ([`Rim`]).
+    /// [`crate::contact::geometry::projection::Projection`]) lies on the surface's rim (`Rim`).
     pub fn on_rim(&self, facet: usize, barycentric: &[f64; 3]) -> bool {
         self.rim
             .contains(self.facet_nodes(facet), facet, barycentric)

@@ -715,7 +715,7 @@ fn converged(
 impl CgAmg {
     /// `y = K x` by PETSc's copy of the matrix (on several ranks each computes its rows, and
     /// every rank receives all of `y`). On one process the product reads PETSc's arrays
-    /// from this side, on every thread, without PETSc's lock ([`PetscRows`]).
+    /// from this side, on every thread, without PETSc's lock (`PetscRows`).
     pub fn multiply(&self, x: &[f64], y: &mut [f64]) -> Result<(), LinalgError> {
         self.on_whole("a product", x, y, |x, y| self.multiply_rows(x, y))
     }

@@ -15,7 +15,7 @@ unsafe extern "C" {
     fn internodes_petsc_error_text(code: c_int) -> *const c_char;
 }
 
-/// Orders every PETSc call of the process: V-cycles ([`CgAmg::precondition`]) take it shared,
+/// Orders every PETSc call of the process: V-cycles ([`super::CgAmg::precondition`]) take it shared,
 /// every other call exclusively (see the module's doc).
 pub(super) static PETSC: RwLock<()> = RwLock::new(());
 /// The outcome of PETSc's initialization (made once, under [`PETSC`] held exclusively): on
@@ -23,7 +23,7 @@ pub(super) static PETSC: RwLock<()> = RwLock::new(());
 /// database but ours).
 static INITIALIZED: OnceLock<Result<bool, (String, i32)>> = OnceLock::new();
 
-/// Whether V-cycles ([`CgAmg::precondition`]) of distinct objects run at the same time: PETSc
+/// Whether V-cycles ([`super::CgAmg::precondition`]) of distinct objects run at the same time: PETSc
 /// is initialized and its options database holds no option but ours (see the module's doc).
 pub fn concurrent_v_cycles() -> bool {
     matches!(INITIALIZED.get(), Some(Ok(true)))
