@@ -28,6 +28,10 @@ const NUM_RHS: usize = 256;
 const THREADS: [usize; 2] = [1, 2];
 
 fn main() {
+    // As the command line does: faer's own parallelism would otherwise cut its LU
+    // factorizations by the pool's thread count, and the answers would differ in their last bits
+    // (`src/lib.rs`, "Threads").
+    faer::set_global_parallelism(faer::Par::Seq);
     // `cargo bench` passes `--bench` to harness-less benches; the case is the first other
     // argument.
     let args: Vec<String> = std::env::args()

@@ -1,8 +1,8 @@
 //! # internodes
 //!
-//! Elastic bodies with non-matching meshes in frictionless contact, solved with the INTERNODES
-//! method (Deparis, Forti, Gervasio, Quarteroni 2016); the method is described in
-//! `docs/method.md`.
+//! Elastic bodies with non-matching meshes in contact (frictionless, tied or Coulomb), solved
+//! with the INTERNODES method (Deparis, Forti, Gervasio, Quarteroni 2016), or with a penalty
+//! beside it; the method is described in `docs/method.md`.
 //!
 //! Each body `k` is a P1 linear-elastic body, `K_k u_k = f_k`. Two bodies in contact are
 //! coupled on their active interface nodes through rescaled Wendland C2 radial-basis
@@ -32,6 +32,14 @@
 //! - [`progress`]: progress lines of long phases;
 //! - [`run`]: `internodes solve CASE`, from the case file to the result files;
 //! - [`study`]: `internodes study CASE`, a mesh refinement study with the grid convergence index.
+//!
+//! **Threads.** The work runs on rayon's threads, cut into parts fixed by the problem, so that
+//! the answers are the same bits for any number of threads. faer's dense and sparse LU
+//! factorizations (the RBF patches, the half-space preconditioner, the Schur complement) take
+//! faer's global parallelism, whose default cuts the work by the thread count: the command
+//! line and the Python module set it to `faer::Par::Seq` before anything is solved, and a
+//! program that calls this library should do the same for its answers not to depend on the
+//! thread count.
 
 pub mod cancel;
 pub mod case;
