@@ -777,6 +777,7 @@ mod tests {
             ],
             geometric: vec![Vec::new(); NY + 1],
             interpolated: secondary.iter().map(|&n| vec![(n, 1.0)]).collect(),
+            walls: vec![Vec::new(); NY + 1],
             loads2: (0..=NY).map(|j| vec![(secondary[j], area(j))]).collect(),
             gaps: vec![[0.0; 3]; NY + 1],
             points: primary_nodes.iter().map(|&n| primary.coords[n]).collect(),
@@ -1107,6 +1108,7 @@ mod tests {
             multipliers: whole.multipliers[inner.clone()].to_vec(),
             geometric: whole.geometric[inner.clone()].to_vec(),
             interpolated: whole.interpolated[inner.clone()].to_vec(),
+            walls: whole.walls[inner.clone()].to_vec(),
             loads2: whole.loads2[inner.clone()].to_vec(),
             gaps: whole.gaps[inner].to_vec(),
         };

@@ -43,7 +43,8 @@ use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::GapRow;
 use crate::contact::geometry::rbf::{Interpolation, interpolation_radii};
 use crate::contact::geometry::surface::ContactSurface;
-use crate::contact::law::{ContactLaw, Multiplier, Reads, Tangential, coulomb};
+use crate::contact::geometry::walls::HeldWall;
+use crate::contact::law::{ContactLaw, Multiplier, Reads, Restates, Tangential, coulomb};
 use crate::contact::method::Enforcement;
 
 /// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
@@ -222,6 +223,7 @@ impl InterfaceOperators {
             .collect();
         let dim = primary.dim;
         let interpolated = |i: usize| to_body2(&self.rows12[&i], &|_, w| w);
+        let mut wall_reads = vec![Vec::new(); active.len()];
         let (geometric, interpolated, normals, gaps, multipliers) = match constraint {
             Constraint::Interpolated { corrections } => (
                 vec![Vec::new(); active.len()],
@@ -248,15 +250,32 @@ impl InterfaceOperators {
                 rows,
                 start_jumps,
                 tangential,
+                walls,
             } => {
                 let state = |i: usize| tangential.map_or(Tangential::Stick, |states| states[i]);
-                let multipliers: Vec<Vec<Multiplier>> = (active.iter())
+                let mut multipliers: Vec<Vec<Multiplier>> = (active.iter())
                     .map(|&i| law.multipliers(rows[i].normal, state(i), dim, gap_compliance))
                     .collect();
+                // A node held by a wall too has the wall's multiplier after the law's, its
+                // column and row the wall's normal (`crate::contact::geometry::walls`).
+                for (node, &i) in multipliers.iter_mut().zip(active) {
+                    if let Some(held) = walls.get(&i) {
+                        node.push(Multiplier {
+                            force: held.wall.normal,
+                            row: held.wall.normal,
+                            reads: Reads::Wall,
+                            restates: Restates::Node,
+                            compliance: gap_compliance,
+                        });
+                    }
+                }
                 // A node whose rows read its tangential jump (a sticking node, a slipping one's
                 // direction in 3D) holds it against the jump at the start of the step.
                 let reads_jump: Vec<bool> = (multipliers.iter())
                     .map(|node| node.iter().any(|m| m.reads == Reads::Interpolated))
+                    .collect();
+                wall_reads = (active.iter())
+                    .map(|i| walls.get(i).map_or_else(Vec::new, |held| to_body2(&held.wall.corners, &|_, b| b)))
                     .collect();
                 (
                     active
@@ -272,6 +291,9 @@ impl InterfaceOperators {
                     active.iter().map(|&i| rows[i].normal).collect(),
                     (active.iter().zip(&reads_jump))
                         .map(|(&i, &reads)| {
+                            if let Some(held) = walls.get(&i) {
+                                return held.target;
+                            }
                             let n = rows[i].normal;
                             let normal = n.map(|n| rows[i].target * n);
                             match (reads, start_jumps) {
@@ -295,6 +317,7 @@ impl InterfaceOperators {
             multipliers,
             geometric,
             interpolated,
+            walls: wall_reads,
             loads2,
             gaps,
         })
@@ -342,11 +365,13 @@ pub enum Constraint<'a> {
     /// row per primary candidate ([`crate::contact::geometry::gap`]); for Coulomb, the tangential
     /// state of every primary candidate and its jump at the start of the load step
     /// ([`Self::jumps`]), which a sticking node's tangential rows hold
-    /// (`crate::contact::law::coulomb`).
+    /// (`crate::contact::law::coulomb`); the wall each active node in a concave vertex holds
+    /// besides (keyed by candidate; frictionless, `crate::contact::geometry::walls`).
     Geometric {
         rows: &'a [GapRow],
         start_jumps: Option<&'a [[f64; 3]]>,
         tangential: Option<&'a [Tangential]>,
+        walls: &'a HashMap<usize, HeldWall>,
     },
 }
 

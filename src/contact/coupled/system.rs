@@ -93,6 +93,10 @@ pub struct Coupling {
     /// The same through the interpolation: the row of `R12` of each active node (empty where
     /// no row of the node reads it).
     pub interpolated: Vec<Vec<(usize, f64)>>,
+    /// The same for the wall a node holds beside its closest facet: the P1 weights of the
+    /// node's closest point on the wall's facet (`crate::contact::geometry::walls`; empty where
+    /// the node holds none).
+    pub walls: Vec<Vec<(usize, f64)>>,
     /// Column of `M2 R21` of each active node: `(secondary body node, A2_j R21[j, i])`, the
     /// force a unit traction at node `i` puts on the secondary's nodes (with the sign of
     /// `lambda_2 = -R21 lambda` applied by the system).
@@ -257,6 +261,7 @@ impl Coupling {
         match multiplier.reads {
             Reads::Geometric => &self.geometric[k],
             Reads::Interpolated => &self.interpolated[k],
+            Reads::Wall => &self.walls[k],
         }
     }
 }

@@ -6,7 +6,8 @@
 //! which tells inside from outside), `rbf_patch.rs` (solves with a sparse matrix restricted to a patch of its graph), `rbf.rs`
 //! (rescaled Wendland C2 interpolation),
 //! `surface.rs` (a candidate surface: nodes, facets, spacings, lumped interface mass), `gap.rs`
-//! (the geometric gap, and the gap linearized at an iterate).
+//! (the geometric gap, and the gap linearized at an iterate), `walls.rs` (the second facet a node
+//! in a concave vertex must not cross).
 
 pub mod boundary;
 pub mod displacement;
@@ -15,3 +16,4 @@ pub mod projection;
 pub mod rbf;
 pub mod rbf_patch;
 pub mod surface;
+pub mod walls;

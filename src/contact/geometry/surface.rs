@@ -155,6 +155,63 @@ impl ContactSurface {
         -normal_force / self.nodal_area[s]
     }
 
+    /// The largest angle, in degrees, between the normals of two facets that meet (at a node
+    /// in 2D, along an edge in 3D), in the reference configuration: 180 / N on a circle of N
+    /// facets, 90 at a square's corner.
+    pub fn sharpest_turn(&self) -> f64 {
+        self.turns().into_iter().fold(0.0, f64::max)
+    }
+
+    /// The surface's corners (the nodes at which it turns by more than `angle` degrees,
+    /// [`Self::turns`]) and the nodes that share a facet with one, increasing.
+    pub fn beside_corners(&self, angle: f64) -> Vec<usize> {
+        let turns = self.turns();
+        let mut nodes: Vec<usize> = (0..self.num_facets())
+            .map(|f| self.facet_nodes(f))
+            .filter(|corners| corners.iter().any(|&s| turns[s] > angle))
+            .flatten()
+            .copied()
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    }
+
+    /// At each node, the largest angle in degrees between the normals of two facets that meet
+    /// there (2D) or along an edge through it (3D), in the reference configuration; zero at a
+    /// node of one facet.
+    fn turns(&self) -> Vec<f64> {
+        let normal = |f: usize| {
+            let x: Vec<[f64; 3]> = (self.facet_nodes(f).iter()).map(|&s| self.coords[s]).collect();
+            facet_measure_and_normal(&x, self.dim).1
+        };
+        let normals: Vec<[f64; 3]> = (0..self.num_facets()).map(normal).collect();
+        let mut meeting: HashMap<Vec<usize>, Vec<usize>> = HashMap::new();
+        for f in 0..self.num_facets() {
+            let corners = self.facet_nodes(f);
+            for k in 0..self.dim {
+                // 2D: each corner; 3D: the edge opposite each corner.
+                let mut shared: Vec<usize> = match self.dim {
+                    2 => vec![corners[k]],
+                    _ => vec![corners[(k + 1) % 3], corners[(k + 2) % 3]],
+                };
+                shared.sort_unstable();
+                meeting.entry(shared).or_default().push(f);
+            }
+        }
+        let mut turns = vec![0.0_f64; self.len()];
+        for (shared, facets) in &meeting {
+            for (a, &f) in facets.iter().enumerate() {
+                for &g in &facets[a + 1..] {
+                    let cos = (0..3).map(|k| normals[f][k] * normals[g][k]).sum::<f64>();
+                    let angle = cos.clamp(-1.0, 1.0).acos().to_degrees();
+                    shared.iter().for_each(|&s| turns[s] = turns[s].max(angle));
+                }
+            }
+        }
+        turns
+    }
+
     /// The number of facets.
     pub fn num_facets(&self) -> usize {
         self.facets.len() / self.dim

@@ -37,6 +37,10 @@ pub(super) struct Safeguard {
     readded: HashSet<usize>,
     pub(super) pinned: HashSet<usize>,
     counters: Counters,
+    /// Whether the last iterate left active nodes in a concave vertex of the other surface
+    /// (`crate::contact::geometry::walls`), set by the loop before each update: [`Self::next`]
+    /// then lets the iteration cap alone end a loop that does not settle.
+    pub(super) in_groove: bool,
 }
 
 /// What the safeguard counts from one iteration to the next: small and `Copy`, so that what an
@@ -104,9 +108,9 @@ impl Counters {
     /// The counters after `update` on the `active` states, and what they call for: a stop
     /// (unstable, no progress, converged or stalled on one set), the same states again, or a
     /// new set for the sets seen to judge.
-    fn after(mut self, active: &NodeStates, update: &Update) -> (Self, Verdict) {
+    fn after(mut self, active: &NodeStates, update: &Update, in_groove: bool) -> (Self, Verdict) {
         let off = update.max_gap_error_over_h;
-        if off > UNSTABLE_GAP_OVER_H {
+        if off > UNSTABLE_GAP_OVER_H && !in_groove {
             if self
                 .off_surface
                 .is_some_and(|last| off > CONTRACTION * last)
@@ -122,7 +126,7 @@ impl Counters {
             (self.best_violation, self.since_best) = (Some(v), 0);
         } else {
             self.since_best += 1;
-            if self.since_best >= NO_PROGRESS_AFTER && !update.settled {
+            if self.since_best >= NO_PROGRESS_AFTER && !update.settled && !in_groove {
                 return (self, Verdict::Stop(ContactStatus::Stalled));
             }
         }
@@ -148,12 +152,11 @@ impl Counters {
             // an edge of the other surface, its closest facet changing from one iteration to
             // the next; within the complementarity tolerance that is an answer, beyond it a
             // failure.
-            let status = if update.within_tolerance {
-                ContactStatus::Converged
-            } else {
-                ContactStatus::Stalled
-            };
-            return (self, Verdict::Stop(status));
+            match (update.within_tolerance, in_groove) {
+                (true, _) => return (self, Verdict::Stop(ContactStatus::Converged)),
+                (false, false) => return (self, Verdict::Stop(ContactStatus::Stalled)),
+                (false, true) => {}
+            }
         }
         (self, Verdict::SameSet { turning: false })
     }
@@ -174,7 +177,7 @@ impl Safeguard {
     /// Such an iterate only feeds the next linearization, so the loop may take it from a loose
     /// solve: nothing it would decide rests on the solve's accuracy.
     pub(super) fn only_linearizes(&self, active: &NodeStates, update: &Update) -> bool {
-        let (after, verdict) = self.counters.after(active, update);
+        let (after, verdict) = self.counters.after(active, update, self.in_groove);
         matches!(verdict, Verdict::SameSet { turning: false })
             && after.slow == 0
             && after.off_surface.is_none()
@@ -189,7 +192,7 @@ impl Safeguard {
             .extend(added_back.into_iter().filter(|i| released.contains(i)));
         self.released.extend(nodes(&update.tension));
         let verdict;
-        (self.counters, verdict) = self.counters.after(active, update);
+        (self.counters, verdict) = self.counters.after(active, update, self.in_groove);
         match verdict {
             Verdict::Stop(status) => return Step::Stop(status),
             Verdict::SameSet { .. } => return Step::Solve(active.clone()),
@@ -205,7 +208,7 @@ impl Safeguard {
         // with the sphere as primary). A partition that keeps returning once they have settled
         // is a repeat, handled below; one that never lets them settle runs into the
         // no-progress rule or the iteration cap.
-        if update.max_direction_change > STILL_TURNING {
+        if update.max_direction_change > STILL_TURNING || self.in_groove {
             return Step::Solve(next);
         }
         if self.seen.contains(&next) {

@@ -82,11 +82,13 @@ use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, 
 use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::{GapRow, RowNormal, gap_rows, gaps_and_rows, geometric_gaps};
 use crate::contact::geometry::surface::ContactSurface;
+use crate::contact::geometry::walls::{HeldWall, walls};
 use crate::contact::iteration::safeguard::{CONTRACTION, Safeguard, Step};
+use crate::contact::iteration::walls::PairWalls;
 use crate::contact::law::coulomb::Turning;
 use crate::contact::law::{ContactLaw, NodeStates, Tangential, coulomb};
 use crate::contact::method::Enforcement;
-use crate::contact::problem::ContactProblem;
+use crate::contact::problem::{CORNER_TURN, ContactProblem};
 use crate::contact::settings::{ContactSettings, CoupledSolver, Transfer};
 use crate::contact::solution::{
     ContactSolution, ContactStatus, FrictionFields, FrictionState, IterationRecord, LinearSolvers,
@@ -544,6 +546,17 @@ impl<'a> ContactSolver<'a> {
         }
     }
 
+    /// Whether pair `p`'s active nodes hold the walls of a concave vertex they sit in
+    /// (`crate::contact::geometry::walls`): a frictionless pair ([`ContactLaw::holds_walls`])
+    /// enforced by INTERNODES, in 2D. The penalty method's rows let a node overlap both planes by
+    /// its pressure over `eps`, which the two rows' common target does not model; in 3D a node
+    /// on an edge meets several facets, and which of them to hold is not built.
+    fn holds_walls(&self, p: usize) -> bool {
+        self.laws[p].holds_walls()
+            && self.methods[p] == Enforcement::Internodes
+            && self.pairs[p].primary_surface.dim == 2
+    }
+
     /// The settings of the loop and its coupled solve, shared by the pairs.
     fn loop_settings(&self) -> &ContactSettings {
         &self.pairs[0].settings
@@ -671,6 +684,8 @@ impl<'a> ContactSolver<'a> {
             pairings: vec![Vec::new(); self.pairs.len()],
             slides: vec![None; self.pairs.len()],
             slide_change: None,
+            walls: (0..self.pairs.len()).map(|_| PairWalls::default()).collect(),
+            taken: vec![HashMap::new(); self.pairs.len()],
         };
         let mut status = ContactStatus::IterationLimit;
         for iteration in 1..=self.loop_settings().max_iterations {
@@ -741,6 +756,10 @@ struct LoopState {
     /// the last iteration that the loop went on for (over the settling margin).
     slides: Vec<Option<[f64; 3]>>,
     slide_change: Option<f64>,
+    /// Each pair's walls at the last iterate and those that pushed
+    /// ([`ContactSolver::holds_walls`]), and the walls the next coupling holds (by candidate).
+    walls: Vec<PairWalls>,
+    taken: Vec<HashMap<usize, HeldWall>>,
 }
 
 /// The last iterate as the loop keeps it between solves: each pair's coupling and the solution,
@@ -826,6 +845,11 @@ impl ContactSolver<'_> {
             .map(|p| self.pair_nodes(&state.active.contact, p))
             .collect();
         let tangential = self.tangential_states(&state.active, &state.directions, &state.turnings);
+        for p in 0..self.pairs.len() {
+            let s1 = &self.pairs[p].primary_surface;
+            let tol = self.pairs[p].settings.penetration_tolerance;
+            state.taken[p] = (state.walls[p]).taken(&state.rows[p], &nodes[p], |i| tol * s1.spacing[i]);
+        }
         let couplings = timed(&mut seconds.operators, || {
             self.couplings(&nodes, state, &tangential)
         })?;
@@ -852,6 +876,19 @@ impl ContactSolver<'_> {
             }
             iterate => iterate?,
         };
+        // Which walls pushed, read along the directions the coupling just solved held its
+        // nodes (`state.rows` has moved on to the iterate).
+        for p in (0..self.pairs.len()).filter(|&p| !state.taken[p].is_empty()) {
+            let k_of: HashMap<usize, usize> = (nodes[p].iter().enumerate())
+                .map(|(k, &i)| (i, k))
+                .collect();
+            let (normals, traction) = (&couplings[p].normals, &solution.traction[p]);
+            state.walls[p].record_pushes(
+                &state.taken[p],
+                |i| normals[k_of[&i]],
+                |i| traction[k_of[&i]],
+            );
+        }
         let drift: Vec<f64> = (0..self.pairs.len())
             .map(|p| {
                 let s1 = &self.pairs[p].primary_surface;
@@ -899,6 +936,31 @@ impl ContactSolver<'_> {
         let slide_moving = slide_change > 1.0
             && (state.slide_change).is_none_or(|last| slide_change <= CONTRACTION * last);
         state.slides = slid.iter().copied().map(Some).collect();
+        //    A pair whose active nodes sit in a concave vertex (they have walls) is paired
+        //    again at every iteration its slide
+        //    rounds to another pairing, settled or not: in the crater a corner digs it slides
+        //    a spacing or two before any set settles, and the transfer would carry the
+        //    corner's force to where the corner was, the crater forming beside the node that
+        //    digs it. A new pairing is a new linear problem, so the safeguard, which judges
+        //    repeats and progress on one, starts again, as after the settled rule's pairing;
+        //    the pairings left are not taken again on the same set, and the iteration cap
+        //    bounds the rest.
+        let in_groove: Vec<bool> = (0..self.pairs.len())
+            .map(|p| nodes[p].iter().any(|i| state.walls[p].found.contains_key(i)))
+            .collect();
+        let repaired: Vec<usize> = (drifted.iter().copied())
+            .filter(|&p| !update.settled && in_groove[p])
+            .collect();
+        for &p in &repaired {
+            let left = (self.operators[p].slid, state.active.clone());
+            state.pairings[p].push(left);
+            timed(&mut seconds.operators, || self.pair_again(p, pairings[p]))?;
+            state.corrections[p] = self.corrections(p, &solution, &gaps[p])?;
+        }
+        if !repaired.is_empty() {
+            state.safeguard = Safeguard::default();
+        }
+        state.safeguard.in_groove = in_groove.iter().any(|&g| g);
         let step = match state.safeguard.next(&state.active, &update) {
             Step::Stop(ContactStatus::Converged) if !drifted.is_empty() => {
                 for &p in &drifted {
@@ -1288,6 +1350,7 @@ impl ContactSolver<'_> {
                     rows: &state.rows[p],
                     start_jumps: state.friction[p].as_ref().map(|start| &start.jumps[..]),
                     tangential: tangential[p].as_deref(),
+                    walls: &state.taken[p],
                 },
                 false => Constraint::Interpolated {
                     corrections: &state.corrections[p],
@@ -1513,6 +1576,10 @@ impl ContactSolver<'_> {
                     let slid = operators.slide(s1, &jumps, &nodes);
                     Ok::<_, ContactError>((gaps, jumps, slid))
                 })?;
+                if self.holds_walls(p) {
+                    let digging = s1.beside_corners(CORNER_TURN);
+                    state.walls[p].found = walls(s1, s2, [u1, u2], rows, &digging);
+                }
                 let pair_linear = operators.linearized_gaps(&jumps);
                 // The gap each active node's constraint holds: the gap of its linearization (under
                 // the penalty method, less the overlap its pressure allows).

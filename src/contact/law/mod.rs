@@ -40,6 +40,9 @@ use crate::contact::settings::{ContactSettings, Formulation};
 pub enum Reads {
     Geometric,
     Interpolated,
+    /// The corners of a wall the node holds beside its closest facet
+    /// (`crate::contact::geometry::walls`).
+    Wall,
 }
 
 /// When a multiplier only restates Dirichlet conditions of the primary (and is dropped from
@@ -145,6 +148,14 @@ impl ContactLaw {
             ContactLaw::Coulomb { .. } => RowNormal::Averaged,
             _ => RowNormal::Facet,
         }
+    }
+
+    /// Whether an active node in a concave vertex of the other surface holds the second facet
+    /// too (`crate::contact::geometry::walls`): frictionless contact. A Coulomb node's
+    /// tangential rows already hold it along the surface while it sticks, and a slipping one's
+    /// friction along the wall would need its own slip law; tied contact holds every direction.
+    pub fn holds_walls(&self) -> bool {
+        matches!(self, Self::Frictionless)
     }
 
     /// Whether the tangential slip of an active node is constrained through `R12` and the

@@ -1,0 +1,170 @@
+//! The walls at a concave vertex: the second facet a primary node must not cross where its
+//! closest facet on the other surface meets another at a concave vertex (2D).
+//!
+//! A node's gap row ([`crate::contact::geometry::gap`]) holds it on the plane of one facet,
+//! the one its closest point lies on. Where the other surface is concave, as the crater a
+//! corner digs into a body of its own stiffness, the node sits in a vertex between two facets:
+//! held on one facet's plane it can slide through the other facet, and at the next iterate it
+//! faces that one and is held on its plane instead, sliding back through the first. With both
+//! facets' rows the node is held at the vertex, in the normal cone of the two planes, which is
+//! what a node in a V-shaped groove is at the answer. Each facet that shares a vertex with the
+//! closest facet and turns towards the node (its far end on the node's side of the closest
+//! facet's plane) by more than [`WALL_ANGLE`] is a *wall*: its gap `g_w = m_w . (x - q_w)`
+//! (`q_w` the node's closest point on that facet, `m_w` its outward normal) linearized as the
+//! gap is, the row `n_w . (u1 - sum_k b_k u2_k) = n_w . (u1^k - sum_k b_k u2_k^k) + g_w(u^k)`,
+//! `n_w = -m_w`. Which of them an active node holds is the loop's decision
+//! (`crate::contact::iteration::walls`).
+
+use std::collections::HashMap;
+
+use crate::contact::geometry::displacement::BodyDisplacement;
+use crate::contact::geometry::gap::GapRow;
+use crate::contact::geometry::surface::ContactSurface;
+use crate::fem::kernels::facet_measure_and_normal;
+
+/// The least angle between the closest facet and a facet meeting it for the second to be a
+/// wall. Below it the two planes hold the node at nearly the same place (the second row
+/// differs from the first by under 1.5% of a gap, `1 - cos 10°`) and the two rows are nearly
+/// parallel, which would make the pair of them ill-conditioned; a P1 surface bending under a
+/// smooth body turns by a few degrees per facet (the Hertz sweep's blocks: under 3).
+pub const WALL_ANGLE: f64 = 10.0;
+
+/// Two rows whose directions are closer than this (`|n . n_w|`) would hold the node along one
+/// direction twice: [`WALL_ANGLE`] keeps walls far from it.
+const PARALLEL: f64 = 0.999;
+
+/// One wall of a primary node: a facet meeting its closest facet at a concave vertex, and the
+/// node's gap to its plane linearized at the iterate, as [`GapRow`] is for the closest facet.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Wall {
+    /// The wall's facet and the node's closest facet (secondary facet indices): a wall is held
+    /// by this pair, so that it is the same wall when the node's closest facet becomes the
+    /// other one of the two.
+    pub facets: [usize; 2],
+    /// The wall's corners (secondary surface indices) and the barycentric coordinates of the
+    /// node's closest point on it.
+    pub corners: Vec<(usize, f64)>,
+    /// The row's direction `n_w = -m_w`, out of body 1.
+    pub normal: [f64; 3],
+    /// The gap to the wall's plane, `g_w(u^k)`.
+    pub gap: f64,
+    /// The right-hand side `n_w . (u1^k - sum_k b_k u2_k^k) + g_w(u^k)`.
+    pub target: f64,
+}
+
+/// A wall an active node holds beside its gap row, and the target vector of the two rows:
+/// both hold the same node, so its target (`crate::contact::coupled::system::Coupling::gaps`,
+/// `r . (u1 - u2(point)) = r . T` for each row `r`) is the one vector that satisfies both, `T =
+/// alpha n + beta n_w` with `alpha = (t - c t_w) / (1 - c^2)`, `beta = (t_w - c t) / (1 - c^2)`
+/// (`t`, `t_w` the two rows' targets, `c = n . n_w`).
+#[derive(Debug, Clone)]
+pub struct HeldWall {
+    pub wall: Wall,
+    pub target: [f64; 3],
+}
+
+impl Wall {
+    /// The wall held beside the gap row `row` of its node; `None` where the two rows are
+    /// nearly parallel ([`PARALLEL`]).
+    pub fn held_with(&self, row: &GapRow) -> Option<HeldWall> {
+        let (n, n_w) = (row.normal, self.normal);
+        let c = dot(n, n_w);
+        if c.abs() > PARALLEL {
+            return None;
+        }
+        let (t, t_w) = (row.target, self.target);
+        let det = 1.0 - c * c;
+        let (alpha, beta) = ((t - c * t_w) / det, (t_w - c * t) / det);
+        Some(HeldWall {
+            wall: self.clone(),
+            target: std::array::from_fn(|k| alpha * n[k] + beta * n_w[k]),
+        })
+    }
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|k| a[k] * b[k]).sum()
+}
+
+/// The walls ([`Wall`]) of each of the primary candidates `nodes` whose gap rows are `rows`
+/// (indexed by candidate), at the displacements `u1`, `u2`. 2D only: a vertex of a 2D surface
+/// joins two facets; in 3D an edge's node sits among several, and the rows would need
+/// choosing among them (no walls are returned). A row measured beside the other surface's rim
+/// (its direction not the closest facet's normal) has none.
+pub fn walls(
+    primary: &ContactSurface,
+    secondary: &ContactSurface,
+    [u1, u2]: [BodyDisplacement; 2],
+    rows: &[GapRow],
+    nodes: &[usize],
+) -> HashMap<usize, Vec<Wall>> {
+    let dim = secondary.dim;
+    if dim != 2 {
+        return HashMap::new();
+    }
+    let mut facets_at: HashMap<usize, Vec<usize>> = HashMap::new();
+    for f in 0..secondary.num_facets() {
+        for &s in secondary.facet_nodes(f) {
+            facets_at.entry(s).or_default().push(f);
+        }
+    }
+    let position = |s: usize| secondary.deformed(u2, s);
+    let displacement = |s: usize| u2.at(dim, secondary.nodes[s]);
+    let normal = |f: usize| {
+        let x: Vec<[f64; 3]> = (secondary.facet_nodes(f).iter()).map(|&s| position(s)).collect();
+        facet_measure_and_normal(&x, dim).1
+    };
+    let min_cos = WALL_ANGLE.to_radians().cos();
+    let mut found = HashMap::new();
+    for &i in nodes {
+        let row = &rows[i];
+        let ends: Vec<usize> = row.corners.iter().map(|c| c.0).collect();
+        let Some(&closest) = (facets_at.get(&ends[0]).into_iter().flatten())
+            .find(|&&f| secondary.facet_nodes(f) == ends.as_slice())
+        else {
+            continue;
+        };
+        let m_f = normal(closest);
+        if dot(m_f, row.normal) > -1.0 + 1e-12 {
+            continue; // beside the rim: measured by its distance, no facet's plane
+        }
+        let x = primary.deformed(u1, i);
+        let own = u1.at(dim, primary.nodes[i]);
+        let mut node_walls = Vec::new();
+        for &vertex in &ends {
+            for &g in facets_at.get(&vertex).into_iter().flatten() {
+                let corners = secondary.facet_nodes(g);
+                if g == closest {
+                    continue;
+                }
+                let far = if corners[0] == vertex { corners[1] } else { corners[0] };
+                let (v, w) = (position(vertex), position(far));
+                let concave = dot(m_f, std::array::from_fn(|k| w[k] - v[k])) > 0.0;
+                let m_g = normal(g);
+                if !concave || dot(m_f, m_g) > min_cos {
+                    continue;
+                }
+                let (a, b) = (position(corners[0]), position(corners[1]));
+                let ab: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
+                let t = (dot(std::array::from_fn(|k| x[k] - a[k]), ab) / dot(ab, ab)).clamp(0.0, 1.0);
+                let gap = dot(m_g, std::array::from_fn(|k| x[k] - a[k] - t * ab[k]));
+                let corners = vec![(corners[0], 1.0 - t), (corners[1], t)];
+                let jump: [f64; 3] = std::array::from_fn(|k| {
+                    own[k] - (corners.iter()).map(|&(s, b)| b * displacement(s)[k]).sum::<f64>()
+                });
+                let n_w = m_g.map(|v| -v);
+                node_walls.push(Wall {
+                    facets: [g, closest],
+                    corners,
+                    normal: n_w,
+                    gap,
+                    target: dot(n_w, jump) + gap,
+                });
+            }
+        }
+        if !node_walls.is_empty() {
+            found.insert(i, node_walls);
+        }
+    }
+    found
+}
