@@ -256,7 +256,8 @@ def _pressed_pair(msh: Path, moving: str, delta: float, youngs_modulus: float, p
 
 def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio: float,
                    reach: float = 2.0, max_iterations: int = 400,
-                   block_modulus: float | None = None, update: str = "exact") -> dict:
+                   block_modulus: float | None = None, update: str = "exact",
+                   start_from: dict | None = None) -> dict:
     """The square of ``geo/tilted_square_2d.geo`` pressed by ``delta`` into the block of the same
     material, both elastic (module doc, ``two_body_solve``).
 
@@ -286,6 +287,14 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
     conditions hold, the two are solutions of the same discrete problem; where they differ, that
     problem has more than one (the gap measured on the deformed surfaces is not convex in the
     displacements), and no solver of it can be held to closer than their difference.
+
+    ``start_from``: the displacement to start from, ``{gmsh node tag: (u_x, u_y)}`` for every node of
+    both bodies (an answer of internodes), each step linearized where the last one ended from the
+    first on (no small-sliding step): the solution of this discrete problem nearest that answer,
+    where the problem has several (the gap measured on the deformed surfaces is not convex in the
+    displacements). Where the answer is near one of them, the steps end there; internodes carries
+    the square's force to the block by its interface operators, this reference node to segment,
+    so the two differ by that discretization's share.
 
     ``block_modulus``: the block's (default: the square's; a rigid block's check, module doc).
     Candidates: the square's contact nodes within ``reach`` delta of the block in the reference
@@ -343,11 +352,17 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
     if update not in ("exact", "primal-dual"):
         raise ValueError(f"update: 'exact' or 'primal-dual', not {update!r}")
     u = u0.copy()
+    if start_from is not None:
+        tags = np.concatenate([square.node_tags, block.node_tags]).astype(int)
+        given = np.array([start_from[int(t)] for t in tags], dtype=float).reshape(-1)
+        u = u0.copy()
+        u[free] = given[free]
     held = set()  # primal-dual: the (node, facet) rows whose multiplier was positive
     small_sliding = None
     change = math.inf
     for iteration in range(1, max_iterations + 1):
-        if iteration == 1:  # small sliding: every candidate on the block's top under it, along y
+        small_step = iteration == 1 and start_from is None
+        if small_step:  # small sliding: every candidate on the block's top under it, along y
             rows = np.zeros((len(candidates), size))
             for r, node in enumerate(candidates):
                 x = square.x[node, 0]
@@ -366,14 +381,14 @@ def two_body_solve(msh: Path, delta: float, youngs_modulus: float, poisson_ratio
             solved[r, free] = factor.solve(rows[r, free])
         W = rows[:, free] @ solved[:, free].T
         W = 0.5 * (W + W.T)
-        at = np.zeros(size) if iteration == 1 else u  # the linearization point
+        at = np.zeros(size) if small_step else u  # the linearization point
         q = gaps + rows @ (u0 - at)
-        lam = _step_multipliers(W, q, update, iteration == 1, walls, gaps, held)
+        lam = _step_multipliers(W, q, update, small_step, walls, gaps, held)
         held = {wall for wall, value in zip(walls, lam) if value > 0.0}
         new = u0 + solved.T @ lam
         change = float(np.abs(new - u).max())
         u = new
-        if iteration == 1:
+        if small_step:
             small_sliding = float(lam.sum())
         if iteration > 1 and change <= 1e-6 * delta:
             break

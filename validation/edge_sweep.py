@@ -118,6 +118,9 @@ POISSON_RATIO = 0.3
 
 # Tolerances, fixed before any run.
 FORCE_TOLERANCE = 0.01
+# A contact zone narrower than this many spacings is not resolved (the stiff square's corner at
+# h = 0.002 and 0.5% or 1%: under 1.5 spacings across, every run named by the resolution indicator).
+RESOLVED_ZONE = 1.5
 ZONE_TOLERANCE = 1.0  # spacings
 MESH_TOLERANCE = 0.25
 FILLET_TOLERANCE = 1e-6  # of rho
@@ -140,6 +143,9 @@ class Family:
     geo: tuple = ()  # fixed geo parameters (name, value)
     e_ratio: float = E_RATIO  # E_stiff / E_compliant
     auto_supported: bool = True  # "auto" must be RIGHT (else RIGHT or NAMED, like an explicit primary)
+    # ... where the reference's contact zone is at least this many spacings of the compliant body
+    # across (below, RIGHT or NAMED: the solver's resolution indicator names such a zone)
+    auto_resolved_from: float = 0.0
 
     @property
     def bodies(self) -> tuple[str, str]:
@@ -156,7 +162,7 @@ FAMILIES = {
         Family("cube-edge", 3, "tilted_cube_3d", "cube", "block", 0.01, 0.4, (0.01, 0.02, 0.04)),
         Family("square-corner-2d", 2, "tilted_square_2d", "square", "block", 0.001, 0.4, (0.01, 0.02, 0.04)),
         Family("square-corner-2d-equal", 2, "tilted_square_2d", "square", "block", 0.001, 0.4, (0.01, 0.02, 0.04),
-               e_ratio=1.0, auto_supported=False),
+               e_ratio=1.0, auto_resolved_from=RESOLVED_ZONE),
         Family("cube-edge-equal", 3, "tilted_cube_3d", "cube", "block", 0.01, 0.4, (0.01,),
                e_ratio=1.0, auto_supported=False),
     )
@@ -439,7 +445,8 @@ def classify(case: EdgeCase, msh: Path, primary: str, run: dict, out: dict | Non
              measured: dict) -> dict:
     """RIGHT / NAMED / WRONG / ERROR (module doc) with its figures."""
     f = case.f
-    record = {"primary_asked": primary, "exit": run["exit"], "seconds": run["seconds"]}
+    record = {"primary_asked": primary, "exit": run["exit"], "seconds": run["seconds"],
+              "zone_spacings": zone_width(ref, f.dim) / measured[f"{f.compliant}_contact"]}
     if out is None:
         return record | {"class": "ERROR", "why": f"no output (exit {run['exit']}): {run['tail']}"}
     contact = out["contact"]
@@ -468,8 +475,30 @@ def classify(case: EdgeCase, msh: Path, primary: str, run: dict, out: dict | Non
     if not math.isfinite(zone):
         return record | {"class": "ERROR", "why": f"the contact zone could not be compared (spacings {measured})"}
     right = abs(record["force_error"]) <= FORCE_TOLERANCE and zone <= ZONE_TOLERANCE
-    return record | {"class": "RIGHT" if right else "WRONG",
-                     "why": f"force {record['force_error']:+.2%}, zone {zone:.2f} spacings"}
+    why = f"force {record['force_error']:+.2%}, zone {zone:.2f} spacings"
+    if not right and f.dim == 2 and f.e_ratio == 1.0:
+        # The discrete problem may have several solutions (module doc): the one nearest ours.
+        nearest = edge_reference.two_body_solve(msh, case.delta, E_COMPLIANT, POISSON_RATIO,
+                                                start_from=solution_displacements(out))
+        error = record["force"] / nearest["force"] - 1
+        near_zone = max(zone_distance(out, record["primary"], nearest, case, msh, measured))
+        record |= {"nearest_force": nearest["force"], "nearest_force_error": error}
+        right = (edge_reference.converged(nearest) and abs(error) <= FORCE_TOLERANCE
+                 and near_zone <= ZONE_TOLERANCE)
+        why += (f"; the reference started from this answer {'converges' if edge_reference.converged(nearest) else 'does not converge'} "
+                f"to P = {nearest['force']:.6g} ({nearest['force'] / ref['force'] - 1:+.2%} from the reference from rest): "
+                f"force {error:+.2%}, zone {near_zone:.2f} spacings from it")
+    return record | {"class": "RIGHT" if right else "WRONG", "why": why}
+
+
+def solution_displacements(out: dict) -> dict:
+    """Our answer's displacement at every node, ``{gmsh node tag: (u_x, u_y)}``."""
+    import h5py
+
+    with h5py.File(out["output"] / "solution.h5", "r") as h5:
+        tags = h5["mesh/node_tag"][()]
+        u = h5["fields/displacement"][()]
+    return {int(t): (float(v[0]), float(v[1])) for t, v in zip(tags, u)}
 
 
 def run_checks(case: EdgeCase, record: dict) -> list[Check]:
@@ -483,7 +512,8 @@ def run_checks(case: EdgeCase, record: dict) -> list[Check]:
                    f"(ours beyond / reference missed); ")
     note = (f"{klass}: exit {record['exit']}, {record.get('status')}, primary {record.get('primary')}; {figures}"
             f"{record.get('why', '')}; {record['seconds']:.1f} s")
-    if record["primary_asked"] == "auto" and not case.f.auto_supported:
+    resolved = record.get("zone_spacings", math.inf) >= case.f.auto_resolved_from
+    if record["primary_asked"] == "auto" and not (case.f.auto_supported and resolved):
         rows = [Check("auto: right or named", label, 0.0 if klass in ("RIGHT", "NAMED") else 1.0, 0.0, note)]
     elif record["primary_asked"] == "auto":
         rows = [Check("auto: right", label, 0.0 if klass == "RIGHT" else 1.0, 0.0,

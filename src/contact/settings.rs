@@ -76,9 +76,11 @@ pub const DEFAULT_PENALTY: f64 = 100.0;
 ///   (`crate::contact::geometry::gap`), and the system stays unsymmetric. Onto a secondary finer
 ///   than the primary it leaves the secondary nodes between the projections of primary nodes
 ///   unloaded, which is why INTERNODES interpolates there.
-/// - `Auto` (default): conservative when the secondary's contact surface is coarser than the
-///   primary's near the other body (`crate::contact::problem::contact_zone_spacing`), interpolation
-///   otherwise.
+/// - `Auto` (default): conservative onto a nearly rigid secondary, from a primary with a corner
+///   or an edge (`crate::contact::problem::CORNER_TURN`: its traction concentrates there, and
+///   its interpolation does not keep the resultant), or when the secondary's contact surface is
+///   coarser than the primary's near the other body
+///   (`crate::contact::problem::contact_zone_spacing`); interpolation otherwise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Transfer {
