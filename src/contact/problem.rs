@@ -324,7 +324,9 @@ fn cornered_side(sides: &[ContactSide; 2]) -> Option<usize> {
     if sides[0].1.dim != 2 {
         return None;
     }
-    let cornered = sides.each_ref().map(|side| side.1.sharpest_turn() > CORNER_TURN);
+    let cornered = sides
+        .each_ref()
+        .map(|side| side.1.sharpest_turn() > CORNER_TURN);
     match cornered {
         [true, false] => Some(0),
         [false, true] => Some(1),

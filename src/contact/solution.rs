@@ -400,8 +400,8 @@ impl ContactSolution {
     /// were paired, what that means (empty otherwise): the pairing follows the slide only once
     /// an active set settles (`docs/method.md` 3.5), so a loop whose surfaces keep sliding
     /// reads the other body's displacement and sends its force where the contact is no longer.
-    /// The equal-material corner ends so (its two sides slide apart by up to ten spacings on
-    /// refined meshes), a body pushed sideways whose set settles does not.
+    /// The equal-material corner as the secondary ends so (its two sides slide apart by up to
+    /// ten spacings on refined meshes), a body pushed sideways whose set settles does not.
     fn slid_off_pairing(&self) -> String {
         let slid = (self.history.last()).map_or(0.0, |r| r.pairing_drift_over_h);
         if slid.is_nan() || slid < SLID_OFF_PAIRING {
@@ -409,8 +409,9 @@ impl ContactSolution {
         }
         format!(
             "; the surfaces had slid {slid:.1} spacings from where the interface was paired, which \
-             follows them only once an active set settles: contact that slides this far before \
-             it settles (a corner pressed into a body as compliant as itself) is beyond it"
+             follows them only once an active set settles (at every iteration only where a corner \
+             of the primary digs a groove): contact that slides this far before it settles (a \
+             corner of the secondary pressed into a body as compliant as itself) is beyond it"
         )
     }
 

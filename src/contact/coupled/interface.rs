@@ -275,7 +275,11 @@ impl InterfaceOperators {
                     .map(|node| node.iter().any(|m| m.reads == Reads::Interpolated))
                     .collect();
                 wall_reads = (active.iter())
-                    .map(|i| walls.get(i).map_or_else(Vec::new, |held| to_body2(&held.wall.corners, &|_, b| b)))
+                    .map(|i| {
+                        walls
+                            .get(i)
+                            .map_or_else(Vec::new, |held| to_body2(&held.wall.corners, &|_, b| b))
+                    })
                     .collect();
                 (
                     active

@@ -182,7 +182,9 @@ impl ContactSurface {
     /// node of one facet.
     fn turns(&self) -> Vec<f64> {
         let normal = |f: usize| {
-            let x: Vec<[f64; 3]> = (self.facet_nodes(f).iter()).map(|&s| self.coords[s]).collect();
+            let x: Vec<[f64; 3]> = (self.facet_nodes(f).iter())
+                .map(|&s| self.coords[s])
+                .collect();
             facet_measure_and_normal(&x, self.dim).1
         };
         let normals: Vec<[f64; 3]> = (0..self.num_facets()).map(normal).collect();

@@ -111,7 +111,9 @@ pub fn walls(
     let position = |s: usize| secondary.deformed(u2, s);
     let displacement = |s: usize| u2.at(dim, secondary.nodes[s]);
     let normal = |f: usize| {
-        let x: Vec<[f64; 3]> = (secondary.facet_nodes(f).iter()).map(|&s| position(s)).collect();
+        let x: Vec<[f64; 3]> = (secondary.facet_nodes(f).iter())
+            .map(|&s| position(s))
+            .collect();
         facet_measure_and_normal(&x, dim).1
     };
     let min_cos = WALL_ANGLE.to_radians().cos();
@@ -137,7 +139,11 @@ pub fn walls(
                 if g == closest {
                     continue;
                 }
-                let far = if corners[0] == vertex { corners[1] } else { corners[0] };
+                let far = if corners[0] == vertex {
+                    corners[1]
+                } else {
+                    corners[0]
+                };
                 let (v, w) = (position(vertex), position(far));
                 let concave = dot(m_f, std::array::from_fn(|k| w[k] - v[k])) > 0.0;
                 let m_g = normal(g);
@@ -146,11 +152,15 @@ pub fn walls(
                 }
                 let (a, b) = (position(corners[0]), position(corners[1]));
                 let ab: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
-                let t = (dot(std::array::from_fn(|k| x[k] - a[k]), ab) / dot(ab, ab)).clamp(0.0, 1.0);
+                let t =
+                    (dot(std::array::from_fn(|k| x[k] - a[k]), ab) / dot(ab, ab)).clamp(0.0, 1.0);
                 let gap = dot(m_g, std::array::from_fn(|k| x[k] - a[k] - t * ab[k]));
                 let corners = vec![(corners[0], 1.0 - t), (corners[1], t)];
                 let jump: [f64; 3] = std::array::from_fn(|k| {
-                    own[k] - (corners.iter()).map(|&(s, b)| b * displacement(s)[k]).sum::<f64>()
+                    own[k]
+                        - (corners.iter())
+                            .map(|&(s, b)| b * displacement(s)[k])
+                            .sum::<f64>()
                 });
                 let n_w = m_g.map(|v| -v);
                 node_walls.push(Wall {

@@ -684,7 +684,9 @@ impl<'a> ContactSolver<'a> {
             pairings: vec![Vec::new(); self.pairs.len()],
             slides: vec![None; self.pairs.len()],
             slide_change: None,
-            walls: (0..self.pairs.len()).map(|_| PairWalls::default()).collect(),
+            walls: (0..self.pairs.len())
+                .map(|_| PairWalls::default())
+                .collect(),
             taken: vec![HashMap::new(); self.pairs.len()],
         };
         let mut status = ContactStatus::IterationLimit;
@@ -848,7 +850,8 @@ impl ContactSolver<'_> {
         for p in 0..self.pairs.len() {
             let s1 = &self.pairs[p].primary_surface;
             let tol = self.pairs[p].settings.penetration_tolerance;
-            state.taken[p] = (state.walls[p]).taken(&state.rows[p], &nodes[p], |i| tol * s1.spacing[i]);
+            state.taken[p] =
+                (state.walls[p]).taken(&state.rows[p], &nodes[p], |i| tol * s1.spacing[i]);
         }
         let couplings = timed(&mut seconds.operators, || {
             self.couplings(&nodes, state, &tangential)
@@ -946,7 +949,11 @@ impl ContactSolver<'_> {
         //    the pairings left are not taken again on the same set, and the iteration cap
         //    bounds the rest.
         let in_groove: Vec<bool> = (0..self.pairs.len())
-            .map(|p| nodes[p].iter().any(|i| state.walls[p].found.contains_key(i)))
+            .map(|p| {
+                nodes[p]
+                    .iter()
+                    .any(|i| state.walls[p].found.contains_key(i))
+            })
             .collect();
         let repaired: Vec<usize> = (drifted.iter().copied())
             .filter(|&p| !update.settled && in_groove[p])

@@ -124,7 +124,9 @@ mod tests {
         // closest one.
         walls.record_pushes(&taken, |_| [0.0, -1.0, 0.0], |_| [2.0, 1.0, 0.0]);
         assert!(walls.held.contains(&(0, 7)) && walls.held.contains(&(0, 3)));
-        walls.found.insert(0, vec![wall([3, 7], [1.0, 0.0, 0.0], 1e-3, 0.5)]);
+        walls
+            .found
+            .insert(0, vec![wall([3, 7], [1.0, 0.0, 0.0], 1e-3, 0.5)]);
         assert_eq!(walls.taken(&rows, &[0], |_| 1e-3)[&0].wall.facets, [3, 7]);
         // A wall that pulls is let go.
         walls.record_pushes(&taken, |_| [0.0, -1.0, 0.0], |_| [-2.0, 1.0, 0.0]);
