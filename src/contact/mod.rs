@@ -52,9 +52,8 @@ pub use certificate::{Certificate, CertificateCheck, CheckKind, ErrorCoverage};
 pub use coupled::coupled_krylov::{KrylovError, KrylovFailure};
 pub use coupled::system;
 pub use driver::{ContactRun, StepFriction, StepRecord, solve_contact, solve_contact_steps};
-pub use geometry::displacement::BodyDisplacement;
 pub use geometry::surface::{ContactSurface, SurfaceError};
-pub use geometry::{gap, projection, rbf, walls};
+pub use geometry::{projection, rbf};
 pub use iteration::solve::ContactSolver;
 pub use problem::{
     ContactProblem, ContactSide, OtherPrimary, PrimaryChoice, PrimaryReport, TransferReport,

@@ -163,7 +163,7 @@ impl ContactSurface {
     }
 
     /// The surface's corners (the nodes at which it turns by more than `angle` degrees,
-    /// [`Self::turns`]) and the nodes that share a facet with one, increasing.
+    /// `Self::turns`) and the nodes that share a facet with one, increasing.
     pub fn beside_corners(&self, angle: f64) -> Vec<usize> {
         let turns = self.turns();
         let mut nodes: Vec<usize> = (0..self.num_facets())

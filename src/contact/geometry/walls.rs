@@ -178,3 +178,92 @@ pub fn walls(
     }
     found
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::contact::geometry::gap::{RowNormal, gap_rows};
+    use crate::mesh::{mesh_geo, read_msh};
+
+    /// The walls of the tilted square's corner node (`geo/tilted_square_2d.geo`, meshed by gmsh
+    /// at 0.004) in a V-shaped groove made by hand in the block's top: the block's surface moved
+    /// down by `depth (1 - |x - x_v| / w)` within `w` of its node `v` under the corner, so that it
+    /// turns at `v` by `2 atan(depth / w)`, and the corner's node moved into the groove below both
+    /// of its sides' planes. The node's wall is the side it is not held on, read by its plane: its
+    /// normal is that side's (computed from the slope, not from the mesh), its gap the node's
+    /// distance to that plane. A groove turning by less than the wall angle, and the flat block,
+    /// have none.
+    #[test]
+    fn a_node_in_a_groove_has_the_other_side_as_its_wall() {
+        let folder = tempfile::tempdir().unwrap();
+        let geo = Path::new(env!("CARGO_MANIFEST_DIR")).join("geo/tilted_square_2d.geo");
+        let msh = folder.path().join("tilted_square_2d.msh");
+        let parameters = [("h_c".to_string(), 0.004), ("h_b".to_string(), 0.0056)];
+        mesh_geo(&geo, &msh, &parameters).expect("gmsh meshes");
+        let mesh = read_msh(&msh).unwrap();
+        let (square_mesh, block_mesh) = (mesh.body("square").unwrap(), mesh.body("block").unwrap());
+        let square = ContactSurface::new(square_mesh, "square_contact").unwrap();
+        let block = ContactSurface::new(block_mesh, "block_contact").unwrap();
+        let corner = (square.beside_corners(45.0).into_iter())
+            .min_by(|&a, &b| square.coords[a][1].total_cmp(&square.coords[b][1]))
+            .unwrap();
+        let x_c = square.coords[corner];
+        let v = (0..block.len())
+            .min_by(|&a, &b| {
+                let d = |s: usize| (block.coords[s][0] - x_c[0]).abs();
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap();
+        let x_v = block.coords[v];
+        let w = 0.02;
+        let groove = |slope: f64| {
+            let mut u2 = vec![0.0; 2 * block_mesh.num_nodes()];
+            for s in 0..block.len() {
+                let along = (block.coords[s][0] - x_v[0]).abs();
+                u2[2 * block.nodes[s] + 1] = -slope * w * (1.0 - along / w).max(0.0);
+            }
+            u2
+        };
+        let walls_of_corner = |slope: f64| {
+            let u2 = groove(slope);
+            // The corner's node half a block spacing right of the vertex, below both sides' planes.
+            let dx = 0.5 * block.spacing[v];
+            let target = [x_v[0] + dx, x_v[1] - slope * w - slope * dx - 1e-4];
+            let mut u1 = vec![0.0; 2 * square_mesh.num_nodes()];
+            (0..2).for_each(|k| u1[2 * square.nodes[corner] + k] = target[k] - x_c[k]);
+            let u = [BodyDisplacement::Whole(&u1), BodyDisplacement::Whole(&u2)];
+            let rows = gap_rows(&square, &block, Some(u[0]), Some(u[1]), RowNormal::Facet);
+            let found = walls(&square, &block, u, &rows, &[corner]);
+            (
+                rows[corner].clone(),
+                found.get(&corner).cloned().unwrap_or_default(),
+                target,
+            )
+        };
+        let slope = 0.5; // each side 26.6 degrees, the vertex turning by 53
+        let (row, found, x) = walls_of_corner(slope);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let wall = &found[0];
+        let length = (1.0 + slope * slope).sqrt();
+        let up_left = [slope / length, 1.0 / length, 0.0]; // out of the block, the side x < x_v
+        let up_right = [-slope / length, 1.0 / length, 0.0];
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] + b[k]).abs() < 1e-9);
+        let held_left = close(row.normal, up_left);
+        assert!(held_left || close(row.normal, up_right), "{:?}", row.normal);
+        let m_w = if held_left { up_right } else { up_left };
+        assert!(close(wall.normal, m_w), "{:?} against {m_w:?}", wall.normal);
+        let bottom = [x_v[0], x_v[1] - slope * w];
+        let gap = (0..2).map(|k| m_w[k] * (x[k] - bottom[k])).sum::<f64>();
+        assert!(
+            gap < 0.0 && (wall.gap - gap).abs() < 1e-12,
+            "{} against {gap}",
+            wall.gap
+        );
+        // Below the wall angle, and flat: none.
+        let shallow = (WALL_ANGLE / 2.0 * 0.9).to_radians().tan();
+        assert!(walls_of_corner(shallow).1.is_empty());
+        assert!(walls_of_corner(0.0).1.is_empty());
+    }
+}

@@ -847,9 +847,13 @@ impl ContactSolver<'_> {
             .map(|p| self.pair_nodes(&state.active.contact, p))
             .collect();
         let tangential = self.tangential_states(&state.active, &state.directions, &state.turnings);
-        for p in 0..self.pairs.len() {
-            let s1 = &self.pairs[p].primary_surface;
-            let tol = self.pairs[p].settings.penetration_tolerance;
+        // The walls each active node holds (frictionless 2D pairs: `ContactSolver::holds_walls`;
+        // `found` is empty for the others).
+        for (p, problem) in self.pairs.iter().enumerate() {
+            let (s1, tol) = (
+                &problem.primary_surface,
+                problem.settings.penetration_tolerance,
+            );
             state.taken[p] =
                 (state.walls[p]).taken(&state.rows[p], &nodes[p], |i| tol * s1.spacing[i]);
         }
