@@ -943,15 +943,14 @@ impl ContactSolver<'_> {
         let slide_moving = slide_change > 1.0
             && (state.slide_change).is_none_or(|last| slide_change <= CONTRACTION * last);
         state.slides = slid.iter().copied().map(Some).collect();
-        //    A pair whose active nodes sit in a concave vertex (they have walls) is paired
-        //    again at every iteration its slide
-        //    rounds to another pairing, settled or not: in the crater a corner digs it slides
-        //    a spacing or two before any set settles, and the transfer would carry the
-        //    corner's force to where the corner was, the crater forming beside the node that
-        //    digs it. A new pairing is a new linear problem, so the safeguard, which judges
-        //    repeats and progress on one, starts again, as after the settled rule's pairing;
-        //    the pairings left are not taken again on the same set, and the iteration cap
-        //    bounds the rest.
+        //    A pair whose active nodes sit in a groove (they have walls) is paired again at
+        //    every iteration its slide rounds to another pairing, settled or not: in the
+        //    crater a corner digs, the corner slides a spacing or two before any set settles,
+        //    and the transfer would carry its force to where it was, the crater forming beside
+        //    the node that digs it. A new pairing is a new linear problem, so the safeguard,
+        //    which judges repeats and progress on one, starts again, as after the settled
+        //    rule's pairing; the pairings left are not taken again on the same set, and the
+        //    iteration cap bounds the rest (the safeguard's stops are held off in a groove).
         let in_groove: Vec<bool> = (0..self.pairs.len())
             .map(|p| {
                 nodes[p]
