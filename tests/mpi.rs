@@ -542,6 +542,14 @@ fn the_conservative_transfer_on_two_ranks_gives_the_serial_answer() {
 }
 
 #[test]
+fn a_corner_in_the_crater_it_digs_on_two_ranks_gives_the_serial_answer() {
+    // A 2D square's corner pressed into a block of its own material: the corner's node held
+    // against both walls of its crater, the pairing following the slide at every iteration
+    // (each rank finds the walls from the gathered gap rows).
+    ranks_give_the_serial_answer(2, "square_corner_on_block_2d", "", 1);
+}
+
+#[test]
 fn a_stack_of_three_2d_bodies_on_two_ranks_gives_the_serial_answer() {
     // Two pairs in a chain (the middle body in both) in 2D, two load steps.
     ranks_give_the_serial_answer(2, "stack_2d", "", 1);
