@@ -64,6 +64,10 @@ pub struct ContactSurface {
     facets: Vec<usize>,
     /// The surface's rim ([`Rim`]): where it ends.
     rim: Rim,
+    /// At each node, the largest angle in degrees between the normals of two facets that meet
+    /// there (2D) or along an edge through it (3D), in the reference configuration; zero at a
+    /// node of one facet.
+    turns: Vec<f64>,
     /// The body's whole boundary, which tells inside from outside.
     pub boundary: BodyBoundary,
 }
@@ -105,7 +109,9 @@ impl ContactSurface {
             group: group_name.to_string(),
             message: e.to_string(),
         })?;
-        let rim = Rim::new(&facets, dim, nodes.len());
+        let meeting = facets_meeting(&facets, dim);
+        let rim = Rim::new(&meeting, &facets, dim, nodes.len());
+        let turns = turns(&meeting, &facets, dim, &coords);
         Ok(Self {
             body: body.name.clone(),
             group: group_name.to_string(),
@@ -118,6 +124,7 @@ impl ContactSurface {
             nodal_area,
             facets,
             rim,
+            turns,
             boundary: BodyBoundary::new(body),
         })
     }
@@ -159,59 +166,21 @@ impl ContactSurface {
     /// in 2D, along an edge in 3D), in the reference configuration: 180 / N on a circle of N
     /// facets, 90 at a square's corner.
     pub fn sharpest_turn(&self) -> f64 {
-        self.turns().into_iter().fold(0.0, f64::max)
+        self.turns.iter().copied().fold(0.0, f64::max)
     }
 
-    /// The surface's corners (the nodes at which it turns by more than `angle` degrees,
-    /// `Self::turns`) and the nodes that share a facet with one, increasing.
+    /// The surface's corners (the nodes at which it turns by more than `angle` degrees) and
+    /// the nodes that share a facet with one, increasing.
     pub fn beside_corners(&self, angle: f64) -> Vec<usize> {
-        let turns = self.turns();
         let mut nodes: Vec<usize> = (0..self.num_facets())
             .map(|f| self.facet_nodes(f))
-            .filter(|corners| corners.iter().any(|&s| turns[s] > angle))
+            .filter(|corners| corners.iter().any(|&s| self.turns[s] > angle))
             .flatten()
             .copied()
             .collect();
         nodes.sort_unstable();
         nodes.dedup();
         nodes
-    }
-
-    /// At each node, the largest angle in degrees between the normals of two facets that meet
-    /// there (2D) or along an edge through it (3D), in the reference configuration; zero at a
-    /// node of one facet.
-    fn turns(&self) -> Vec<f64> {
-        let normal = |f: usize| {
-            let x: Vec<[f64; 3]> = (self.facet_nodes(f).iter())
-                .map(|&s| self.coords[s])
-                .collect();
-            facet_measure_and_normal(&x, self.dim).1
-        };
-        let normals: Vec<[f64; 3]> = (0..self.num_facets()).map(normal).collect();
-        let mut meeting: HashMap<Vec<usize>, Vec<usize>> = HashMap::new();
-        for f in 0..self.num_facets() {
-            let corners = self.facet_nodes(f);
-            for k in 0..self.dim {
-                // 2D: each corner; 3D: the edge opposite each corner.
-                let mut shared: Vec<usize> = match self.dim {
-                    2 => vec![corners[k]],
-                    _ => vec![corners[(k + 1) % 3], corners[(k + 2) % 3]],
-                };
-                shared.sort_unstable();
-                meeting.entry(shared).or_default().push(f);
-            }
-        }
-        let mut turns = vec![0.0_f64; self.len()];
-        for (shared, facets) in &meeting {
-            for (a, &f) in facets.iter().enumerate() {
-                for &g in &facets[a + 1..] {
-                    let cos = (0..3).map(|k| normals[f][k] * normals[g][k]).sum::<f64>();
-                    let angle = cos.clamp(-1.0, 1.0).acos().to_degrees();
-                    shared.iter().for_each(|&s| turns[s] = turns[s].max(angle));
-                }
-            }
-        }
-        turns
     }
 
     /// The number of facets.
@@ -293,28 +262,81 @@ struct Rim {
     edges: Vec<[bool; 3]>,
 }
 
-impl Rim {
-    fn new(facets: &[usize], dim: usize, num_nodes: usize) -> Self {
-        let mut nodes = vec![false; num_nodes];
-        let mut edges = Vec::new();
-        if dim == 2 {
-            let mut count = vec![0usize; num_nodes];
-            facets.iter().for_each(|&s| count[s] += 1);
-            (nodes.iter_mut().zip(count)).for_each(|(rim, c)| *rim = c == 1);
-            return Self { nodes, edges };
+/// Where the facets of a surface meet ([`meeting_key`]: at a node in 2D, along an edge in 3D),
+/// and which facets meet there.
+fn facets_meeting(facets: &[usize], dim: usize) -> HashMap<(usize, usize), Vec<usize>> {
+    let mut meeting: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+    for (f, corners) in facets.chunks_exact(dim).enumerate() {
+        for k in 0..dim {
+            meeting.entry(meeting_key(corners, k)).or_default().push(f);
         }
-        let edge = |corners: &[usize], k: usize| {
+    }
+    meeting
+}
+
+/// The `k`-th place where a facet with `corners` meets others: its corner `k` in 2D (the key
+/// `(s, s)`), the edge opposite its corner `k` in 3D (its two nodes, in increasing order).
+fn meeting_key(corners: &[usize], k: usize) -> (usize, usize) {
+    match corners.len() {
+        2 => (corners[k], corners[k]),
+        _ => {
             let (a, b) = (corners[(k + 1) % 3], corners[(k + 2) % 3]);
             (a.min(b), a.max(b))
-        };
-        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
-        for corners in facets.chunks_exact(3) {
-            (0..3).for_each(|k| *count.entry(edge(corners, k)).or_default() += 1);
+        }
+    }
+}
+
+/// At each node, the largest angle in degrees between the normals of two facets that meet
+/// there or along an edge through it (`ContactSurface::turns`).
+fn turns(
+    meeting: &HashMap<(usize, usize), Vec<usize>>,
+    facets: &[usize],
+    dim: usize,
+    coords: &[[f64; 3]],
+) -> Vec<f64> {
+    let normals: Vec<[f64; 3]> = (facets.chunks_exact(dim))
+        .map(|corners| {
+            let x: Vec<[f64; 3]> = corners.iter().map(|&s| coords[s]).collect();
+            facet_measure_and_normal(&x, dim).1
+        })
+        .collect();
+    let mut turns = vec![0.0_f64; coords.len()];
+    for (&(a, b), meeting_facets) in meeting {
+        for (i, &f) in meeting_facets.iter().enumerate() {
+            for &g in &meeting_facets[i + 1..] {
+                let cos = (0..3).map(|k| normals[f][k] * normals[g][k]).sum::<f64>();
+                let angle = cos.clamp(-1.0, 1.0).acos().to_degrees();
+                turns[a] = turns[a].max(angle);
+                turns[b] = turns[b].max(angle);
+            }
+        }
+    }
+    turns
+}
+
+impl Rim {
+    /// The rim of the surface of `facets` whose facets meet as `meeting` says
+    /// ([`facets_meeting`]): the nodes of one facet (2D), the edges of one facet and their
+    /// nodes (3D).
+    fn new(
+        meeting: &HashMap<(usize, usize), Vec<usize>>,
+        facets: &[usize],
+        dim: usize,
+        num_nodes: usize,
+    ) -> Self {
+        let mut nodes = vec![false; num_nodes];
+        let mut edges = Vec::new();
+        let free = |corners: &[usize], k: usize| meeting[&meeting_key(corners, k)].len() == 1;
+        if dim == 2 {
+            for corners in facets.chunks_exact(2) {
+                (0..2).for_each(|k| nodes[corners[k]] |= free(corners, k));
+            }
+            return Self { nodes, edges };
         }
         for corners in facets.chunks_exact(3) {
-            let free: [bool; 3] = std::array::from_fn(|k| count[&edge(corners, k)] == 1);
+            let free: [bool; 3] = std::array::from_fn(|k| free(corners, k));
             for k in (0..3).filter(|&k| free[k]) {
-                let (a, b) = edge(corners, k);
+                let (a, b) = meeting_key(corners, k);
                 nodes[a] = true;
                 nodes[b] = true;
             }
@@ -340,13 +362,17 @@ impl Rim {
 
 #[cfg(test)]
 mod tests {
-    use super::Rim;
+    use super::{Rim, facets_meeting};
+
+    fn rim(facets: &[usize], dim: usize, num_nodes: usize) -> Rim {
+        Rim::new(&facets_meeting(facets, dim), facets, dim, num_nodes)
+    }
 
     #[test]
     fn the_rim_of_a_square_of_four_triangles_is_its_outline() {
         // Corners 0..3 of the unit square and its centre 4, four triangles about the centre.
         let facets = [0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4];
-        let rim = Rim::new(&facets, 3, 5);
+        let rim = rim(&facets, 3, 5);
         assert_eq!(rim.nodes, [true, true, true, true, false]);
         // Each triangle's free edge is the one opposite the centre (its third corner).
         assert!(rim.edges.iter().all(|e| *e == [false, false, true]));
@@ -362,7 +388,7 @@ mod tests {
     #[test]
     fn the_rim_of_a_polyline_is_its_two_ends() {
         let facets = [0, 1, 1, 2, 2, 3];
-        let rim = Rim::new(&facets, 2, 4);
+        let rim = rim(&facets, 2, 4);
         assert_eq!(rim.nodes, [true, false, false, true]);
         assert!(rim.contains(&facets[0..2], 0, &[1.0, 0.0, 0.0]));
         assert!(!rim.contains(&facets[0..2], 0, &[0.0, 1.0, 0.0]));
