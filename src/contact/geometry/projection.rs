@@ -198,7 +198,7 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 
 /// Closest point of a segment (2 corners) or triangle (3 corners) to `x`, and its barycentric
 /// coordinates.
-fn closest_point(corners: &[[f64; 3]], x: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn closest_point(corners: &[[f64; 3]], x: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
     match corners {
         [a, b] => {
             let ab = sub(b, a);

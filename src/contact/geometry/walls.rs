@@ -1,5 +1,5 @@
-//! The walls at a concave vertex: the second facet a primary node must not cross where its
-//! closest facet on the other surface meets another at a concave vertex (2D).
+//! The walls at a concave vertex or edge: the second facet a primary node must not cross where
+//! its closest facet on the other surface meets another at a concave vertex (2D) or edge (3D).
 //!
 //! A node's gap row ([`crate::contact::geometry::gap`]) holds it on the plane of one facet,
 //! the one its closest point lies on. Where the other surface is concave, as the crater a
@@ -7,18 +7,21 @@
 //! held on one facet's plane it can slide through the other facet, and at the next iterate it
 //! faces that one and is held on its plane instead, sliding back through the first. With both
 //! facets' rows the node is held at the vertex, in the normal cone of the two planes, which is
-//! what a node in a V-shaped groove is at the answer. Each facet that shares a vertex with the
-//! closest facet and turns towards the node (its far end on the node's side of the closest
-//! facet's plane) by more than [`WALL_ANGLE`] is a *wall*: its gap `g_w = m_w . (x - q_w)`
-//! (`q_w` the node's closest point on that facet, `m_w` its outward normal) linearized as the
-//! gap is, the row `n_w . (u1 - sum_k b_k u2_k) = n_w . (u1^k - sum_k b_k u2_k^k) + g_w(u^k)`,
-//! `n_w = -m_w`. Which of them an active node holds is the loop's decision
+//! what a node in a V-shaped groove is at the answer (in 3D the groove an edge digs along its
+//! length: the node held on the groove's bottom edge). Each facet that shares a vertex with the
+//! closest facet and turns towards the node (its corners off the closest facet on the node's
+//! side of the closest facet's plane) by more than [`WALL_ANGLE`] is a *wall*: its gap
+//! `g_w = m_w . (x - q_w)` (`q_w` the node's closest point on that facet, `m_w` its outward
+//! normal) linearized as the gap is, the row
+//! `n_w . (u1 - sum_k b_k u2_k) = n_w . (u1^k - sum_k b_k u2_k^k) + g_w(u^k)`, `n_w = -m_w`.
+//! Which of them an active node holds is the loop's decision
 //! (`crate::contact::iteration::walls`).
 
 use std::collections::HashMap;
 
 use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::GapRow;
+use crate::contact::geometry::projection::closest_point;
 use crate::contact::geometry::surface::ContactSurface;
 use crate::fem::kernels::facet_measure_and_normal;
 
@@ -87,10 +90,10 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// The walls ([`Wall`]) of each of the primary candidates `nodes` whose gap rows are `rows`
-/// (indexed by candidate), at the displacements `u1`, `u2`. 2D only: a vertex of a 2D surface
-/// joins two facets; in 3D an edge's node sits among several, and the rows would need
-/// choosing among them (no walls are returned). A row measured beside the other surface's rim
-/// (its direction not the closest facet's normal) has none.
+/// (indexed by candidate), at the displacements `u1`, `u2`: in 2D the facets at either end of
+/// the closest one, in 3D those around its corners (each listed once), where they are walls.
+/// A row measured beside the other surface's rim (its direction not the closest facet's normal)
+/// has none.
 pub fn walls(
     primary: &ContactSurface,
     secondary: &ContactSurface,
@@ -99,9 +102,6 @@ pub fn walls(
     nodes: &[usize],
 ) -> HashMap<usize, Vec<Wall>> {
     let dim = secondary.dim;
-    if dim != 2 {
-        return HashMap::new();
-    }
     let mut facets_at: HashMap<usize, Vec<usize>> = HashMap::new();
     for f in 0..secondary.num_facets() {
         for &s in secondary.facet_nodes(f) {
@@ -110,12 +110,12 @@ pub fn walls(
     }
     let position = |s: usize| secondary.deformed(u2, s);
     let displacement = |s: usize| u2.at(dim, secondary.nodes[s]);
-    let normal = |f: usize| {
-        let x: Vec<[f64; 3]> = (secondary.facet_nodes(f).iter())
+    let corners_at = |f: usize| -> Vec<[f64; 3]> {
+        (secondary.facet_nodes(f).iter())
             .map(|&s| position(s))
-            .collect();
-        facet_measure_and_normal(&x, dim).1
+            .collect()
     };
+    let normal = |f: usize| facet_measure_and_normal(&corners_at(f), dim).1;
     let min_cos = WALL_ANGLE.to_radians().cos();
     let mut found = HashMap::new();
     for &i in nodes {
@@ -132,45 +132,53 @@ pub fn walls(
         }
         let x = primary.deformed(u1, i);
         let own = u1.at(dim, primary.nodes[i]);
+        let base = position(ends[0]);
+        // The facets sharing a vertex (in 3D possibly an edge: listed once) with the closest.
+        let mut around: Vec<usize> = (ends.iter())
+            .flat_map(|vertex| facets_at.get(vertex).into_iter().flatten().copied())
+            .filter(|&g| g != closest)
+            .collect();
+        around.sort_unstable();
+        around.dedup();
         let mut node_walls = Vec::new();
-        for &vertex in &ends {
-            for &g in facets_at.get(&vertex).into_iter().flatten() {
-                let corners = secondary.facet_nodes(g);
-                if g == closest {
-                    continue;
-                }
-                let far = if corners[0] == vertex {
-                    corners[1]
-                } else {
-                    corners[0]
-                };
-                let (v, w) = (position(vertex), position(far));
-                let concave = dot(m_f, std::array::from_fn(|k| w[k] - v[k])) > 0.0;
-                let m_g = normal(g);
-                if !concave || dot(m_f, m_g) > min_cos {
-                    continue;
-                }
-                let (a, b) = (position(corners[0]), position(corners[1]));
-                let ab: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
-                let t =
-                    (dot(std::array::from_fn(|k| x[k] - a[k]), ab) / dot(ab, ab)).clamp(0.0, 1.0);
-                let gap = dot(m_g, std::array::from_fn(|k| x[k] - a[k] - t * ab[k]));
-                let corners = vec![(corners[0], 1.0 - t), (corners[1], t)];
-                let jump: [f64; 3] = std::array::from_fn(|k| {
-                    own[k]
-                        - (corners.iter())
-                            .map(|&(s, b)| b * displacement(s)[k])
-                            .sum::<f64>()
-                });
-                let n_w = m_g.map(|v| -v);
-                node_walls.push(Wall {
-                    facets: [g, closest],
-                    corners,
-                    normal: n_w,
-                    gap,
-                    target: dot(n_w, jump) + gap,
-                });
+        for g in around {
+            let corners = secondary.facet_nodes(g);
+            // Concave: every corner of the wall off the closest facet on the node's side of
+            // the closest facet's plane.
+            let concave = (corners.iter())
+                .filter(|s| !ends.contains(s))
+                .all(|&s| dot(m_f, std::array::from_fn(|k| position(s)[k] - base[k])) > 0.0);
+            let m_g = normal(g);
+            if !concave || dot(m_f, m_g) > min_cos {
+                continue;
             }
+            let y = corners_at(g);
+            let (_, barycentric) = closest_point(&y, &x);
+            // x - q with q = y_0 + sum_j b_j (y_j - y_0), the closest point on the wall.
+            let gap = dot(
+                m_g,
+                std::array::from_fn(|k| {
+                    x[k] - y[0][k]
+                        - (1..y.len())
+                            .map(|j| barycentric[j] * (y[j][k] - y[0][k]))
+                            .sum::<f64>()
+                }),
+            );
+            let corners: Vec<(usize, f64)> = (corners.iter().copied()).zip(barycentric).collect();
+            let jump: [f64; 3] = std::array::from_fn(|k| {
+                own[k]
+                    - (corners.iter())
+                        .map(|&(s, b)| b * displacement(s)[k])
+                        .sum::<f64>()
+            });
+            let n_w = m_g.map(|v| -v);
+            node_walls.push(Wall {
+                facets: [g, closest],
+                corners,
+                normal: n_w,
+                gap,
+                target: dot(n_w, jump) + gap,
+            });
         }
         if !node_walls.is_empty() {
             found.insert(i, node_walls);
@@ -265,5 +273,89 @@ mod tests {
         let shallow = (WALL_ANGLE / 2.0 * 0.9).to_radians().tan();
         assert!(walls_of_corner(shallow).1.is_empty());
         assert!(walls_of_corner(0.0).1.is_empty());
+    }
+
+    /// A box's node pressed into a straight V-shaped groove in a block's structured top (3D): the
+    /// top meshed by gmsh as a 4 x 4 grid of squares, each cut in two triangles, so that its
+    /// line x = 0 is a line of the mesh and every facet lies on one side of the groove,
+    /// `z = -slope (w - |x|)` within `w` (one square) of it. The node, on the side x > 0 below
+    /// both sides' planes, is held on that side's facet; its walls are the facets of the other
+    /// side around that facet (every one on the plane of that side), each with that side's
+    /// normal (from the slope, not the mesh) and the node's signed distance to that plane. A
+    /// groove turning by less than the wall angle and the flat top have none, a ridge none on
+    /// its far side.
+    #[test]
+    fn a_node_in_a_straight_groove_has_the_far_side_as_its_walls_in_3d() {
+        let folder = tempfile::tempdir().unwrap();
+        let geo = folder.path().join("box_on_block.geo");
+        std::fs::write(
+            &geo,
+            "SetFactory(\"OpenCASCADE\");\n\
+             Box(1) = {-1, -1, -1, 2, 2, 1};\n\
+             Box(2) = {-0.3, -0.3, 0.1, 0.6, 0.6, 0.3};\n\
+             Transfinite Curve{:} = 5;\n\
+             Transfinite Surface{:};\n\
+             Physical Volume(\"block\") = {1};\n\
+             Physical Volume(\"box\") = {2};\n\
+             Physical Surface(\"block_contact\") = {6};\n\
+             Physical Surface(\"box_contact\") = {11};\n",
+        )
+        .unwrap();
+        let msh = folder.path().join("box_on_block.msh");
+        mesh_geo(&geo, &msh, &[]).expect("gmsh meshes");
+        let mesh = read_msh(&msh).unwrap();
+        let (box_mesh, block_mesh) = (mesh.body("box").unwrap(), mesh.body("block").unwrap());
+        let pressed = ContactSurface::new(box_mesh, "box_contact").unwrap();
+        let block = ContactSurface::new(block_mesh, "block_contact").unwrap();
+        let w = 0.5;
+        let node = 0;
+        let walls_of_node = |slope: f64| {
+            let mut u2 = vec![0.0; 3 * block_mesh.num_nodes()];
+            for s in 0..block.len() {
+                let x = block.coords[s][0];
+                u2[3 * block.nodes[s] + 2] = -slope * (w - x.abs()).max(0.0);
+            }
+            // A tenth of a square right of the groove's bottom, 1e-3 below the far side's plane
+            // (and so below the near side's).
+            let target = [0.1, 0.05, -slope * (w + 0.1) - 1e-3];
+            let x0 = pressed.coords[node];
+            let mut u1 = vec![0.0; 3 * box_mesh.num_nodes()];
+            (0..3).for_each(|k| u1[3 * pressed.nodes[node] + k] = target[k] - x0[k]);
+            let u = [BodyDisplacement::Whole(&u1), BodyDisplacement::Whole(&u2)];
+            let rows = gap_rows(&pressed, &block, Some(u[0]), Some(u[1]), RowNormal::Facet);
+            let found = walls(&pressed, &block, u, &rows, &[node]);
+            (
+                rows[node].clone(),
+                found.get(&node).cloned().unwrap_or_default(),
+                target,
+            )
+        };
+        let slope = 0.5; // each side 26.6 degrees, the groove turning by 53
+        let (row, found, x) = walls_of_node(slope);
+        let length = (1.0 + slope * slope).sqrt();
+        let near = [-slope / length, 0.0, 1.0 / length]; // out of the block, the side x > 0
+        let far = [slope / length, 0.0, 1.0 / length];
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] + b[k]).abs() < 1e-9);
+        assert!(close(row.normal, near), "{:?}", row.normal);
+        assert!(!found.is_empty());
+        let bottom = [0.0, 0.0, -slope * w];
+        let gap = (0..3).map(|k| far[k] * (x[k] - bottom[k])).sum::<f64>();
+        assert!(gap < 0.0);
+        for wall in &found {
+            assert!(close(wall.normal, far), "{:?} against {far:?}", wall.normal);
+            assert!((wall.gap - gap).abs() < 1e-12, "{} against {gap}", wall.gap);
+            let corners: Vec<usize> = wall.corners.iter().map(|c| c.0).collect();
+            assert!(corners.iter().all(|&s| block.coords[s][0] <= 1e-12));
+        }
+        // Below the wall angle, a ridge, and flat: none.
+        let shallow = (WALL_ANGLE / 2.0 * 0.9).to_radians().tan();
+        assert!(walls_of_node(shallow).1.is_empty());
+        // A ridge's far side is no wall: only the flat top at its foot, where the slope meets
+        // it concavely.
+        let ridge = walls_of_node(-slope).1;
+        let at_foot =
+            |wall: &Wall| (wall.corners.iter()).all(|c| block.coords[c.0][0] >= w - 1e-12);
+        assert!(ridge.iter().all(at_foot), "{ridge:?}");
+        assert!(walls_of_node(0.0).1.is_empty());
     }
 }

@@ -549,8 +549,15 @@ impl<'a> ContactSolver<'a> {
     /// Whether pair `p`'s active nodes hold the walls of a concave vertex they sit in
     /// (`crate::contact::geometry::walls`): a frictionless pair ([`ContactLaw::holds_walls`])
     /// enforced by INTERNODES, in 2D. The penalty method's rows let a node overlap both planes by
-    /// its pressure over `eps`, which the two rows' common target does not model; in 3D a node
-    /// on an edge meets several facets, and which of them to hold is not built.
+    /// its pressure over `eps`, which the two rows' common target does not model. In 3D the walls
+    /// are found (the groove a cube's edge digs, `crate::contact::geometry::walls`) but not
+    /// held: the groove runs along the whole contact zone, every active node is in it, and on
+    /// the edge sweep's cube pressed 2% of its side into a block of its own material no rule
+    /// tried let the loop settle (the stops held off: one node switching between tension and
+    /// penetration to the iteration cap; that node kept: the gap error swinging between 5e-3 and
+    /// 5e-2 h as the pairing followed the slide; the pairing kept: swinging with period two),
+    /// where without walls the loop ends `cycling`, named, in a second; at 1% no node crossed a
+    /// wall (`docs/decisions.md`, 2026-12-07, "the 3D edge").
     fn holds_walls(&self, p: usize) -> bool {
         self.laws[p].holds_walls()
             && self.methods[p] == Enforcement::Internodes

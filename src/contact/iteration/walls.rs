@@ -5,7 +5,8 @@
 //! **Taken.** An active node whose wall pushed at the last solve keeps it; otherwise it takes
 //! the wall whose plane it has crossed the deepest, by more than the penetration tolerance
 //! (`tol_p h`, the gap the checks accept). One wall per node: in 2D a vertex joins two facets,
-//! so the closest facet and one wall are all a node in a groove can touch.
+//! so the closest facet and one wall are all a node in a groove can touch (3D pairs hold none:
+//! `ContactSolver::holds_walls` says why).
 //!
 //! **Held.** After each solve a node's traction is split along the two rows' directions,
 //! `t = a n + b n_w` (`n . n_w = c`, `|c| < 1`: `b = (t . n_w - c t . n) / (1 - c^2)`); the wall
@@ -34,7 +35,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 impl PairWalls {
-    /// The wall each of the `active` candidates takes (module doc), `tolerance[i]` the depth
+    /// The wall each of the `active` candidates takes (module doc), `tolerance(i)` the depth
     /// beyond which candidate `i` is taken to cross a wall's plane.
     pub(super) fn taken(
         &self,
