@@ -1,10 +1,11 @@
-//! A 3D cube's edge pressed into a block of its own material (`geo/tilted_cube_3d.geo`, meshed
-//! at test time, coarse: 0.02 along the edge, the block 1.4 times coarser). Between bodies of
-//! similar stiffness `auto` takes as primary the body whose contact surface has a corner or an
-//! edge (`docs/method.md` 3.6), here the cube, where the coarser-surface rule took the block:
-//! held node to facet, the edge's nodes cannot cross the block, while as the secondary the edge
-//! cuts into the block between the block's nodes, which no row sees. The contact zone is the
-//! edge's line, one node across, which the resolution indicator names.
+//! A 3D cube's edge pressed into a block of its own material, the 3D sibling of
+//! `contact_corner.rs` (`geo/tilted_cube_3d.geo`, meshed at test time, coarse: 0.02 along the
+//! edge, the block 1.4 times coarser). Between bodies of similar stiffness `auto` takes as
+//! primary the body whose contact surface has a corner or an edge (`docs/method.md` 3.6), here
+//! the cube, where the coarser-surface rule took the block: held node to facet, the edge's
+//! nodes cannot cross the block, while as the secondary the edge cuts into the block between
+//! the block's nodes, which no row sees. The contact zone is the edge's line, one node across,
+//! which the resolution indicator names.
 
 mod common;
 
