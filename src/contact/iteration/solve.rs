@@ -969,10 +969,13 @@ impl ContactSolver<'_> {
             .filter(|&p| !update.settled && in_groove[p])
             .collect();
         for &p in &repaired {
-            let left = (self.operators[p].slid, state.active.clone());
-            state.pairings[p].push(left);
-            timed(&mut seconds.operators, || self.pair_again(p, pairings[p]))?;
-            state.corrections[p] = self.corrections(p, &solution, &gaps[p])?;
+            self.pair_from_iterate(
+                p,
+                pairings[p],
+                state,
+                (&solution, &gaps[p][..]),
+                &mut seconds,
+            )?;
         }
         if !repaired.is_empty() {
             state.safeguard = Safeguard::default();
@@ -981,13 +984,8 @@ impl ContactSolver<'_> {
         let step = match state.safeguard.next(&state.active, &update) {
             Step::Stop(ContactStatus::Converged) if !drifted.is_empty() => {
                 for &p in &drifted {
-                    let left = (self.operators[p].slid, state.active.clone());
-                    state.pairings[p].push(left);
-                    timed(&mut seconds.operators, || self.pair_again(p, pairings[p]))?;
-                    state.corrections[p] = self.corrections(p, &solution, &gaps[p])?;
-                    if let Some(start) = state.friction[p].as_mut() {
-                        start.jumps = self.operators[p].jumps_of(&start.displacements)?;
-                    }
+                    let iterate = (&solution, &gaps[p][..]);
+                    self.pair_from_iterate(p, pairings[p], state, iterate, &mut seconds)?;
                 }
                 state.safeguard = Safeguard::default();
                 state.slide_change = None;
@@ -1783,6 +1781,28 @@ impl ContactSolver<'_> {
             })?);
         }
         Ok(answers)
+    }
+
+    /// Pairs `p` again for the slide `slid` from the loop's iterate (`solution`, and the
+    /// pair's geometric `gaps` there): the pairing it leaves is remembered with the active set
+    /// (not taken again on that set), and what the iterate gives the new operators is read
+    /// again through them (the tied corrections, a Coulomb step's starting jumps).
+    fn pair_from_iterate(
+        &mut self,
+        p: usize,
+        slid: [f64; 3],
+        state: &mut LoopState,
+        (solution, gaps): (&CoupledSolution, &[f64]),
+        seconds: &mut PhaseSeconds,
+    ) -> Result<(), ContactError> {
+        let left = (self.operators[p].slid, state.active.clone());
+        state.pairings[p].push(left);
+        timed(&mut seconds.operators, || self.pair_again(p, slid))?;
+        state.corrections[p] = self.corrections(p, solution, gaps)?;
+        if let Some(start) = state.friction[p].as_mut() {
+            start.jumps = self.operators[p].jumps_of(&start.displacements)?;
+        }
+        Ok(())
     }
 
     /// Builds pair `p`'s interface operators again, paired with its primary surface slid by
