@@ -5,7 +5,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use crate::contact::ContactError;
 use crate::contact::geometry::surface::ContactSurface;
-use crate::contact::settings::{ContactSettings, Transfer};
+use crate::contact::settings::{ContactSettings, Formulation, Transfer};
 use crate::elastic::{ElasticProblem, StepFactors};
 
 /// A secondary body whose share of the two bodies' compliance (`1 / E'`) is below this is
@@ -47,7 +47,7 @@ impl<'de> Deserialize<'de> for PrimaryChoice {
 /// How the secondary's force is computed, and why (printed, and in the summary).
 #[derive(Debug, Clone, Serialize)]
 pub struct TransferReport {
-    /// `Interpolation` or `Conservative` (never `Auto`: the choice made).
+    /// `Interpolation`, `Conservative` or `NodeToFacet` (never `Auto`: the choice made).
     pub transfer: Transfer,
     pub reason: String,
 }
@@ -187,9 +187,19 @@ impl<'m> ContactProblem<'m> {
 
     fn transfer_for(&self, settings: &ContactSettings) -> TransferReport {
         match settings.transfer {
-            named @ (Transfer::Interpolation | Transfer::Conservative) => TransferReport {
-                transfer: named,
-                reason: "named in the case file".into(),
+            named @ (Transfer::Interpolation | Transfer::Conservative | Transfer::NodeToFacet) => {
+                TransferReport {
+                    transfer: named,
+                    reason: "named in the case file".into(),
+                }
+            }
+            Transfer::Auto if self.groove_at_an_edge(settings) => TransferReport {
+                transfer: Transfer::NodeToFacet,
+                reason: format!(
+                    "the primary surface has an edge or corner (its facets turn by {:.0} degrees \
+                     > {CORNER_TURN}) pressed into a body of similar stiffness, in 3D",
+                    self.primary_surface.sharpest_turn()
+                ),
             },
             // A nearly rigid body's deformation does not depend on how its load is spread,
             // only on the resultant, which the conservative transfer carries exactly; the
@@ -233,6 +243,17 @@ impl<'m> ContactProblem<'m> {
                 }
             }
         }
+    }
+
+    /// Whether auto sends the force node to facet ([`Transfer`]): a frictionless 3D pair whose
+    /// primary has an edge or corner ([`CORNER_TURN`]) and whose bodies are of similar
+    /// stiffness ([`SIMILAR_STIFFNESS`]), the groove the edge digs deforming with it.
+    fn groove_at_an_edge(&self, settings: &ContactSettings) -> bool {
+        let [w1, w2] = self.normal_weights();
+        settings.formulation == Formulation::Frictionless
+            && self.primary_surface.dim == 3
+            && self.primary_surface.sharpest_turn() > CORNER_TURN
+            && (w1 / w2).max(w2 / w1) < SIMILAR_STIFFNESS
     }
 
     /// The contact moduli `E / (1 - nu^2)` of the primary and secondary bodies, normalized to

@@ -76,11 +76,28 @@ pub const DEFAULT_PENALTY: f64 = 100.0;
 ///   (`crate::contact::geometry::gap`), and the system stays unsymmetric. Onto a secondary finer
 ///   than the primary it leaves the secondary nodes between the projections of primary nodes
 ///   unloaded, which is why INTERNODES interpolates there.
-/// - `Auto` (default): conservative onto a nearly rigid secondary, from a primary with a corner
-///   or an edge (`crate::contact::problem::CORNER_TURN`: its traction concentrates there, and
-///   its interpolation does not keep the resultant), or when the secondary's contact surface is
-///   coarser than the primary's near the other body
-///   (`crate::contact::problem::contact_zone_spacing`); interpolation otherwise.
+/// - `NodeToFacet`: the secondary receives each primary node's force at the corners of the
+///   facet its gap row holds it against, by the P1 weights of its closest point there (the
+///   transpose of the rows, so the forces balance exactly and never pull), and the rows hold
+///   each node along the secondary's nodal normals interpolated at that point
+///   (`crate::contact::geometry::gap::RowNormal::Averaged`) rather than the facet's: the
+///   node-to-surface formulation with smoothed normals, for the geometric rows of frictionless
+///   and Coulomb pairs (a tied pair's rows are `R12`'s: refused there).
+/// - `Auto` (default): conservative onto a nearly rigid secondary; node to facet in 3D from a
+///   frictionless primary with an edge or corner (`crate::contact::problem::CORNER_TURN`)
+///   pressed into a body of similar stiffness (`crate::contact::problem::SIMILAR_STIFFNESS`),
+///   conservative from such a primary otherwise (its traction concentrates at the corner, and
+///   its interpolation does not keep the resultant); conservative when the secondary's contact
+///   surface is coarser than the primary's near the other body
+///   (`crate::contact::problem::contact_zone_spacing`); interpolation otherwise. Why node to
+///   facet at a 3D edge between similar bodies: both surfaces deform there, the secondary into
+///   a groove along the edge whose facets turn by a few degrees each, and the primary's nodes
+///   slide across them; a row along the closest facet's normal jumps as the closest facet
+///   does, with no fixed point for the loop to settle on, and `R12^T`, whose Wendland weights
+///   are not all positive, pulls secondary nodes beside a zone one node across (`docs/method.md`
+///   4.1). In 2D the groove's two sides are held by walls (`crate::contact::geometry::walls`),
+///   and a stiff primary's edge in a compliant body settles with the conservative transfer
+///   within 0.05% of the same-mesh reference: both keep it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Transfer {
@@ -88,6 +105,15 @@ pub enum Transfer {
     Auto,
     Interpolation,
     Conservative,
+    NodeToFacet,
+}
+
+impl Transfer {
+    /// Whether the secondary's force goes through the interpolation `R21` (otherwise no `R21`
+    /// is built).
+    pub fn interpolates(self) -> bool {
+        matches!(self, Self::Interpolation)
+    }
 }
 
 /// A setting outside its range.
@@ -96,7 +122,8 @@ pub enum Transfer {
 pub struct SettingsError {
     pub name: &'static str,
     pub expected: &'static str,
-    pub value: f64,
+    /// The value given, as the case file spells it.
+    pub value: String,
 }
 
 /// How each iteration's coupled system is solved (`crate::contact::coupled::coupled_solver` says
@@ -267,13 +294,22 @@ impl ContactSettings {
 
     /// Checks every setting's range.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        let error = |name, expected, value| {
+        let error = |name, expected, value: f64| {
             Err(SettingsError {
                 name,
                 expected,
-                value,
+                value: value.to_string(),
             })
         };
+        if self.formulation == Formulation::Tied && self.transfer == Transfer::NodeToFacet {
+            return Err(SettingsError {
+                name: "transfer",
+                expected: "\"auto\", \"interpolation\" or \"conservative\" for formulation = \"tied\" \
+                           (node to facet sends the force through the rows of the geometric gap, \
+                           and a tied pair's rows are the interpolation's)",
+                value: "\"node-to-facet\"".into(),
+            });
+        }
         match (self.formulation, self.friction_coefficient) {
             (Formulation::Coulomb, None) => {
                 return error(

@@ -10,7 +10,10 @@
 //! stay as built (`crate::contact::coupled::interface`), `b_(i,c)` depends only on the node and the
 //! component: it is computed (one solve with the body's solver per component) the first time
 //! the node is active, and kept for every later iteration and load step, until the operators
-//! are paired again. Per component, not per multiplier: the frictionless traction acts along
+//! are paired again; a response is kept with a fingerprint of the load it answers, and a load
+//! that changed is solved again (under the node-to-facet transfer the secondary's load is the
+//! P1 weights of the node's closest point, which move with every iterate). Per component, not
+//! per multiplier: the frictionless traction acts along
 //! the normal of the secondary facet the node is held on (`crate::contact::geometry::gap`), which
 //! turns with the displacement from one iteration to the next; the price is `dim` solves per
 //! node instead of one.
@@ -25,6 +28,7 @@
 //! kept beside the tractions' on the dofs its row reads.
 
 use std::collections::HashMap;
+use std::hash::{DefaultHasher, Hash, Hasher};
 
 use crate::contact::ContactError;
 use crate::linalg::BodySolver;
@@ -52,7 +56,18 @@ pub struct SurfaceResponse {
     row: Vec<usize>,
     /// Body dof of each row.
     surface_dofs: Vec<usize>,
-    responses: HashMap<MultiplierKey, Vec<f64>>,
+    /// Each response with the fingerprint of its load ([`fingerprint`]).
+    responses: HashMap<MultiplierKey, (u64, Vec<f64>)>,
+}
+
+/// A hash of a sparse load `(dof, value)`, entry by entry: two loads with the same fingerprint
+/// are taken as the same (a collision of 64-bit hashes is beyond any run's count of loads).
+fn fingerprint(load: &[(usize, f64)]) -> u64 {
+    let mut hasher = DefaultHasher::new();
+    for &(dof, value) in load {
+        (dof, value.to_bits()).hash(&mut hasher);
+    }
+    hasher.finish()
 }
 
 impl SurfaceResponse {
@@ -85,7 +100,8 @@ impl SurfaceResponse {
     }
 
     /// Computes and keeps the responses to the `loads` (each a key and its sparse body force
-    /// `(dof, value)`), with multi-right-hand-side solves; a key already known is skipped.
+    /// `(dof, value)`; empty where the force does not reach the body, whose response is then
+    /// dropped), with multi-right-hand-side solves; a key known with the same load is skipped.
     pub fn extend(
         &mut self,
         factor: &BodySolver,
@@ -94,9 +110,14 @@ impl SurfaceResponse {
         // In chunks, so that the right-hand sides of a large first active set fit in memory.
         const CHUNK: usize = 64;
         let n = self.row.len();
-        let missing: Vec<&(MultiplierKey, Vec<(usize, f64)>)> = loads
-            .iter()
-            .filter(|(key, _)| !self.contains(key))
+        for (key, _) in loads.iter().filter(|(_, load)| load.is_empty()) {
+            self.responses.remove(key);
+        }
+        let missing: Vec<&(MultiplierKey, Vec<(usize, f64)>)> = (loads.iter())
+            .filter(|(key, load)| {
+                !load.is_empty()
+                    && (self.responses.get(key)).is_none_or(|(f, _)| *f != fingerprint(load))
+            })
             .collect();
         for chunk in missing.chunks(CHUNK) {
             let mut rhs = vec![0.0; n * chunk.len()];
@@ -108,10 +129,10 @@ impl SurfaceResponse {
             factor
                 .solve_in_place(&mut rhs, chunk.len())
                 .map_err(|e| ContactError::Linalg(format!("a body's response: {e}")))?;
-            for (j, (key, _)) in chunk.iter().enumerate() {
+            for (j, (key, load)) in chunk.iter().enumerate() {
                 let full = &rhs[j * n..(j + 1) * n];
                 let response = self.surface_dofs.iter().map(|&d| full[d]).collect();
-                self.responses.insert(*key, response);
+                self.responses.insert(*key, (fingerprint(load), response));
             }
         }
         Ok(())
@@ -137,7 +158,7 @@ impl SurfaceResponse {
     /// `Y_key` at the stored rows `rows` (from [`Self::rows`]), into `out`; the response must
     /// have been computed by [`Self::extend`].
     pub fn gather(&self, key: &MultiplierKey, rows: &[usize], out: &mut [f64]) {
-        let response = &self.responses[key];
+        let (_, response) = &self.responses[key];
         for (value, &row) in out.iter_mut().zip(rows) {
             *value = response[row];
         }

@@ -547,29 +547,26 @@ fn solve_bodies(
         .map_err(body_solve_error)
 }
 
-/// Each body's responses to the unit forces of `system` not seen before
+/// Each body's responses to the unit forces of `system` not seen before with the same load
 /// (`crate::contact::coupled::compliance`).
 fn extend_responses(
     system: &CoupledSystem,
     solvers: &[BodySolver],
     responses: &mut [SurfaceResponse],
 ) -> Result<(), ContactError> {
-    let new = |response: &SurfaceResponse, body: usize| {
+    let on_body = |body: usize| {
         let dofs = system.body_dofs(body);
         (system.unit_loads.iter())
-            .filter(|unit| !response.contains(&unit.key))
-            .filter_map(|unit| {
+            .map(|unit| {
                 let on_body: Vec<(usize, f64)> = (unit.load.iter())
                     .filter(|(row, _)| dofs.contains(row))
                     .map(|&(row, value)| (row - dofs.start, value))
                     .collect();
-                (!on_body.is_empty()).then_some((unit.key, on_body))
+                (unit.key, on_body)
             })
             .collect::<Vec<_>>()
     };
-    let loads: Vec<_> = (responses.iter().enumerate())
-        .map(|(body, response)| new(response, body))
-        .collect();
+    let loads: Vec<_> = (0..responses.len()).map(on_body).collect();
     (responses.par_iter_mut())
         .zip(solvers)
         .zip(&loads)

@@ -46,6 +46,7 @@ use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::geometry::walls::HeldWall;
 use crate::contact::law::{ContactLaw, Multiplier, Reads, Restates, Tangential, coulomb};
 use crate::contact::method::Enforcement;
+use crate::contact::settings::Transfer;
 
 /// `R12`, `R21`, the contact normals and reference gaps of every primary candidate, and the
 /// rows and columns of the transfers computed so far (an explicit cache: callers hold it `mut`).
@@ -53,10 +54,12 @@ pub struct InterfaceOperators {
     /// From the secondary candidates to the projections of the primary candidates.
     r12: Interpolation,
     /// From the primary candidates to the projections of the secondary candidates that face
-    /// the primary surface, `receiving` (surface indices). Not built for the conservative
-    /// transfer, which does not use it: a secondary node outside every primary support is then
-    /// loaded through `R12^T`, and is no error.
+    /// the primary surface, `receiving` (surface indices). Built for the interpolation
+    /// transfer alone: under the others a secondary node outside every primary support is
+    /// loaded through `R12^T` or the rows' own weights, and is no error.
     r21: Option<Interpolation>,
+    /// How the secondary receives the force (never `Auto`: `crate::contact::Transfer`).
+    transfer: Transfer,
     receiving: Vec<usize>,
     /// How far the primary surface has slid over the secondary when the operators were
     /// built ([`Self::slide`]): the pairing's offset.
@@ -83,7 +86,7 @@ impl InterfaceOperators {
         secondary: &ContactSurface,
         radius: f64,
         weights: [f64; 2],
-        conservative: bool,
+        transfer: Transfer,
         slid: [f64; 3],
     ) -> Result<Self, ContactError> {
         let [w1, w2] = weights;
@@ -93,7 +96,7 @@ impl InterfaceOperators {
         let r12 = covering_interpolation(secondary, radius, &targets12, primary, |t| t)?;
         // Only the secondary nodes that face the primary surface receive its traction.
         let receiving: Vec<usize> = (0..secondary.len()).filter(|&j| facing2[j]).collect();
-        let r21 = if conservative {
+        let r21 = if !transfer.interpolates() {
             None
         } else {
             let targets: Vec<[f64; 3]> = receiving.iter().map(|&j| on_primary[j]).collect();
@@ -119,6 +122,7 @@ impl InterfaceOperators {
         Ok(Self {
             r12,
             r21,
+            transfer,
             receiving,
             slid,
             normals,
@@ -205,10 +209,18 @@ impl InterfaceOperators {
                 .collect()
         };
         let gap_compliance = enforcement.gap_compliance();
+        let node_to_facet = match (self.transfer, &constraint) {
+            (Transfer::NodeToFacet, Constraint::Geometric { rows, .. }) => Some(*rows),
+            _ => None,
+        };
         let loads2 = active
             .iter()
             .map(|&i| {
-                if self.r21.is_none() {
+                if let Some(rows) = node_to_facet {
+                    // The node-to-facet transfer: the transpose of the node's gap row, the P1
+                    // weights of its closest point times A1_i ([`crate::contact::Transfer`]).
+                    to_body2(&rows[i].corners, &|_, b| primary.nodal_area[i] * b)
+                } else if self.r21.is_none() {
                     // The conservative transfer, `-R12^T M1 lambda` ([`crate::contact::Transfer`]):
                     // row i of R12 times A1_i is column i of R12^T M1.
                     to_body2(&self.rows12[&i], &|_, w| primary.nodal_area[i] * w)

@@ -247,6 +247,8 @@ pub struct ContactSolver<'a> {
     laws: Vec<ContactLaw>,
     /// How each pair's law is enforced.
     methods: Vec<Enforcement>,
+    /// How each pair's secondary receives its force (`crate::contact::Transfer`, resolved).
+    transfers: Vec<Transfer>,
     /// In a distributed run, how each body's values at the nodes the contact geometry reads
     /// (its boundary's and its contact surfaces': [`geometry_nodes`]) reach every rank after a
     /// solve; `None` on one process.
@@ -331,7 +333,7 @@ fn pair(problem: &ContactProblem, slid: [f64; 3]) -> Result<InterfaceOperators, 
         &problem.secondary_surface,
         problem.settings.rbf_radius,
         problem.normal_weights(),
-        problem.transfer().transfer == Transfer::Conservative,
+        problem.transfer().transfer,
         slid,
     )
 }
@@ -533,6 +535,7 @@ impl<'a> ContactSolver<'a> {
             kept,
             laws: pairs.iter().map(|p| ContactLaw::of(&p.settings)).collect(),
             methods: pairs.iter().map(Enforcement::of).collect(),
+            transfers: pairs.iter().map(|p| p.transfer().transfer).collect(),
             reads,
         })
     }
@@ -562,6 +565,7 @@ impl<'a> ContactSolver<'a> {
         self.laws[p].holds_walls()
             && self.methods[p] == Enforcement::Internodes
             && self.pairs[p].primary_surface.dim == 2
+            && self.transfers[p] != Transfer::NodeToFacet
     }
 
     /// The settings of the loop and its coupled solve, shared by the pairs.
@@ -628,7 +632,13 @@ impl<'a> ContactSolver<'a> {
                     nodes: (0..s1.len())
                         .filter(|&i| gaps[i] < tol * s1.spacing[i])
                         .collect(),
-                    rows: gap_rows(s1, s2, None, None, law.row_normal()),
+                    rows: gap_rows(
+                        s1,
+                        s2,
+                        None,
+                        None,
+                        law.row_normal(problem.transfer().transfer),
+                    ),
                     corrections: vec![0.0; s1.len()],
                     slip: BTreeMap::new(),
                     history: None,
@@ -1581,7 +1591,7 @@ impl ContactSolver<'_> {
                 let (u1, u2) = (solution.displacement(a), solution.displacement(b));
                 let nodes = self.pair_nodes(&active.contact, p);
                 let operators = &self.operators[p];
-                let row_normal = self.laws[p].row_normal();
+                let row_normal = self.laws[p].row_normal(self.transfers[p]);
                 let rows = &mut state.rows[p];
                 let shared = self.reads.is_some();
                 let (pair_gaps, jumps, pair_slid) = timed(&mut seconds.search, || {

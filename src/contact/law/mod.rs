@@ -30,7 +30,7 @@ mod tied;
 pub use state::NodeStates;
 
 use crate::contact::geometry::gap::RowNormal;
-use crate::contact::settings::{ContactSettings, Formulation};
+use crate::contact::settings::{ContactSettings, Formulation, Transfer};
 
 /// Which point of the secondary surface a constraint row reads: the P1 corners of the facet
 /// the node projects onto (the geometric gap linearized, `crate::contact::geometry::gap`), or the
@@ -140,12 +140,14 @@ impl ContactLaw {
     }
 
     /// The direction a node's gap row holds it along
-    /// (`crate::contact::geometry::gap::RowNormal`): the facet's normal, the gradient of the gap,
-    /// except for Coulomb pairs, whose answer (a slip direction in 3D, a node's state at the
-    /// stick zone's edge in 2D) has no fixed point when the normal jumps between facets.
-    pub fn row_normal(&self) -> RowNormal {
-        match self {
-            ContactLaw::Coulomb { .. } => RowNormal::Averaged,
+    /// (`crate::contact::geometry::gap::RowNormal`) when the secondary's force is sent by
+    /// `transfer`: the facet's normal, the gradient of the gap, except for Coulomb pairs, whose
+    /// answer (a slip direction in 3D, a node's state at the stick zone's edge in 2D) has no
+    /// fixed point when the normal jumps between facets, and under the node-to-facet transfer,
+    /// whose rows cross the small kinks of the groove an edge digs (`crate::contact::Transfer`).
+    pub fn row_normal(&self, transfer: Transfer) -> RowNormal {
+        match (self, transfer) {
+            (ContactLaw::Coulomb { .. }, _) | (_, Transfer::NodeToFacet) => RowNormal::Averaged,
             _ => RowNormal::Facet,
         }
     }

@@ -127,7 +127,8 @@ pub fn certify(
     // The penalty method's overlap `p / eps` at each primary node: what its law allows
     // (`crate::contact::method`); zero under INTERNODES.
     let law = ContactLaw::of(settings);
-    let rows = gap_rows(s1, s2, Some(u1), Some(u2), law.row_normal());
+    let row_normal = law.row_normal(problem.transfer().transfer);
+    let rows = gap_rows(s1, s2, Some(u1), Some(u2), row_normal);
     let enforcement = Enforcement::of(problem);
     let mut overlap = vec![0.0; s1.len()];
     for (k, &i) in solved.iter().enumerate() {
