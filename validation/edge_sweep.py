@@ -55,7 +55,8 @@ stiff one (E ratio 1e3), nu = 0.3:
   premise row ``premise: candidates``). At 2% its iteration did not settle within 400 steps
   (block ratio 0.7: the largest change of a displacement still 2e-2 d a step, the edge sliding
   across the groove it digs), so the family holds the approach where the reference is known. The
-  zone is the edge's line, one node across: RIGHT or NAMED, auto's too.
+  zone is the edge's line, one node across: RIGHT or NAMED, auto's too (auto takes the cube and
+  sends its force node to facet along the block's smoothed normals, ``docs/method.md`` 3.6).
 
 Each run is classified (``classify``) from its exit status and its answer:
 

@@ -69,7 +69,7 @@ class TransferChoice(TypedDict):
     """How the secondary's contact force is computed, and why."""
 
     transfer: str
-    """"interpolation" or "conservative"."""
+    """"interpolation", "conservative" or "node-to-facet"."""
     reason: str
 
 

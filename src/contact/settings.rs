@@ -412,7 +412,26 @@ impl ContactSettings {
 
 #[cfg(test)]
 mod tests {
-    use super::ContactSettings;
+    use super::{ContactSettings, Formulation, Transfer};
+
+    #[test]
+    fn node_to_facet_is_refused_for_tied_contact_alone() {
+        let with = |formulation, friction_coefficient| ContactSettings {
+            formulation,
+            friction_coefficient,
+            transfer: Transfer::NodeToFacet,
+            ..ContactSettings::default()
+        };
+        let error = with(Formulation::Tied, None).validate().unwrap_err();
+        assert_eq!(error.name, "transfer");
+        let message = error.to_string();
+        assert!(
+            message.contains("tied") && message.contains("got \"node-to-facet\""),
+            "{message}"
+        );
+        assert!(with(Formulation::Frictionless, None).validate().is_ok());
+        assert!(with(Formulation::Coulomb, Some(0.3)).validate().is_ok());
+    }
 
     #[test]
     fn the_iteration_cap_has_bounds() {
