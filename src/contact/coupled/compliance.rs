@@ -113,26 +113,25 @@ impl SurfaceResponse {
         for (key, _) in loads.iter().filter(|(_, load)| load.is_empty()) {
             self.responses.remove(key);
         }
-        let missing: Vec<&(MultiplierKey, Vec<(usize, f64)>)> = (loads.iter())
-            .filter(|(key, load)| {
-                !load.is_empty()
-                    && (self.responses.get(key)).is_none_or(|(f, _)| *f != fingerprint(load))
-            })
+        let missing: Vec<_> = (loads.iter())
+            .filter(|(_, load)| !load.is_empty())
+            .map(|(key, load)| (fingerprint(load), key, load))
+            .filter(|(print, key, _)| (self.responses.get(key)).is_none_or(|(f, _)| f != print))
             .collect();
         for chunk in missing.chunks(CHUNK) {
             let mut rhs = vec![0.0; n * chunk.len()];
-            for (j, (_, load)) in chunk.iter().enumerate() {
-                for &(dof, value) in load {
+            for (j, (_, _, load)) in chunk.iter().enumerate() {
+                for &(dof, value) in load.iter() {
                     rhs[j * n + dof] += value;
                 }
             }
             factor
                 .solve_in_place(&mut rhs, chunk.len())
                 .map_err(|e| ContactError::Linalg(format!("a body's response: {e}")))?;
-            for (j, (key, load)) in chunk.iter().enumerate() {
+            for (j, &(print, key, _)) in chunk.iter().enumerate() {
                 let full = &rhs[j * n..(j + 1) * n];
                 let response = self.surface_dofs.iter().map(|&d| full[d]).collect();
-                self.responses.insert(*key, (fingerprint(load), response));
+                self.responses.insert(*key, (print, response));
             }
         }
         Ok(())

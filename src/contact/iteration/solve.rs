@@ -623,8 +623,8 @@ impl<'a> ContactSolver<'a> {
     /// Each pair's primary candidates that touch or penetrate in the reference configuration,
     /// with their constraints linearized there.
     pub fn initial_active_set(&self) -> Vec<ActiveSet> {
-        (self.pairs.iter().zip(&self.laws))
-            .map(|(problem, law)| {
+        (self.pairs.iter().zip(&self.laws).zip(&self.transfers))
+            .map(|((problem, law), &transfer)| {
                 let (s1, s2) = (&problem.primary_surface, &problem.secondary_surface);
                 let tol = problem.settings.penetration_tolerance;
                 let gaps = geometric_gaps(s1, s2, None, None);
@@ -632,13 +632,7 @@ impl<'a> ContactSolver<'a> {
                     nodes: (0..s1.len())
                         .filter(|&i| gaps[i] < tol * s1.spacing[i])
                         .collect(),
-                    rows: gap_rows(
-                        s1,
-                        s2,
-                        None,
-                        None,
-                        law.row_normal(problem.transfer().transfer),
-                    ),
+                    rows: gap_rows(s1, s2, None, None, law.row_normal(transfer)),
                     corrections: vec![0.0; s1.len()],
                     slip: BTreeMap::new(),
                     history: None,
