@@ -42,6 +42,7 @@ use crate::contact::coupled::system::Coupling;
 use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::GapRow;
 use crate::contact::geometry::rbf::{Interpolation, interpolation_radii};
+use crate::contact::geometry::rbf_patch::BlockShare;
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::geometry::walls::HeldWall;
 use crate::contact::law::{ContactLaw, Multiplier, Reads, Restates, Tangential, coulomb};
@@ -80,20 +81,22 @@ impl InterfaceOperators {
     /// nearest-node distance. `slid` is how far the primary surface has slid over the
     /// secondary ([`Self::slide`]; zero in the reference configuration): the primary nodes
     /// are paired from their positions moved by it, the secondary's by its opposite
-    /// ([`paired_points`]).
+    /// ([`paired_points`]). `share`: how the ranks of a distributed run share the
+    /// interpolations' rows ([`Interpolation`]; collective with several ranks), one process
+    /// [`BlockShare::ALL`].
     pub fn new(
         primary: &ContactSurface,
         secondary: &ContactSurface,
         radius: f64,
         weights: [f64; 2],
-        transfer: Transfer,
+        (transfer, share): (Transfer, BlockShare),
         slid: [f64; 3],
     ) -> Result<Self, ContactError> {
         let [w1, w2] = weights;
         let back = slid.map(|v| -v);
         let (targets12, _) = paired_points(primary, secondary, [w1, w2], slid)?;
         let (on_primary, facing2) = paired_points(secondary, primary, [w2, w1], back)?;
-        let r12 = covering_interpolation(secondary, radius, &targets12, primary, |t| t)?;
+        let r12 = covering_interpolation(secondary, radius, &targets12, share, (primary, |t| t))?;
         // Only the secondary nodes that face the primary surface receive its traction.
         let receiving: Vec<usize> = (0..secondary.len()).filter(|&j| facing2[j]).collect();
         let r21 = if !transfer.interpolates() {
@@ -104,8 +107,8 @@ impl InterfaceOperators {
                 primary,
                 radius,
                 &targets,
-                secondary,
-                |t| receiving[t],
+                share,
+                (secondary, |t| receiving[t]),
             )?)
         };
         let n2_flat: Vec<f64> = secondary.normals.iter().flatten().copied().collect();
@@ -455,17 +458,17 @@ fn paired_points(
 }
 
 /// The interpolation from the nodes of `sources` to `targets` (points on that surface; target
-/// `t` belongs to node `target_node(t)` of `target_surface`); a target outside every support is
-/// an error that names its node.
+/// `t` belongs to node `target_node(t)` of `target_surface`), its rows shared as `share` says;
+/// a target outside every support is an error that names its node.
 fn covering_interpolation(
     sources: &ContactSurface,
     radius: f64,
     targets: &[[f64; 3]],
-    target_surface: &ContactSurface,
-    target_node: impl Fn(usize) -> usize,
+    share: BlockShare,
+    (target_surface, target_node): (&ContactSurface, impl Fn(usize) -> usize),
 ) -> Result<Interpolation, ContactError> {
     let radii = interpolation_radii(&sources.coords, radius)?;
-    let interpolation = Interpolation::new(&sources.coords, &radii, targets)?;
+    let interpolation = Interpolation::shared(&sources.coords, &radii, targets, share)?;
     if let Some(&t) = interpolation.uncovered_targets().first() {
         return Err(ContactError::Uncovered {
             body: target_surface.body.clone(),

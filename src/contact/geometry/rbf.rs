@@ -28,13 +28,15 @@
 //! `O(h)` (see `tests/interpolation.rs` for the measured rates).
 
 use std::num::NonZeroUsize;
+use std::ops::Range;
+use std::sync::OnceLock;
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::SymbolicSparseRowMat;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::contact::geometry::rbf_patch::{
-    self as patch, BlockShare, CompressedRows, Graph, row_entries,
+    self as patch, BlockShare, CompressedRows, NodeCache, PatchMatrix, PatchNode, row_entries,
 };
 use crate::linalg::gmres;
 
@@ -112,6 +114,9 @@ pub enum RbfError {
         /// What failed.
         detail: String,
     },
+    /// The ranks sharing the interpolation could not exchange their rows' values.
+    #[error("sharing the interpolation among the ranks: {0}")]
+    Ranks(String),
     /// The k-d tree could not be built (more than `u32::MAX` points).
     #[error("k-d tree construction failed: {0}")]
     KdTree(#[from] kiddo::kd_tree::ConstructionError),
@@ -219,9 +224,11 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
 /// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` from source nodes with
 /// support radii to target points.
 ///
-/// Holds `Phi_MM` and `Phi_NM` (sparse rows), the graph of `Phi_MM` and `D_NN^-1`; `R_NM`
-/// (dense in general) is never formed, except on request by [`Interpolation::matrix`], and
-/// `Phi_MM` is not factored where GMRES serves. Two kinds of solve with `Phi_MM`:
+/// Holds the rows of `Phi_MM` and `Phi_NM` of its share ([`BlockShare`]: every row on one
+/// process) and `D_NN^-1`; any other row of either matrix, and the graph of `Phi_MM`, it
+/// computes when it needs them, from the points and a k-d tree ([`Sources`]). `R_NM` (dense in
+/// general) is never formed, except on request by [`Interpolation::matrix`], and `Phi_MM` is
+/// not factored where GMRES serves. Two kinds of solve with `Phi_MM`:
 ///
 /// * **Whole fields** ([`Interpolation::apply`], and `D_NN` itself): GMRES on `Phi_MM`, stopped
 ///   at a residual of [`SOLVE_TOL`] of the right-hand side. Wendland's matrix with the radii of
@@ -236,19 +243,24 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
 /// Why not the whole factor always: its fill is many times `Phi_MM`'s nonzeros and grows
 /// faster than the surface, every rank of a distributed run held it, and each row cost a solve
 /// with all of it; a patch's solve costs the same on any surface.
+///
+/// **Shared among ranks.** Built with a share of `N > 1` ranks, rank `r` holds the rows of
+/// `Phi_MM` of the `r`-th of `N` consecutive ranges of sources and the rows of `Phi_NM` of the
+/// `r`-th range of targets, and each product of a whole-field GMRES is every rank's rows
+/// gathered on every rank (`MPI_Allgatherv` of `M` values); `D_NN` and an applied field are
+/// gathered the same way. Every rank then runs the same GMRES on the same numbers, the
+/// serial one's, bit for bit: a row is summed in the same order wherever it is computed. So
+/// [`Interpolation::shared`] and [`Interpolation::apply`] are collective. Why not whole on
+/// every rank: `Phi_MM`, `Phi_NM` and `Phi_MM`'s graph took about 0.7 KB per candidate node,
+/// on every rank, where the points and the tree take about 0.1 KB (`docs/parallel.md`).
 #[derive(Debug)]
 pub struct Interpolation {
-    /// `Phi_MM`, in compressed rows.
-    phi_mm: CompressedRows,
-    /// `Phi_NM`, in compressed rows.
-    phi_nm: CompressedRows,
-    /// Each source's neighbours in `Phi_MM`'s graph (the pattern of `Phi_MM + Phi_MM^T`
-    /// without the diagonal): what a patch grows along.
-    graph: Graph,
-    /// Where the sources and the targets lie: the order in which rows and columns are
-    /// computed in blocks of nearby ones.
-    sources: Vec<[f64; 3]>,
+    /// The sources and their radii: any row of `Phi_MM` or `Phi_NM`, on demand.
+    sources: Sources,
+    /// Where the targets lie: the order in which rows are computed in blocks of nearby ones.
     targets: Vec<[f64; 3]>,
+    /// The rows this process holds and how the ranks share them.
+    held: HeldRows,
     /// `1 / D_ii` for covered targets, `0` for uncovered ones.
     inv_d: Vec<f64>,
     /// Targets with `D_ii` not clearly positive (see [`UNCOVERED_TOL`]).
@@ -258,20 +270,182 @@ pub struct Interpolation {
     whole: patch::WholeFactor,
 }
 
+/// The source nodes, their radii and k-d trees over them: any row of the RBF matrices
+/// (`(Phi)_tj = phi(|x_t - xi_j| / r_j)` against every source `j`), and node `i`'s row of
+/// `Phi_MM` with its neighbours in the graph of `Phi_MM`, for a patch ([`PatchMatrix`]).
+#[derive(Debug)]
+struct Sources {
+    points: Vec<[f64; 3]>,
+    radii: Vec<f64>,
+    /// The sources by their radii ([`RadiusClass`]).
+    classes: Vec<RadiusClass>,
+}
+
+/// The sources whose radii lie within a factor of two of each other (`[2^k, 2^(k + 1))` times
+/// the smallest), in a k-d tree of their own. Why not one tree searched to the largest radius:
+/// on a graded surface the coarse far field's radii are tens of times the contact zone's, and a
+/// search to them from a node of the zone returns hundreds of times the sources its row holds
+/// (at 1M DOFs the patches' rows took 6.5 s an iteration that way, against 0.8 s with the
+/// matrix stored); searched class by class to the class's largest radius, a search returns
+/// at most about four times them.
+#[derive(Debug)]
+struct RadiusClass {
+    largest: f64,
+    /// Source index of each of the tree's items.
+    members: Vec<usize>,
+    tree: ImmutableKdTree<f64, 3>,
+}
+
+impl Sources {
+    fn new(points: &[[f64; 3]], radii: &[f64]) -> Result<Self, RbfError> {
+        let smallest = radii.iter().copied().fold(f64::INFINITY, f64::min);
+        let class_of = |r: f64| (r / smallest).log2().floor().max(0.0) as usize;
+        let count = radii.iter().map(|&r| class_of(r) + 1).max().unwrap_or(0);
+        let mut members = vec![Vec::new(); count];
+        for (j, &r) in radii.iter().enumerate() {
+            members[class_of(r)].push(j);
+        }
+        let classes = (members.into_iter())
+            .filter(|members| !members.is_empty())
+            .map(|members| {
+                let at: Vec<[f64; 3]> = members.iter().map(|&j| points[j]).collect();
+                Ok(RadiusClass {
+                    largest: members.iter().map(|&j| radii[j]).fold(0.0, f64::max),
+                    tree: ImmutableKdTree::<f64, 3>::new_from_slice(&at)?,
+                    members,
+                })
+            })
+            .collect::<Result<_, RbfError>>()?;
+        Ok(Self {
+            points: points.to_vec(),
+            radii: radii.to_vec(),
+            classes,
+        })
+    }
+
+    /// The sources within `max(r_j, reach)` of `point`, and more, with `|point - xi_j|`:
+    /// every source of `point`'s row (`reach = 0`), unsorted.
+    fn within_reach<'a>(
+        &'a self,
+        point: &'a [f64; 3],
+        reach: f64,
+    ) -> impl Iterator<Item = (usize, f64)> + 'a {
+        self.classes.iter().flat_map(move |class| {
+            let radius = class.largest.max(reach);
+            let hits = (class.tree.query(point))
+                .within::<SquaredEuclidean<f64>>(search_radius_squared(radius))
+                .unsorted()
+                .execute();
+            hits.into_iter().map(move |hit| {
+                let j = class.members[hit.item as usize];
+                (j, distance(point, &self.points[j]))
+            })
+        })
+    }
+
+    /// The row of `point`: `(j, phi(|point - xi_j| / r_j))` for the sources whose support
+    /// holds it, the columns increasing.
+    fn row(&self, point: &[f64; 3]) -> Entries {
+        let mut row: Entries = (self.within_reach(point, 0.0))
+            .filter_map(|(j, d)| {
+                let delta = d / self.radii[j];
+                (delta < 1.0).then(|| (j, wendland_c2(delta)))
+            })
+            .collect();
+        row.sort_unstable_by_key(|&(j, _)| j);
+        row
+    }
+
+    /// The rows of `points`, in compressed rows over every source.
+    fn rows(&self, points: &[[f64; 3]]) -> CompressedRows {
+        let mut offsets = Vec::with_capacity(points.len() + 1);
+        offsets.push(0);
+        let (mut cols, mut vals) = (Vec::new(), Vec::new());
+        for p in points {
+            for (j, v) in self.row(p) {
+                cols.push(j);
+                vals.push(v);
+            }
+            offsets.push(cols.len());
+        }
+        let symbolic =
+            SymbolicSparseRowMat::new_checked(points.len(), self.points.len(), offsets, None, cols);
+        CompressedRows::new(symbolic, vals)
+    }
+}
+
+impl PatchMatrix for Sources {
+    fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Row `i` of `Phi_MM` and the sources `j != i` either of whose supports holds the other
+    /// (`|xi_i - xi_j| < r_j`: `j` in row `i`; `< r_i`: `i` in row `j`), from one radius search.
+    fn node(&self, i: usize) -> PatchNode {
+        let point = &self.points[i];
+        let (mut row, mut neighbours) = (Vec::new(), Vec::new());
+        for (j, d) in self.within_reach(point, self.radii[i]) {
+            let delta = d / self.radii[j];
+            if delta < 1.0 {
+                row.push((j, wendland_c2(delta)));
+            }
+            if j != i && (delta < 1.0 || d / self.radii[i] < 1.0) {
+                neighbours.push(j);
+            }
+        }
+        row.sort_unstable_by_key(|&(j, _)| j);
+        neighbours.sort_unstable();
+        PatchNode { row, neighbours }
+    }
+}
+
+/// The rows of `Phi_MM` and `Phi_NM` one process holds: those of its share's ranges of sources
+/// and targets ([`Interpolation`]'s doc), with every rank's number of them.
+#[derive(Debug)]
+struct HeldRows {
+    sources: Range<usize>,
+    targets: Range<usize>,
+    /// The held rows of `Phi_MM` (row `k` is source `sources.start + k`).
+    phi_mm: CompressedRows,
+    /// The held rows of `Phi_NM` (row `k` is target `targets.start + k`).
+    phi_nm: CompressedRows,
+    /// Each rank's number of sources and of targets.
+    source_counts: Vec<usize>,
+    target_counts: Vec<usize>,
+}
+
+/// The `rank`-th of `size` consecutive ranges of `0..len`, as even as can be.
+fn range_of(len: usize, rank: usize, size: usize) -> Range<usize> {
+    len * rank / size..len * (rank + 1) / size
+}
+
+/// Every rank's values, each rank's `local` ones (`counts[r]` from rank `r`), on every rank.
+fn gathered(local: Vec<f64>, counts: &[usize]) -> Result<Vec<f64>, RbfError> {
+    match counts.len() {
+        1 => Ok(local),
+        _ => {
+            crate::parallel::all_gather(&local, counts).map_err(|e| RbfError::Ranks(e.to_string()))
+        }
+    }
+}
+
 /// The whole-field solves with `Phi_MM` stop at a residual of this fraction of the right-hand
 /// side's. With `Phi_MM`'s condition number about 6, the solution is then within a few
 /// `1e-15` of the exact one, the round-off of a direct solve.
 pub const SOLVE_TOL: f64 = 1e-15;
 
-/// GMRES on `Phi_MM` with no preconditioner (its diagonal is one).
-struct PhiOperator<'a>(&'a CompressedRows);
+/// GMRES on `Phi_MM` with no preconditioner (its diagonal is one): each rank's held rows, the
+/// product gathered.
+struct PhiOperator<'a>(&'a HeldRows);
 
 impl gmres::Operators for PhiOperator<'_> {
-    type Error = std::convert::Infallible;
+    type Error = RbfError;
     fn apply(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = row_entries(self.0, i).map(|(j, v)| v * x[j]).sum();
-        }
+        let held = self.0;
+        let local: Vec<f64> = (0..held.sources.len())
+            .map(|k| row_entries(&held.phi_mm, k).map(|(j, v)| v * x[j]).sum())
+            .collect();
+        out.copy_from_slice(&gathered(local, &held.source_counts)?);
         Ok(())
     }
     fn precondition(&mut self, r: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
@@ -281,19 +455,30 @@ impl gmres::Operators for PhiOperator<'_> {
 }
 
 impl Interpolation {
-    /// Assembles `Phi_MM` and `Phi_NM` with a k-d tree radius search and computes
-    /// `D_NN = diag(Phi_NM Phi_MM^-1 1)`.
-    ///
-    /// Targets whose `D_ii` is not clearly positive (outside every source support; threshold
-    /// [`UNCOVERED_TOL`]) do not make `new` fail: their row of `R` is zero and they are listed by
-    /// [`Interpolation::uncovered_targets`].
-    ///
-    /// Cost: one radius search per source and per target (radius `max_j r_j`) and one GMRES
-    /// solve with `Phi_MM`.
+    /// [`Self::shared`] on one process: every row held.
     pub fn new(
         sources: &[[f64; 3]],
         radii: &[f64],
         targets: &[[f64; 3]],
+    ) -> Result<Self, RbfError> {
+        Self::shared(sources, radii, targets, BlockShare::ALL)
+    }
+
+    /// Assembles this process's rows of `Phi_MM` and `Phi_NM` (those of `share`: the type's
+    /// doc) with a k-d tree radius search and computes `D_NN = diag(Phi_NM Phi_MM^-1 1)`.
+    /// Collective with a share of several ranks.
+    ///
+    /// Targets whose `D_ii` is not clearly positive (outside every source support; threshold
+    /// [`UNCOVERED_TOL`]) do not make it fail: their row of `R` is zero and they are listed by
+    /// [`Interpolation::uncovered_targets`].
+    ///
+    /// Cost: one radius search per held source and target (radius `max_j r_j`) and one GMRES
+    /// solve with `Phi_MM`.
+    pub fn shared(
+        sources: &[[f64; 3]],
+        radii: &[f64],
+        targets: &[[f64; 3]],
+        share: BlockShare,
     ) -> Result<Self, RbfError> {
         if sources.is_empty() {
             return Err(RbfError::NoSources);
@@ -313,37 +498,46 @@ impl Interpolation {
         }
         check_finite(sources)?;
         check_finite(targets)?;
-        let m = sources.len();
-        let tree = ImmutableKdTree::<f64, 3>::new_from_slice(sources)?;
-        let r_max = radii.iter().copied().fold(0.0, f64::max);
-        let phi_mm = rbf_rows(&tree, sources, radii, r_max, sources);
-        let phi_nm = rbf_rows(&tree, sources, radii, r_max, targets);
-        let graph = Graph::of(&phi_mm);
+        let (m, n) = (sources.len(), targets.len());
+        let sources = Sources::new(sources, radii)?;
+        let (rank, size) = (share.rank, share.size);
+        let (held_sources, held_targets) = (range_of(m, rank, size), range_of(n, rank, size));
+        let held = HeldRows {
+            phi_mm: sources.rows(&sources.points[held_sources.clone()]),
+            phi_nm: sources.rows(&targets[held_targets.clone()]),
+            sources: held_sources,
+            targets: held_targets,
+            source_counts: (0..size).map(|r| range_of(m, r, size).len()).collect(),
+            target_counts: (0..size).map(|r| range_of(n, r, size).len()).collect(),
+        };
         let mut interpolation = Self {
-            phi_mm,
-            phi_nm,
-            graph,
-            sources: sources.to_vec(),
+            sources,
             targets: targets.to_vec(),
+            held,
             inv_d: Vec::new(),
             uncovered: Vec::new(),
             whole: patch::WholeFactor::new(),
         };
 
-        // y = Phi_MM^-1 1
+        // y = Phi_MM^-1 1; each held target's 1 / D_ii and whether it is covered.
         let y = interpolation.solve(&vec![1.0; m])?;
-        for t in 0..targets.len() {
-            let (sum, magnitude) = row_entries(&interpolation.phi_nm, t)
+        let held = &interpolation.held;
+        let mut local = Vec::with_capacity(2 * held.targets.len());
+        for k in 0..held.targets.len() {
+            let (sum, magnitude) = row_entries(&held.phi_nm, k)
                 .fold((0.0, 0.0), |(s, a), (j, v)| {
                     (s + v * y[j], a + v * y[j].abs())
                 });
-            if sum > UNCOVERED_TOL * magnitude {
-                interpolation.inv_d.push(1.0 / sum);
-            } else {
-                interpolation.inv_d.push(0.0);
-                interpolation.uncovered.push(t);
-            }
+            let covered = sum > UNCOVERED_TOL * magnitude;
+            local.extend([if covered { 1.0 / sum } else { 0.0 }, f64::from(covered)]);
         }
+        let counts: Vec<usize> = held.target_counts.iter().map(|c| 2 * c).collect();
+        let all = gathered(local, &counts)?;
+        interpolation.inv_d = all.iter().step_by(2).copied().collect();
+        interpolation.uncovered = (all.chunks_exact(2).enumerate())
+            .filter(|(_, d)| d[1] == 0.0)
+            .map(|(t, _)| t)
+            .collect();
         Ok(interpolation)
     }
 
@@ -351,7 +545,7 @@ impl Interpolation {
     /// GMRES stops short of its tolerance (wide supports make `Phi_MM` ill-conditioned: with
     /// `rbf_radius = 10` on the 3D hemisphere's surfaces GMRES is still at `3e-6` after 200
     /// products). A matrix that cannot be factored then is [`RbfError::SingularPhi`], with why
-    /// GMRES stopped.
+    /// GMRES stopped. Collective with a share of several ranks (each product is).
     fn solve(&self, b: &[f64]) -> Result<Vec<f64>, RbfError> {
         let m = b.len();
         let with_factor = |lu: &faer::sparse::linalg::solvers::Lu<usize, f64>| {
@@ -369,11 +563,21 @@ impl Interpolation {
             max_iterations: MAX_SOLVE_ITERATIONS,
             restart: MAX_SOLVE_ITERATIONS,
         };
-        let Ok(stats) = gmres::solve(&mut PhiOperator(&self.phi_mm), b, &mut x, settings);
+        let stats = gmres::solve(&mut PhiOperator(&self.held), b, &mut x, settings)?;
         let Some(failure) = stats.failure else {
             return Ok(x);
         };
-        match patch::whole_factor(&self.phi_mm, &self.whole) {
+        // Every rank gets here together (the same GMRES on the same numbers), and each
+        // factors the whole matrix: the rare case of supports too wide for GMRES.
+        let whole_rows;
+        let phi_mm = match self.held.sources.len() == m {
+            true => &self.held.phi_mm,
+            false => {
+                whole_rows = self.sources.rows(&self.sources.points);
+                &whole_rows
+            }
+        };
+        match patch::whole_factor(phi_mm, &self.whole) {
             Ok(lu) => finite(with_factor(lu)),
             Err(detail) => Err(RbfError::SingularPhi {
                 detail: format!(
@@ -388,7 +592,7 @@ impl Interpolation {
 
     /// Number of source nodes `M`.
     pub fn num_sources(&self) -> usize {
-        self.sources.len()
+        self.sources.points.len()
     }
 
     /// Number of target points `N`.
@@ -396,9 +600,18 @@ impl Interpolation {
         self.inv_d.len()
     }
 
+    /// Row `t` of `Phi_NM`: held, or computed.
+    fn target_row(&self, t: usize) -> Entries {
+        match self.held.targets.contains(&t) {
+            true => row_entries(&self.held.phi_nm, t - self.held.targets.start).collect(),
+            false => self.sources.row(&self.targets[t]),
+        }
+    }
+
     /// Interpolates a field with `components` values per source node, interleaved
     /// (`values[j * components + k]`), to the targets: returns `R_NM g` in the same interleaved
-    /// layout (`N * components` values). Rows of uncovered targets are zero.
+    /// layout (`N * components` values). Rows of uncovered targets are zero. Collective with a
+    /// share of several ranks.
     ///
     /// Cost: one GMRES solve with `Phi_MM` per component and one product with `Phi_NM`.
     ///
@@ -411,17 +624,23 @@ impl Interpolation {
             m * components,
             "expected {components} values for each of the {m} source nodes"
         );
-        let n = self.num_targets();
-        let mut out = vec![0.0; n * components];
-        for k in 0..components {
-            let g: Vec<f64> = values.iter().skip(k).step_by(components).copied().collect();
-            let x = self.solve(&g)?;
-            for (t, row) in out.chunks_exact_mut(components).enumerate() {
-                let value: f64 = row_entries(&self.phi_nm, t).map(|(j, v)| v * x[j]).sum();
-                row[k] = self.inv_d[t] * value;
+        let solved: Vec<Vec<f64>> = (0..components)
+            .map(|k| {
+                let g: Vec<f64> = values.iter().skip(k).step_by(components).copied().collect();
+                self.solve(&g)
+            })
+            .collect::<Result<_, _>>()?;
+        let held = &self.held;
+        let mut local = vec![0.0; held.targets.len() * components];
+        for (k, row) in local.chunks_exact_mut(components).enumerate() {
+            let t = held.targets.start + k;
+            for (c, x) in solved.iter().enumerate() {
+                let value: f64 = row_entries(&held.phi_nm, k).map(|(j, v)| v * x[j]).sum();
+                row[c] = self.inv_d[t] * value;
             }
         }
-        Ok(out)
+        let counts: Vec<usize> = held.target_counts.iter().map(|c| c * components).collect();
+        gathered(local, &counts)
     }
 
     /// The dense `N x M` interpolation matrix `R_NM`, column by column ([`Self::apply`] of
@@ -451,7 +670,7 @@ impl Interpolation {
 
     /// [`Self::rows`] of the blocks of nearby rows that `share` gives this process
     /// (`rbf_patch::in_blocks`), `None` for the others; an uncovered target's empty row is
-    /// everyone's.
+    /// everyone's. Not collective: any process can compute any row.
     pub fn rows_of_share(
         &self,
         targets: &[usize],
@@ -460,16 +679,17 @@ impl Interpolation {
         let covered: Vec<usize> = (targets.iter().copied())
             .filter(|&t| self.inv_d[t] != 0.0)
             .collect();
+        let nodes = NodeCache::new(&self.sources);
         let solved = patch::in_blocks(&self.targets, &covered, share, |block| {
-            let seeds: Vec<usize> = (block.iter())
-                .flat_map(|&t| row_entries(&self.phi_nm, t).map(|(j, _)| j))
+            let rows: Vec<Entries> = block.iter().map(|&t| self.target_row(t)).collect();
+            let seeds: Vec<usize> = (rows.iter())
+                .flat_map(|row| row.iter().map(|&(j, _)| j))
                 .collect();
             let right_hand_side = |k: usize, set: &mut dyn FnMut(usize, f64)| {
-                row_entries(&self.phi_nm, block[k]).for_each(|(j, v)| set(j, v))
+                rows[k].iter().for_each(|&(j, v)| set(j, v))
             };
             let solution = patch::solve(
-                &self.phi_mm,
-                &self.graph,
+                &nodes,
                 &self.whole,
                 &seeds,
                 block.len(),
@@ -509,24 +729,46 @@ impl Interpolation {
     }
 
     /// [`Self::columns`] of the blocks of nearby columns that `share` gives this process
-    /// (`rbf_patch::in_blocks`), `None` for the others.
+    /// (`rbf_patch::in_blocks`), `None` for the others. Not collective.
     pub fn columns_of_share(
         &self,
         sources: &[usize],
         share: BlockShare,
     ) -> Result<Vec<Option<Entries>>, RbfError> {
-        // The targets each source's support holds: those a patch's solution reaches.
-        let mut reached = vec![Vec::new(); self.num_sources()];
-        for t in 0..self.num_targets() {
-            if self.inv_d[t] != 0.0 {
-                row_entries(&self.phi_nm, t).for_each(|(j, _)| reached[j].push(t));
-            }
-        }
-        patch::in_blocks(&self.sources, sources, share, |block| {
+        // The covered targets each source's support holds (those a patch's solution reaches),
+        // by a radius search among the targets; each source's and each target's row once for
+        // the whole request, as the patches' nodes ([`NodeCache`]).
+        let tree = match self.targets.is_empty() {
+            true => None,
+            false => Some(ImmutableKdTree::<f64, 3>::new_from_slice(&self.targets)?),
+        };
+        let reached: Vec<OnceLock<Vec<usize>>> =
+            (0..self.num_sources()).map(|_| OnceLock::new()).collect();
+        let reached = |j: usize| -> &[usize] {
+            reached[j].get_or_init(|| {
+                let (point, radius) = (&self.sources.points[j], self.sources.radii[j]);
+                let Some(tree) = &tree else {
+                    return Vec::new();
+                };
+                (tree.query(point))
+                    .within::<SquaredEuclidean<f64>>(search_radius_squared(radius))
+                    .unsorted()
+                    .execute()
+                    .into_iter()
+                    .map(|hit| hit.item as usize)
+                    .filter(|&t| {
+                        self.inv_d[t] != 0.0 && distance(&self.targets[t], point) / radius < 1.0
+                    })
+                    .collect()
+            })
+        };
+        let target_rows: Vec<OnceLock<Entries>> =
+            (0..self.num_targets()).map(|_| OnceLock::new()).collect();
+        let nodes = NodeCache::new(&self.sources);
+        patch::in_blocks(&self.sources.points, sources, share, |block| {
             let right_hand_side = |k: usize, set: &mut dyn FnMut(usize, f64)| set(block[k], 1.0);
             let solution = patch::solve(
-                &self.phi_mm,
-                &self.graph,
+                &nodes,
                 &self.whole,
                 block,
                 block.len(),
@@ -535,16 +777,17 @@ impl Interpolation {
             )
             .map_err(|detail| RbfError::SingularPhi { detail })?;
             let mut candidates: Vec<usize> = (solution.nodes.iter())
-                .flat_map(|&j| reached[j].iter().copied())
+                .flat_map(|&j| reached(j).iter().copied())
                 .collect();
             candidates.sort_unstable();
             candidates.dedup();
+            let rows: Vec<&Entries> = (candidates.iter())
+                .map(|&t| target_rows[t].get_or_init(|| self.target_row(t)))
+                .collect();
             Ok((0..block.len())
                 .map(|k| {
-                    let column = candidates.iter().map(|&t| {
-                        let value: f64 = row_entries(&self.phi_nm, t)
-                            .map(|(j, v)| v * solution.at(k, j))
-                            .sum();
+                    let column = candidates.iter().zip(&rows).map(|(&t, row)| {
+                        let value: f64 = row.iter().map(|&(j, v)| v * solution.at(k, j)).sum();
                         (t, self.inv_d[t] * value)
                     });
                     sparse(column)
@@ -654,45 +897,6 @@ fn nearest_other_distances(
 /// distance never drops a node that the exact filter `distance < radius` keeps.
 fn search_radius_squared(radius: f64) -> f64 {
     radius * radius * (1.0 + 1e-12)
-}
-
-/// Rows of the RBF matrix `(Phi)_tj = phi(|x_t - xi_j| / r_j)` for the given points against the
-/// sources in `tree` (`Phi_MM` or `Phi_NM`), in compressed rows
-/// with the columns of each row sorted.
-fn rbf_rows(
-    tree: &ImmutableKdTree<f64, 3>,
-    sources: &[[f64; 3]],
-    radii: &[f64],
-    r_max: f64,
-    points: &[[f64; 3]],
-) -> CompressedRows {
-    let mut offsets = Vec::with_capacity(points.len() + 1);
-    offsets.push(0);
-    let mut cols = Vec::new();
-    let mut vals = Vec::new();
-    let mut row: Vec<(usize, f64)> = Vec::new();
-    for p in points {
-        row.clear();
-        row.extend(
-            tree.query(p)
-                .within::<SquaredEuclidean<f64>>(search_radius_squared(r_max))
-                .unsorted()
-                .execute()
-                .into_iter()
-                .filter_map(|hit| {
-                    let j = hit.item as usize;
-                    let delta = distance(p, &sources[j]) / radii[j];
-                    (delta < 1.0).then(|| (j, wendland_c2(delta)))
-                }),
-        );
-        row.sort_unstable_by_key(|&(j, _)| j);
-        cols.extend(row.iter().map(|&(j, _)| j));
-        vals.extend(row.iter().map(|&(_, v)| v));
-        offsets.push(cols.len());
-    }
-    let symbolic =
-        SymbolicSparseRowMat::new_checked(points.len(), sources.len(), offsets, None, cols);
-    CompressedRows::new(symbolic, vals)
 }
 
 #[cfg(test)]
@@ -806,9 +1010,7 @@ mod tests {
             })
             .collect();
         let radii = support_radii(&points).expect("radii");
-        let tree = ImmutableKdTree::<f64, 3>::new_from_slice(&points).expect("tree");
-        let r_max = radii.iter().copied().fold(0.0, f64::max);
-        let phi = rbf_rows(&tree, &points, &radii, r_max, &points);
+        let phi = cap_sources(&points, &radii).rows(&points);
         let m = points.len();
         let mut sparse = vec![0.0; m * m];
         for i in 0..m {
@@ -832,6 +1034,51 @@ mod tests {
             let col: f64 = (0..m).filter(|&i| i != j).map(|i| sparse[i * m + j]).sum();
             assert!(col < 1.0, "column {j}: off-diagonal sum {col}");
         }
+    }
+
+    fn cap_sources(points: &[[f64; 3]], radii: &[f64]) -> Sources {
+        Sources::new(points, radii).expect("trees")
+    }
+
+    #[test]
+    fn a_patch_node_is_its_row_of_phi_mm_and_its_neighbours_in_the_graph() {
+        // A graded, uneven spacing: radii of several classes, and pairs that hold each other
+        // one way only.
+        let points: Vec<[f64; 3]> = (0..60)
+            .map(|k| {
+                let x = 0.02 * (1.06f64.powi(k) - 1.0) / 0.06;
+                [x, 0.2 * x * (k as f64 * 0.9).cos(), 0.0]
+            })
+            .collect();
+        let radii = interpolation_radii(&points, 2.5).unwrap();
+        let sources = cap_sources(&points, &radii);
+        assert!(
+            sources.classes.len() > 2,
+            "{} radius classes",
+            sources.classes.len()
+        );
+        let phi = sources.rows(&points);
+        let (mut one_way, m) = (0, points.len());
+        for i in 0..m {
+            let node = sources.node(i);
+            assert_eq!(
+                node.row,
+                row_entries(&phi, i).collect::<Vec<_>>(),
+                "row {i}"
+            );
+            // The pattern of Phi_MM + Phi_MM^T without the diagonal, from the whole matrix.
+            let expected: Vec<usize> = (0..m)
+                .filter(|&j| {
+                    let in_row = |a: usize, b: usize| row_entries(&phi, a).any(|(c, _)| c == b);
+                    j != i && (in_row(i, j) || in_row(j, i))
+                })
+                .collect();
+            one_way += (expected.iter())
+                .filter(|&&j| !row_entries(&phi, i).any(|(c, _)| c == j))
+                .count();
+            assert_eq!(node.neighbours, expected, "neighbours of {i}");
+        }
+        assert!(one_way > 0, "the test set must have one-way pairs");
     }
 
     #[test]

@@ -63,50 +63,51 @@ pub fn row_entries(a: &CompressedRows, i: usize) -> impl Iterator<Item = (usize,
     (a.col_idx_of_row_raw(i).iter().copied()).zip(a.val_of_row(i).iter().copied())
 }
 
-/// The neighbours of each node of a square sparse matrix's graph (its pattern made symmetric,
-/// without the diagonal), in compressed rows.
-#[derive(Debug)]
-pub struct Graph {
-    offsets: Vec<usize>,
-    neighbours: Vec<u32>,
+/// A square sparse matrix read one node at a time, as a patch grows along its graph and
+/// factors its rows: computed on demand rather than stored, so that a process needs none of
+/// the matrix to solve on a patch of it ([`NodeCache`] over
+/// `crate::contact::geometry::rbf`'s sources).
+pub trait PatchMatrix: Sync {
+    /// Number of nodes (rows).
+    fn len(&self) -> usize;
+    /// Node `i`'s row and its neighbours in the graph.
+    fn node(&self, i: usize) -> PatchNode;
 }
 
-impl Graph {
-    /// The graph of the square matrix `a`.
-    pub fn of(a: &CompressedRows) -> Self {
-        let n = a.nrows();
-        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for i in 0..n {
-            for (j, _) in row_entries(a, i).filter(|&(j, _)| j != i) {
-                lists[i].push(j as u32);
-                lists[j].push(i as u32);
-            }
-        }
-        let mut offsets = Vec::with_capacity(n + 1);
-        offsets.push(0);
-        let mut neighbours = Vec::new();
-        for mut list in lists {
-            // A pair with each in the other's support is listed twice.
-            list.sort_unstable();
-            list.dedup();
-            neighbours.extend(list);
-            offsets.push(neighbours.len());
-        }
+/// The nodes of a [`PatchMatrix`] computed so far, each once: what the blocks of one request
+/// share (a source lies in the patches of some fifty blocks of rows). Made for one request of
+/// rows or columns and dropped after it, so that it holds the nodes of this process's blocks'
+/// patches only ([`BlockShare`]), and those only while they are solved.
+pub struct NodeCache<'a, A> {
+    matrix: &'a A,
+    nodes: Vec<OnceLock<PatchNode>>,
+}
+
+impl<'a, A: PatchMatrix> NodeCache<'a, A> {
+    pub fn new(matrix: &'a A) -> Self {
         Self {
-            offsets,
-            neighbours,
+            matrix,
+            nodes: (0..matrix.len()).map(|_| OnceLock::new()).collect(),
         }
     }
 
-    /// Number of nodes.
-    pub fn len(&self) -> usize {
-        self.offsets.len() - 1
+    fn len(&self) -> usize {
+        self.nodes.len()
     }
 
-    /// The neighbours of node `i`.
-    pub fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        (self.neighbours[self.offsets[i]..self.offsets[i + 1]].iter()).map(|&j| j as usize)
+    fn node(&self, i: usize) -> &PatchNode {
+        self.nodes[i].get_or_init(|| self.matrix.node(i))
     }
+}
+
+/// One node of a [`PatchMatrix`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PatchNode {
+    /// Its row's entries `(column, value)`, the columns increasing.
+    pub row: Vec<(usize, f64)>,
+    /// Its neighbours in the matrix's graph (the pattern of `A + A^T` without the diagonal),
+    /// increasing.
+    pub neighbours: Vec<usize>,
 }
 
 /// The solutions of one patch: `count` vectors over its nodes.
@@ -147,8 +148,9 @@ pub fn whole_factor<'w>(
     a: &CompressedRows,
     whole: &'w WholeFactor,
 ) -> Result<&'w Lu<usize, f64>, String> {
-    let nodes: Vec<usize> = (0..a.nrows()).collect();
-    (whole.get_or_init(|| factor(a, &nodes, Some)).as_ref()).map_err(|e| e.clone())
+    let n = a.nrows();
+    let rows = (0..n).map(|i| row_entries(a, i));
+    (whole.get_or_init(|| factor(n, rows, Some)).as_ref()).map_err(|e| e.clone())
 }
 
 /// Solves `A x_k = b_k` (or `A^T x_k = b_k` with `transpose`) for `count` right-hand sides whose
@@ -156,9 +158,8 @@ pub fn whole_factor<'w>(
 /// the whole factor where it exists ([`WholeFactor`]).
 /// `fill(k, set)` calls `set(global index, value)` for the entries of `b_k`. A failure is said
 /// in words: a non-finite value, or a matrix that cannot be factored.
-pub fn solve(
-    a: &CompressedRows,
-    graph: &Graph,
+pub fn solve<A: PatchMatrix>(
+    a: &NodeCache<'_, A>,
     whole: &WholeFactor,
     seeds: &[usize],
     count: usize,
@@ -166,15 +167,16 @@ pub fn solve(
     fill: impl Fn(usize, &mut dyn FnMut(usize, f64)),
 ) -> Result<PatchSolution, String> {
     if let Some(Ok(lu)) = whole.get() {
-        let patch = Patch::whole(graph.len());
+        let patch = Patch::whole(a.len());
         let values = solve_with(lu, &patch, count, transpose, &fill);
         return patch.into_solution(values);
     }
-    let mut patch = Patch::new(graph, seeds);
-    patch.grow(graph, START_STEPS);
+    let mut patch = Patch::new(a, seeds);
+    patch.grow(a, START_STEPS);
     let values = loop {
         let local = |j: usize| Some(patch.local[j] as usize).filter(|&q| q != u32::MAX as usize);
-        let factored = factor(a, &patch.nodes, local);
+        let rows = patch.data.iter().map(|node| node.row.iter().copied());
+        let factored = factor(patch.nodes.len(), rows, local);
         let settled = match &factored {
             Ok(lu) => {
                 let values = solve_with(lu, &patch, count, transpose, &fill);
@@ -189,7 +191,7 @@ pub fn solve(
         };
         match settled {
             Some(values) => break values,
-            None => patch.grow(graph, GROW_STEPS),
+            None => patch.grow(a, GROW_STEPS),
         }
     };
     patch.into_solution(values)
@@ -220,8 +222,9 @@ fn solve_with(
 }
 
 /// Which of the blocks of rows (columns) one process computes ([`in_blocks`]): in a distributed
-/// run each rank the blocks `b` with `b % size == rank`, taking turns along the Z curve so that
-/// the ranks share the blocks of every part of the surface; on one process every block.
+/// run rank `r` of `N` the `r`-th of `N` consecutive runs of blocks along the Z curve, as even
+/// as can be, so that its blocks' patches cover one region of the surface (the nodes its
+/// [`NodeCache`] computes); on one process every block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BlockShare {
     pub rank: usize,
@@ -232,8 +235,9 @@ impl BlockShare {
     /// Every block.
     pub const ALL: Self = Self { rank: 0, size: 1 };
 
-    fn takes(&self, block: usize) -> bool {
-        block % self.size == self.rank
+    /// Whether this process computes block `block` of `blocks`.
+    fn takes(&self, block: usize, blocks: usize) -> bool {
+        (blocks * self.rank / self.size..blocks * (self.rank + 1) / self.size).contains(&block)
     }
 }
 
@@ -252,8 +256,9 @@ pub fn in_blocks<T: Send, E: Send>(
     let keys = z_curve_keys(&coords, 3);
     let mut order: Vec<usize> = (0..indices.len()).collect();
     order.sort_unstable_by_key(|&k| (keys[k], k));
+    let blocks = order.len().div_ceil(BLOCK);
     let mine: Vec<&[usize]> = (order.chunks(BLOCK).enumerate())
-        .filter(|&(b, _)| share.takes(b))
+        .filter(|&(b, _)| share.takes(b, blocks))
         .map(|(_, chunk)| chunk)
         .collect();
     let results: Vec<Vec<T>> = (mine.par_iter())
@@ -269,8 +274,11 @@ pub fn in_blocks<T: Send, E: Send>(
 }
 
 /// A patch being grown: its nodes layer by layer, and each node's place in it.
-struct Patch {
+struct Patch<'a> {
     nodes: Vec<usize>,
+    /// Each node's row and neighbours, in the order of `nodes` (empty for [`Patch::whole`],
+    /// which is never factored nor grown).
+    data: Vec<&'a PatchNode>,
     /// Where the outermost layer starts in `nodes`.
     outer: usize,
     /// `local[global]`: the node's place in `nodes`, `u32::MAX` outside.
@@ -279,16 +287,17 @@ struct Patch {
     exhausted: bool,
 }
 
-impl Patch {
-    fn new(graph: &Graph, seeds: &[usize]) -> Self {
+impl<'a> Patch<'a> {
+    fn new<A: PatchMatrix>(a: &'a NodeCache<'_, A>, seeds: &[usize]) -> Self {
         let mut patch = Self {
             nodes: Vec::new(),
+            data: Vec::new(),
             outer: 0,
-            local: vec![u32::MAX; graph.len()],
+            local: vec![u32::MAX; a.len()],
             exhausted: false,
         };
         for &s in seeds {
-            patch.add(s);
+            patch.add(a, s);
         }
         patch
     }
@@ -297,26 +306,29 @@ impl Patch {
     fn whole(n: usize) -> Self {
         Self {
             nodes: (0..n).collect(),
+            data: Vec::new(),
             outer: n,
             local: (0..n as u32).collect(),
             exhausted: true,
         }
     }
 
-    fn add(&mut self, node: usize) {
+    fn add<A: PatchMatrix>(&mut self, a: &'a NodeCache<'_, A>, node: usize) {
         if self.local[node] == u32::MAX {
             self.local[node] = self.nodes.len() as u32;
             self.nodes.push(node);
+            self.data.push(a.node(node));
         }
     }
 
     /// Adds `steps` layers: the neighbours of the outermost layer not yet in the patch.
-    fn grow(&mut self, graph: &Graph, steps: usize) {
+    fn grow<A: PatchMatrix>(&mut self, a: &'a NodeCache<'_, A>, steps: usize) {
         for _ in 0..steps {
             let (start, end) = (self.outer, self.nodes.len());
             for p in start..end {
-                for j in graph.neighbours(self.nodes[p]) {
-                    self.add(j);
+                let node: &'a PatchNode = self.data[p];
+                for &j in &node.neighbours {
+                    self.add(a, j);
                 }
             }
             if self.nodes.len() == end {
@@ -359,17 +371,16 @@ impl Patch {
     }
 }
 
-/// The sparse LU of `a` restricted to `nodes` (rows and columns in their order; `local`
-/// gives a node's place among them, `None` outside), or why it failed.
-fn factor(
-    a: &CompressedRows,
-    nodes: &[usize],
+/// The sparse LU of a matrix restricted to `n` nodes, from their `rows` (in the nodes' order;
+/// `local` gives a column's place among the nodes, `None` outside), or why it failed.
+fn factor<R: Iterator<Item = (usize, f64)>>(
+    n: usize,
+    rows: impl Iterator<Item = R>,
     local: impl Fn(usize) -> Option<usize>,
 ) -> Result<Lu<usize, f64>, String> {
-    let n = nodes.len();
     let mut triplets = Vec::new();
-    for (p, &i) in nodes.iter().enumerate() {
-        for (j, value) in row_entries(a, i) {
+    for (p, row) in rows.enumerate() {
+        for (j, value) in row {
             if let Some(q) = local(j) {
                 triplets.push(Triplet::new(p, q, value));
             }

@@ -81,6 +81,7 @@ use crate::contact::coupled::row_ownership::Keepers;
 use crate::contact::coupled::system::{CoupledSolution, CoupledSystem, Coupling, Pair};
 use crate::contact::geometry::displacement::BodyDisplacement;
 use crate::contact::geometry::gap::{GapRow, RowNormal, gap_rows, gaps_and_rows, geometric_gaps};
+use crate::contact::geometry::rbf_patch::BlockShare;
 use crate::contact::geometry::surface::ContactSurface;
 use crate::contact::geometry::walls::{HeldWall, walls};
 use crate::contact::iteration::safeguard::{CONTRACTION, Safeguard, Step};
@@ -326,16 +327,34 @@ fn geometry_nodes(surfaces: &[&ContactSurface]) -> Vec<u32> {
 }
 
 /// The interface operators of `problem`, paired with the primary surface slid by `slid` over
-/// the secondary ([`InterfaceOperators::slide`]).
-fn pair(problem: &ContactProblem, slid: [f64; 3]) -> Result<InterfaceOperators, ContactError> {
+/// the secondary ([`InterfaceOperators::slide`]), their interpolations' rows shared among the
+/// ranks as `share` says (collective in a distributed run).
+fn pair(
+    problem: &ContactProblem,
+    slid: [f64; 3],
+    share: BlockShare,
+) -> Result<InterfaceOperators, ContactError> {
     InterfaceOperators::new(
         &problem.primary_surface,
         &problem.secondary_surface,
         problem.settings.rbf_radius,
         problem.normal_weights(),
-        problem.transfer().transfer,
+        (problem.transfer().transfer, share),
         slid,
     )
+}
+
+/// How the ranks share the interpolations' rows: among all of them in a distributed run
+/// (`shared`), on one process every row.
+fn interface_share(shared: bool) -> BlockShare {
+    let ranks = crate::parallel::ranks();
+    match shared {
+        true => BlockShare {
+            rank: ranks.rank,
+            size: ranks.size,
+        },
+        false => BlockShare::ALL,
+    }
 }
 
 /// The nodes of a body whose displacements the constraint rows read: its candidate surfaces',
@@ -479,8 +498,9 @@ impl<'a> ContactSolver<'a> {
             ),
             _ => None,
         };
+        let share = interface_share(reads.is_some());
         let operators = (pairs.iter())
-            .map(|problem| pair(problem, [0.0; 3]))
+            .map(|problem| pair(problem, [0.0; 3], share))
             .collect::<Result<Vec<_>, _>>()?;
         let mut kept = Vec::with_capacity(pairs.len());
         for (problem, &[_, secondary]) in pairs.iter().zip(&pair_bodies) {
@@ -1812,7 +1832,8 @@ impl ContactSolver<'_> {
     /// Builds pair `p`'s interface operators again, paired with its primary surface slid by
     /// `slid`; the bodies' responses computed with the old ones are forgotten.
     fn pair_again(&mut self, p: usize, slid: [f64; 3]) -> Result<(), ContactError> {
-        self.operators[p] = pair(&self.pairs[p], slid)?;
+        let share = interface_share(self.reads.is_some());
+        self.operators[p] = pair(&self.pairs[p], slid, share)?;
         if let Some(factors) = self.factors.as_mut() {
             factors.forget_responses();
         }
