@@ -45,7 +45,11 @@ PARTS = [
     ("PETSc: matrix, KSP (create)", "internodes_cgamg_create"),
     # The whole Phi_MM's sparse LU, factored only where a solve needs it (rbf_patch.rs).
     ("RBF interpolation: whole factor of Phi_MM (where used)", "rbf_patch::whole_factor"),
-    ("RBF interpolation: set-up (Phi_MM, Phi_NM, their graph)", "Interpolation::new"),
+    # The rows of Phi_MM and Phi_NM a process holds, the sources' trees, D_NN (before
+    # 2026-12-07 the whole Phi_MM, Phi_NM and Phi_MM's graph on every rank, under
+    # `Interpolation::new`).
+    ("RBF interpolation: set-up", "Interpolation::shared"),
+    ("RBF interpolation: set-up", "Interpolation::new"),
     ("RBF interpolation: rows and columns", "rbf::Interpolation::"),
     # The patches' solves, on rayon's threads.
     ("RBF interpolation: rows and columns", "rbf_patch::"),
