@@ -542,6 +542,14 @@ fn the_conservative_transfer_on_two_ranks_gives_the_serial_answer() {
 }
 
 #[test]
+fn supports_too_wide_for_gmres_on_two_ranks_give_the_serial_answer() {
+    // The demo with supports of ten spacings: Phi_MM is ill-conditioned, its whole-field GMRES
+    // stops short, and every rank factors the whole matrix, which it builds from the sources
+    // for that (a rank stores only its range of Phi_MM's rows).
+    ranks_give_the_serial_answer(2, "hemisphere_on_block", "rbf_radius = 10", 1);
+}
+
+#[test]
 fn a_corner_in_the_crater_it_digs_on_two_ranks_gives_the_serial_answer() {
     // A 2D square's corner pressed into a block of its own material: the corner's node held
     // against both walls of its crater, the pairing following the slide at every iteration

@@ -24,9 +24,12 @@
 //!
 //! Nearby rows (columns) share a patch: the requested ones are sorted along a Z curve and taken
 //! in blocks of [`BLOCK`], each block's patch factored once by faer's sparse LU, the blocks in
-//! parallel. On the 3D contact surfaces with the default radius a patch holds a few thousand
-//! sources, whatever the size of the surface: a row costs the same on any surface, and nothing
-//! of the surface's size is factored. Where the whole-field solves needed the whole factor
+//! parallel. A patch reads the matrix node by node ([`PatchMatrix`]: a node's row and its
+//! neighbours in the graph), each node computed once for all the blocks of one request
+//! ([`NodeCache`]), so that no process stores the matrix or its graph. On the 3D contact
+//! surfaces with the default radius a patch holds a few thousand sources, whatever the size of
+//! the surface: a row costs the same on any surface, and nothing of the surface's size is
+//! factored. Where the whole-field solves needed the whole factor
 //! ([`WholeFactor`]: `Phi_MM` ill-conditioned, its inverse decaying slowly) it serves the rows
 //! and columns too.
 
@@ -75,7 +78,8 @@ pub trait PatchMatrix: Sync {
 }
 
 /// The nodes of a [`PatchMatrix`] computed so far, each once: what the blocks of one request
-/// share (a source lies in the patches of some fifty blocks of rows). Made for one request of
+/// share (a patch of a few thousand sources around a block of [`BLOCK`] rows overlaps many
+/// others). Made for one request of
 /// rows or columns and dropped after it, so that it holds the nodes of this process's blocks'
 /// patches only ([`BlockShare`]), and those only while they are solved.
 pub struct NodeCache<'a, A> {
