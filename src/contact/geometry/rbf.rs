@@ -224,9 +224,9 @@ pub fn interpolation_radii(points: &[[f64; 3]], radius: f64) -> Result<Vec<f64>,
 /// Rescaled localized RBF interpolation `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` from source nodes with
 /// support radii to target points.
 ///
-/// Holds the rows of `Phi_MM` and `Phi_NM` of its share ([`BlockShare`]: every row on one
-/// process) and `D_NN^-1`; any other row of either matrix, and the graph of `Phi_MM`, it
-/// computes when it needs them, from the points and a k-d tree ([`Sources`]). `R_NM` (dense in
+/// Holds the rows of `Phi_MM` and `Phi_NM` of its share (`rbf_patch::BlockShare`: every row on
+/// one process) and `D_NN^-1`; any other row of either matrix, and the graph of `Phi_MM`, it
+/// computes when it needs them, from the points and k-d trees (`Sources`). `R_NM` (dense in
 /// general) is never formed, except on request by [`Interpolation::matrix`], and `Phi_MM` is
 /// not factored where GMRES serves. Two kinds of solve with `Phi_MM`:
 ///
