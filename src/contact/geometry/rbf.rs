@@ -283,8 +283,8 @@ struct Sources {
 
 /// The sources whose radii lie within a factor of two of each other (`[2^k, 2^(k + 1))` times
 /// the smallest), in a k-d tree of their own. Why not one tree searched to the largest radius:
-/// on a graded surface the coarse far field's radii are tens of times the contact zone's, and a
-/// search to them from a node of the zone returns hundreds of times the sources its row holds,
+/// on a graded surface the coarse far field's radii are many times the contact zone's, and a
+/// search to them from a node of the zone returns many times the sources its row holds,
 /// which the patches, computing their rows by search, pay for every node
 /// (`docs/decisions.md`, 2026-12-07, night); searched class by class to the class's largest
 /// radius, a search reaches at most twice as far as the row it serves.
