@@ -11,9 +11,10 @@
 //!   interpolation matrix is `R_NM = D_NN^-1 Phi_NM Phi_MM^-1` with
 //!   `D_NN = diag(Phi_NM Phi_MM^-1 1)`. Every row of `R_NM` therefore sums to one:
 //!   constants are reproduced exactly.
-//! * Because column `j` uses its own radius `r_j`, `Phi_MM` is not symmetric; it is factored with a
-//!   sparse LU. Both RBF matrices are sparse (compact support) and are assembled with a k-d tree
-//!   radius search, never by visiting all pairs.
+//! * Because column `j` uses its own radius `r_j`, `Phi_MM` is not symmetric: its solves are
+//!   GMRES (whole fields) and sparse LU on patches (rows and columns of `R`; [`Interpolation`]).
+//!   Both RBF matrices are sparse (compact support), their rows found by k-d tree radius
+//!   searches, never by visiting all pairs.
 //! * Radii: Algorithm 1 ([`support_radii`]) is the reference; the transfer operators of a
 //!   contact solve use radii of the same form with `c` held at Algorithm 1's starting value
 //!   ([`interpolation_radii`]), for the accuracy reason given there. An iterative search for
