@@ -542,6 +542,13 @@ fn the_conservative_transfer_on_two_ranks_gives_the_serial_answer() {
 }
 
 #[test]
+fn tied_contact_on_two_ranks_gives_the_serial_answer() {
+    // The demo tied: each iterate's gap corrections read the jumps `R12 u2`, a whole-field
+    // interpolation every rank computes with its rows of Phi_MM and Phi_NM (collective).
+    ranks_give_the_serial_answer(2, "hemisphere_on_block", "formulation = \"tied\"", 1);
+}
+
+#[test]
 fn supports_too_wide_for_gmres_on_two_ranks_give_the_serial_answer() {
     // The demo with supports of ten spacings: Phi_MM is ill-conditioned, its whole-field GMRES
     // stops short, and every rank factors the whole matrix, which it builds from the sources
