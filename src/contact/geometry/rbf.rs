@@ -680,6 +680,10 @@ impl Interpolation {
         let covered: Vec<usize> = (targets.iter().copied())
             .filter(|&t| self.inv_d[t] != 0.0)
             .collect();
+        if covered.is_empty() {
+            // Nothing to solve (an iteration whose rows are all known): no cache to make.
+            return Ok(targets.iter().map(|_| Some(Vec::new())).collect());
+        }
         let nodes = NodeCache::new(&self.sources);
         let solved = patch::in_blocks(&self.targets, &covered, share, |block| {
             let rows: Vec<Entries> = block.iter().map(|&t| self.target_row(t)).collect();
@@ -736,6 +740,10 @@ impl Interpolation {
         sources: &[usize],
         share: BlockShare,
     ) -> Result<Vec<Option<Entries>>, RbfError> {
+        if sources.is_empty() {
+            // An iteration whose columns are all known: no tree or cache to make.
+            return Ok(Vec::new());
+        }
         // The covered targets each source's support holds (those a patch's solution reaches),
         // by a radius search among the targets; each source's and each target's row once for
         // the whole request, as the patches' nodes ([`NodeCache`]).
