@@ -123,6 +123,13 @@ fn pairs(summary: &serde_json::Value) -> Vec<serde_json::Value> {
     }
 }
 
+/// Whether each iteration of a pair's history (the last load step's) paired the interface again.
+fn paired_again(pair: &serde_json::Value) -> Vec<bool> {
+    (pair["iterations"].as_array().unwrap().iter())
+        .map(|record| record["paired_again"].as_bool().unwrap())
+        .collect()
+}
+
 /// `max |a - b| / max |a|`.
 fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
@@ -320,6 +327,15 @@ fn ranks_give_the_serial_answer_of(
             };
             assert_eq!(verdicts(p), verdicts(q), "{name}: {report}");
             assert_eq!(p[report]["passed"], q[report]["passed"], "{name}: {report}");
+        }
+        // The same iterations paired the interface again where the surfaces had slid to (on
+        // ranks a collective set-up: every rank pairs at once or the run hangs).
+        if extra_iterations == 0 {
+            assert_eq!(
+                paired_again(p),
+                paired_again(q),
+                "{name}: the iterations that paired the interface again"
+            );
         }
         let (steps_p, steps_q) = (
             p["steps"].as_array().unwrap(),
@@ -561,7 +577,10 @@ fn a_corner_in_the_crater_it_digs_on_two_ranks_gives_the_serial_answer() {
     // A 2D square's corner pressed into a block of its own material: the corner's node held
     // against both walls of its crater, the pairing following the slide at every iteration
     // (each rank finds the walls from the gathered gap rows).
-    ranks_give_the_serial_answer(2, "square_corner_on_block_2d", "", 1);
+    let dir = ranks_give_the_serial_answer_of(2, "square_corner_on_block_2d", "", 1, 0, &|_| {});
+    // It goes through the ranks' pairing again (compared iteration by iteration above).
+    let pair = &pairs(&summary(&dir.path().join("one")))[0];
+    assert!(paired_again(pair).contains(&true), "{pair}");
 }
 
 #[test]

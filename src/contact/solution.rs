@@ -101,6 +101,9 @@ pub struct IterationRecord {
     /// of the active primary nodes (the pairing follows the slide on a grid of 0.05 of that
     /// spacing, unslid within one step: `docs/method.md` 3.5).
     pub pairing_drift_over_h: f64,
+    /// The interface operators were paired again after this iteration, where the surfaces
+    /// had slid to (`docs/method.md` 3.5): the next iteration solves on the new pairing.
+    pub paired_again: bool,
     pub relative_residual: f64,
     /// GMRES iterations of the iteration's interface solves (a loose solve and, when its
     /// answer keeps the active set, the exact one); `None` on the dense paths.
@@ -137,7 +140,10 @@ impl IterationRecord {
             self.max_gap_error_over_h,
             self.pairing_drift_over_h,
             t.operators + t.solve + t.search + t.checks,
-        ) + &self.slipping.map_or(String::new(), |slip| {
+        ) + match self.paired_again {
+            true => "; paired again",
+            false => "",
+        } + &self.slipping.map_or(String::new(), |slip| {
             format!(
                 "; slipping {slip}, direction change {:.1e}",
                 self.max_direction_change.unwrap_or(0.0)

@@ -1001,7 +1001,8 @@ impl ContactSolver<'_> {
                 &mut seconds,
             )?;
         }
-        if !repaired.is_empty() {
+        let mut paired_again = !repaired.is_empty();
+        if paired_again {
             state.safeguard = Safeguard::default();
         }
         state.safeguard.in_groove = in_groove.iter().any(|&g| g);
@@ -1011,6 +1012,7 @@ impl ContactSolver<'_> {
                     let iterate = (&solution, &gaps[p][..]);
                     self.pair_from_iterate(p, pairings[p], state, iterate, &mut seconds)?;
                 }
+                paired_again = true;
                 state.safeguard = Safeguard::default();
                 state.slide_change = None;
                 Step::Solve(state.active.clone())
@@ -1036,6 +1038,7 @@ impl ContactSolver<'_> {
             krylov_iterations,
             seconds,
         );
+        record.paired_again = paired_again;
         if self.laws.iter().any(ContactLaw::has_friction) {
             record.slipping = Some(update.next.slip.len());
             record.max_direction_change = Some(update.max_direction_change);
@@ -2003,6 +2006,7 @@ fn record(
         max_tension_over_p: max(&update.tension),
         max_gap_error_over_h: update.max_gap_error_over_h,
         pairing_drift_over_h,
+        paired_again: false,
         relative_residual: residual,
         krylov_iterations,
         slipping: None,
