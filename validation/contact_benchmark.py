@@ -341,8 +341,9 @@ def not_run_reason(path: str, count: int) -> str | None:
 # ---------------------------------------------------------------------------
 
 LOAD_STEP_LINE = re.compile(r"^load step (\d+)/(\d+): factor (\S+)$")
-ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-(\d+)\s.*; ([-+0-9.eE]+) s"
-                            r"(?: \((.*)\))?\s*$")
+# (Trailing "; paired again" or "; slipping ..." after the seconds and phases.)
+ITERATION_LINE = re.compile(r"^\s+iteration\s+(\d+): active\s+(\d+), \+(\d+)\s+-(\d+)\s.*?; ([-+0-9.eE]+) s"
+                            r"(?: \(([^)]*)\))?(?:; .*)?\s*$")
 # "  Cholesky of the 2 bodies: 0.290 s" ("of both bodies" before several pairs): the body solvers' set-up (the factors, or PETSc + the AMG
 # hierarchies on the iterative path, whatever the label says).
 BODY_SETUP_LINE = re.compile(r"^\s+(\S.*?) of (?:both|the \d+) bodies: ([-+0-9.eE]+) s$")
